@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages Projbot builds, tests and runs with, when they are missing.
+# Safe to run again: it asks apt only for what dpkg does not already have.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build ccache pkg-config git
+  libvulkan-dev vulkan-validationlayers mesa-vulkan-drivers glslang-tools vulkan-tools
+  libglm-dev libeigen3-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
+  libglfw3-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libx11-dev libxrandr-dev xvfb x11-apps xauth
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if ((${#missing[@]} == 0)); then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then
+  command -v sudo >/dev/null || { echo "setup: not root and no sudo; install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
