@@ -1,0 +1,33 @@
+#pragma once
+// RGBA8 images as stored (no colour-space conversion), and PNG files.
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+namespace projbot::assets {
+
+/// A bad model or image file: the message names the file and what is wrong.
+class AssetError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Row-major RGBA8 pixels, top row first, values exactly as stored in the source file.
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba;  ///< width * height * 4 bytes
+
+  std::uint8_t* pixel(int x, int y) { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
+  const std::uint8_t* pixel(int x, int y) const { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
+};
+
+/// Writes an RGBA8 PNG. Throws AssetError when the file cannot be written.
+void write_png(const std::filesystem::path& path, const Image& image);
+
+/// Reads a PNG or JPEG into RGBA8. Throws AssetError naming the file.
+Image read_image(const std::filesystem::path& path);
+
+}  // namespace projbot::assets

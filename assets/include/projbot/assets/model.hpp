@@ -1,0 +1,85 @@
+#pragma once
+// CPU-side textured meshes: what the engine uploads and what alignment samples into points.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "projbot/assets/image.hpp"
+
+namespace projbot::assets {
+
+enum class AlphaMode { kOpaque, kMask, kBlend };
+enum class Wrap { kRepeat, kClampToEdge, kMirroredRepeat };
+enum class Filter { kNearest, kLinear };
+
+/// Texture sampling state (glTF sampler; defaults: repeat, linear).
+struct Sampler {
+  Wrap wrap_s = Wrap::kRepeat;
+  Wrap wrap_t = Wrap::kRepeat;
+  Filter mag = Filter::kLinear;
+  Filter min = Filter::kLinear;
+};
+
+/// Unlit material: a pixel shows texture * base_color_factor * vertex colour.
+struct Material {
+  std::array<float, 4> base_color_factor{1.0F, 1.0F, 1.0F, 1.0F};  ///< linear RGBA multiplier
+  int base_color_image = -1;  ///< index into Model::images, -1 for none
+  Sampler sampler;
+  AlphaMode alpha_mode = AlphaMode::kOpaque;
+  float alpha_cutoff = 0.5F;  ///< used with kMask
+  bool double_sided = false;
+};
+
+/// Interleaved vertex as uploaded to the GPU. Position in the model frame, metres.
+struct Vertex {
+  std::array<float, 3> position{};
+  std::array<float, 3> normal{};  ///< unit length, model frame
+  std::array<float, 2> uv{};      ///< TEXCOORD_0 (0,0 when absent)
+  std::array<float, 4> color{1.0F, 1.0F, 1.0F, 1.0F};  ///< COLOR_0 (white when absent)
+};
+
+/// A triangle list with one material. Indices are counter-clockwise seen from the front.
+struct Primitive {
+  std::vector<Vertex> vertices;
+  std::vector<std::uint32_t> indices;
+  int material = 0;  ///< index into Model::materials
+};
+
+/// A whole model in its model frame (glTF scene frame with node transforms applied), metres.
+struct Model {
+  std::string source;  ///< file name, for messages
+  std::vector<Primitive> primitives;
+  std::vector<Material> materials;  ///< never empty after loading (a default material is added)
+  std::vector<Image> images;
+
+  std::size_t triangle_count() const;
+  Eigen::AlignedBox3d bounds() const;
+  /// Area-weighted centroid of the surface (the paper's model frame origin after recentring).
+  Eigen::Vector3d surface_centroid() const;
+};
+
+/// Loads a glTF 2.0 file (.gltf with external or data-URI buffers, or .glb).
+/// Throws AssetError naming the file and the problem; never returns a partly loaded model.
+Model load_gltf(const std::filesystem::path& path);
+
+/// Scales the model frame uniformly, then (if recenter) moves the origin to the surface centroid.
+void scale_and_recenter(Model& model, double scale, bool recenter);
+
+/// Points with normals sampled uniformly by area over the surface, model frame.
+struct SurfaceSamples {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<Eigen::Vector3f> normals;  ///< unit, from the triangle's geometric normal
+};
+
+/// Samples `count` points uniformly over the model's surface area, reproducibly for a seed.
+SurfaceSamples sample_surface(const Model& model, std::size_t count, std::uint32_t seed);
+
+/// A textured UV sphere (rings x segments quads, two triangles each): a large mesh for benchmarks.
+Model make_uv_sphere(double radius_m, int rings, int segments);
+
+}  // namespace projbot::assets

@@ -1,0 +1,438 @@
+// glTF 2.0 loading through tinygltf (Debian's libtinygltf). Every index, offset and value read from the
+// file is checked here before use: tinygltf parses the JSON but does not bound accessors by their
+// buffers, and a malformed file must give an error, never a crash or a half-loaded model.
+
+#include <tiny_gltf.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+
+#include "projbot/assets/model.hpp"
+
+namespace projbot::assets {
+namespace {
+
+class Loader {
+ public:
+  Loader(const tinygltf::Model& gltf, std::string file) : g_(gltf), file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& why) const { throw AssetError(file_ + ": " + why); }
+
+  Model build() {
+    Model out;
+    out.source = file_;
+    load_images(out);
+    load_materials(out);
+    for (int root : root_nodes()) {
+      std::set<int> path;
+      visit_node(root, Eigen::Matrix4d::Identity(), path, out);
+    }
+    if (out.primitives.empty()) fail("no triangle meshes in the scene");
+    bool need_default = false;
+    for (auto& p : out.primitives) {
+      if (p.material < 0) {
+        p.material = static_cast<int>(out.materials.size());
+        need_default = true;
+      }
+    }
+    if (need_default) out.materials.emplace_back();
+    return out;
+  }
+
+ private:
+  template <typename T>
+  void check_index(int index, const std::vector<T>& items, const std::string& what) const {
+    if (index < 0 || static_cast<std::size_t>(index) >= items.size())
+      fail(what + " index " + std::to_string(index) + " is out of range (have " + std::to_string(items.size()) + ")");
+  }
+
+  std::vector<int> root_nodes() const {
+    if (!g_.scenes.empty()) {
+      const int scene = g_.defaultScene >= 0 ? g_.defaultScene : 0;
+      check_index(scene, g_.scenes, "scene");
+      return g_.scenes[static_cast<std::size_t>(scene)].nodes;
+    }
+    // No scenes: every node that is nobody's child is a root.
+    std::set<int> children;
+    for (const auto& n : g_.nodes) children.insert(n.children.begin(), n.children.end());
+    std::vector<int> roots;
+    for (int i = 0; i < static_cast<int>(g_.nodes.size()); ++i)
+      if (!children.contains(i)) roots.push_back(i);
+    return roots;
+  }
+
+  Eigen::Matrix4d local_transform(const tinygltf::Node& n, int index) const {
+    Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
+    if (n.matrix.size() == 16) {
+      for (int i = 0; i < 16; ++i) M(i % 4, i / 4) = n.matrix[static_cast<std::size_t>(i)];  // column-major
+    } else if (!n.matrix.empty()) {
+      fail("node " + std::to_string(index) + ": matrix must have 16 numbers");
+    } else {
+      Eigen::Vector3d t = Eigen::Vector3d::Zero();
+      Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+      Eigen::Vector3d s = Eigen::Vector3d::Ones();
+      if (n.translation.size() == 3) t = {n.translation[0], n.translation[1], n.translation[2]};
+      if (n.rotation.size() == 4) {
+        q = Eigen::Quaterniond(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);  // glTF is x y z w
+        if (!(q.norm() > 1e-9)) fail("node " + std::to_string(index) + ": rotation quaternion has zero length");
+        q.normalize();
+      }
+      if (n.scale.size() == 3) s = {n.scale[0], n.scale[1], n.scale[2]};
+      M.topLeftCorner<3, 3>() = q.toRotationMatrix() * s.asDiagonal();
+      M.topRightCorner<3, 1>() = t;
+    }
+    if (!M.allFinite()) fail("node " + std::to_string(index) + ": transform is not finite");
+    return M;
+  }
+
+  void visit_node(int index, const Eigen::Matrix4d& parent, std::set<int>& path, Model& out) {
+    check_index(index, g_.nodes, "node");
+    if (!path.insert(index).second) fail("node " + std::to_string(index) + " is its own ancestor (cycle in node hierarchy)");
+    const auto& node = g_.nodes[static_cast<std::size_t>(index)];
+    const Eigen::Matrix4d world = parent * local_transform(node, index);
+    if (node.mesh >= 0) {
+      check_index(node.mesh, g_.meshes, "mesh");
+      const auto& mesh = g_.meshes[static_cast<std::size_t>(node.mesh)];
+      for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
+        load_primitive(mesh.primitives[p], world, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p), out);
+    }
+    for (int child : node.children) visit_node(child, world, path, out);
+    path.erase(index);
+  }
+
+  // Returns a pointer to element i of an accessor after checking it lies inside its buffer view.
+  struct View {
+    const unsigned char* base = nullptr;
+    std::size_t stride = 0;
+    std::size_t count = 0;
+    int component_type = 0;
+    int type = 0;
+    bool normalized = false;
+  };
+
+  View accessor_view(int accessor_index, const std::string& what) const {
+    check_index(accessor_index, g_.accessors, what + " accessor");
+    const auto& a = g_.accessors[static_cast<std::size_t>(accessor_index)];
+    const std::string name = what + " (accessor " + std::to_string(accessor_index) + ")";
+    if (a.sparse.isSparse) fail(name + ": sparse accessors are not supported");
+    if (a.bufferView < 0) fail(name + ": has no bufferView");
+    check_index(a.bufferView, g_.bufferViews, name + ": bufferView");
+    const auto& bv = g_.bufferViews[static_cast<std::size_t>(a.bufferView)];
+    check_index(bv.buffer, g_.buffers, name + ": buffer");
+    const auto& buffer = g_.buffers[static_cast<std::size_t>(bv.buffer)];
+    const int comp_size = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType));
+    const int comps = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
+    if (comp_size <= 0 || comps <= 0) fail(name + ": unknown component or element type");
+    const std::size_t elem = static_cast<std::size_t>(comp_size) * static_cast<std::size_t>(comps);
+    const std::size_t stride = bv.byteStride > 0 ? bv.byteStride : elem;
+    if (stride < elem) fail(name + ": byteStride " + std::to_string(stride) + " is smaller than the element");
+    if (bv.byteOffset > buffer.data.size() || bv.byteLength > buffer.data.size() - bv.byteOffset)
+      fail(name + ": bufferView " + std::to_string(a.bufferView) + " runs past the end of buffer " +
+           std::to_string(bv.buffer) + " (" + std::to_string(buffer.data.size()) + " bytes loaded)");
+    if (a.count > 0) {
+      const std::size_t needed = a.byteOffset + stride * (a.count - 1) + elem;
+      if (needed < a.byteOffset || needed > bv.byteLength)
+        fail(name + ": " + std::to_string(a.count) + " elements need " + std::to_string(needed) +
+             " bytes but bufferView " + std::to_string(a.bufferView) + " has " + std::to_string(bv.byteLength));
+    }
+    return {buffer.data.data() + bv.byteOffset + a.byteOffset, stride, a.count, a.componentType, a.type, a.normalized};
+  }
+
+  // Reads component c of element i as float, applying glTF's normalisation rules.
+  static float read_component(const View& v, std::size_t i, int c) {
+    const unsigned char* p = v.base + v.stride * i;
+    switch (v.component_type) {
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        float f;
+        std::memcpy(&f, p + 4 * c, 4);
+        return f;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return static_cast<float>(p[c]) / (v.normalized ? 255.0F : 1.0F);
+      case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        const float f = static_cast<float>(static_cast<std::int8_t>(p[c]));
+        return v.normalized ? std::max(f / 127.0F, -1.0F) : f;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        std::uint16_t s;
+        std::memcpy(&s, p + 2 * c, 2);
+        return static_cast<float>(s) / (v.normalized ? 65535.0F : 1.0F);
+      }
+      case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        std::int16_t s;
+        std::memcpy(&s, p + 2 * c, 2);
+        return v.normalized ? std::max(static_cast<float>(s) / 32767.0F, -1.0F) : static_cast<float>(s);
+      }
+      default: return 0.0F;  // rejected by the callers' type checks
+    }
+  }
+
+  View float_attribute(int accessor, const std::string& what, std::initializer_list<int> types, bool allow_normalized) const {
+    View v = accessor_view(accessor, what);
+    if (std::find(types.begin(), types.end(), v.type) == types.end()) fail(what + ": unexpected element type");
+    const bool ok_component = v.component_type == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+                              (allow_normalized && v.normalized &&
+                               (v.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                v.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT));
+    if (!ok_component) fail(what + ": unsupported component type " + std::to_string(v.component_type));
+    return v;
+  }
+
+  void load_primitive(const tinygltf::Primitive& prim, const Eigen::Matrix4d& world, const std::string& what, Model& out) {
+    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
+      fail(what + ": mode " + std::to_string(mode) + " is not a triangle primitive (points and lines cannot be projected)");
+    const auto pos_it = prim.attributes.find("POSITION");
+    if (pos_it == prim.attributes.end()) fail(what + ": has no POSITION attribute");
+    const View pos = float_attribute(pos_it->second, what + " POSITION", {TINYGLTF_TYPE_VEC3}, false);
+    const std::size_t n = pos.count;
+    if (n == 0) return;
+
+    Primitive p;
+    p.vertices.resize(n);
+    const Eigen::Matrix3d L = world.topLeftCorner<3, 3>();
+    if (!(std::abs(L.determinant()) > 1e-18)) fail(what + ": node transform is singular");
+    const Eigen::Matrix3d normal_matrix = L.inverse().transpose();
+    for (std::size_t i = 0; i < n; ++i) {
+      Eigen::Vector4d x(read_component(pos, i, 0), read_component(pos, i, 1), read_component(pos, i, 2), 1.0);
+      if (!x.allFinite()) fail(what + ": POSITION " + std::to_string(i) + " is not finite");
+      const Eigen::Vector4d w = world * x;
+      p.vertices[i].position = {static_cast<float>(w.x()), static_cast<float>(w.y()), static_cast<float>(w.z())};
+    }
+
+    bool have_normals = false;
+    if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
+      const View nv = float_attribute(it->second, what + " NORMAL", {TINYGLTF_TYPE_VEC3}, false);
+      if (nv.count != n) fail(what + ": NORMAL count differs from POSITION count");
+      have_normals = true;
+      for (std::size_t i = 0; i < n; ++i) {
+        Eigen::Vector3d nn(read_component(nv, i, 0), read_component(nv, i, 1), read_component(nv, i, 2));
+        nn = normal_matrix * nn;
+        if (!nn.allFinite() || nn.norm() < 1e-12) {
+          have_normals = false;  // degenerate normals in the file: recompute them all
+          break;
+        }
+        nn.normalize();
+        p.vertices[i].normal = {static_cast<float>(nn.x()), static_cast<float>(nn.y()), static_cast<float>(nn.z())};
+      }
+    }
+    if (auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
+      const View tv = float_attribute(it->second, what + " TEXCOORD_0", {TINYGLTF_TYPE_VEC2}, true);
+      if (tv.count != n) fail(what + ": TEXCOORD_0 count differs from POSITION count");
+      for (std::size_t i = 0; i < n; ++i) {
+        p.vertices[i].uv = {read_component(tv, i, 0), read_component(tv, i, 1)};
+        if (!std::isfinite(p.vertices[i].uv[0]) || !std::isfinite(p.vertices[i].uv[1]))
+          fail(what + ": TEXCOORD_0 " + std::to_string(i) + " is not finite");
+      }
+    }
+    if (auto it = prim.attributes.find("COLOR_0"); it != prim.attributes.end()) {
+      const View cv = float_attribute(it->second, what + " COLOR_0", {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, true);
+      if (cv.count != n) fail(what + ": COLOR_0 count differs from POSITION count");
+      const int comps = cv.type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+      for (std::size_t i = 0; i < n; ++i)
+        for (int c = 0; c < comps; ++c) {
+          const float value = read_component(cv, i, c);
+          if (!std::isfinite(value)) fail(what + ": COLOR_0 " + std::to_string(i) + " is not finite");
+          p.vertices[i].color[static_cast<std::size_t>(c)] = value;
+        }
+    }
+
+    std::vector<std::uint32_t> raw;
+    if (prim.indices >= 0) {
+      const View iv = accessor_view(prim.indices, what + " indices");
+      if (iv.type != TINYGLTF_TYPE_SCALAR) fail(what + ": indices must be scalars");
+      raw.resize(iv.count);
+      for (std::size_t i = 0; i < iv.count; ++i) {
+        const unsigned char* q = iv.base + iv.stride * i;
+        switch (iv.component_type) {
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: raw[i] = q[0]; break;
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t s; std::memcpy(&s, q, 2); raw[i] = s; break; }
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&raw[i], q, 4); break;
+          default: fail(what + ": index component type " + std::to_string(iv.component_type) + " is not an unsigned integer");
+        }
+        if (raw[i] >= n) fail(what + ": index " + std::to_string(raw[i]) + " at position " + std::to_string(i) +
+                              " is out of range (" + std::to_string(n) + " vertices)");
+      }
+    } else {
+      raw.resize(n);
+      for (std::size_t i = 0; i < n; ++i) raw[i] = static_cast<std::uint32_t>(i);
+    }
+
+    // Triangle lists, with strips and fans unrolled; a mirroring transform flips the winding back.
+    const bool flip = L.determinant() < 0.0;
+    auto emit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+      if (flip) std::swap(b, c);
+      p.indices.insert(p.indices.end(), {a, b, c});
+    };
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      if (raw.size() % 3 != 0) fail(what + ": " + std::to_string(raw.size()) + " indices is not a multiple of 3");
+      for (std::size_t i = 0; i + 2 < raw.size(); i += 3) emit(raw[i], raw[i + 1], raw[i + 2]);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      for (std::size_t i = 0; i + 2 < raw.size(); ++i)
+        (i % 2 == 0) ? emit(raw[i], raw[i + 1], raw[i + 2]) : emit(raw[i + 1], raw[i], raw[i + 2]);
+    } else {
+      for (std::size_t i = 1; i + 1 < raw.size(); ++i) emit(raw[0], raw[i], raw[i + 1]);
+    }
+
+    if (!have_normals) compute_normals(p);
+    if (prim.material >= 0) check_index(prim.material, g_.materials, what + ": material");
+    p.material = prim.material;
+    out.primitives.push_back(std::move(p));
+  }
+
+  // Area-weighted vertex normals, for primitives without NORMAL.
+  static void compute_normals(Primitive& p) {
+    std::vector<Eigen::Vector3d> acc(p.vertices.size(), Eigen::Vector3d::Zero());
+    auto at = [&](std::uint32_t i) {
+      const auto& v = p.vertices[i].position;
+      return Eigen::Vector3d(v[0], v[1], v[2]);
+    };
+    for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+      const auto a = p.indices[t], b = p.indices[t + 1], c = p.indices[t + 2];
+      const Eigen::Vector3d fn = (at(b) - at(a)).cross(at(c) - at(a));  // length = 2 * area
+      acc[a] += fn;
+      acc[b] += fn;
+      acc[c] += fn;
+    }
+    for (std::size_t i = 0; i < acc.size(); ++i) {
+      const Eigen::Vector3d nn = acc[i].norm() > 0 ? acc[i].normalized() : Eigen::Vector3d::UnitZ();
+      p.vertices[i].normal = {static_cast<float>(nn.x()), static_cast<float>(nn.y()), static_cast<float>(nn.z())};
+    }
+  }
+
+  void load_images(Model& out) {
+    for (std::size_t i = 0; i < g_.images.size(); ++i) {
+      const auto& im = g_.images[i];
+      const std::string name = "image " + std::to_string(i) + (im.uri.empty() || im.uri.rfind("data:", 0) == 0 ? "" : " ('" + im.uri + "')");
+      Image img;
+      if (im.image.empty() || im.width <= 0 || im.height <= 0) {
+        // tinygltf keeps going when an image file is missing or undecodable; an unused image is harmless,
+        // so record it empty and fail only if a material uses it.
+        out.images.push_back(std::move(img));
+        continue;
+      }
+      if (im.bits != 8 && im.bits != 16) fail(name + ": " + std::to_string(im.bits) + "-bit images are not supported");
+      const int comps = im.component;
+      if (comps < 1 || comps > 4) fail(name + ": " + std::to_string(comps) + " components per pixel");
+      const std::size_t pixels = static_cast<std::size_t>(im.width) * static_cast<std::size_t>(im.height);
+      const std::size_t bytes_per = static_cast<std::size_t>(im.bits / 8);
+      if (im.image.size() < pixels * static_cast<std::size_t>(comps) * bytes_per) fail(name + ": decoded data is short");
+      img.width = im.width;
+      img.height = im.height;
+      img.rgba.resize(pixels * 4);
+      for (std::size_t px = 0; px < pixels; ++px) {
+        std::uint8_t c[4] = {0, 0, 0, 255};
+        for (int k = 0; k < comps; ++k) {
+          // 16-bit: keep the high byte (big-endian in PNG, decoded to native by stb).
+          const std::size_t off = (px * static_cast<std::size_t>(comps) + static_cast<std::size_t>(k)) * bytes_per;
+          std::uint8_t value = im.image[off];
+          if (bytes_per == 2) {
+            std::uint16_t s;
+            std::memcpy(&s, &im.image[off], 2);
+            value = static_cast<std::uint8_t>(s >> 8);
+          }
+          c[k] = value;
+        }
+        if (comps == 1) c[1] = c[2] = c[0];
+        if (comps == 2) { c[3] = c[1]; c[1] = c[2] = c[0]; }  // grey + alpha
+        std::memcpy(&img.rgba[px * 4], c, 4);
+      }
+      out.images.push_back(std::move(img));
+    }
+  }
+
+  static Wrap wrap_of(int mode) {
+    switch (mode) {
+      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return Wrap::kClampToEdge;
+      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return Wrap::kMirroredRepeat;
+      default: return Wrap::kRepeat;
+    }
+  }
+
+  void load_materials(Model& out) {
+    for (std::size_t i = 0; i < g_.materials.size(); ++i) {
+      const auto& gm = g_.materials[i];
+      const std::string name = "material " + std::to_string(i);
+      Material m;
+      const auto& f = gm.pbrMetallicRoughness.baseColorFactor;
+      if (f.size() == 4)
+        for (std::size_t k = 0; k < 4; ++k) {
+          if (!std::isfinite(f[k])) fail(name + ": baseColorFactor is not finite");
+          m.base_color_factor[k] = static_cast<float>(f[k]);
+        }
+      const int tex = gm.pbrMetallicRoughness.baseColorTexture.index;
+      if (tex >= 0) {
+        check_index(tex, g_.textures, name + ": baseColorTexture");
+        const auto& t = g_.textures[static_cast<std::size_t>(tex)];
+        check_index(t.source, g_.images, name + ": texture " + std::to_string(tex) + " source image");
+        const auto& img = out.images[static_cast<std::size_t>(t.source)];
+        if (img.rgba.empty()) {
+          const auto& uri = g_.images[static_cast<std::size_t>(t.source)].uri;
+          fail(name + ": base colour image " + std::to_string(t.source) +
+               (uri.empty() || uri.rfind("data:", 0) == 0 ? "" : " ('" + uri + "')") + " is missing or could not be decoded");
+        }
+        if (gm.pbrMetallicRoughness.baseColorTexture.texCoord != 0)
+          fail(name + ": baseColorTexture uses TEXCOORD_" + std::to_string(gm.pbrMetallicRoughness.baseColorTexture.texCoord) +
+               "; only TEXCOORD_0 is supported");
+        m.base_color_image = t.source;
+        if (t.sampler >= 0) {
+          check_index(t.sampler, g_.samplers, name + ": sampler");
+          const auto& s = g_.samplers[static_cast<std::size_t>(t.sampler)];
+          m.sampler.wrap_s = wrap_of(s.wrapS);
+          m.sampler.wrap_t = wrap_of(s.wrapT);
+          m.sampler.mag = s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ? Filter::kNearest : Filter::kLinear;
+          m.sampler.min = (s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST || s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+                           s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR)
+                              ? Filter::kNearest
+                              : Filter::kLinear;
+        }
+      }
+      if (gm.alphaMode == "MASK") m.alpha_mode = AlphaMode::kMask;
+      else if (gm.alphaMode == "BLEND") m.alpha_mode = AlphaMode::kBlend;
+      else if (gm.alphaMode.empty() || gm.alphaMode == "OPAQUE") m.alpha_mode = AlphaMode::kOpaque;
+      else fail(name + ": alphaMode '" + gm.alphaMode + "' is not OPAQUE, MASK or BLEND");
+      if (!std::isfinite(gm.alphaCutoff) || gm.alphaCutoff < 0.0) fail(name + ": alphaCutoff must be a finite number >= 0");
+      m.alpha_cutoff = static_cast<float>(gm.alphaCutoff);
+      m.double_sided = gm.doubleSided;
+      out.materials.push_back(m);
+    }
+  }
+
+  const tinygltf::Model& g_;
+  std::string file_;
+};
+
+bool is_glb(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[4] = {};
+  in.read(magic, 4);
+  return in.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
+}
+
+}  // namespace
+
+Model load_gltf(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw AssetError(file + ": no such model file");
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model gltf;
+  std::string err;
+  std::string warn;
+  bool ok = false;
+  try {
+    ok = is_glb(path) ? loader.LoadBinaryFromFile(&gltf, &err, &warn, file) : loader.LoadASCIIFromFile(&gltf, &err, &warn, file);
+  } catch (const std::exception& e) {  // nlohmann::json throws on some malformed input
+    throw AssetError(file + ": malformed glTF: " + e.what());
+  }
+  if (!ok) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    throw AssetError(file + ": " + (err.empty() ? std::string("tinygltf could not parse the file") : err));
+  }
+  return Loader(gltf, file).build();
+}
+
+}  // namespace projbot::assets
