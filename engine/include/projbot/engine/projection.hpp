@@ -1,0 +1,19 @@
+#pragma once
+// Eq. 3 of the paper, x = A_p (R_p X_m + X_p), as the projector pass computes it, and its CPU twin.
+
+#include <Eigen/Core>
+
+#include "projbot/config/scene.hpp"
+
+namespace projbot::engine {
+
+/// Vulkan clip coordinates from projector-frame coordinates (OpenCV pinhole, x right, y down, z forward).
+/// After the divide by w = Z and the viewport transform onto a width x height target, a point lands at
+/// framebuffer coordinate (u + 0.5, v + 0.5) with u = fx X/Z + cx, v = fy Y/Z + cy: pixel (i, j) has
+/// its centre at u = i, v = j. Depth maps near..far to 0..1.
+Eigen::Matrix4d clip_from_projector(const config::ProjectorConfig& projector);
+
+/// CPU reference of Eq. 3: pixel coordinates (u, v) of a projector-frame point (Z > 0).
+Eigen::Vector2d project_to_pixel(const config::ProjectorConfig& projector, const Eigen::Vector3d& p_projector);
+
+}  // namespace projbot::engine

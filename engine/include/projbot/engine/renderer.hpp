@@ -1,0 +1,133 @@
+#pragma once
+// The projector renderer: draws textured target models through the projector intrinsics (Eq. 3)
+// into an offscreen image or a GLFW window. Owns every Vulkan object; one thread (the render thread)
+// creates it and calls every member.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "projbot/assets/model.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/engine/frame_profiler.hpp"
+
+namespace projbot::engine {
+
+/// An expected engine failure: no Vulkan device, no display, no requested layer. The message says
+/// what is missing and what to do about it.
+class EngineError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct RendererOptions {
+  bool validation = false;  ///< enable VK_LAYER_KHRONOS_validation; fails if the layer is missing
+  bool windowing = false;   ///< initialise GLFW so windows can be made; fails without a display
+  int device_index = -1;    ///< physical device to use; -1 picks discrete > integrated > CPU
+};
+
+/// What was chosen at start-up.
+struct DeviceInfo {
+  std::string name;    ///< e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string driver;  ///< driver name and info
+  std::uint32_t api_version = 0;
+  bool gpu_timestamps = false;
+};
+
+enum class PresentMode { kFifo, kMailbox, kImmediate };
+
+/// A GLFW window: the projector output (fullscreen) or a preview (windowed).
+struct WindowOptions {
+  std::string title = "projbot";
+  int width_px = 1280;   ///< windowed size; ignored fullscreen (the monitor's mode is used)
+  int height_px = 800;
+  bool fullscreen = false;
+  int monitor = 0;       ///< index into the connected monitors, for fullscreen
+  PresentMode present_mode = PresentMode::kFifo;  ///< falls back to FIFO where unsupported
+};
+
+/// One target to draw: which uploaded model, and T_projector_target (model frame -> projector frame).
+struct DrawItem {
+  std::size_t model = 0;
+  Eigen::Matrix4d T_projector_target = Eigen::Matrix4d::Identity();
+};
+
+/// Called once per frame, as late as possible, to fill the poses to draw (the newest ones).
+using PoseReader = std::function<void(std::vector<DrawItem>& items)>;
+
+namespace detail {
+class TargetBackend;
+}
+
+/// Where frames go: an offscreen image or a window. Made by a Renderer; it shares ownership of the
+/// device, so it may outlive the Renderer object.
+class RenderTarget {
+ public:
+  explicit RenderTarget(std::unique_ptr<detail::TargetBackend> backend);
+  ~RenderTarget();
+  RenderTarget(const RenderTarget&) = delete;
+  RenderTarget& operator=(const RenderTarget&) = delete;
+
+  int width() const;   ///< current size in pixels
+  int height() const;
+  /// Windows: handles events, true once the user closed it. Offscreen: always false.
+  bool poll_close();
+  /// X11 window id of a window target (for screenshots), 0 otherwise.
+  std::uint64_t native_window() const;
+  /// Offscreen: the last drawn frame as RGBA8 (waits for it). Windows: throws EngineError.
+  assets::Image read_back();
+
+  detail::TargetBackend& backend() { return *backend_; }
+
+ private:
+  std::unique_ptr<detail::TargetBackend> backend_;
+};
+
+class Renderer {
+ public:
+  /// Creates the Vulkan instance and device. Throws EngineError naming what is missing.
+  explicit Renderer(const RendererOptions& options);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  const DeviceInfo& device_info() const;
+
+  /// Uploads a model's meshes and textures; returns its id for DrawItem::model.
+  std::size_t add_model(const assets::Model& model);
+
+  /// An offscreen RGBA8 target of the given size.
+  std::unique_ptr<RenderTarget> make_offscreen(int width_px, int height_px);
+  /// A window with a swapchain. Needs RendererOptions::windowing.
+  std::unique_ptr<RenderTarget> make_window(const WindowOptions& options);
+
+  /// Draws one frame: black background, depth-tested, unlit textured models placed by their poses and
+  /// projected through `projector` (whose size is stretched onto the target). Returns false if the frame
+  /// was skipped (window minimised or swapchain rebuilt). Records timing into `profiler` if given.
+  bool draw_frame(RenderTarget& target, const config::ProjectorConfig& projector, const PoseReader& read_poses,
+                  FrameProfiler* profiler = nullptr);
+  bool draw_frame(RenderTarget& target, const config::ProjectorConfig& projector, std::span<const DrawItem> items,
+                  FrameProfiler* profiler = nullptr);
+
+  /// Waits for every frame submitted to `target` and hands their pending timings to their profilers.
+  void finish(RenderTarget& target);
+
+  /// Validation-layer messages seen so far (warnings and errors), when validation is on.
+  std::size_t validation_warnings() const;
+  std::size_t validation_errors() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Converts a host transform to the float matrix the GPU gets (the one Eigen -> GPU conversion).
+std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m);
+
+}  // namespace projbot::engine

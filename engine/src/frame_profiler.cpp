@@ -1,0 +1,81 @@
+#include "projbot/engine/frame_profiler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+namespace projbot::engine {
+
+FrameProfiler::FrameProfiler() : t0_(std::chrono::steady_clock::now()) {}
+
+double FrameProfiler::now_ms() const {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count();
+}
+
+void FrameProfiler::add(const FrameRecord& record) { records_.push_back(record); }
+
+double percentile(std::vector<double> values, double q) {
+  std::erase_if(values, [](double v) { return std::isnan(v); });
+  if (values.empty()) return std::nan("");
+  std::sort(values.begin(), values.end());
+  const double pos = std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, values.size() - 1);
+  return values[lo] + (pos - static_cast<double>(lo)) * (values[hi] - values[lo]);
+}
+
+FrameSummary FrameProfiler::summary() const {
+  FrameSummary s;
+  s.frames = records_.size();
+  if (records_.empty()) return s;
+  std::vector<FrameRecord> r = records_;
+  std::sort(r.begin(), r.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
+  // Frame time: from one frame's start to the next one's; the last frame ends when its fence signals.
+  std::vector<double> frame, gpu, record;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    frame.push_back((i + 1 < r.size() ? r[i + 1].start_ms : r[i].completed_ms) - r[i].start_ms);
+    gpu.push_back(r[i].gpu_ms);
+    record.push_back(r[i].recorded_ms - r[i].pose_read_ms);
+  }
+  s.p50_ms = percentile(frame, 0.50);
+  s.p95_ms = percentile(frame, 0.95);
+  s.p99_ms = percentile(frame, 0.99);
+  s.max_ms = *std::max_element(frame.begin(), frame.end());
+  double sum = 0;
+  for (double f : frame) sum += f;
+  s.mean_ms = sum / static_cast<double>(frame.size());
+  const double wall = r.back().completed_ms - r.front().start_ms;
+  s.fps = wall > 0 ? static_cast<double>(r.size()) * 1000.0 / wall : 0.0;
+  s.gpu_p50_ms = percentile(gpu, 0.50);
+  s.gpu_p99_ms = percentile(gpu, 0.99);
+  s.cpu_record_p50_ms = percentile(record, 0.50);
+  return s;
+}
+
+void FrameProfiler::write_csv(const std::filesystem::path& path) const {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path.string() + ": cannot write profile");
+  out << "frame,start_ms,pose_read_ms,recorded_ms,submitted_ms,presented_ms,completed_ms,frame_ms,gpu_ms\n";
+  for (std::size_t i = 0; i < records_.size(); ++i) {
+    const auto& r = records_[i];
+    const double frame = (i + 1 < records_.size() ? records_[i + 1].start_ms : r.completed_ms) - r.start_ms;
+    char line[256];
+    std::snprintf(line, sizeof line, "%llu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", static_cast<unsigned long long>(r.index),
+                  r.start_ms, r.pose_read_ms, r.recorded_ms, r.submitted_ms, r.presented_ms, r.completed_ms, frame, r.gpu_ms);
+    out << line;
+  }
+  if (!out) throw std::runtime_error(path.string() + ": write failed");
+}
+
+std::string format_summary(const FrameSummary& s) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "%zu frames, %.1f fps; frame time p50 %.2f ms, p95 %.2f ms, p99 %.2f ms, max %.2f ms; "
+                "gpu p50 %.2f ms, p99 %.2f ms; cpu record p50 %.3f ms",
+                s.frames, s.fps, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms, s.gpu_p50_ms, s.gpu_p99_ms, s.cpu_record_p50_ms);
+  return buf;
+}
+
+}  // namespace projbot::engine

@@ -1,0 +1,381 @@
+// The projector pass: uploads models, builds pipelines, records and submits frames in flight.
+
+#include "projbot/engine/renderer.hpp"
+
+#include <projbot/shaders/mesh.frag.spv.h>
+#include <projbot/shaders/mesh.vert.spv.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include "gpu.hpp"
+#include "projbot/engine/projection.hpp"
+
+namespace projbot::engine {
+namespace {
+
+using detail::Buffer;
+using detail::Gpu;
+
+constexpr std::size_t kFramesInFlight = 2;
+
+/// Push constants of mesh.vert / mesh.frag (std430 layout: 88 bytes).
+struct DrawConstants {
+  std::array<float, 16> clip_from_model;
+  std::array<float, 4> base_color_factor;
+  float alpha_cutoff;
+  std::int32_t alpha_mode;
+};
+static_assert(sizeof(DrawConstants) == 88);
+
+vk::SamplerAddressMode to_vk(assets::Wrap w) {
+  switch (w) {
+    case assets::Wrap::kClampToEdge: return vk::SamplerAddressMode::eClampToEdge;
+    case assets::Wrap::kMirroredRepeat: return vk::SamplerAddressMode::eMirroredRepeat;
+    default: return vk::SamplerAddressMode::eRepeat;
+  }
+}
+
+vk::Filter to_vk(assets::Filter f) { return f == assets::Filter::kNearest ? vk::Filter::eNearest : vk::Filter::eLinear; }
+
+// A model on the GPU: one vertex and one index buffer for all its primitives, its textures, and one
+// descriptor set per material.
+struct GpuModel {
+  struct Part {
+    std::uint32_t first_index = 0;
+    std::uint32_t index_count = 0;
+    std::int32_t vertex_offset = 0;
+    std::size_t material = 0;
+  };
+  Buffer vertices;
+  Buffer indices;
+  std::vector<Part> parts;
+  std::vector<assets::Material> materials;
+  std::vector<detail::Image> textures;
+  std::vector<vk::raii::Sampler> samplers;
+  vk::raii::DescriptorPool pool{nullptr};
+  std::vector<vk::raii::DescriptorSet> sets;  // one per material
+};
+
+}  // namespace
+
+std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m) {
+  std::array<float, 16> out{};
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) out[static_cast<std::size_t>(c * 4 + r)] = static_cast<float>(m(r, c));  // GLSL: column-major
+  return out;
+}
+
+struct Renderer::Impl {
+  std::shared_ptr<Gpu> gpu;
+  vk::raii::DescriptorSetLayout set_layout{nullptr};
+  vk::raii::PipelineLayout pipeline_layout{nullptr};
+  vk::raii::ShaderModule vert{nullptr};
+  vk::raii::ShaderModule frag{nullptr};
+  std::map<std::tuple<vk::Format, bool, bool>, vk::raii::Pipeline> pipelines;  // (format, cull back, blend)
+  detail::Image white;  // bound where a material has no texture
+  std::vector<GpuModel> models;
+  std::vector<DrawItem> items;
+  std::uint64_t frame_index = 0;
+
+  explicit Impl(const RendererOptions& options) : gpu(std::make_shared<Gpu>(options)) {
+    vk::DescriptorSetLayoutBinding binding(0, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment);
+    set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, binding));
+    vk::PushConstantRange push(vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, sizeof(DrawConstants));
+    const vk::DescriptorSetLayout layouts[] = {*set_layout};
+    pipeline_layout = vk::raii::PipelineLayout(gpu->device, vk::PipelineLayoutCreateInfo({}, layouts, push));
+    vert = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_vert_spv), k_mesh_vert_spv));
+    frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_frag_spv), k_mesh_frag_spv));
+    assets::Image w;
+    w.width = w.height = 1;
+    w.rgba = {255, 255, 255, 255};
+    white = upload_texture(w);
+  }
+
+  ~Impl() {
+    if (*gpu->device) gpu->device.waitIdle();
+  }
+
+  detail::Image upload_texture(const assets::Image& img) {
+    const vk::Extent2D extent(static_cast<std::uint32_t>(img.width), static_cast<std::uint32_t>(img.height));
+    // UNORM, not SRGB: texels reach the target exactly as stored in the file.
+    detail::Image tex = gpu->make_image(extent, vk::Format::eR8G8B8A8Unorm,
+                                        vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst,
+                                        vk::ImageAspectFlagBits::eColor);
+    Buffer staging = gpu->make_buffer(img.rgba.size(), vk::BufferUsageFlagBits::eTransferSrc,
+                                      vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
+    std::memcpy(staging.mapped, img.rgba.data(), img.rgba.size());
+    gpu->one_shot([&](vk::raii::CommandBuffer& cmd) {
+      detail::transition(cmd, *tex.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
+                         vk::ImageLayout::eTransferDstOptimal, vk::PipelineStageFlagBits2::eNone, vk::AccessFlagBits2::eNone,
+                         vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite);
+      cmd.copyBufferToImage(*staging.buffer, *tex.image, vk::ImageLayout::eTransferDstOptimal,
+                            vk::BufferImageCopy(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, 1),
+                                                {0, 0, 0}, vk::Extent3D(extent, 1)));
+      detail::transition(cmd, *tex.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eTransferDstOptimal,
+                         vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eCopy,
+                         vk::AccessFlagBits2::eTransferWrite, vk::PipelineStageFlagBits2::eFragmentShader,
+                         vk::AccessFlagBits2::eShaderSampledRead);
+    });
+    return tex;
+  }
+
+  // One pipeline builder: every variant differs only in target format, culling and blending.
+  const vk::raii::Pipeline& pipeline(vk::Format format, bool cull_back, bool blend) {
+    const auto key = std::make_tuple(format, cull_back, blend);
+    if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
+    const vk::PipelineShaderStageCreateInfo stages[] = {{{}, vk::ShaderStageFlagBits::eVertex, *vert, "main"},
+                                                        {{}, vk::ShaderStageFlagBits::eFragment, *frag, "main"}};
+    vk::VertexInputBindingDescription binding(0, sizeof(assets::Vertex), vk::VertexInputRate::eVertex);
+    const vk::VertexInputAttributeDescription attributes[] = {
+        {0, 0, vk::Format::eR32G32B32Sfloat, offsetof(assets::Vertex, position)},
+        {1, 0, vk::Format::eR32G32B32Sfloat, offsetof(assets::Vertex, normal)},
+        {2, 0, vk::Format::eR32G32Sfloat, offsetof(assets::Vertex, uv)},
+        {3, 0, vk::Format::eR32G32B32A32Sfloat, offsetof(assets::Vertex, color)}};
+    vk::PipelineVertexInputStateCreateInfo vertex_input({}, binding, attributes);
+    vk::PipelineInputAssemblyStateCreateInfo assembly({}, vk::PrimitiveTopology::eTriangleList);
+    vk::PipelineViewportStateCreateInfo viewport({}, 1, nullptr, 1, nullptr);
+    // With y down in both the OpenCV image and Vulkan's framebuffer, glTF's counter-clockwise front
+    // faces stay counter-clockwise on screen.
+    vk::PipelineRasterizationStateCreateInfo raster({}, VK_FALSE, VK_FALSE, vk::PolygonMode::eFill,
+                                                    cull_back ? vk::CullModeFlagBits::eBack : vk::CullModeFlagBits::eNone,
+                                                    vk::FrontFace::eCounterClockwise, VK_FALSE, 0, 0, 0, 1.0F);
+    vk::PipelineMultisampleStateCreateInfo multisample({}, vk::SampleCountFlagBits::e1);
+    vk::PipelineDepthStencilStateCreateInfo depth({}, VK_TRUE, blend ? VK_FALSE : VK_TRUE, vk::CompareOp::eLess);
+    vk::PipelineColorBlendAttachmentState attachment(
+        blend ? VK_TRUE : VK_FALSE, vk::BlendFactor::eSrcAlpha, vk::BlendFactor::eOneMinusSrcAlpha, vk::BlendOp::eAdd,
+        vk::BlendFactor::eOne, vk::BlendFactor::eOneMinusSrcAlpha, vk::BlendOp::eAdd,
+        vk::ColorComponentFlagBits::eR | vk::ColorComponentFlagBits::eG | vk::ColorComponentFlagBits::eB |
+            vk::ColorComponentFlagBits::eA);
+    vk::PipelineColorBlendStateCreateInfo blending({}, VK_FALSE, vk::LogicOp::eCopy, attachment);
+    const vk::DynamicState dynamic_states[] = {vk::DynamicState::eViewport, vk::DynamicState::eScissor};
+    vk::PipelineDynamicStateCreateInfo dynamic({}, dynamic_states);
+    vk::PipelineRenderingCreateInfo rendering(0, format, detail::kDepthFormat);
+    vk::GraphicsPipelineCreateInfo info({}, stages, &vertex_input, &assembly, nullptr, &viewport, &raster, &multisample, &depth,
+                                        &blending, &dynamic, *pipeline_layout);
+    info.pNext = &rendering;
+    return pipelines.emplace(key, vk::raii::Pipeline(gpu->device, nullptr, info)).first->second;
+  }
+
+  std::size_t add_model(const assets::Model& model) {
+    if (model.primitives.empty()) throw EngineError(model.source + ": model has no triangles to draw");
+    GpuModel g;
+    std::vector<assets::Vertex> vertices;
+    std::vector<std::uint32_t> indices;
+    for (const auto& p : model.primitives) {
+      if (p.material < 0 || static_cast<std::size_t>(p.material) >= model.materials.size())
+        throw EngineError(model.source + ": primitive refers to a missing material");
+      g.parts.push_back({static_cast<std::uint32_t>(indices.size()), static_cast<std::uint32_t>(p.indices.size()),
+                         static_cast<std::int32_t>(vertices.size()), static_cast<std::size_t>(p.material)});
+      vertices.insert(vertices.end(), p.vertices.begin(), p.vertices.end());
+      indices.insert(indices.end(), p.indices.begin(), p.indices.end());
+    }
+    g.vertices = gpu->upload_buffer(vertices.data(), vertices.size() * sizeof(assets::Vertex), vk::BufferUsageFlagBits::eVertexBuffer);
+    g.indices = gpu->upload_buffer(indices.data(), indices.size() * sizeof(std::uint32_t), vk::BufferUsageFlagBits::eIndexBuffer);
+    for (const auto& img : model.images)
+      g.textures.push_back(img.rgba.empty() ? detail::Image{} : upload_texture(img));
+    g.materials = model.materials;
+
+    const auto n = static_cast<std::uint32_t>(model.materials.size());
+    vk::DescriptorPoolSize size(vk::DescriptorType::eCombinedImageSampler, n);
+    g.pool = vk::raii::DescriptorPool(gpu->device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, n, size));
+    std::vector<vk::DescriptorSetLayout> layouts(n, *set_layout);
+    vk::raii::DescriptorSets sets(gpu->device, vk::DescriptorSetAllocateInfo(*g.pool, layouts));
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const auto& m = model.materials[i];
+      const bool textured = m.base_color_image >= 0 && static_cast<std::size_t>(m.base_color_image) < g.textures.size() &&
+                            *g.textures[static_cast<std::size_t>(m.base_color_image)].view;
+      if (m.base_color_image >= 0 && !textured) throw EngineError(model.source + ": material " + std::to_string(i) + " has no usable texture");
+      g.samplers.emplace_back(gpu->device, vk::SamplerCreateInfo({}, to_vk(m.sampler.mag), to_vk(m.sampler.min),
+                                                                 vk::SamplerMipmapMode::eNearest, to_vk(m.sampler.wrap_s),
+                                                                 to_vk(m.sampler.wrap_t), vk::SamplerAddressMode::eRepeat));
+      const vk::ImageView view = textured ? *g.textures[static_cast<std::size_t>(m.base_color_image)].view : *white.view;
+      vk::DescriptorImageInfo image_info(*g.samplers.back(), view, vk::ImageLayout::eShaderReadOnlyOptimal);
+      gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*sets[i], 0, 0, vk::DescriptorType::eCombinedImageSampler, image_info), {});
+    }
+    for (auto& s : sets) g.sets.push_back(std::move(s));
+    models.push_back(std::move(g));
+    return models.size() - 1;
+  }
+
+  void ensure_slots(detail::TargetBackend& t) {
+    if (!t.slots.empty()) return;
+    vk::raii::CommandBuffers cmds(gpu->device, vk::CommandBufferAllocateInfo(*gpu->command_pool, vk::CommandBufferLevel::ePrimary,
+                                                                             static_cast<std::uint32_t>(kFramesInFlight)));
+    for (std::size_t i = 0; i < kFramesInFlight; ++i) {
+      detail::FrameSlot slot;
+      slot.cmd = std::move(cmds[i]);
+      slot.fence = vk::raii::Fence(gpu->device, vk::FenceCreateInfo(vk::FenceCreateFlagBits::eSignaled));
+      slot.acquired = vk::raii::Semaphore(gpu->device, vk::SemaphoreCreateInfo());
+      t.slots.push_back(std::move(slot));
+    }
+    if (gpu->info.gpu_timestamps)
+      t.timestamps = vk::raii::QueryPool(gpu->device, vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp,
+                                                                             static_cast<std::uint32_t>(2 * kFramesInFlight)));
+  }
+
+  // Waits for a slot's previous frame and hands its timing to its profiler.
+  void retire(detail::TargetBackend& t, std::size_t index) {
+    detail::FrameSlot& slot = t.slots[index];
+    if (gpu->device.waitForFences(*slot.fence, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
+      throw EngineError("a frame's fence never signalled");
+    if (!slot.pending) return;
+    slot.pending = false;
+    if (slot.profiler == nullptr) return;
+    slot.record.completed_ms = slot.profiler->now_ms();
+    slot.record.gpu_ms = std::nan("");
+    if (*t.timestamps) {
+      const auto [result, ticks] = t.timestamps.getResults<std::uint64_t>(static_cast<std::uint32_t>(2 * index), 2,
+                                                                         2 * sizeof(std::uint64_t), sizeof(std::uint64_t),
+                                                                         vk::QueryResultFlagBits::e64);
+      if (result == vk::Result::eSuccess && ticks[1] >= ticks[0])
+        slot.record.gpu_ms = static_cast<double>(ticks[1] - ticks[0]) * gpu->timestamp_period_ns * 1e-6;
+    }
+    slot.profiler->add(slot.record);
+  }
+
+  void record_draws(const vk::raii::CommandBuffer& cmd, vk::Format format, const config::ProjectorConfig& projector) {
+    const Eigen::Matrix4d clip_from_projector_m = clip_from_projector(projector);
+    // Opaque and masked first, blended after them so they blend over what is behind.
+    for (const bool blend_pass : {false, true})
+      for (const DrawItem& item : items) {
+        if (item.model >= models.size()) throw EngineError("draw item refers to model " + std::to_string(item.model) + ", not uploaded");
+        const GpuModel& m = models[item.model];
+        const vk::Buffer vb = *m.vertices.buffer;
+        cmd.bindVertexBuffers(0, vb, vk::DeviceSize(0));
+        cmd.bindIndexBuffer(*m.indices.buffer, 0, vk::IndexType::eUint32);
+        DrawConstants c{};
+        c.clip_from_model = to_gpu_matrix(clip_from_projector_m * item.T_projector_target);  // Eq. 3
+        for (const auto& part : m.parts) {
+          const assets::Material& mat = m.materials[part.material];
+          if ((mat.alpha_mode == assets::AlphaMode::kBlend) != blend_pass) continue;
+          cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline(format, !mat.double_sided, blend_pass));
+          cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout, 0, *m.sets[part.material], {});
+          c.base_color_factor = mat.base_color_factor;
+          c.alpha_cutoff = mat.alpha_cutoff;
+          c.alpha_mode = mat.alpha_mode == assets::AlphaMode::kOpaque ? 0 : mat.alpha_mode == assets::AlphaMode::kMask ? 1 : 2;
+          cmd.pushConstants<DrawConstants>(*pipeline_layout, vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, c);
+          cmd.drawIndexed(part.index_count, 1, part.first_index, part.vertex_offset, 0);
+        }
+      }
+  }
+
+  bool draw_frame(detail::TargetBackend& t, const config::ProjectorConfig& projector, const PoseReader& read_poses,
+                  FrameProfiler* profiler) {
+    ensure_slots(t);
+    FrameRecord rec;
+    rec.index = frame_index;
+    rec.start_ms = profiler ? profiler->now_ms() : 0.0;
+    const std::size_t si = t.next_slot;
+    retire(t, si);
+    detail::FrameSlot& slot = t.slots[si];
+    const auto frame = t.acquire(*slot.acquired);
+    if (!frame) return false;
+
+    items.clear();
+    read_poses(items);
+    if (profiler) rec.pose_read_ms = profiler->now_ms();
+
+    gpu->device.resetFences(*slot.fence);
+    const vk::raii::CommandBuffer& cmd = slot.cmd;
+    cmd.reset();
+    cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+    const auto q0 = static_cast<std::uint32_t>(2 * si);
+    if (*t.timestamps) {
+      cmd.resetQueryPool(*t.timestamps, q0, 2);
+      cmd.writeTimestamp2(vk::PipelineStageFlagBits2::eTopOfPipe, *t.timestamps, q0);
+    }
+    const vk::Extent2D extent = t.extent();
+    const vk::Image depth = *t.depth().image;
+    detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
+                       vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
+                       vk::AccessFlagBits2::eNone, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
+                       vk::AccessFlagBits2::eColorAttachmentWrite);
+    detail::transition(cmd, depth, vk::ImageAspectFlagBits::eDepth, vk::ImageLayout::eUndefined,
+                       vk::ImageLayout::eDepthAttachmentOptimal, vk::PipelineStageFlagBits2::eLateFragmentTests,
+                       vk::AccessFlagBits2::eDepthStencilAttachmentWrite, vk::PipelineStageFlagBits2::eEarlyFragmentTests,
+                       vk::AccessFlagBits2::eDepthStencilAttachmentWrite | vk::AccessFlagBits2::eDepthStencilAttachmentRead);
+    vk::RenderingAttachmentInfo color_att(frame->color_view, vk::ImageLayout::eColorAttachmentOptimal, {}, {}, {},
+                                          vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eStore,
+                                          vk::ClearColorValue(std::array<float, 4>{0.0F, 0.0F, 0.0F, 1.0F}));
+    vk::RenderingAttachmentInfo depth_att(*t.depth().view, vk::ImageLayout::eDepthAttachmentOptimal, {}, {}, {},
+                                          vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eDontCare,
+                                          vk::ClearDepthStencilValue(1.0F, 0));
+    cmd.beginRendering(vk::RenderingInfo({}, vk::Rect2D({0, 0}, extent), 1, 0, color_att, &depth_att));
+    // The projector image (width x height of the intrinsics) is stretched onto the target.
+    cmd.setViewport(0, vk::Viewport(0.0F, 0.0F, static_cast<float>(extent.width), static_cast<float>(extent.height), 0.0F, 1.0F));
+    cmd.setScissor(0, vk::Rect2D({0, 0}, extent));
+    record_draws(cmd, t.color_format(), projector);
+    cmd.endRendering();
+    const bool to_present = frame->color_final_layout == vk::ImageLayout::ePresentSrcKHR;
+    detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eColorAttachmentOptimal,
+                       frame->color_final_layout, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
+                       vk::AccessFlagBits2::eColorAttachmentWrite,
+                       to_present ? vk::PipelineStageFlagBits2::eNone : vk::PipelineStageFlagBits2::eCopy,
+                       to_present ? vk::AccessFlagBits2::eNone : vk::AccessFlagBits2::eTransferRead);
+    if (*t.timestamps) cmd.writeTimestamp2(vk::PipelineStageFlagBits2::eAllCommands, *t.timestamps, q0 + 1);
+    cmd.end();
+    if (profiler) rec.recorded_ms = profiler->now_ms();
+
+    const vk::CommandBuffer raw = *cmd;
+    const vk::PipelineStageFlags wait_stage = vk::PipelineStageFlagBits::eColorAttachmentOutput;
+    vk::SubmitInfo submit(0, nullptr, nullptr, 1, &raw);
+    if (frame->wait) submit.setWaitSemaphoreCount(1).setPWaitSemaphores(&frame->wait).setPWaitDstStageMask(&wait_stage);
+    if (frame->signal) submit.setSignalSemaphoreCount(1).setPSignalSemaphores(&frame->signal);
+    gpu->queue.submit(submit, *slot.fence);
+    if (profiler) rec.submitted_ms = profiler->now_ms();
+    t.present(*frame);
+    if (profiler) rec.presented_ms = profiler->now_ms();
+
+    slot.record = rec;
+    slot.profiler = profiler;
+    slot.pending = true;
+    t.next_slot = (si + 1) % t.slots.size();
+    ++frame_index;
+    return true;
+  }
+};
+
+RenderTarget::RenderTarget(std::unique_ptr<detail::TargetBackend> backend) : backend_(std::move(backend)) {}
+RenderTarget::~RenderTarget() = default;
+int RenderTarget::width() const { return static_cast<int>(backend_->extent().width); }
+int RenderTarget::height() const { return static_cast<int>(backend_->extent().height); }
+bool RenderTarget::poll_close() { return backend_->poll_close(); }
+std::uint64_t RenderTarget::native_window() const { return backend_->native_window(); }
+assets::Image RenderTarget::read_back() { return backend_->read_back(); }
+
+Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl>(options)) {}
+Renderer::~Renderer() = default;
+const DeviceInfo& Renderer::device_info() const { return impl_->gpu->info; }
+std::size_t Renderer::add_model(const assets::Model& model) { return impl_->add_model(model); }
+
+std::unique_ptr<RenderTarget> Renderer::make_offscreen(int width_px, int height_px) {
+  if (width_px <= 0 || height_px <= 0) throw EngineError("offscreen target size must be positive");
+  return std::make_unique<RenderTarget>(detail::make_offscreen_backend(
+      impl_->gpu, vk::Extent2D(static_cast<std::uint32_t>(width_px), static_cast<std::uint32_t>(height_px))));
+}
+
+std::unique_ptr<RenderTarget> Renderer::make_window(const WindowOptions& options) {
+  return std::make_unique<RenderTarget>(detail::make_window_backend(impl_->gpu, options));
+}
+
+bool Renderer::draw_frame(RenderTarget& target, const config::ProjectorConfig& projector, const PoseReader& read_poses,
+                          FrameProfiler* profiler) {
+  return impl_->draw_frame(target.backend(), projector, read_poses, profiler);
+}
+
+bool Renderer::draw_frame(RenderTarget& target, const config::ProjectorConfig& projector, std::span<const DrawItem> items,
+                          FrameProfiler* profiler) {
+  return draw_frame(target, projector, [items](std::vector<DrawItem>& out) { out.assign(items.begin(), items.end()); }, profiler);
+}
+
+void Renderer::finish(RenderTarget& target) {
+  auto& t = target.backend();
+  for (std::size_t k = 0; k < t.slots.size(); ++k) impl_->retire(t, (t.next_slot + k) % t.slots.size());
+}
+
+std::size_t Renderer::validation_warnings() const { return impl_->gpu->validation_warnings; }
+std::size_t Renderer::validation_errors() const { return impl_->gpu->validation_errors; }
+
+}  // namespace projbot::engine
