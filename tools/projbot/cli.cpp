@@ -1,0 +1,77 @@
+#include "cli.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+namespace projbot::cli {
+
+Args::Args(const std::vector<OptionSpec>& specs, int argc, char** argv, int first) {
+  for (int i = first; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg.rfind("--", 0) != 0 || arg == "--") {
+      positional_.push_back(arg);
+      continue;
+    }
+    std::string name = arg.substr(2);
+    std::optional<std::string> inline_value;
+    if (const auto eq = name.find('='); eq != std::string::npos) {
+      inline_value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    }
+    const OptionSpec* spec = nullptr;
+    for (const auto& s : specs)
+      if (s.name == name) spec = &s;
+    if (spec == nullptr) throw UsageError("unknown option --" + name);
+    if (spec->value.empty()) {
+      if (inline_value) throw UsageError("--" + name + " takes no value");
+      values_[name] = "1";
+    } else if (inline_value) {
+      values_[name] = *inline_value;
+    } else {
+      if (i + 1 >= argc) throw UsageError("--" + name + " needs a value (" + spec->value + ")");
+      values_[name] = argv[++i];
+    }
+  }
+}
+
+std::optional<std::string> Args::get(const std::string& name) const {
+  if (auto it = values_.find(name); it != values_.end()) return it->second;
+  return std::nullopt;
+}
+
+std::string Args::get_or(const std::string& name, const std::string& fallback) const { return get(name).value_or(fallback); }
+
+int Args::get_int(const std::string& name, int fallback, int min_value, int max_value) const {
+  const auto v = get(name);
+  if (!v) return fallback;
+  int out = 0;
+  const auto [end, ec] = std::from_chars(v->data(), v->data() + v->size(), out);
+  if (ec != std::errc() || end != v->data() + v->size() || out < min_value || out > max_value)
+    throw UsageError("--" + name + " must be an integer in " + std::to_string(min_value) + ".." + std::to_string(max_value) +
+                     ", got '" + *v + "'");
+  return out;
+}
+
+double Args::get_double(const std::string& name, double fallback) const {
+  const auto v = get(name);
+  if (!v) return fallback;
+  double out = 0;
+  const auto [end, ec] = std::from_chars(v->data(), v->data() + v->size(), out);
+  if (ec != std::errc() || end != v->data() + v->size() || !std::isfinite(out))
+    throw UsageError("--" + name + " must be a finite number, got '" + *v + "'");
+  return out;
+}
+
+std::string format_options(const std::vector<OptionSpec>& specs) {
+  std::ostringstream out;
+  for (const auto& s : specs) {
+    std::string head = "  --" + s.name + (s.value.empty() ? "" : " " + s.value);
+    if (head.size() < 28) head.resize(28, ' ');
+    else head += "\n" + std::string(28, ' ');
+    out << head << s.help << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace projbot::cli

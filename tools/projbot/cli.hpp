@@ -1,0 +1,45 @@
+#pragma once
+// Command-line parsing for the projbot subcommands: declared options, so unknown flags and missing
+// values are reported with the subcommand's help.
+
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace projbot::cli {
+
+/// A wrong command line: printed with a pointer to --help, exit code 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct OptionSpec {
+  std::string name;      ///< without the leading dashes
+  std::string value;     ///< placeholder shown in help ("FILE"); empty for a flag
+  std::string help;
+};
+
+class Args {
+ public:
+  /// Parses argv[first..] against `specs`. Throws UsageError on unknown options or missing values.
+  Args(const std::vector<OptionSpec>& specs, int argc, char** argv, int first);
+
+  bool flag(const std::string& name) const { return values_.contains(name); }
+  std::optional<std::string> get(const std::string& name) const;
+  std::string get_or(const std::string& name, const std::string& fallback) const;
+  int get_int(const std::string& name, int fallback, int min_value, int max_value) const;
+  double get_double(const std::string& name, double fallback) const;
+  const std::vector<std::string>& positional() const { return positional_; }
+
+ private:
+  std::map<std::string, std::string> values_;
+  std::vector<std::string> positional_;
+};
+
+/// "  --scene FILE     help" lines for a subcommand's help text.
+std::string format_options(const std::vector<OptionSpec>& specs);
+
+}  // namespace projbot::cli

@@ -1,0 +1,24 @@
+#pragma once
+// The subcommands of the projbot executable.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+
+namespace projbot::tools {
+
+struct Command {
+  std::string name;
+  std::string summary;  ///< one line for `projbot --help`
+  std::string usage;    ///< the top of `projbot NAME --help`
+  std::vector<cli::OptionSpec> options;
+  std::function<int(const cli::Args&)> run;  ///< returns the exit code
+};
+
+extern const Command kRender;
+extern const Command kShow;
+extern const Command kBenchRender;
+
+}  // namespace projbot::tools

@@ -1,0 +1,85 @@
+// projbot: one executable, one subcommand per job. Exceptions end here as one clear line.
+
+#include <iostream>
+
+#include "commands.hpp"
+#include "projbot/assets/image.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/engine/renderer.hpp"
+
+namespace {
+
+using projbot::tools::Command;
+
+const std::vector<const Command*>& commands() {
+  static const std::vector<const Command*> all{&projbot::tools::kRender, &projbot::tools::kShow, &projbot::tools::kBenchRender};
+  return all;
+}
+
+void print_help() {
+  std::cout << "projbot: projection mapping for a projector robot.\n\n"
+               "Renders textured 3-D models of target objects through a calibrated projector so the\n"
+               "content lands on the real objects.\n\n"
+               "Usage: projbot COMMAND [options]     (projbot COMMAND --help for its options)\n\nCommands:\n";
+  for (const auto* c : commands()) {
+    std::string name = "  " + c->name;
+    name.resize(16, ' ');
+    std::cout << name << c->summary << '\n';
+  }
+  std::cout << "\nExamples:\n"
+               "  projbot render --out frame.png                    the demo scene, headless\n"
+               "  projbot render --model duck.glb --out duck.png    one model, framed in view\n"
+               "  projbot show --scene my.yaml --fullscreen --monitor 1\n"
+               "  projbot bench render\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h" || std::string(argv[1]) == "help") {
+    print_help();
+    return argc < 2 ? 2 : 0;
+  }
+  std::string name = argv[1];
+  int first = 2;
+  if (name == "bench") {  // "bench render": the benchmark of a subsystem
+    if (argc < 3 || std::string(argv[2]) != "render") {
+      std::cerr << "projbot bench: say what to benchmark: projbot bench render\n";
+      return 2;
+    }
+    name = "bench render";
+    first = 3;
+  }
+  const Command* cmd = nullptr;
+  for (const auto* c : commands())
+    if (c->name == name) cmd = c;
+  if (cmd == nullptr) {
+    std::cerr << "projbot: unknown command '" << name << "' (projbot --help lists them)\n";
+    return 2;
+  }
+  for (int i = first; i < argc; ++i)
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::cout << "Usage: " << cmd->usage << "\nOptions:\n" << projbot::cli::format_options(cmd->options);
+      return 0;
+    }
+  try {
+    const projbot::cli::Args args(cmd->options, argc, argv, first);
+    if (!args.positional().empty()) throw projbot::cli::UsageError("unexpected argument '" + args.positional().front() + "'");
+    return cmd->run(args);
+  } catch (const projbot::cli::UsageError& e) {
+    std::cerr << "projbot " << name << ": " << e.what() << " (see projbot " << name << " --help)\n";
+    return 2;
+  } catch (const projbot::config::ConfigError& e) {
+    std::cerr << "projbot " << name << ": " << e.what() << '\n';
+    return 1;
+  } catch (const projbot::assets::AssetError& e) {
+    std::cerr << "projbot " << name << ": " << e.what() << '\n';
+    return 1;
+  } catch (const projbot::engine::EngineError& e) {
+    std::cerr << "projbot " << name << ": " << e.what() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "projbot " << name << ": " << e.what() << '\n';
+    return 1;
+  }
+}

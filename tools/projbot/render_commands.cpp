@@ -1,0 +1,120 @@
+// projbot render | show | bench render: the projector pass, offscreen or in a window.
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+
+#include "commands.hpp"
+#include "projbot/assets/model.hpp"
+#include "projbot/engine/frame_profiler.hpp"
+#include "projbot/engine/renderer.hpp"
+#include "scene_setup.hpp"
+
+namespace projbot::tools {
+namespace {
+
+engine::RendererOptions renderer_options(const cli::Args& args, bool windowing) {
+  engine::RendererOptions o;
+  o.validation = args.flag("validation");
+  o.windowing = windowing;
+  o.device_index = args.get_int("device", -1, -1, 64);
+  return o;
+}
+
+engine::PresentMode present_mode(const std::string& name) {
+  if (name == "fifo") return engine::PresentMode::kFifo;
+  if (name == "mailbox") return engine::PresentMode::kMailbox;
+  if (name == "immediate") return engine::PresentMode::kImmediate;
+  throw cli::UsageError("--present-mode must be fifo, mailbox or immediate, got '" + name + "'");
+}
+
+// Prints validation results and returns false when the layer reported anything.
+bool report_validation(const cli::Args& args, const engine::Renderer& renderer) {
+  if (!args.flag("validation")) return true;
+  std::cout << "validation: " << renderer.validation_errors() << " errors, " << renderer.validation_warnings() << " warnings\n";
+  return renderer.validation_errors() == 0 && renderer.validation_warnings() == 0;
+}
+
+void finish_profile(const cli::Args& args, const engine::FrameProfiler& profiler) {
+  std::cout << engine::format_summary(profiler.summary()) << '\n';
+  if (const auto csv = args.get("profile")) {
+    profiler.write_csv(*csv);
+    std::cout << "per-frame profile written to " << *csv << '\n';
+  }
+}
+
+}  // namespace
+
+const Command kRender{
+    "render", "render the projector image headless (offscreen) to a PNG",
+    "projbot render [--scene S.yaml] --out frame.png [--frames N] [--profile p.csv] [overrides]\n\n"
+    "Draws every target of the scene through the projector's intrinsics, with no window system, and\n"
+    "writes the last frame as an RGBA PNG: exactly the image the projector must show.\n",
+    [] {
+      auto o = scene_options();
+      o.insert(o.begin(), {{"out", "FILE", "PNG to write (required)"},
+                           {"frames", "N", "frames to draw, for timing (default 1)"},
+                           {"profile", "FILE", "write one CSV row of timings per frame"}});
+      return o;
+    }(),
+    [](const cli::Args& args) {
+      const auto out = args.get("out");
+      if (!out) throw cli::UsageError("--out FILE is required");
+      const int frames = args.get_int("frames", 1, 1, 1000000);
+      const config::Scene scene = scene_from_args(args);
+      engine::Renderer renderer(renderer_options(args, false));
+      std::cout << "device: " << renderer.device_info().name << '\n';
+      const auto items = upload_scene(renderer, scene);
+      auto target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+      engine::FrameProfiler profiler;
+      for (int i = 0; i < frames; ++i) renderer.draw_frame(*target, scene.projector, items, &profiler);
+      renderer.finish(*target);
+      assets::write_png(*out, target->read_back());
+      std::cout << "wrote " << *out << " (" << scene.projector.width_px << "x" << scene.projector.height_px << ", "
+                << scene.targets.size() << " target" << (scene.targets.size() == 1 ? "" : "s") << ")\n";
+      finish_profile(args, profiler);
+      return report_validation(args, renderer) ? 0 : 1;
+    }};
+
+const Command kShow{
+    "show", "open the projector output in a window (fullscreen on a projector, or a preview)",
+    "projbot show [--scene S.yaml] [--fullscreen] [--monitor N] [--present-mode fifo|mailbox|immediate]\n\n"
+    "Opens a window showing the projector image and redraws it every frame until the window is closed\n"
+    "(or --frames have been drawn). Without --fullscreen the window has the projector's size.\n",
+    [] {
+      auto o = scene_options();
+      o.insert(o.begin(), {{"fullscreen", "", "fullscreen on --monitor (the projector)"},
+                           {"monitor", "N", "monitor index for --fullscreen (default 0)"},
+                           {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
+                           {"frames", "N", "close after N frames (default: run until closed)"},
+                           {"profile", "FILE", "write one CSV row of timings per frame"}});
+      return o;
+    }(),
+    [](const cli::Args& args) {
+      const config::Scene scene = scene_from_args(args);
+      const int frames = args.get_int("frames", 0, 0, 100000000);
+      engine::WindowOptions w;
+      w.title = "projbot: " + (scene.source.empty() ? std::string("model") : scene.source.filename().string());
+      w.width_px = scene.projector.width_px;
+      w.height_px = scene.projector.height_px;
+      w.fullscreen = args.flag("fullscreen");
+      w.monitor = args.get_int("monitor", 0, 0, 64);
+      w.present_mode = present_mode(args.get_or("present-mode", "fifo"));
+      engine::Renderer renderer(renderer_options(args, true));
+      std::cout << "device: " << renderer.device_info().name << '\n';
+      const auto items = upload_scene(renderer, scene);
+      auto window = renderer.make_window(w);
+      if (w.fullscreen && (window->width() != scene.projector.width_px || window->height() != scene.projector.height_px))
+        std::cerr << "projbot: warning: monitor is " << window->width() << "x" << window->height() << " but the projector model is "
+                  << scene.projector.width_px << "x" << scene.projector.height_px << "; the image is stretched\n";
+      engine::FrameProfiler profiler;
+      int drawn = 0;
+      while (!window->poll_close() && (frames == 0 || drawn < frames))
+        if (renderer.draw_frame(*window, scene.projector, items, &profiler)) ++drawn;
+      renderer.finish(*window);
+      finish_profile(args, profiler);
+      return report_validation(args, renderer) ? 0 : 1;
+    }};
+
+}  // namespace projbot::tools

@@ -1,0 +1,105 @@
+#include "scene_setup.hpp"
+
+#include <cmath>
+#include <cstdlib>
+
+#include "projbot/assets/model.hpp"
+
+namespace projbot::tools {
+
+std::vector<cli::OptionSpec> scene_options() {
+  return {
+      {"scene", "FILE", "scene YAML (default: the shipped demo scene)"},
+      {"model", "FILE", "glTF model for the scene's single target (without --scene: framed in view)"},
+      {"size", "WxH", "projector image size in pixels, e.g. 1920x1080"},
+      {"intrinsics", "fx,fy,cx,cy", "projector intrinsics in pixels (OpenCV pinhole)"},
+      {"near", "M", "near clipping distance, metres"},
+      {"far", "M", "far clipping distance, metres"},
+      {"pose-matrix", "m00,...,m33", "T_projector_target of the single target: 16 numbers, row-major, metres"},
+      {"device", "N", "Vulkan physical device index (default: best available)"},
+      {"validation", "", "enable the Vulkan validation layer and report its messages"},
+  };
+}
+
+std::filesystem::path asset_dir() {
+  if (const char* env = std::getenv("PROJBOT_ASSETS"); env != nullptr && *env != '\0') return env;
+  return PROJBOT_ASSET_DIR;
+}
+
+Eigen::Matrix4d framing_pose(const config::ProjectorConfig& p, double radius_m) {
+  const double half_fov = std::atan(std::min(p.width_px / (2.0 * p.fx_px), p.height_px / (2.0 * p.fy_px)));
+  const double distance = radius_m / std::sin(half_fov * 0.8);
+  Eigen::Matrix4d T = config::pose_from_xyz_rpy({0.0, 0.0, distance}, {180.0, 0.0, 0.0});
+  // Aim at the principal point's ray for the image centre.
+  T(0, 3) = distance * ((p.width_px - 1) / 2.0 - p.cx_px) / p.fx_px;
+  T(1, 3) = distance * ((p.height_px - 1) / 2.0 - p.cy_px) / p.fy_px;
+  return T;
+}
+
+config::Scene scene_from_args(const cli::Args& args) {
+  const auto scene_path = args.get("scene");
+  config::Scene scene;
+  bool frame_model = false;
+  if (scene_path) {
+    scene = config::load_scene(*scene_path);
+  } else if (args.get("model")) {
+    scene.targets.push_back({"model", {}, 1.0, true, Eigen::Matrix4d::Identity()});
+    frame_model = !args.get("pose-matrix");
+  } else {
+    scene = config::load_scene(asset_dir() / "scenes" / "demo.yaml");
+  }
+
+  if (const auto model = args.get("model")) {
+    if (scene.targets.size() != 1)
+      throw cli::UsageError("--model replaces the model of a scene's single target, but the scene has " +
+                            std::to_string(scene.targets.size()));
+    scene.targets[0].model = *model;
+  }
+  auto& p = scene.projector;
+  if (const auto size = args.get("size")) {
+    const auto x = size->find('x');
+    if (x == std::string::npos) throw cli::UsageError("--size must look like 1920x1080, got '" + *size + "'");
+    const auto wh = config::parse_number_list(size->substr(0, x) + "," + size->substr(x + 1), 2, "--size");
+    if (wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1])) throw cli::UsageError("--size needs whole pixels");
+    p.width_px = static_cast<int>(wh[0]);
+    p.height_px = static_cast<int>(wh[1]);
+  }
+  if (const auto k = args.get("intrinsics")) {
+    const auto v = config::parse_number_list(*k, 4, "--intrinsics");
+    p.fx_px = v[0], p.fy_px = v[1], p.cx_px = v[2], p.cy_px = v[3];
+  }
+  p.near_m = args.get_double("near", p.near_m);
+  p.far_m = args.get_double("far", p.far_m);
+  config::validate_projector(p, "projector (after command-line overrides)");
+
+  if (const auto m = args.get("pose-matrix")) {
+    if (scene.targets.size() != 1)
+      throw cli::UsageError("--pose-matrix sets the pose of a single target, but the scene has " +
+                            std::to_string(scene.targets.size()));
+    const auto v = config::parse_number_list(*m, 16, "--pose-matrix");
+    Eigen::Matrix4d T;
+    for (int i = 0; i < 16; ++i) T(i / 4, i % 4) = v[static_cast<std::size_t>(i)];
+    config::validate_rigid(T, "--pose-matrix");
+    scene.targets[0].T_projector_target = T;
+  }
+  if (frame_model) {
+    // Framing needs the model's size: load it once here (upload_scene loads it again, cheaply).
+    auto model = assets::load_gltf(scene.targets[0].model);
+    assets::scale_and_recenter(model, 1.0, true);
+    const double radius = 0.5 * model.bounds().diagonal().norm();
+    scene.targets[0].T_projector_target = framing_pose(p, radius);
+  }
+  return scene;
+}
+
+std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene) {
+  std::vector<engine::DrawItem> items;
+  for (const auto& target : scene.targets) {
+    auto model = assets::load_gltf(target.model);
+    assets::scale_and_recenter(model, target.scale, target.recenter);
+    items.push_back({renderer.add_model(model), target.T_projector_target});
+  }
+  return items;
+}
+
+}  // namespace projbot::tools

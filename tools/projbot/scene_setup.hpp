@@ -1,0 +1,31 @@
+#pragma once
+// From a command line to a scene on the GPU: the scene file (or the built-in demo), the overrides the
+// render-type subcommands share, and the upload of every target's model.
+
+#include <filesystem>
+#include <vector>
+
+#include "cli.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/engine/renderer.hpp"
+
+namespace projbot::tools {
+
+/// Options every subcommand that draws a scene accepts.
+std::vector<cli::OptionSpec> scene_options();
+
+/// The folder holding the shipped demo assets (PROJBOT_ASSETS overrides the built-in path).
+std::filesystem::path asset_dir();
+
+/// Loads --scene (or the demo scene) and applies --model, --size, --intrinsics, --near, --far and
+/// --pose-matrix. Throws config::ConfigError or cli::UsageError.
+config::Scene scene_from_args(const cli::Args& args);
+
+/// A pose that frames a model of bounding radius r in the projector's view: model +y up in the image,
+/// model front (+z) towards the projector.
+Eigen::Matrix4d framing_pose(const config::ProjectorConfig& projector, double radius_m);
+
+/// Loads, scales and recentres each target's model and uploads it; returns one DrawItem per target.
+std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene);
+
+}  // namespace projbot::tools
