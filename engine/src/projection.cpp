@@ -21,4 +21,11 @@ Eigen::Vector2d project_to_pixel(const config::ProjectorConfig& p, const Eigen::
   return {p.fx_px * x.x() / x.z() + p.cx_px, p.fy_px * x.y() / x.z() + p.cy_px};
 }
 
+std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m) {
+  std::array<float, 16> out{};
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) out[static_cast<std::size_t>(c * 4 + r)] = static_cast<float>(m(r, c));  // GLSL: column-major
+  return out;
+}
+
 }  // namespace projbot::engine

@@ -60,13 +60,6 @@ struct GpuModel {
 
 }  // namespace
 
-std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m) {
-  std::array<float, 16> out{};
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r) out[static_cast<std::size_t>(c * 4 + r)] = static_cast<float>(m(r, c));  // GLSL: column-major
-  return out;
-}
-
 struct Renderer::Impl {
   std::shared_ptr<Gpu> gpu;
   vk::raii::DescriptorSetLayout set_layout{nullptr};
@@ -240,7 +233,6 @@ struct Renderer::Impl {
     // Opaque and masked first, blended after them so they blend over what is behind.
     for (const bool blend_pass : {false, true})
       for (const DrawItem& item : items) {
-        if (item.model >= models.size()) throw EngineError("draw item refers to model " + std::to_string(item.model) + ", not uploaded");
         const GpuModel& m = models[item.model];
         const vk::Buffer vb = *m.vertices.buffer;
         cmd.bindVertexBuffers(0, vb, vk::DeviceSize(0));
@@ -276,6 +268,11 @@ struct Renderer::Impl {
     items.clear();
     read_poses(items);
     if (profiler) rec.pose_read_ms = profiler->now_ms();
+    // Checked before the fence is reset: a throw past that point would leave the slot unsignalled forever.
+    for (const DrawItem& item : items)
+      if (item.model >= models.size())
+        throw EngineError("draw item refers to model " + std::to_string(item.model) + ", but " + std::to_string(models.size()) +
+                          " are uploaded");
 
     gpu->device.resetFences(*slot.fence);
     const vk::raii::CommandBuffer& cmd = slot.cmd;

@@ -49,10 +49,9 @@ class OffscreenBackend final : public TargetBackend {
   const Image& depth() const override { return depth_; }
 
   std::optional<FrameImage> acquire(vk::Semaphore /*acquired*/) override {
-    drawn_ = true;
     return FrameImage{*color_.image, *color_.view, vk::ImageLayout::eTransferSrcOptimal, nullptr, nullptr, 0};
   }
-  void present(const FrameImage& /*frame*/) override {}
+  void present(const FrameImage& /*frame*/) override { drawn_ = true; }  // a frame was submitted
 
   assets::Image read_back() override {
     if (!drawn_) throw EngineError("read_back: nothing has been drawn into this target yet");

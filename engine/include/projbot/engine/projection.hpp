@@ -2,6 +2,7 @@
 // Eq. 3 of the paper, x = A_p (R_p X_m + X_p), as the projector pass computes it, and its CPU twin.
 
 #include <Eigen/Core>
+#include <array>
 
 #include "projbot/config/scene.hpp"
 
@@ -15,5 +16,8 @@ Eigen::Matrix4d clip_from_projector(const config::ProjectorConfig& projector);
 
 /// CPU reference of Eq. 3: pixel coordinates (u, v) of a projector-frame point (Z > 0).
 Eigen::Vector2d project_to_pixel(const config::ProjectorConfig& projector, const Eigen::Vector3d& p_projector);
+
+/// Converts a host transform to the column-major float matrix the GPU gets (the one Eigen -> GPU conversion).
+std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m);
 
 }  // namespace projbot::engine

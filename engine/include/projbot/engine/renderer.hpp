@@ -127,7 +127,4 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Converts a host transform to the float matrix the GPU gets (the one Eigen -> GPU conversion).
-std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m);
-
 }  // namespace projbot::engine

@@ -1,0 +1,137 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "projbot/config/scene.hpp"
+
+using projbot::config::ConfigError;
+using projbot::config::parse_scene;
+
+namespace {
+
+const char* kGood = R"(projector: {width: 640, height: 480, fx: 500, fy: 520, cx: 300.5, cy: 250, near: 0.2, far: 5}
+targets:
+  - name: a
+    model: models/a.glb
+    scale: 0.5
+    recenter: true
+    pose: {translation: [0.1, -0.2, 1.5], rpy_deg: [10, 20, 30]}
+  - name: b
+    model: /abs/b.gltf
+    pose: {matrix: [1,0,0,0.5, 0,1,0,0, 0,0,1,2, 0,0,0,1]}
+)";
+
+// The error message for `text`, or "" if it parsed.
+std::string error_of(const std::string& text) {
+  try {
+    parse_scene(text, "/scenes/s.yaml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(SceneTest, ParsesEveryField) {
+  const auto s = parse_scene(kGood, "/scenes/s.yaml");
+  EXPECT_EQ(s.projector.width_px, 640);
+  EXPECT_EQ(s.projector.height_px, 480);
+  EXPECT_DOUBLE_EQ(s.projector.fx_px, 500);
+  EXPECT_DOUBLE_EQ(s.projector.fy_px, 520);
+  EXPECT_DOUBLE_EQ(s.projector.cx_px, 300.5);
+  EXPECT_DOUBLE_EQ(s.projector.near_m, 0.2);
+  EXPECT_DOUBLE_EQ(s.projector.far_m, 5);
+  ASSERT_EQ(s.targets.size(), 2U);
+  EXPECT_EQ(s.targets[0].model, std::filesystem::path("/scenes/models/a.glb"));  // relative to the scene's folder
+  EXPECT_EQ(s.targets[1].model, std::filesystem::path("/abs/b.gltf"));
+  EXPECT_DOUBLE_EQ(s.targets[0].scale, 0.5);
+  EXPECT_TRUE(s.targets[0].recenter);
+  EXPECT_FALSE(s.targets[1].recenter);
+  EXPECT_NEAR(s.targets[1].T_projector_target(0, 3), 0.5, 1e-12);
+  EXPECT_NEAR(s.targets[1].T_projector_target(2, 3), 2.0, 1e-12);
+}
+
+TEST(SceneTest, RpyIsRzRyRx) {
+  const auto s = parse_scene(kGood, "/scenes/s.yaml");
+  const double d = M_PI / 180.0;
+  const Eigen::Matrix3d expected = (Eigen::AngleAxisd(30 * d, Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(20 * d, Eigen::Vector3d::UnitY()) *
+                                    Eigen::AngleAxisd(10 * d, Eigen::Vector3d::UnitX()))
+                                       .toRotationMatrix();
+  const Eigen::Matrix4d& T = s.targets[0].T_projector_target;
+  EXPECT_LT((T.topLeftCorner<3, 3>() - expected).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((T.topRightCorner<3, 1>() - Eigen::Vector3d(0.1, -0.2, 1.5)).norm(), 1e-12);
+  // A hand-computed case: yaw 90 turns x into y.
+  const Eigen::Matrix4d Y = projbot::config::pose_from_xyz_rpy({0, 0, 0}, {0, 0, 90});
+  EXPECT_LT((Y.topLeftCorner<3, 3>() * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm(), 1e-12);
+}
+
+struct BadCase {
+  const char* name;
+  std::string yaml;
+  std::vector<std::string> must_contain;
+};
+
+class BadSceneTest : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadSceneTest, IsRejectedWithFileLineAndKey) {
+  const std::string msg = error_of(GetParam().yaml);
+  ASSERT_FALSE(msg.empty()) << "accepted: " << GetParam().yaml;
+  for (const auto& part : GetParam().must_contain) EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
+}
+
+const std::string kProj = "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240}\n";
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadSceneTest,
+    ::testing::Values(
+        BadCase{"unknown_top_key", kProj + "targets: []\nprojecter: 3\n", {"s.yaml:3:", "projecter", "unknown key"}},
+        BadCase{"unknown_projector_key", "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240, fz: 1}\ntargets: []\n",
+                {"s.yaml:1:", "projector.fz", "unknown key"}},
+        BadCase{"missing_fx", "projector: {width: 640, height: 480, fy: 500, cx: 320, cy: 240}\ntargets: []\n", {"projector.fx", "missing"}},
+        BadCase{"fx_zero", "projector: {width: 640, height: 480, fx: 0, fy: 500, cx: 320, cy: 240}\ntargets: []\n", {"s.yaml:1:", "fx and fy"}},
+        BadCase{"width_zero", "projector: {width: 0, height: 480, fx: 5, fy: 500, cx: 320, cy: 240}\ntargets: []\n", {"size 0x480"}},
+        BadCase{"near_ge_far", "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, near: 2, far: 1}\ntargets: []\n", {"near < far"}},
+        BadCase{"wrong_type", "projector: {width: wide, height: 480, fx: 5, fy: 500, cx: 320, cy: 240}\ntargets: []\n",
+                {"projector.width", "integer", "wide"}},
+        BadCase{"missing_targets", kProj, {"targets", "missing"}},
+        BadCase{"targets_not_list", kProj + "targets: {a: 1}\n", {"s.yaml:2:", "targets", "list"}},
+        BadCase{"target_missing_model", kProj + "targets:\n  - name: a\n", {"s.yaml:3:", "targets[0].model", "missing"}},
+        BadCase{"target_unknown_key", kProj + "targets:\n  - name: a\n    model: a.glb\n    colour: red\n", {"s.yaml:5:", "targets[0].colour"}},
+        BadCase{"duplicate_name", kProj + "targets:\n  - {name: a, model: a.glb}\n  - {name: a, model: b.glb}\n", {"targets[1].name", "duplicate"}},
+        BadCase{"negative_scale", kProj + "targets:\n  - {name: a, model: a.glb, scale: -1}\n", {"targets[0].scale", "> 0"}},
+        BadCase{"matrix_15", kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0]}}\n",
+                {"s.yaml:3:", "targets[0].pose.matrix", "16 numbers"}},
+        BadCase{"matrix_scaled", kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [2,0,0,0, 0,2,0,0, 0,0,2,0, 0,0,0,1]}}\n",
+                {"targets[0].pose", "proper rotation"}},
+        BadCase{"matrix_nan", kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [.nan,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}}\n",
+                {"targets[0].pose.matrix", "finite"}},
+        BadCase{"both_pose_forms", kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], translation: [0,0,1]}}\n",
+                {"either"}},
+        BadCase{"translation_2", kProj + "targets:\n  - {name: a, model: a.glb, pose: {translation: [0, 1]}}\n", {"pose.translation", "3 numbers"}},
+        BadCase{"yaml_syntax", "projector: {width: 640\ntargets: [\n", {"s.yaml:", "YAML syntax error"}},
+        BadCase{"empty", "", {"s.yaml", "empty"}},
+        BadCase{"root_not_map", "- 1\n- 2\n", {"s.yaml:1:", "mapping"}}),
+    [](const ::testing::TestParamInfo<BadCase>& param_info) { return std::string(param_info.param.name); });
+
+TEST(SceneTest, MissingFileIsNamed) {
+  try {
+    projbot::config::load_scene("/nonexistent/scene.yaml");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.yaml"), std::string::npos);
+  }
+}
+
+TEST(NumberListTest, ParsesAndRejects) {
+  const auto v = projbot::config::parse_number_list(" 1, -2.5,3e2", 3, "--x");
+  ASSERT_EQ(v.size(), 3U);
+  EXPECT_DOUBLE_EQ(v[1], -2.5);
+  EXPECT_DOUBLE_EQ(v[2], 300.0);
+  EXPECT_THROW(projbot::config::parse_number_list("1,2", 3, "--x"), ConfigError);
+  EXPECT_THROW(projbot::config::parse_number_list("1,two,3", 3, "--x"), ConfigError);
+  EXPECT_THROW(projbot::config::parse_number_list("1,nan,3", 3, "--x"), ConfigError);
+  EXPECT_THROW(projbot::config::parse_number_list("", 1, "--x"), ConfigError);
+}

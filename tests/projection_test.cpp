@@ -1,0 +1,62 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "projbot/engine/projection.hpp"
+
+using projbot::config::ProjectorConfig;
+using projbot::engine::clip_from_projector;
+
+namespace {
+
+// Framebuffer coordinate of a projector-frame point after clip, divide and the viewport (Vulkan rules).
+Eigen::Vector3d to_framebuffer(const ProjectorConfig& p, const Eigen::Vector3d& x) {
+  const Eigen::Vector4d clip = clip_from_projector(p) * x.homogeneous();
+  const Eigen::Vector3d ndc = clip.head<3>() / clip.w();
+  return {(ndc.x() + 1.0) * 0.5 * p.width_px, (ndc.y() + 1.0) * 0.5 * p.height_px, ndc.z()};
+}
+
+}  // namespace
+
+TEST(ProjectionTest, PixelCentreConventionWithOffCentrePrincipalPoint) {
+  ProjectorConfig p;
+  p.width_px = 800;
+  p.height_px = 600;
+  p.fx_px = 900;
+  p.fy_px = 700;  // non-square pixels
+  p.cx_px = 350.25;
+  p.cy_px = 280.75;
+  p.near_m = 0.2;
+  p.far_m = 8.0;
+  for (const Eigen::Vector3d& x : {Eigen::Vector3d(0.1, -0.2, 1.3), Eigen::Vector3d(-0.4, 0.3, 2.7), Eigen::Vector3d(0, 0, 5)}) {
+    const Eigen::Vector2d uv = projbot::engine::project_to_pixel(p, x);
+    EXPECT_NEAR(uv.x(), 900 * x.x() / x.z() + 350.25, 1e-9);
+    EXPECT_NEAR(uv.y(), 700 * x.y() / x.z() + 280.75, 1e-9);
+    // Pixel (i, j) has its centre at u = i: framebuffer coordinate i + 0.5.
+    const Eigen::Vector3d fb = to_framebuffer(p, x);
+    EXPECT_NEAR(fb.x(), uv.x() + 0.5, 1e-9);
+    EXPECT_NEAR(fb.y(), uv.y() + 0.5, 1e-9);
+  }
+  // The principal point lands on the pixel centre (cx, cy).
+  const Eigen::Vector3d centre = to_framebuffer(p, {0, 0, 1});
+  EXPECT_NEAR(centre.x(), 350.75, 1e-9);
+  EXPECT_NEAR(centre.y(), 281.25, 1e-9);
+}
+
+TEST(ProjectionTest, DepthRangeNearToFar) {
+  ProjectorConfig p;
+  p.near_m = 0.5;
+  p.far_m = 4.0;
+  EXPECT_NEAR(to_framebuffer(p, {0, 0, 0.5}).z(), 0.0, 1e-12);
+  EXPECT_NEAR(to_framebuffer(p, {0, 0, 4.0}).z(), 1.0, 1e-12);
+  EXPECT_LT(to_framebuffer(p, {0, 0, 1.0}).z(), to_framebuffer(p, {0, 0, 2.0}).z());  // nearer is smaller
+}
+
+TEST(ProjectionTest, GpuMatrixIsColumnMajor) {
+  Eigen::Matrix4d m;
+  for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = i;
+  const auto g = projbot::engine::to_gpu_matrix(m);
+  EXPECT_FLOAT_EQ(g[1], 4.0F);   // column 0, row 1
+  EXPECT_FLOAT_EQ(g[4], 1.0F);   // column 1, row 0
+  EXPECT_FLOAT_EQ(g[15], 15.0F);
+}
