@@ -23,8 +23,8 @@ Eigen::Vector3d position(const projbot::assets::Vertex& v) { return {v.position[
 class CorruptBox : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("projbot_box_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() /
+           ("projbot_box_" + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     fs::copy(kData / "BoxTextured" / "glTF", dir_, fs::copy_options::recursive);
@@ -118,7 +118,8 @@ TEST(GltfTest, WindingAgreesWithNormalsAfterNodeTransform) {
     for (const auto& p : m.primitives)
       for (std::size_t t = 0; t < p.indices.size(); t += 3) {
         const auto& a = p.vertices[p.indices[t]];
-        const Eigen::Vector3d n = (position(p.vertices[p.indices[t + 1]]) - position(a)).cross(position(p.vertices[p.indices[t + 2]]) - position(a));
+        const Eigen::Vector3d n =
+            (position(p.vertices[p.indices[t + 1]]) - position(a)).cross(position(p.vertices[p.indices[t + 2]]) - position(a));
         const Eigen::Vector3d vn(a.normal[0], a.normal[1], a.normal[2]);
         agree += n.dot(vn) > 0 ? 1 : 0;
         ++total;
@@ -154,7 +155,7 @@ TEST(SamplingTest, PointsLieOnTheSurfaceUniformlyByArea) {
   for (std::size_t i = 0; i < s.points.size(); ++i) {
     const Eigen::Vector3f& p = s.points[i];
     const Eigen::Vector3f& n = s.normals[i];
-    ASSERT_NEAR(p.cwiseAbs().maxCoeff(), 0.5F, 1e-5F);   // on the cube's surface
+    ASSERT_NEAR(p.cwiseAbs().maxCoeff(), 0.5F, 1e-5F);  // on the cube's surface
     ASSERT_NEAR(n.norm(), 1.0F, 1e-5F);
     int axis = 0;
     n.cwiseAbs().maxCoeff(&axis);
@@ -179,7 +180,8 @@ TEST_F(CorruptBox, ComputesMissingNormals) {
   const Model m = load_gltf(gltf());
   for (std::size_t i = 0; i < 24; ++i)
     for (int k = 0; k < 3; ++k)
-      EXPECT_NEAR(m.primitives[0].vertices[i].normal[static_cast<std::size_t>(k)], original.primitives[0].vertices[i].normal[static_cast<std::size_t>(k)], 1e-5);
+      EXPECT_NEAR(m.primitives[0].vertices[i].normal[static_cast<std::size_t>(k)],
+                  original.primitives[0].vertices[i].normal[static_cast<std::size_t>(k)], 1e-5);
 }
 
 TEST_F(CorruptBox, SceneWithoutScenesUsesRootNodes) {
@@ -189,7 +191,14 @@ TEST_F(CorruptBox, SceneWithoutScenesUsesRootNodes) {
   EXPECT_EQ(load_gltf(gltf()).triangle_count(), 12U);
 }
 
-TEST_F(CorruptBox, MissingFile) { expect_contains([&] { fs::remove(gltf()); return error(); }(), "no such model file"); }
+TEST_F(CorruptBox, MissingFile) {
+  expect_contains(
+      [&] {
+        fs::remove(gltf());
+        return error();
+      }(),
+      "no such model file");
+}
 
 TEST_F(CorruptBox, MalformedJson) {
   std::ofstream(gltf()) << json_.dump().substr(0, 200);

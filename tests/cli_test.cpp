@@ -1,11 +1,11 @@
 // The projbot executable as a user meets it: exit codes and the one line it prints on bad input.
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
 #include <fstream>
-#include <sys/wait.h>
 
 #include "projbot/assets/image.hpp"
 
@@ -73,7 +73,7 @@ TEST_F(CliTest, OverridesAndProfile) {
   const fs::path out = dir_ / "duck.png";
   const fs::path csv = dir_ / "p.csv";
   const CliRun r = run_projbot("render --model " + kDuck + " --size 320x240 --intrinsics 300,280,150,130 --out " + out.string() +
-                        " --frames 4 --profile " + csv.string());
+                               " --frames 4 --profile " + csv.string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(projbot::assets::read_image(out).width, 320);
   std::ifstream in(csv);
@@ -82,7 +82,7 @@ TEST_F(CliTest, OverridesAndProfile) {
   EXPECT_EQ(lines, 5);  // header + 4 frames
   // --pose-matrix puts the single target exactly where asked: behind the projector, nothing shows.
   const CliRun behind = run_projbot("render --model " + kDuck + " --size 64x48 --out " + out.string() +
-                             " --pose-matrix 1,0,0,0,0,1,0,0,0,0,1,-3,0,0,0,1");
+                                    " --pose-matrix 1,0,0,0,0,1,0,0,0,0,1,-3,0,0,0,1");
   ASSERT_EQ(behind.code, 0) << behind.output;
   const auto img = projbot::assets::read_image(out);
   for (std::size_t i = 0; i < img.rgba.size(); i += 4) ASSERT_EQ(img.rgba[i], 0);
@@ -90,8 +90,8 @@ TEST_F(CliTest, OverridesAndProfile) {
 
 struct BadRun {
   const char* name;
-  std::string args;       // {dir} is replaced by the scratch folder
-  std::string scene;      // written to {dir}/bad.yaml when not empty
+  std::string args;   // {dir} is replaced by the scratch folder
+  std::string scene;  // written to {dir}/bad.yaml when not empty
   int code;
   std::vector<std::string> must_contain;
 };
@@ -105,7 +105,8 @@ TEST_P(CliBadInputTest, FailsWithOneClearLine) {
   for (std::size_t at; (at = args.find("{dir}")) != std::string::npos;) args.replace(at, 5, dir_.string());
   const CliRun r = run_projbot(args);
   EXPECT_EQ(r.code, b.code) << r.output;
-  for (const auto& part : b.must_contain) EXPECT_NE(r.output.find(part), std::string::npos) << "'" << part << "' not in: " << r.output;
+  for (const auto& part : b.must_contain)
+    EXPECT_NE(r.output.find(part), std::string::npos) << "'" << part << "' not in: " << r.output;
   EXPECT_EQ(r.output.find("terminate called"), std::string::npos);
 }
 
@@ -114,8 +115,7 @@ const std::string kProj = "projector: {width: 64, height: 48, fx: 50, fy: 50, cx
 INSTANTIATE_TEST_SUITE_P(
     Cases, CliBadInputTest,
     ::testing::Values(
-        BadRun{"no_command", "", "", 2, {"Usage"}},
-        BadRun{"unknown_command", "paint", "", 2, {"unknown command 'paint'"}},
+        BadRun{"no_command", "", "", 2, {"Usage"}}, BadRun{"unknown_command", "paint", "", 2, {"unknown command 'paint'"}},
         BadRun{"unknown_flag", "render --out x.png --colour red", "", 2, {"unknown option --colour", "render --help"}},
         BadRun{"missing_out", "render", "", 2, {"--out FILE is required"}},
         BadRun{"missing_value", "render --out", "", 2, {"--out needs a value"}},
@@ -124,17 +124,36 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"bad_intrinsics", "render --out {dir}/a.png --intrinsics 1,2,3", "", 1, {"--intrinsics", "4"}},
         BadRun{"negative_fx", "render --out {dir}/a.png --intrinsics -1,2,3,4", "", 1, {"fx and fy"}},
         BadRun{"near_far", "render --out {dir}/a.png --near 5 --far 1", "", 1, {"near < far"}},
-        BadRun{"pose_not_rigid", "render --out {dir}/a.png --model " + kDuck + " --pose-matrix 2,0,0,0,0,2,0,0,0,0,2,1,0,0,0,1", "", 1,
+        BadRun{"pose_not_rigid",
+               "render --out {dir}/a.png --model " + kDuck + " --pose-matrix 2,0,0,0,0,2,0,0,0,0,2,1,0,0,0,1",
+               "",
+               1,
                {"--pose-matrix", "rotation"}},
-        BadRun{"pose_with_two_targets", "render --out {dir}/a.png --pose-matrix 1,0,0,0,0,1,0,0,0,0,1,1,0,0,0,1", "", 2,
+        BadRun{"pose_with_two_targets",
+               "render --out {dir}/a.png --pose-matrix 1,0,0,0,0,1,0,0,0,0,1,1,0,0,0,1",
+               "",
+               2,
                {"single target", "2"}},
         BadRun{"missing_scene", "render --out {dir}/a.png --scene {dir}/none.yaml", "", 1, {"none.yaml", "cannot open"}},
-        BadRun{"scene_unknown_key", "render --out {dir}/a.png --scene {dir}/bad.yaml", kProj + "targets: []\nextra: 1\n", 1,
+        BadRun{"scene_unknown_key",
+               "render --out {dir}/a.png --scene {dir}/bad.yaml",
+               kProj + "targets: []\nextra: 1\n",
+               1,
                {"bad.yaml:3:", "extra", "unknown key"}},
-        BadRun{"scene_missing_model", "render --out {dir}/a.png --scene {dir}/bad.yaml",
-               kProj + "targets:\n  - {name: a, model: nothere.glb}\n", 1, {"nothere.glb", "no such model file"}},
-        BadRun{"scene_bad_model", "render --out {dir}/a.png --scene {dir}/bad.yaml", kProj + "targets:\n  - {name: a, model: bad.yaml}\n", 1,
+        BadRun{"scene_missing_model",
+               "render --out {dir}/a.png --scene {dir}/bad.yaml",
+               kProj + "targets:\n  - {name: a, model: nothere.glb}\n",
+               1,
+               {"nothere.glb", "no such model file"}},
+        BadRun{"scene_bad_model",
+               "render --out {dir}/a.png --scene {dir}/bad.yaml",
+               kProj + "targets:\n  - {name: a, model: bad.yaml}\n",
+               1,
                {"bad.yaml"}},
-        BadRun{"unwritable_png", "render --out /nonexistent-dir/a.png --size 64x48", "", 1, {"/nonexistent-dir/a.png", "cannot write"}},
+        BadRun{"unwritable_png",
+               "render --out /nonexistent-dir/a.png --size 64x48",
+               "",
+               1,
+               {"/nonexistent-dir/a.png", "cannot write"}},
         BadRun{"bench_without_target", "bench", "", 2, {"bench render"}}),
     [](const ::testing::TestParamInfo<BadRun>& param_info) { return std::string(param_info.param.name); });

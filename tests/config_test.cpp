@@ -56,10 +56,10 @@ TEST(SceneTest, ParsesEveryField) {
 TEST(SceneTest, RpyIsRzRyRx) {
   const auto s = parse_scene(kGood, "/scenes/s.yaml");
   const double d = M_PI / 180.0;
-  const Eigen::Matrix3d expected = (Eigen::AngleAxisd(30 * d, Eigen::Vector3d::UnitZ()) *
-                                    Eigen::AngleAxisd(20 * d, Eigen::Vector3d::UnitY()) *
-                                    Eigen::AngleAxisd(10 * d, Eigen::Vector3d::UnitX()))
-                                       .toRotationMatrix();
+  const Eigen::Matrix3d expected =
+      (Eigen::AngleAxisd(30 * d, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(20 * d, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(10 * d, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   const Eigen::Matrix4d& T = s.targets[0].T_projector_target;
   EXPECT_LT((T.topLeftCorner<3, 3>() - expected).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_LT((T.topRightCorner<3, 1>() - Eigen::Vector3d(0.1, -0.2, 1.5)).norm(), 1e-12);
@@ -79,7 +79,8 @@ class BadSceneTest : public ::testing::TestWithParam<BadCase> {};
 TEST_P(BadSceneTest, IsRejectedWithFileLineAndKey) {
   const std::string msg = error_of(GetParam().yaml);
   ASSERT_FALSE(msg.empty()) << "accepted: " << GetParam().yaml;
-  for (const auto& part : GetParam().must_contain) EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
+  for (const auto& part : GetParam().must_contain)
+    EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
 }
 
 const std::string kProj = "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240}\n";
@@ -88,32 +89,51 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, BadSceneTest,
     ::testing::Values(
         BadCase{"unknown_top_key", kProj + "targets: []\nprojecter: 3\n", {"s.yaml:3:", "projecter", "unknown key"}},
-        BadCase{"unknown_projector_key", "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240, fz: 1}\ntargets: []\n",
+        BadCase{"unknown_projector_key",
+                "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240, fz: 1}\ntargets: []\n",
                 {"s.yaml:1:", "projector.fz", "unknown key"}},
-        BadCase{"missing_fx", "projector: {width: 640, height: 480, fy: 500, cx: 320, cy: 240}\ntargets: []\n", {"projector.fx", "missing"}},
-        BadCase{"fx_zero", "projector: {width: 640, height: 480, fx: 0, fy: 500, cx: 320, cy: 240}\ntargets: []\n", {"s.yaml:1:", "fx and fy"}},
-        BadCase{"width_zero", "projector: {width: 0, height: 480, fx: 5, fy: 500, cx: 320, cy: 240}\ntargets: []\n", {"size 0x480"}},
-        BadCase{"near_ge_far", "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, near: 2, far: 1}\ntargets: []\n", {"near < far"}},
-        BadCase{"wrong_type", "projector: {width: wide, height: 480, fx: 5, fy: 500, cx: 320, cy: 240}\ntargets: []\n",
+        BadCase{"missing_fx",
+                "projector: {width: 640, height: 480, fy: 500, cx: 320, cy: 240}\ntargets: []\n",
+                {"projector.fx", "missing"}},
+        BadCase{"fx_zero",
+                "projector: {width: 640, height: 480, fx: 0, fy: 500, cx: 320, cy: 240}\ntargets: []\n",
+                {"s.yaml:1:", "fx and fy"}},
+        BadCase{
+            "width_zero", "projector: {width: 0, height: 480, fx: 5, fy: 500, cx: 320, cy: 240}\ntargets: []\n", {"size 0x480"}},
+        BadCase{"near_ge_far",
+                "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, near: 2, far: 1}\ntargets: []\n",
+                {"near < far"}},
+        BadCase{"wrong_type",
+                "projector: {width: wide, height: 480, fx: 5, fy: 500, cx: 320, cy: 240}\ntargets: []\n",
                 {"projector.width", "integer", "wide"}},
         BadCase{"missing_targets", kProj, {"targets", "missing"}},
         BadCase{"targets_not_list", kProj + "targets: {a: 1}\n", {"s.yaml:2:", "targets", "list"}},
         BadCase{"target_missing_model", kProj + "targets:\n  - name: a\n", {"s.yaml:3:", "targets[0].model", "missing"}},
-        BadCase{"target_unknown_key", kProj + "targets:\n  - name: a\n    model: a.glb\n    colour: red\n", {"s.yaml:5:", "targets[0].colour"}},
-        BadCase{"duplicate_name", kProj + "targets:\n  - {name: a, model: a.glb}\n  - {name: a, model: b.glb}\n", {"targets[1].name", "duplicate"}},
+        BadCase{"target_unknown_key",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    colour: red\n",
+                {"s.yaml:5:", "targets[0].colour"}},
+        BadCase{"duplicate_name",
+                kProj + "targets:\n  - {name: a, model: a.glb}\n  - {name: a, model: b.glb}\n",
+                {"targets[1].name", "duplicate"}},
         BadCase{"negative_scale", kProj + "targets:\n  - {name: a, model: a.glb, scale: -1}\n", {"targets[0].scale", "> 0"}},
-        BadCase{"matrix_15", kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0]}}\n",
+        BadCase{"matrix_15",
+                kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0]}}\n",
                 {"s.yaml:3:", "targets[0].pose.matrix", "16 numbers"}},
-        BadCase{"matrix_scaled", kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [2,0,0,0, 0,2,0,0, 0,0,2,0, 0,0,0,1]}}\n",
+        BadCase{"matrix_scaled",
+                kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [2,0,0,0, 0,2,0,0, 0,0,2,0, 0,0,0,1]}}\n",
                 {"targets[0].pose", "proper rotation"}},
-        BadCase{"matrix_nan", kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [.nan,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}}\n",
+        BadCase{"matrix_nan",
+                kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [.nan,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}}\n",
                 {"targets[0].pose.matrix", "finite"}},
-        BadCase{"both_pose_forms", kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], translation: [0,0,1]}}\n",
+        BadCase{"both_pose_forms",
+                kProj + "targets:\n  - {name: a, model: a.glb, pose: {matrix: [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], translation: "
+                        "[0,0,1]}}\n",
                 {"either"}},
-        BadCase{"translation_2", kProj + "targets:\n  - {name: a, model: a.glb, pose: {translation: [0, 1]}}\n", {"pose.translation", "3 numbers"}},
+        BadCase{"translation_2",
+                kProj + "targets:\n  - {name: a, model: a.glb, pose: {translation: [0, 1]}}\n",
+                {"pose.translation", "3 numbers"}},
         BadCase{"yaml_syntax", "projector: {width: 640\ntargets: [\n", {"s.yaml:", "YAML syntax error"}},
-        BadCase{"empty", "", {"s.yaml", "empty"}},
-        BadCase{"root_not_map", "- 1\n- 2\n", {"s.yaml:1:", "mapping"}}),
+        BadCase{"empty", "", {"s.yaml", "empty"}}, BadCase{"root_not_map", "- 1\n- 2\n", {"s.yaml:1:", "mapping"}}),
     [](const ::testing::TestParamInfo<BadCase>& param_info) { return std::string(param_info.param.name); });
 
 TEST(SceneTest, MissingFileIsNamed) {

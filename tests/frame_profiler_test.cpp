@@ -1,9 +1,9 @@
+#include "projbot/engine/frame_profiler.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
-
-#include "projbot/engine/frame_profiler.hpp"
 
 using projbot::engine::FrameProfiler;
 using projbot::engine::FrameRecord;

@@ -1,8 +1,8 @@
+#include "projbot/engine/projection.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
-#include "projbot/engine/projection.hpp"
 
 using projbot::config::ProjectorConfig;
 using projbot::engine::clip_from_projector;
@@ -56,7 +56,7 @@ TEST(ProjectionTest, GpuMatrixIsColumnMajor) {
   Eigen::Matrix4d m;
   for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = i;
   const auto g = projbot::engine::to_gpu_matrix(m);
-  EXPECT_FLOAT_EQ(g[1], 4.0F);   // column 0, row 1
-  EXPECT_FLOAT_EQ(g[4], 1.0F);   // column 1, row 0
+  EXPECT_FLOAT_EQ(g[1], 4.0F);  // column 0, row 1
+  EXPECT_FLOAT_EQ(g[4], 1.0F);  // column 1, row 0
   EXPECT_FLOAT_EQ(g[15], 15.0F);
 }

@@ -83,7 +83,8 @@ std::vector<bool> cpu_silhouette(const Model& m, const Eigen::Matrix4d& T, const
     for (std::size_t t = 0; t < prim.indices.size(); t += 3) {
       Eigen::Vector2d q[3];
       for (int k = 0; k < 3; ++k)
-        q[k] = projbot::engine::project_to_pixel(p, (T * pos(prim.vertices[prim.indices[t + static_cast<std::size_t>(k)]]).homogeneous()).head<3>());
+        q[k] = projbot::engine::project_to_pixel(
+            p, (T * pos(prim.vertices[prim.indices[t + static_cast<std::size_t>(k)]]).homogeneous()).head<3>());
       const double area = (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
       if (std::abs(area) < 1e-12) continue;
       const int x0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}))));
@@ -198,11 +199,12 @@ TEST_F(RenderTest, ProjectedVertexPositionsWithinHalfPixel) {
       if (std::any_of(centres.begin(), centres.end(), [&](const Eigen::Vector2d& o) { return (o - uv).norm() < 40; })) continue;
       centres.push_back(uv);
       const std::size_t k = tris.size();
-      const double r = 14.0 * c.z() / p.fx_px;                                     // about 14 px radius
+      const double r = 14.0 * c.z() / p.fx_px;  // about 14 px radius
       std::array<Eigen::Vector3d, 3> tri;
       for (int i = 0; i < 3; ++i) {
         const double a = 2.0 * M_PI * i / 3.0 + 0.3 * static_cast<double>(k);
-        tri[static_cast<std::size_t>(i)] = (T_inv * (c + r * Eigen::Vector3d(std::cos(a), std::sin(a), 0)).homogeneous()).head<3>();
+        tri[static_cast<std::size_t>(i)] =
+            (T_inv * (c + r * Eigen::Vector3d(std::cos(a), std::sin(a), 0)).homogeneous()).head<3>();
       }
       tris.push_back(tri);
       colors.push_back({static_cast<float>(k + 1) / 255.0F, 1.0F, 0.0F, 1.0F});
@@ -264,7 +266,8 @@ TEST_F(RenderTest, TextureColourLandsWhereCpuPredicts) {
     // Stay 3 px inside the triangle so the pixel centre belongs to this face.
     Eigen::Vector2d q[3];
     for (int k = 0; k < 3; ++k)
-      q[k] = projbot::engine::project_to_pixel(p, (T * pos(prim.vertices[prim.indices[t + static_cast<std::size_t>(k)]]).homogeneous()).head<3>());
+      q[k] = projbot::engine::project_to_pixel(
+          p, (T * pos(prim.vertices[prim.indices[t + static_cast<std::size_t>(k)]]).homogeneous()).head<3>());
     bool inside = true;
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector2d e = q[(k + 1) % 3] - q[k];
@@ -287,14 +290,16 @@ TEST_F(RenderTest, TextureColourLandsWhereCpuPredicts) {
     for (int k = 0; k < 3; ++k) same = same && std::abs(int(want[k]) - int(got[k])) <= 2;
     matched += same ? 1 : 0;
     EXPECT_TRUE(same) << "pixel (" << i << "," << j << ") shows " << int(got[0]) << "," << int(got[1]) << "," << int(got[2])
-                      << " but texel (" << tx << "," << ty << ") is " << int(want[0]) << "," << int(want[1]) << "," << int(want[2]);
+                      << " but texel (" << tx << "," << ty << ") is " << int(want[0]) << "," << int(want[1]) << ","
+                      << int(want[2]);
   }
   EXPECT_GE(checked, 100) << "too few uniform texture points were checked";
 }
 
 TEST_F(RenderTest, TextureValuesAreReproducedAsStored) {
   // A 2x2 texture with nearest filtering: the UNORM path must not apply any sRGB curve.
-  Model m = quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1), Eigen::Vector3d(-0.5, 0.5, 1)},
+  Model m = quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
+                  Eigen::Vector3d(-0.5, 0.5, 1)},
                  {1, 1, 1, 1});
   Image tex;
   tex.width = tex.height = 2;
@@ -307,13 +312,15 @@ TEST_F(RenderTest, TextureValuesAreReproducedAsStored) {
   // Quad corner (-0.5,-0.5) has uv (0,0) and lands top-left: each quadrant shows one texel.
   const int at[4][2] = {{70, 70}, {130, 70}, {70, 130}, {130, 130}};
   for (int k = 0; k < 4; ++k)
-    for (int c = 0; c < 3; ++c) EXPECT_EQ(img.pixel(at[k][0], at[k][1])[c], tex.rgba[static_cast<std::size_t>(k * 4 + c)]) << "texel " << k;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_EQ(img.pixel(at[k][0], at[k][1])[c], tex.rgba[static_cast<std::size_t>(k * 4 + c)]) << "texel " << k;
 }
 
 TEST_F(RenderTest, BaseColorFactorAndVertexColourMultiply) {
   projbot::assets::Material mat;
   mat.base_color_factor = {0.5F, 1.0F, 0.25F, 1.0F};
-  Model m = quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1), Eigen::Vector3d(-0.5, 0.5, 1)},
+  Model m = quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
+                  Eigen::Vector3d(-0.5, 0.5, 1)},
                  {1.0F, 0.5F, 1.0F, 1.0F}, mat);
   const ProjectorConfig p = projector(100, 100, 80, 80, 49.5, 49.5);
   const Image img = render(p, {{renderer_->add_model(m), Eigen::Matrix4d::Identity()}});
@@ -324,8 +331,8 @@ TEST_F(RenderTest, BaseColorFactorAndVertexColourMultiply) {
 }
 
 TEST_F(RenderTest, AlphaModes) {
-  const std::array<Eigen::Vector3d, 4> c{Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
-                                         Eigen::Vector3d(-0.5, 0.5, 1)};
+  const std::array<Eigen::Vector3d, 4> c{Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1),
+                                         Eigen::Vector3d(0.5, 0.5, 1), Eigen::Vector3d(-0.5, 0.5, 1)};
   projbot::assets::Material mask;
   mask.alpha_mode = projbot::assets::AlphaMode::kMask;
   mask.alpha_cutoff = 0.5F;
@@ -336,10 +343,10 @@ TEST_F(RenderTest, AlphaModes) {
   const std::size_t half = renderer_->add_model(quad(c, {1, 1, 1, 0.5F}, blend));
   const std::size_t opaque = renderer_->add_model(quad(c, {1, 1, 1, 0.1F}));
   const ProjectorConfig p = projector(100, 100, 80, 80, 49.5, 49.5);
-  EXPECT_EQ(render(p, {{below, Eigen::Matrix4d::Identity()}}).pixel(50, 50)[0], 0);     // discarded
-  EXPECT_EQ(render(p, {{above, Eigen::Matrix4d::Identity()}}).pixel(50, 50)[0], 255);   // kept, alpha ignored
+  EXPECT_EQ(render(p, {{below, Eigen::Matrix4d::Identity()}}).pixel(50, 50)[0], 0);        // discarded
+  EXPECT_EQ(render(p, {{above, Eigen::Matrix4d::Identity()}}).pixel(50, 50)[0], 255);      // kept, alpha ignored
   EXPECT_NEAR(render(p, {{half, Eigen::Matrix4d::Identity()}}).pixel(50, 50)[0], 128, 1);  // half over black
-  EXPECT_EQ(render(p, {{opaque, Eigen::Matrix4d::Identity()}}).pixel(50, 50)[0], 255);  // OPAQUE ignores alpha
+  EXPECT_EQ(render(p, {{opaque, Eigen::Matrix4d::Identity()}}).pixel(50, 50)[0], 255);     // OPAQUE ignores alpha
 }
 
 TEST_F(RenderTest, DepthTestBetweenTwoTargetsInEitherOrder) {
@@ -351,11 +358,12 @@ TEST_F(RenderTest, DepthTestBetweenTwoTargetsInEitherOrder) {
   const std::size_t far_green = renderer_->add_model(quad(square(0.6, 0), {0, 1, 0, 1}));
   const ProjectorConfig p = projector(200, 200, 150, 150, 99.5, 99.5);
   const Eigen::Matrix4d Tn = pose(0, 0, 1.0, 0, 0, 0), Tf = pose(0, 0, 1.5, 0, 0, 0);
-  for (const auto& items : {std::vector<DrawItem>{{near_red, Tn}, {far_green, Tf}}, std::vector<DrawItem>{{far_green, Tf}, {near_red, Tn}}}) {
+  for (const auto& items :
+       {std::vector<DrawItem>{{near_red, Tn}, {far_green, Tf}}, std::vector<DrawItem>{{far_green, Tf}, {near_red, Tn}}}) {
     const Image img = render(p, items);
     EXPECT_EQ(img.pixel(100, 100)[0], 255);  // the nearer red square wins in the middle
     EXPECT_EQ(img.pixel(100, 100)[1], 0);
-    EXPECT_EQ(img.pixel(100, 50)[1], 255);   // only the green one covers here (it spans 40..160)
+    EXPECT_EQ(img.pixel(100, 50)[1], 255);  // only the green one covers here (it spans 40..160)
     EXPECT_EQ(img.pixel(100, 50)[0], 0);
   }
 }
@@ -363,9 +371,9 @@ TEST_F(RenderTest, DepthTestBetweenTwoTargetsInEitherOrder) {
 TEST_F(RenderTest, TargetPartlyBehindTheProjector) {
   // A floor strip at y = 0.3 from z = -1 (behind) to z = 3: only its part in front of the near plane shows.
   const ProjectorConfig p = projector(320, 240, 250, 250, 159.5, 119.5);
-  const std::size_t strip = renderer_->add_model(
-      quad({Eigen::Vector3d(-0.5, 0.3, -1), Eigen::Vector3d(0.5, 0.3, -1), Eigen::Vector3d(0.5, 0.3, 3), Eigen::Vector3d(-0.5, 0.3, 3)},
-           {1, 1, 1, 1}));
+  const std::size_t strip = renderer_->add_model(quad({Eigen::Vector3d(-0.5, 0.3, -1), Eigen::Vector3d(0.5, 0.3, -1),
+                                                       Eigen::Vector3d(0.5, 0.3, 3), Eigen::Vector3d(-0.5, 0.3, 3)},
+                                                      {1, 1, 1, 1}));
   const Image img = render(p, {{strip, Eigen::Matrix4d::Identity()}});
   std::vector<bool> expected(static_cast<std::size_t>(p.width_px) * p.height_px);
   for (int j = 0; j < p.height_px; ++j)
@@ -399,8 +407,8 @@ TEST_F(RenderTest, TargetPartlyOutsideTheImageMatchesACrop) {
       lit += pb[0] ? 1 : 0;
       for (int c = 0; c < 3; ++c) differ += std::abs(int(pa[c]) - int(pb[c])) > 2 ? 1 : 0;
     }
-  EXPECT_GT(lit, 20000U);                 // the duck fills much of the crop...
-  EXPECT_LT(differ, 300U);                // ...and it is the same picture (edge pixels may round differently)
+  EXPECT_GT(lit, 20000U);   // the duck fills much of the crop...
+  EXPECT_LT(differ, 300U);  // ...and it is the same picture (edge pixels may round differently)
 }
 
 TEST_F(RenderTest, ProfilerGetsOneRecordPerFrame) {
@@ -411,10 +419,13 @@ TEST_F(RenderTest, ProfilerGetsOneRecordPerFrame) {
   projbot::engine::FrameProfiler prof;
   int pose_reads = 0;
   for (int i = 0; i < 12; ++i)
-    renderer_->draw_frame(*target, p, [&](std::vector<DrawItem>& items) {
-      ++pose_reads;
-      items.push_back({id, pose(0, 0, 2, 0, 0, 0)});
-    }, &prof);
+    renderer_->draw_frame(
+        *target, p,
+        [&](std::vector<DrawItem>& items) {
+          ++pose_reads;
+          items.push_back({id, pose(0, 0, 2, 0, 0, 0)});
+        },
+        &prof);
   renderer_->finish(*target);
   EXPECT_EQ(pose_reads, 12);
   ASSERT_EQ(prof.records().size(), 12U);
@@ -434,7 +445,8 @@ TEST_F(RenderTest, BadRequestsAreErrors) {
   const ProjectorConfig p = projector(16, 16, 10, 10, 7.5, 7.5);
   auto target = renderer_->make_offscreen(16, 16);
   EXPECT_THROW(target->read_back(), projbot::engine::EngineError);  // nothing drawn yet
-  EXPECT_THROW(renderer_->draw_frame(*target, p, std::vector<DrawItem>{{999, Eigen::Matrix4d::Identity()}}), projbot::engine::EngineError);
+  EXPECT_THROW(renderer_->draw_frame(*target, p, std::vector<DrawItem>{{999, Eigen::Matrix4d::Identity()}}),
+               projbot::engine::EngineError);
   Model empty;
   empty.source = "empty";
   EXPECT_THROW(renderer_->add_model(empty), projbot::engine::EngineError);

@@ -131,13 +131,13 @@ class Loader {
     const std::size_t stride = bv.byteStride > 0 ? bv.byteStride : elem;
     if (stride < elem) fail(name + ": byteStride " + std::to_string(stride) + " is smaller than the element");
     if (bv.byteOffset > buffer.data.size() || bv.byteLength > buffer.data.size() - bv.byteOffset)
-      fail(name + ": bufferView " + std::to_string(a.bufferView) + " runs past the end of buffer " +
-           std::to_string(bv.buffer) + " (" + std::to_string(buffer.data.size()) + " bytes loaded)");
+      fail(name + ": bufferView " + std::to_string(a.bufferView) + " runs past the end of buffer " + std::to_string(bv.buffer) +
+           " (" + std::to_string(buffer.data.size()) + " bytes loaded)");
     if (a.count > 0) {
       const std::size_t needed = a.byteOffset + stride * (a.count - 1) + elem;
       if (needed < a.byteOffset || needed > bv.byteLength)
-        fail(name + ": " + std::to_string(a.count) + " elements need " + std::to_string(needed) +
-             " bytes but bufferView " + std::to_string(a.bufferView) + " has " + std::to_string(bv.byteLength));
+        fail(name + ": " + std::to_string(a.count) + " elements need " + std::to_string(needed) + " bytes but bufferView " +
+             std::to_string(a.bufferView) + " has " + std::to_string(bv.byteLength));
     }
     return {buffer.data.data() + bv.byteOffset + a.byteOffset, stride, a.count, a.componentType, a.type, a.normalized};
   }
@@ -151,7 +151,8 @@ class Loader {
         std::memcpy(&f, p + 4 * c, 4);
         return f;
       }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return static_cast<float>(p[c]) / (v.normalized ? 255.0F : 1.0F);
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return static_cast<float>(p[c]) / (v.normalized ? 255.0F : 1.0F);
       case TINYGLTF_COMPONENT_TYPE_BYTE: {
         const float f = static_cast<float>(static_cast<std::int8_t>(p[c]));
         return v.normalized ? std::max(f / 127.0F, -1.0F) : f;
@@ -166,17 +167,18 @@ class Loader {
         std::memcpy(&s, p + 2 * c, 2);
         return v.normalized ? std::max(static_cast<float>(s) / 32767.0F, -1.0F) : static_cast<float>(s);
       }
-      default: return 0.0F;  // rejected by the callers' type checks
+      default:
+        return 0.0F;  // rejected by the callers' type checks
     }
   }
 
   View float_attribute(int accessor, const std::string& what, std::initializer_list<int> types, bool allow_normalized) const {
     View v = accessor_view(accessor, what);
     if (std::find(types.begin(), types.end(), v.type) == types.end()) fail(what + ": unexpected element type");
-    const bool ok_component = v.component_type == TINYGLTF_COMPONENT_TYPE_FLOAT ||
-                              (allow_normalized && v.normalized &&
-                               (v.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
-                                v.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT));
+    const bool ok_component =
+        v.component_type == TINYGLTF_COMPONENT_TYPE_FLOAT || (allow_normalized && v.normalized &&
+                                                              (v.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                                               v.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT));
     if (!ok_component) fail(what + ": unsupported component type " + std::to_string(v.component_type));
     return v;
   }
@@ -248,13 +250,24 @@ class Loader {
       for (std::size_t i = 0; i < iv.count; ++i) {
         const unsigned char* q = iv.base + iv.stride * i;
         switch (iv.component_type) {
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: raw[i] = q[0]; break;
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t s; std::memcpy(&s, q, 2); raw[i] = s; break; }
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&raw[i], q, 4); break;
-          default: fail(what + ": index component type " + std::to_string(iv.component_type) + " is not an unsigned integer");
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            raw[i] = q[0];
+            break;
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            std::uint16_t s;
+            std::memcpy(&s, q, 2);
+            raw[i] = s;
+            break;
+          }
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+            std::memcpy(&raw[i], q, 4);
+            break;
+          default:
+            fail(what + ": index component type " + std::to_string(iv.component_type) + " is not an unsigned integer");
         }
-        if (raw[i] >= n) fail(what + ": index " + std::to_string(raw[i]) + " at position " + std::to_string(i) +
-                              " is out of range (" + std::to_string(n) + " vertices)");
+        if (raw[i] >= n)
+          fail(what + ": index " + std::to_string(raw[i]) + " at position " + std::to_string(i) + " is out of range (" +
+               std::to_string(n) + " vertices)");
       }
     } else {
       raw.resize(n);
@@ -306,7 +319,8 @@ class Loader {
   void load_images(Model& out) {
     for (std::size_t i = 0; i < g_.images.size(); ++i) {
       const auto& im = g_.images[i];
-      const std::string name = "image " + std::to_string(i) + (im.uri.empty() || im.uri.rfind("data:", 0) == 0 ? "" : " ('" + im.uri + "')");
+      const std::string name =
+          "image " + std::to_string(i) + (im.uri.empty() || im.uri.rfind("data:", 0) == 0 ? "" : " ('" + im.uri + "')");
       Image img;
       if (im.image.empty() || im.width <= 0 || im.height <= 0) {
         // tinygltf keeps going when an image file is missing or undecodable; an unused image is harmless,
@@ -337,7 +351,10 @@ class Loader {
           c[k] = value;
         }
         if (comps == 1) c[1] = c[2] = c[0];
-        if (comps == 2) { c[3] = c[1]; c[1] = c[2] = c[0]; }  // grey + alpha
+        if (comps == 2) {
+          c[3] = c[1];
+          c[1] = c[2] = c[0];
+        }  // grey + alpha
         std::memcpy(&img.rgba[px * 4], c, 4);
       }
       out.images.push_back(std::move(img));
@@ -346,9 +363,12 @@ class Loader {
 
   static Wrap wrap_of(int mode) {
     switch (mode) {
-      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return Wrap::kClampToEdge;
-      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return Wrap::kMirroredRepeat;
-      default: return Wrap::kRepeat;
+      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+        return Wrap::kClampToEdge;
+      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+        return Wrap::kMirroredRepeat;
+      default:
+        return Wrap::kRepeat;
     }
   }
 
@@ -384,16 +404,21 @@ class Loader {
           m.sampler.wrap_s = wrap_of(s.wrapS);
           m.sampler.wrap_t = wrap_of(s.wrapT);
           m.sampler.mag = s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ? Filter::kNearest : Filter::kLinear;
-          m.sampler.min = (s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST || s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
-                           s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR)
-                              ? Filter::kNearest
-                              : Filter::kLinear;
+          m.sampler.min =
+              (s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST || s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+               s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR)
+                  ? Filter::kNearest
+                  : Filter::kLinear;
         }
       }
-      if (gm.alphaMode == "MASK") m.alpha_mode = AlphaMode::kMask;
-      else if (gm.alphaMode == "BLEND") m.alpha_mode = AlphaMode::kBlend;
-      else if (gm.alphaMode.empty() || gm.alphaMode == "OPAQUE") m.alpha_mode = AlphaMode::kOpaque;
-      else fail(name + ": alphaMode '" + gm.alphaMode + "' is not OPAQUE, MASK or BLEND");
+      if (gm.alphaMode == "MASK")
+        m.alpha_mode = AlphaMode::kMask;
+      else if (gm.alphaMode == "BLEND")
+        m.alpha_mode = AlphaMode::kBlend;
+      else if (gm.alphaMode.empty() || gm.alphaMode == "OPAQUE")
+        m.alpha_mode = AlphaMode::kOpaque;
+      else
+        fail(name + ": alphaMode '" + gm.alphaMode + "' is not OPAQUE, MASK or BLEND");
       if (!std::isfinite(gm.alphaCutoff) || gm.alphaCutoff < 0.0) fail(name + ": alphaCutoff must be a finite number >= 0");
       m.alpha_cutoff = static_cast<float>(gm.alphaCutoff);
       m.double_sided = gm.doubleSided;

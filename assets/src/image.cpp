@@ -1,7 +1,7 @@
+#include "projbot/assets/image.hpp"
+
 #include <stb_image.h>
 #include <stb_image_write.h>
-
-#include "projbot/assets/image.hpp"
 
 namespace projbot::assets {
 

@@ -1,8 +1,8 @@
+#include "projbot/assets/model.hpp"
+
 #include <cmath>
 #include <numeric>
 #include <random>
-
-#include "projbot/assets/model.hpp"
 
 namespace projbot::assets {
 namespace {
@@ -48,7 +48,8 @@ void scale_and_recenter(Model& model, double scale, bool recenter) {
   const Eigen::Vector3d c = model.surface_centroid();
   for (auto& p : model.primitives)
     for (auto& v : p.vertices)
-      for (int k = 0; k < 3; ++k) v.position[static_cast<std::size_t>(k)] = static_cast<float>(v.position[static_cast<std::size_t>(k)] - c[k]);
+      for (int k = 0; k < 3; ++k)
+        v.position[static_cast<std::size_t>(k)] = static_cast<float>(v.position[static_cast<std::size_t>(k)] - c[k]);
 }
 
 SurfaceSamples sample_surface(const Model& model, std::size_t count, std::uint32_t seed) {
@@ -76,7 +77,8 @@ SurfaceSamples sample_surface(const Model& model, std::size_t count, std::uint32
   for (std::size_t i = 0; i < count; ++i) {
     const double pick = uni(rng) * total;
     const auto it = std::lower_bound(cumulative.begin(), cumulative.end(), pick);
-    const Tri& t = tris[static_cast<std::size_t>(std::min<std::ptrdiff_t>(it - cumulative.begin(), static_cast<std::ptrdiff_t>(tris.size()) - 1))];
+    const Tri& t = tris[static_cast<std::size_t>(
+        std::min<std::ptrdiff_t>(it - cumulative.begin(), static_cast<std::ptrdiff_t>(tris.size()) - 1))];
     // Uniform point in a triangle: reflect (u, v) back into the lower half of the unit square.
     double u = uni(rng), v = uni(rng);
     if (u + v > 1.0) {
@@ -100,7 +102,8 @@ Model make_uv_sphere(double radius_m, int rings, int segments) {
       const double phi = 2.0 * M_PI * s / segments;
       const Eigen::Vector3d n(std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi));
       Vertex v;
-      v.position = {static_cast<float>(radius_m * n.x()), static_cast<float>(radius_m * n.y()), static_cast<float>(radius_m * n.z())};
+      v.position = {static_cast<float>(radius_m * n.x()), static_cast<float>(radius_m * n.y()),
+                    static_cast<float>(radius_m * n.z())};
       v.normal = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
       v.uv = {static_cast<float>(s) / static_cast<float>(segments), static_cast<float>(r) / static_cast<float>(rings)};
       p.vertices.push_back(v);

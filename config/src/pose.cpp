@@ -9,10 +9,10 @@ namespace projbot::config {
 
 Eigen::Matrix4d pose_from_xyz_rpy(const Eigen::Vector3d& translation_m, const Eigen::Vector3d& rpy_deg) {
   const Eigen::Vector3d rad = rpy_deg * (M_PI / 180.0);
-  const Eigen::Matrix3d R = (Eigen::AngleAxisd(rad.z(), Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(rad.y(), Eigen::Vector3d::UnitY()) *
-                             Eigen::AngleAxisd(rad.x(), Eigen::Vector3d::UnitX()))
-                                .toRotationMatrix();
+  const Eigen::Matrix3d R =
+      (Eigen::AngleAxisd(rad.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rad.y(), Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(rad.x(), Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
   T.topLeftCorner<3, 3>() = R;
   T.topRightCorner<3, 1>() = translation_m;
@@ -22,13 +22,12 @@ Eigen::Matrix4d pose_from_xyz_rpy(const Eigen::Vector3d& translation_m, const Ei
 void validate_rigid(const Eigen::Matrix4d& T, std::string_view where) {
   const auto fail = [&](const std::string& why) { throw ConfigError(std::string(where) + ": " + why); };
   if (!T.allFinite()) fail("pose has a non-finite entry");
-  if ((T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > 1e-9)
-    fail("pose's last row must be 0 0 0 1");
+  if ((T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > 1e-9) fail("pose's last row must be 0 0 0 1");
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   const double orth = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (orth > 1e-6 || R.determinant() < 0.0)
-    fail("pose's rotation is not a proper rotation (orthonormality error " + std::to_string(orth) +
-         ", det " + std::to_string(R.determinant()) + "); scale the model with 'scale' instead");
+    fail("pose's rotation is not a proper rotation (orthonormality error " + std::to_string(orth) + ", det " +
+         std::to_string(R.determinant()) + "); scale the model with 'scale' instead");
 }
 
 std::vector<double> parse_number_list(std::string_view text, std::size_t count, std::string_view what) {

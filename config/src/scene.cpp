@@ -1,11 +1,11 @@
+#include "projbot/config/scene.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
-
-#include "projbot/config/scene.hpp"
 
 namespace projbot::config {
 namespace {
@@ -54,8 +54,7 @@ class MapReader {
   }
 
   std::vector<double> numbers(const YAML::Node& n, const std::string& key_path, std::size_t count) const {
-    if (!n.IsSequence() || n.size() != count)
-      fail(n, key_path, "expected a list of " + std::to_string(count) + " numbers");
+    if (!n.IsSequence() || n.size() != count) fail(n, key_path, "expected a list of " + std::to_string(count) + " numbers");
     std::vector<double> out;
     for (const auto& item : n) {
       double v = 0.0;
@@ -79,10 +78,14 @@ class MapReader {
  private:
   template <typename T>
   static std::string type_name() {
-    if constexpr (std::is_same_v<T, bool>) return "boolean";
-    else if constexpr (std::is_integral_v<T>) return "integer";
-    else if constexpr (std::is_floating_point_v<T>) return "number";
-    else return "string";
+    if constexpr (std::is_same_v<T, bool>)
+      return "boolean";
+    else if constexpr (std::is_integral_v<T>)
+      return "integer";
+    else if constexpr (std::is_floating_point_v<T>)
+      return "number";
+    else
+      return "string";
   }
 
   YAML::Node node_;

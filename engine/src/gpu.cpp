@@ -26,11 +26,16 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverity
 
 int device_rank(vk::PhysicalDeviceType type) {
   switch (type) {
-    case vk::PhysicalDeviceType::eDiscreteGpu: return 4;
-    case vk::PhysicalDeviceType::eIntegratedGpu: return 3;
-    case vk::PhysicalDeviceType::eVirtualGpu: return 2;
-    case vk::PhysicalDeviceType::eCpu: return 1;
-    default: return 0;
+    case vk::PhysicalDeviceType::eDiscreteGpu:
+      return 4;
+    case vk::PhysicalDeviceType::eIntegratedGpu:
+      return 3;
+    case vk::PhysicalDeviceType::eVirtualGpu:
+      return 2;
+    case vk::PhysicalDeviceType::eCpu:
+      return 1;
+    default:
+      return 0;
   }
 }
 
@@ -57,7 +62,9 @@ Gpu::Gpu(const RendererOptions& options) : windowing(options.windowing) {
       bool found = false;
       for (const auto& layer : context.enumerateInstanceLayerProperties())
         found = found || std::strcmp(layer.layerName, kValidationLayer) == 0;
-      if (!found) throw EngineError("validation requested but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)");
+      if (!found)
+        throw EngineError(
+            "validation requested but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)");
       layers.push_back(kValidationLayer);
       extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     }
@@ -65,8 +72,7 @@ Gpu::Gpu(const RendererOptions& options) : windowing(options.windowing) {
       throw EngineError("the Vulkan loader is older than 1.3; Projbot needs Vulkan 1.3");
     vk::ApplicationInfo app("projbot", 1, "projbot", 1, VK_API_VERSION_1_3);
     vk::DebugUtilsMessengerCreateInfoEXT messenger_info(
-        {},
-        vk::DebugUtilsMessageSeverityFlagBitsEXT::eWarning | vk::DebugUtilsMessageSeverityFlagBitsEXT::eError,
+        {}, vk::DebugUtilsMessageSeverityFlagBitsEXT::eWarning | vk::DebugUtilsMessageSeverityFlagBitsEXT::eError,
         vk::DebugUtilsMessageTypeFlagBitsEXT::eGeneral | vk::DebugUtilsMessageTypeFlagBitsEXT::eValidation |
             vk::DebugUtilsMessageTypeFlagBitsEXT::ePerformance,
         &on_validation_message, this);
@@ -201,7 +207,8 @@ void Gpu::one_shot(const std::function<void(vk::raii::CommandBuffer&)>& record) 
   vk::raii::Fence fence(device, vk::FenceCreateInfo());
   const vk::CommandBuffer raw = *cmd;
   queue.submit(vk::SubmitInfo({}, {}, raw), *fence);
-  if (device.waitForFences(*fence, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess) throw EngineError("one-shot GPU command did not finish");
+  if (device.waitForFences(*fence, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
+    throw EngineError("one-shot GPU command did not finish");
 }
 
 void transition(const vk::raii::CommandBuffer& cmd, vk::Image image, vk::ImageAspectFlags aspect, vk::ImageLayout from,

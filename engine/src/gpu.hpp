@@ -2,14 +2,13 @@
 // The Vulkan device every engine object shares: instance, optional validation messenger, device,
 // one graphics queue and helpers for buffers, images and one-shot commands. Render thread only.
 
-#include <vulkan/vulkan_raii.hpp>
-
 #include <atomic>
 #include <functional>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
+#include <vulkan/vulkan_raii.hpp>
 
 #include "projbot/engine/renderer.hpp"
 

@@ -31,9 +31,12 @@ static_assert(sizeof(DrawConstants) == 88);
 
 vk::SamplerAddressMode to_vk(assets::Wrap w) {
   switch (w) {
-    case assets::Wrap::kClampToEdge: return vk::SamplerAddressMode::eClampToEdge;
-    case assets::Wrap::kMirroredRepeat: return vk::SamplerAddressMode::eMirroredRepeat;
-    default: return vk::SamplerAddressMode::eRepeat;
+    case assets::Wrap::kClampToEdge:
+      return vk::SamplerAddressMode::eClampToEdge;
+    case assets::Wrap::kMirroredRepeat:
+      return vk::SamplerAddressMode::eMirroredRepeat;
+    default:
+      return vk::SamplerAddressMode::eRepeat;
   }
 }
 
@@ -67,7 +70,7 @@ struct Renderer::Impl {
   vk::raii::ShaderModule vert{nullptr};
   vk::raii::ShaderModule frag{nullptr};
   std::map<std::tuple<vk::Format, bool, bool>, vk::raii::Pipeline> pipelines;  // (format, cull back, blend)
-  detail::Image white;  // bound where a material has no texture
+  detail::Image white;                                                         // bound where a material has no texture
   std::vector<GpuModel> models;
   std::vector<DrawItem> items;
   std::uint64_t frame_index = 0;
@@ -93,9 +96,9 @@ struct Renderer::Impl {
   detail::Image upload_texture(const assets::Image& img) {
     const vk::Extent2D extent(static_cast<std::uint32_t>(img.width), static_cast<std::uint32_t>(img.height));
     // UNORM, not SRGB: texels reach the target exactly as stored in the file.
-    detail::Image tex = gpu->make_image(extent, vk::Format::eR8G8B8A8Unorm,
-                                        vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst,
-                                        vk::ImageAspectFlagBits::eColor);
+    detail::Image tex =
+        gpu->make_image(extent, vk::Format::eR8G8B8A8Unorm,
+                        vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst, vk::ImageAspectFlagBits::eColor);
     Buffer staging = gpu->make_buffer(img.rgba.size(), vk::BufferUsageFlagBits::eTransferSrc,
                                       vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
     std::memcpy(staging.mapped, img.rgba.data(), img.rgba.size());
@@ -136,11 +139,11 @@ struct Renderer::Impl {
                                                     vk::FrontFace::eCounterClockwise, VK_FALSE, 0, 0, 0, 1.0F);
     vk::PipelineMultisampleStateCreateInfo multisample({}, vk::SampleCountFlagBits::e1);
     vk::PipelineDepthStencilStateCreateInfo depth({}, VK_TRUE, blend ? VK_FALSE : VK_TRUE, vk::CompareOp::eLess);
-    vk::PipelineColorBlendAttachmentState attachment(
-        blend ? VK_TRUE : VK_FALSE, vk::BlendFactor::eSrcAlpha, vk::BlendFactor::eOneMinusSrcAlpha, vk::BlendOp::eAdd,
-        vk::BlendFactor::eOne, vk::BlendFactor::eOneMinusSrcAlpha, vk::BlendOp::eAdd,
-        vk::ColorComponentFlagBits::eR | vk::ColorComponentFlagBits::eG | vk::ColorComponentFlagBits::eB |
-            vk::ColorComponentFlagBits::eA);
+    vk::PipelineColorBlendAttachmentState attachment(blend ? VK_TRUE : VK_FALSE, vk::BlendFactor::eSrcAlpha,
+                                                     vk::BlendFactor::eOneMinusSrcAlpha, vk::BlendOp::eAdd, vk::BlendFactor::eOne,
+                                                     vk::BlendFactor::eOneMinusSrcAlpha, vk::BlendOp::eAdd,
+                                                     vk::ColorComponentFlagBits::eR | vk::ColorComponentFlagBits::eG |
+                                                         vk::ColorComponentFlagBits::eB | vk::ColorComponentFlagBits::eA);
     vk::PipelineColorBlendStateCreateInfo blending({}, VK_FALSE, vk::LogicOp::eCopy, attachment);
     const vk::DynamicState dynamic_states[] = {vk::DynamicState::eViewport, vk::DynamicState::eScissor};
     vk::PipelineDynamicStateCreateInfo dynamic({}, dynamic_states);
@@ -164,28 +167,31 @@ struct Renderer::Impl {
       vertices.insert(vertices.end(), p.vertices.begin(), p.vertices.end());
       indices.insert(indices.end(), p.indices.begin(), p.indices.end());
     }
-    g.vertices = gpu->upload_buffer(vertices.data(), vertices.size() * sizeof(assets::Vertex), vk::BufferUsageFlagBits::eVertexBuffer);
+    g.vertices =
+        gpu->upload_buffer(vertices.data(), vertices.size() * sizeof(assets::Vertex), vk::BufferUsageFlagBits::eVertexBuffer);
     g.indices = gpu->upload_buffer(indices.data(), indices.size() * sizeof(std::uint32_t), vk::BufferUsageFlagBits::eIndexBuffer);
-    for (const auto& img : model.images)
-      g.textures.push_back(img.rgba.empty() ? detail::Image{} : upload_texture(img));
+    for (const auto& img : model.images) g.textures.push_back(img.rgba.empty() ? detail::Image{} : upload_texture(img));
     g.materials = model.materials;
 
     const auto n = static_cast<std::uint32_t>(model.materials.size());
     vk::DescriptorPoolSize size(vk::DescriptorType::eCombinedImageSampler, n);
-    g.pool = vk::raii::DescriptorPool(gpu->device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, n, size));
+    g.pool = vk::raii::DescriptorPool(
+        gpu->device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, n, size));
     std::vector<vk::DescriptorSetLayout> layouts(n, *set_layout);
     vk::raii::DescriptorSets sets(gpu->device, vk::DescriptorSetAllocateInfo(*g.pool, layouts));
     for (std::uint32_t i = 0; i < n; ++i) {
       const auto& m = model.materials[i];
       const bool textured = m.base_color_image >= 0 && static_cast<std::size_t>(m.base_color_image) < g.textures.size() &&
                             *g.textures[static_cast<std::size_t>(m.base_color_image)].view;
-      if (m.base_color_image >= 0 && !textured) throw EngineError(model.source + ": material " + std::to_string(i) + " has no usable texture");
-      g.samplers.emplace_back(gpu->device, vk::SamplerCreateInfo({}, to_vk(m.sampler.mag), to_vk(m.sampler.min),
-                                                                 vk::SamplerMipmapMode::eNearest, to_vk(m.sampler.wrap_s),
-                                                                 to_vk(m.sampler.wrap_t), vk::SamplerAddressMode::eRepeat));
+      if (m.base_color_image >= 0 && !textured)
+        throw EngineError(model.source + ": material " + std::to_string(i) + " has no usable texture");
+      g.samplers.emplace_back(
+          gpu->device, vk::SamplerCreateInfo({}, to_vk(m.sampler.mag), to_vk(m.sampler.min), vk::SamplerMipmapMode::eNearest,
+                                             to_vk(m.sampler.wrap_s), to_vk(m.sampler.wrap_t), vk::SamplerAddressMode::eRepeat));
       const vk::ImageView view = textured ? *g.textures[static_cast<std::size_t>(m.base_color_image)].view : *white.view;
       vk::DescriptorImageInfo image_info(*g.samplers.back(), view, vk::ImageLayout::eShaderReadOnlyOptimal);
-      gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*sets[i], 0, 0, vk::DescriptorType::eCombinedImageSampler, image_info), {});
+      gpu->device.updateDescriptorSets(
+          vk::WriteDescriptorSet(*sets[i], 0, 0, vk::DescriptorType::eCombinedImageSampler, image_info), {});
     }
     for (auto& s : sets) g.sets.push_back(std::move(s));
     models.push_back(std::move(g));
@@ -204,8 +210,8 @@ struct Renderer::Impl {
       t.slots.push_back(std::move(slot));
     }
     if (gpu->info.gpu_timestamps)
-      t.timestamps = vk::raii::QueryPool(gpu->device, vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp,
-                                                                             static_cast<std::uint32_t>(2 * kFramesInFlight)));
+      t.timestamps = vk::raii::QueryPool(
+          gpu->device, vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, static_cast<std::uint32_t>(2 * kFramesInFlight)));
   }
 
   // Waits for a slot's previous frame and hands its timing to its profiler.
@@ -219,9 +225,9 @@ struct Renderer::Impl {
     slot.record.completed_ms = slot.profiler->now_ms();
     slot.record.gpu_ms = std::nan("");
     if (*t.timestamps) {
-      const auto [result, ticks] = t.timestamps.getResults<std::uint64_t>(static_cast<std::uint32_t>(2 * index), 2,
-                                                                         2 * sizeof(std::uint64_t), sizeof(std::uint64_t),
-                                                                         vk::QueryResultFlagBits::e64);
+      const auto [result, ticks] =
+          t.timestamps.getResults<std::uint64_t>(static_cast<std::uint32_t>(2 * index), 2, 2 * sizeof(std::uint64_t),
+                                                 sizeof(std::uint64_t), vk::QueryResultFlagBits::e64);
       if (result == vk::Result::eSuccess && ticks[1] >= ticks[0])
         slot.record.gpu_ms = static_cast<double>(ticks[1] - ticks[0]) * gpu->timestamp_period_ns * 1e-6;
     }
@@ -247,7 +253,8 @@ struct Renderer::Impl {
           c.base_color_factor = mat.base_color_factor;
           c.alpha_cutoff = mat.alpha_cutoff;
           c.alpha_mode = mat.alpha_mode == assets::AlphaMode::kOpaque ? 0 : mat.alpha_mode == assets::AlphaMode::kMask ? 1 : 2;
-          cmd.pushConstants<DrawConstants>(*pipeline_layout, vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, c);
+          cmd.pushConstants<DrawConstants>(*pipeline_layout,
+                                           vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, c);
           cmd.drawIndexed(part.index_count, 1, part.first_index, part.vertex_offset, 0);
         }
       }
@@ -364,7 +371,8 @@ bool Renderer::draw_frame(RenderTarget& target, const config::ProjectorConfig& p
 
 bool Renderer::draw_frame(RenderTarget& target, const config::ProjectorConfig& projector, std::span<const DrawItem> items,
                           FrameProfiler* profiler) {
-  return draw_frame(target, projector, [items](std::vector<DrawItem>& out) { out.assign(items.begin(), items.end()); }, profiler);
+  return draw_frame(
+      target, projector, [items](std::vector<DrawItem>& out) { out.assign(items.begin(), items.end()); }, profiler);
 }
 
 void Renderer::finish(RenderTarget& target) {

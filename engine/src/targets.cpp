@@ -31,12 +31,12 @@ class OffscreenBackend final : public TargetBackend {
  public:
   OffscreenBackend(std::shared_ptr<Gpu> shared, vk::Extent2D extent) : TargetBackend(std::move(shared)) {
     check_extent(extent.width, extent.height, "offscreen target");
-    color_ = gpu->make_image(extent, kOffscreenFormat,
-                              vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
-                              vk::ImageAspectFlagBits::eColor);
+    color_ =
+        gpu->make_image(extent, kOffscreenFormat, vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
+                        vk::ImageAspectFlagBits::eColor);
     depth_ = make_depth(*gpu, extent);
     readback_ = gpu->make_buffer(vk::DeviceSize(extent.width) * extent.height * 4, vk::BufferUsageFlagBits::eTransferDst,
-                                  vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
+                                 vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
   }
   ~OffscreenBackend() override {
     gpu->device.waitIdle();
@@ -79,17 +79,19 @@ class OffscreenBackend final : public TargetBackend {
 
 vk::PresentModeKHR to_vk(PresentMode mode) {
   switch (mode) {
-    case PresentMode::kMailbox: return vk::PresentModeKHR::eMailbox;
-    case PresentMode::kImmediate: return vk::PresentModeKHR::eImmediate;
-    default: return vk::PresentModeKHR::eFifo;
+    case PresentMode::kMailbox:
+      return vk::PresentModeKHR::eMailbox;
+    case PresentMode::kImmediate:
+      return vk::PresentModeKHR::eImmediate;
+    default:
+      return vk::PresentModeKHR::eFifo;
   }
 }
 
 // A GLFW window and its swapchain, rebuilt when the window is resized or the swapchain goes out of date.
 class WindowBackend final : public TargetBackend {
  public:
-  WindowBackend(std::shared_ptr<Gpu> shared, const WindowOptions& options)
-      : TargetBackend(std::move(shared)), options_(options) {
+  WindowBackend(std::shared_ptr<Gpu> shared, const WindowOptions& options) : TargetBackend(std::move(shared)), options_(options) {
     if (!gpu->windowing) throw EngineError("make_window: the renderer was created without windowing");
     glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
     GLFWmonitor* monitor = nullptr;
@@ -107,11 +109,11 @@ class WindowBackend final : public TargetBackend {
     }
     check_extent(static_cast<std::uint32_t>(std::max(w, 0)), static_cast<std::uint32_t>(std::max(h, 0)), "window");
     window_ = glfwCreateWindow(w, h, options.title.c_str(), monitor, nullptr);
-    if (window_ == nullptr) throw EngineError("GLFW could not create a " + std::to_string(w) + "x" + std::to_string(h) + " window");
+    if (window_ == nullptr)
+      throw EngineError("GLFW could not create a " + std::to_string(w) + "x" + std::to_string(h) + " window");
     glfwSetWindowUserPointer(window_, this);
-    glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* win, int, int) {
-      static_cast<WindowBackend*>(glfwGetWindowUserPointer(win))->resized_ = true;
-    });
+    glfwSetFramebufferSizeCallback(
+        window_, [](GLFWwindow* win, int, int) { static_cast<WindowBackend*>(glfwGetWindowUserPointer(win))->resized_ = true; });
     VkSurfaceKHR raw_surface = VK_NULL_HANDLE;
     if (glfwCreateWindowSurface(*gpu->instance, window_, nullptr, &raw_surface) != VK_SUCCESS) {
       glfwDestroyWindow(window_);
@@ -171,7 +173,8 @@ class WindowBackend final : public TargetBackend {
   void present(const FrameImage& frame) override {
     const vk::SwapchainKHR chain = *swapchain_;
     try {
-      if (gpu->queue.presentKHR(vk::PresentInfoKHR(frame.signal, chain, frame.index)) == vk::Result::eSuboptimalKHR) stale_ = true;
+      if (gpu->queue.presentKHR(vk::PresentInfoKHR(frame.signal, chain, frame.index)) == vk::Result::eSuboptimalKHR)
+        stale_ = true;
     } catch (const vk::OutOfDateKHRError&) {
       stale_ = true;
     }
@@ -196,10 +199,11 @@ class WindowBackend final : public TargetBackend {
     const auto caps = gpu->physical.getSurfaceCapabilitiesKHR(*surface_);
     int fw = 0, fh = 0;
     glfwGetFramebufferSize(window_, &fw, &fh);
-    extent_ = caps.currentExtent.width != UINT32_MAX
-                  ? caps.currentExtent
-                  : vk::Extent2D(std::clamp(static_cast<std::uint32_t>(fw), caps.minImageExtent.width, caps.maxImageExtent.width),
-                                 std::clamp(static_cast<std::uint32_t>(fh), caps.minImageExtent.height, caps.maxImageExtent.height));
+    extent_ =
+        caps.currentExtent.width != UINT32_MAX
+            ? caps.currentExtent
+            : vk::Extent2D(std::clamp(static_cast<std::uint32_t>(fw), caps.minImageExtent.width, caps.maxImageExtent.width),
+                           std::clamp(static_cast<std::uint32_t>(fh), caps.minImageExtent.height, caps.maxImageExtent.height));
     if (extent_.width == 0 || extent_.height == 0) return;
     const auto modes = gpu->physical.getSurfacePresentModesKHR(*surface_);
     vk::PresentModeKHR mode = to_vk(options_.present_mode);
@@ -221,8 +225,9 @@ class WindowBackend final : public TargetBackend {
     swapchain_ = std::move(next);
     images_ = swapchain_.getImages();
     for (vk::Image image : images_) {
-      views_.emplace_back(gpu->device, vk::ImageViewCreateInfo({}, image, vk::ImageViewType::e2D, format_, {},
-                                                                vk::ImageSubresourceRange(vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1)));
+      views_.emplace_back(gpu->device,
+                          vk::ImageViewCreateInfo({}, image, vk::ImageViewType::e2D, format_, {},
+                                                  vk::ImageSubresourceRange(vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1)));
       render_done_.emplace_back(gpu->device, vk::SemaphoreCreateInfo());
     }
     depth_ = make_depth(*gpu, extent_);

@@ -47,7 +47,8 @@ std::vector<std::pair<int, int>> parse_sizes(const std::string& text) {
 }  // namespace
 
 const Command kBenchRender{
-    "bench render", "benchmark the projector pass (frame rate, frame-time percentiles)",
+    "bench render",
+    "benchmark the projector pass (frame rate, frame-time percentiles)",
     "projbot bench render [--frames N] [--sizes WxH,...] [--offscreen-only | --windowed-only]\n\n"
     "Draws the Duck (4212 triangles) and a 100k-triangle textured sphere at each size, offscreen and\n"
     "(when a display is there, e.g. under xvfb-run) in a window, and prints one row per run. Frame time\n"
@@ -112,8 +113,8 @@ const Command kBenchRender{
             const auto s = profiler.summary();
             char size[32];
             std::snprintf(size, sizeof size, "%dx%d", w, h);
-            std::printf("%-11s %8zu %10s %-9s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f\n", m.name.c_str(), m.model.triangle_count(), size,
-                        windowed ? "window" : "offscreen", s.fps, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms, s.gpu_p50_ms);
+            std::printf("%-11s %8zu %10s %-9s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f\n", m.name.c_str(), m.model.triangle_count(),
+                        size, windowed ? "window" : "offscreen", s.fps, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms, s.gpu_p50_ms);
             std::fflush(stdout);
           }
         }

@@ -67,8 +67,10 @@ std::string format_options(const std::vector<OptionSpec>& specs) {
   std::ostringstream out;
   for (const auto& s : specs) {
     std::string head = "  --" + s.name + (s.value.empty() ? "" : " " + s.value);
-    if (head.size() < 28) head.resize(28, ' ');
-    else head += "\n" + std::string(28, ' ');
+    if (head.size() < 28)
+      head.resize(28, ' ');
+    else
+      head += "\n" + std::string(28, ' ');
     out << head << s.help << '\n';
   }
   return out.str();

@@ -17,8 +17,8 @@ class UsageError : public std::runtime_error {
 };
 
 struct OptionSpec {
-  std::string name;      ///< without the leading dashes
-  std::string value;     ///< placeholder shown in help ("FILE"); empty for a flag
+  std::string name;   ///< without the leading dashes
+  std::string value;  ///< placeholder shown in help ("FILE"); empty for a flag
   std::string help;
 };
 

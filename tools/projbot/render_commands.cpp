@@ -46,36 +46,35 @@ void finish_profile(const cli::Args& args, const engine::FrameProfiler& profiler
 
 }  // namespace
 
-const Command kRender{
-    "render", "render the projector image headless (offscreen) to a PNG",
-    "projbot render [--scene S.yaml] --out frame.png [--frames N] [--profile p.csv] [overrides]\n\n"
-    "Draws every target of the scene through the projector's intrinsics, with no window system, and\n"
-    "writes the last frame as an RGBA PNG: exactly the image the projector must show.\n",
-    [] {
-      auto o = scene_options();
-      o.insert(o.begin(), {{"out", "FILE", "PNG to write (required)"},
-                           {"frames", "N", "frames to draw, for timing (default 1)"},
-                           {"profile", "FILE", "write one CSV row of timings per frame"}});
-      return o;
-    }(),
-    [](const cli::Args& args) {
-      const auto out = args.get("out");
-      if (!out) throw cli::UsageError("--out FILE is required");
-      const int frames = args.get_int("frames", 1, 1, 1000000);
-      const config::Scene scene = scene_from_args(args);
-      engine::Renderer renderer(renderer_options(args, false));
-      std::cout << "device: " << renderer.device_info().name << '\n';
-      const auto items = upload_scene(renderer, scene);
-      auto target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
-      engine::FrameProfiler profiler;
-      for (int i = 0; i < frames; ++i) renderer.draw_frame(*target, scene.projector, items, &profiler);
-      renderer.finish(*target);
-      assets::write_png(*out, target->read_back());
-      std::cout << "wrote " << *out << " (" << scene.projector.width_px << "x" << scene.projector.height_px << ", "
-                << scene.targets.size() << " target" << (scene.targets.size() == 1 ? "" : "s") << ")\n";
-      finish_profile(args, profiler);
-      return report_validation(args, renderer) ? 0 : 1;
-    }};
+const Command kRender{"render", "render the projector image headless (offscreen) to a PNG",
+                      "projbot render [--scene S.yaml] --out frame.png [--frames N] [--profile p.csv] [overrides]\n\n"
+                      "Draws every target of the scene through the projector's intrinsics, with no window system, and\n"
+                      "writes the last frame as an RGBA PNG: exactly the image the projector must show.\n",
+                      [] {
+                        auto o = scene_options();
+                        o.insert(o.begin(), {{"out", "FILE", "PNG to write (required)"},
+                                             {"frames", "N", "frames to draw, for timing (default 1)"},
+                                             {"profile", "FILE", "write one CSV row of timings per frame"}});
+                        return o;
+                      }(),
+                      [](const cli::Args& args) {
+                        const auto out = args.get("out");
+                        if (!out) throw cli::UsageError("--out FILE is required");
+                        const int frames = args.get_int("frames", 1, 1, 1000000);
+                        const config::Scene scene = scene_from_args(args);
+                        engine::Renderer renderer(renderer_options(args, false));
+                        std::cout << "device: " << renderer.device_info().name << '\n';
+                        const auto items = upload_scene(renderer, scene);
+                        auto target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+                        engine::FrameProfiler profiler;
+                        for (int i = 0; i < frames; ++i) renderer.draw_frame(*target, scene.projector, items, &profiler);
+                        renderer.finish(*target);
+                        assets::write_png(*out, target->read_back());
+                        std::cout << "wrote " << *out << " (" << scene.projector.width_px << "x" << scene.projector.height_px
+                                  << ", " << scene.targets.size() << " target" << (scene.targets.size() == 1 ? "" : "s") << ")\n";
+                        finish_profile(args, profiler);
+                        return report_validation(args, renderer) ? 0 : 1;
+                      }};
 
 const Command kShow{
     "show", "open the projector output in a window (fullscreen on a projector, or a preview)",
@@ -106,8 +105,9 @@ const Command kShow{
       const auto items = upload_scene(renderer, scene);
       auto window = renderer.make_window(w);
       if (w.fullscreen && (window->width() != scene.projector.width_px || window->height() != scene.projector.height_px))
-        std::cerr << "projbot: warning: monitor is " << window->width() << "x" << window->height() << " but the projector model is "
-                  << scene.projector.width_px << "x" << scene.projector.height_px << "; the image is stretched\n";
+        std::cerr << "projbot: warning: monitor is " << window->width() << "x" << window->height()
+                  << " but the projector model is " << scene.projector.width_px << "x" << scene.projector.height_px
+                  << "; the image is stretched\n";
       engine::FrameProfiler profiler;
       int drawn = 0;
       while (!window->poll_close() && (frames == 0 || drawn < frames))

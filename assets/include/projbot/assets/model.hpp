@@ -28,7 +28,7 @@ struct Sampler {
 /// Unlit material: a pixel shows texture * base_color_factor * vertex colour.
 struct Material {
   std::array<float, 4> base_color_factor{1.0F, 1.0F, 1.0F, 1.0F};  ///< linear RGBA multiplier
-  int base_color_image = -1;  ///< index into Model::images, -1 for none
+  int base_color_image = -1;                                       ///< index into Model::images, -1 for none
   Sampler sampler;
   AlphaMode alpha_mode = AlphaMode::kOpaque;
   float alpha_cutoff = 0.5F;  ///< used with kMask
@@ -38,8 +38,8 @@ struct Material {
 /// Interleaved vertex as uploaded to the GPU. Position in the model frame, metres.
 struct Vertex {
   std::array<float, 3> position{};
-  std::array<float, 3> normal{};  ///< unit length, model frame
-  std::array<float, 2> uv{};      ///< TEXCOORD_0 (0,0 when absent)
+  std::array<float, 3> normal{};                       ///< unit length, model frame
+  std::array<float, 2> uv{};                           ///< TEXCOORD_0 (0,0 when absent)
   std::array<float, 4> color{1.0F, 1.0F, 1.0F, 1.0F};  ///< COLOR_0 (white when absent)
 };
 

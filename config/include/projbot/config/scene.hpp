@@ -32,10 +32,10 @@ struct ProjectorConfig {
 
 /// One target object: its textured model and its pose in the projector frame.
 struct TargetConfig {
-  std::string name;              ///< unique within the scene
-  std::filesystem::path model;   ///< glTF (.gltf/.glb); relative paths resolved against the scene's folder
-  double scale = 1.0;            ///< uniform scale applied to the model frame (> 0)
-  bool recenter = false;         ///< move the model frame's origin to the surface centroid
+  std::string name;             ///< unique within the scene
+  std::filesystem::path model;  ///< glTF (.gltf/.glb); relative paths resolved against the scene's folder
+  double scale = 1.0;           ///< uniform scale applied to the model frame (> 0)
+  bool recenter = false;        ///< move the model frame's origin to the surface centroid
   /// T_projector_target: maps model-frame points (metres) into the projector frame. Rigid.
   Eigen::Matrix4d T_projector_target = Eigen::Matrix4d::Identity();
 };

@@ -13,20 +13,20 @@ namespace projbot::engine {
 /// One frame's timeline, milliseconds since the profiler started (NaN where not measured).
 struct FrameRecord {
   std::uint64_t index = 0;
-  double start_ms = 0.0;       ///< frame begins (before waiting for its frame slot)
-  double pose_read_ms = 0.0;   ///< poses read for this frame
-  double recorded_ms = 0.0;    ///< command buffer recorded
-  double submitted_ms = 0.0;   ///< queue submit returned
-  double presented_ms = 0.0;   ///< present returned (swapchain) or = submitted (offscreen)
-  double completed_ms = 0.0;   ///< the frame's fence was seen signalled
-  double gpu_ms = 0.0;         ///< GPU time from timestamp queries, NaN if the device has none
+  double start_ms = 0.0;      ///< frame begins (before waiting for its frame slot)
+  double pose_read_ms = 0.0;  ///< poses read for this frame
+  double recorded_ms = 0.0;   ///< command buffer recorded
+  double submitted_ms = 0.0;  ///< queue submit returned
+  double presented_ms = 0.0;  ///< present returned (swapchain) or = submitted (offscreen)
+  double completed_ms = 0.0;  ///< the frame's fence was seen signalled
+  double gpu_ms = 0.0;        ///< GPU time from timestamp queries, NaN if the device has none
 };
 
 /// Percentiles of frame time (start to next start) and GPU time, milliseconds.
 struct FrameSummary {
   std::size_t frames = 0;
   double p50_ms = 0, p95_ms = 0, p99_ms = 0, max_ms = 0, mean_ms = 0;
-  double fps = 0;  ///< frames / wall time from first start to last completion
+  double fps = 0;                         ///< frames / wall time from first start to last completion
   double gpu_p50_ms = 0, gpu_p99_ms = 0;  ///< NaN without timestamp queries
   double cpu_record_p50_ms = 0;           ///< pose read to command buffer recorded
 };

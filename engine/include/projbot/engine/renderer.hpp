@@ -45,10 +45,10 @@ enum class PresentMode { kFifo, kMailbox, kImmediate };
 /// A GLFW window: the projector output (fullscreen) or a preview (windowed).
 struct WindowOptions {
   std::string title = "projbot";
-  int width_px = 1280;   ///< windowed size; ignored fullscreen (the monitor's mode is used)
+  int width_px = 1280;  ///< windowed size; ignored fullscreen (the monitor's mode is used)
   int height_px = 800;
   bool fullscreen = false;
-  int monitor = 0;       ///< index into the connected monitors, for fullscreen
+  int monitor = 0;                                ///< index into the connected monitors, for fullscreen
   PresentMode present_mode = PresentMode::kFifo;  ///< falls back to FIFO where unsupported
 };
 
@@ -74,7 +74,7 @@ class RenderTarget {
   RenderTarget(const RenderTarget&) = delete;
   RenderTarget& operator=(const RenderTarget&) = delete;
 
-  int width() const;   ///< current size in pixels
+  int width() const;  ///< current size in pixels
   int height() const;
   /// Windows: handles events, true once the user closed it. Offscreen: always false.
   bool poll_close();
