@@ -112,6 +112,11 @@ class WindowBackend final : public TargetBackend {
     if (window_ == nullptr)
       throw EngineError("GLFW could not create a " + std::to_string(w) + "x" + std::to_string(h) + " window");
     glfwSetWindowUserPointer(window_, this);
+    // Esc closes the output; a projector shows no mouse cursor.
+    glfwSetKeyCallback(window_, [](GLFWwindow* win, int key, int, int action, int) {
+      if (key == GLFW_KEY_ESCAPE && action == GLFW_PRESS) glfwSetWindowShouldClose(win, GLFW_TRUE);
+    });
+    if (options.fullscreen) glfwSetInputMode(window_, GLFW_CURSOR, GLFW_CURSOR_HIDDEN);
     glfwSetFramebufferSizeCallback(
         window_, [](GLFWwindow* win, int, int) { static_cast<WindowBackend*>(glfwGetWindowUserPointer(win))->resized_ = true; });
     VkSurfaceKHR raw_surface = VK_NULL_HANDLE;
