@@ -5,6 +5,7 @@
 #include <projbot/shaders/mesh.frag.spv.h>
 #include <projbot/shaders/mesh.vert.spv.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -20,14 +21,34 @@ using detail::Gpu;
 
 constexpr std::size_t kFramesInFlight = 2;
 
-/// Push constants of mesh.vert / mesh.frag (std430 layout: 88 bytes).
+/// Push constants of mesh.vert / mesh.frag (std430 layout: 84 bytes).
 struct DrawConstants {
   std::array<float, 16> clip_from_model;
   std::array<float, 4> base_color_factor;
   float alpha_cutoff;
-  std::int32_t alpha_mode;
 };
-static_assert(sizeof(DrawConstants) == 88);
+static_assert(sizeof(DrawConstants) == 84);
+
+/// The fragment shader's kAlphaMode specialisation constant.
+std::int32_t alpha_mode_id(assets::AlphaMode mode) {
+  return mode == assets::AlphaMode::kOpaque ? 0 : mode == assets::AlphaMode::kMask ? 1 : 2;
+}
+
+/// What a vertex is on the GPU: 24 bytes, half of assets::Vertex. The projector pass needs no normal, and
+/// COLOR_0 as UNORM8 is exact for 8-bit glTF colours and within half a step of the 8-bit output otherwise.
+struct GpuVertex {
+  std::array<float, 3> position;
+  std::array<float, 2> uv;
+  std::array<std::uint8_t, 4> color;
+};
+static_assert(sizeof(GpuVertex) == 24);
+
+GpuVertex to_gpu(const assets::Vertex& v) {
+  GpuVertex g{v.position, v.uv, {}};
+  for (std::size_t k = 0; k < 4; ++k)
+    g.color[k] = static_cast<std::uint8_t>(std::lround(std::clamp(v.color[k], 0.0F, 1.0F) * 255.0F));
+  return g;
+}
 
 vk::SamplerAddressMode to_vk(assets::Wrap w) {
   switch (w) {
@@ -69,8 +90,8 @@ struct Renderer::Impl {
   vk::raii::PipelineLayout pipeline_layout{nullptr};
   vk::raii::ShaderModule vert{nullptr};
   vk::raii::ShaderModule frag{nullptr};
-  std::map<std::tuple<vk::Format, bool, bool>, vk::raii::Pipeline> pipelines;  // (format, cull back, blend)
-  detail::Image white;                                                         // bound where a material has no texture
+  std::map<std::tuple<vk::Format, bool, std::int32_t>, vk::raii::Pipeline> pipelines;  // (format, cull back, alpha mode)
+  detail::Image white;                                                                 // bound where a material has no texture
   std::vector<GpuModel> models;
   std::vector<DrawItem> items;
   std::uint64_t frame_index = 0;
@@ -118,17 +139,18 @@ struct Renderer::Impl {
   }
 
   // One pipeline builder: every variant differs only in target format, culling and blending.
-  const vk::raii::Pipeline& pipeline(vk::Format format, bool cull_back, bool blend) {
-    const auto key = std::make_tuple(format, cull_back, blend);
+  const vk::raii::Pipeline& pipeline(vk::Format format, bool cull_back, std::int32_t alpha_mode) {
+    const auto key = std::make_tuple(format, cull_back, alpha_mode);
     if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
+    const bool blend = alpha_mode == 2;
+    const vk::SpecializationMapEntry entry(0, 0, sizeof(std::int32_t));
+    const vk::SpecializationInfo specialization(1, &entry, sizeof(alpha_mode), &alpha_mode);
     const vk::PipelineShaderStageCreateInfo stages[] = {{{}, vk::ShaderStageFlagBits::eVertex, *vert, "main"},
-                                                        {{}, vk::ShaderStageFlagBits::eFragment, *frag, "main"}};
-    vk::VertexInputBindingDescription binding(0, sizeof(assets::Vertex), vk::VertexInputRate::eVertex);
-    const vk::VertexInputAttributeDescription attributes[] = {
-        {0, 0, vk::Format::eR32G32B32Sfloat, offsetof(assets::Vertex, position)},
-        {1, 0, vk::Format::eR32G32B32Sfloat, offsetof(assets::Vertex, normal)},
-        {2, 0, vk::Format::eR32G32Sfloat, offsetof(assets::Vertex, uv)},
-        {3, 0, vk::Format::eR32G32B32A32Sfloat, offsetof(assets::Vertex, color)}};
+                                                        {{}, vk::ShaderStageFlagBits::eFragment, *frag, "main", &specialization}};
+    vk::VertexInputBindingDescription binding(0, sizeof(GpuVertex), vk::VertexInputRate::eVertex);
+    const vk::VertexInputAttributeDescription attributes[] = {{0, 0, vk::Format::eR32G32B32Sfloat, offsetof(GpuVertex, position)},
+                                                              {1, 0, vk::Format::eR32G32Sfloat, offsetof(GpuVertex, uv)},
+                                                              {2, 0, vk::Format::eR8G8B8A8Unorm, offsetof(GpuVertex, color)}};
     vk::PipelineVertexInputStateCreateInfo vertex_input({}, binding, attributes);
     vk::PipelineInputAssemblyStateCreateInfo assembly({}, vk::PrimitiveTopology::eTriangleList);
     vk::PipelineViewportStateCreateInfo viewport({}, 1, nullptr, 1, nullptr);
@@ -157,18 +179,17 @@ struct Renderer::Impl {
   std::size_t add_model(const assets::Model& model) {
     if (model.primitives.empty()) throw EngineError(model.source + ": model has no triangles to draw");
     GpuModel g;
-    std::vector<assets::Vertex> vertices;
+    std::vector<GpuVertex> vertices;
     std::vector<std::uint32_t> indices;
     for (const auto& p : model.primitives) {
       if (p.material < 0 || static_cast<std::size_t>(p.material) >= model.materials.size())
         throw EngineError(model.source + ": primitive refers to a missing material");
       g.parts.push_back({static_cast<std::uint32_t>(indices.size()), static_cast<std::uint32_t>(p.indices.size()),
                          static_cast<std::int32_t>(vertices.size()), static_cast<std::size_t>(p.material)});
-      vertices.insert(vertices.end(), p.vertices.begin(), p.vertices.end());
+      for (const auto& v : p.vertices) vertices.push_back(to_gpu(v));
       indices.insert(indices.end(), p.indices.begin(), p.indices.end());
     }
-    g.vertices =
-        gpu->upload_buffer(vertices.data(), vertices.size() * sizeof(assets::Vertex), vk::BufferUsageFlagBits::eVertexBuffer);
+    g.vertices = gpu->upload_buffer(vertices.data(), vertices.size() * sizeof(GpuVertex), vk::BufferUsageFlagBits::eVertexBuffer);
     g.indices = gpu->upload_buffer(indices.data(), indices.size() * sizeof(std::uint32_t), vk::BufferUsageFlagBits::eIndexBuffer);
     for (const auto& img : model.images) g.textures.push_back(img.rgba.empty() ? detail::Image{} : upload_texture(img));
     g.materials = model.materials;
@@ -248,11 +269,10 @@ struct Renderer::Impl {
         for (const auto& part : m.parts) {
           const assets::Material& mat = m.materials[part.material];
           if ((mat.alpha_mode == assets::AlphaMode::kBlend) != blend_pass) continue;
-          cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline(format, !mat.double_sided, blend_pass));
+          cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline(format, !mat.double_sided, alpha_mode_id(mat.alpha_mode)));
           cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout, 0, *m.sets[part.material], {});
           c.base_color_factor = mat.base_color_factor;
           c.alpha_cutoff = mat.alpha_cutoff;
-          c.alpha_mode = mat.alpha_mode == assets::AlphaMode::kOpaque ? 0 : mat.alpha_mode == assets::AlphaMode::kMask ? 1 : 2;
           cmd.pushConstants<DrawConstants>(*pipeline_layout,
                                            vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, c);
           cmd.drawIndexed(part.index_count, 1, part.first_index, part.vertex_offset, 0);
