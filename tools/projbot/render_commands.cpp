@@ -50,13 +50,9 @@ const Command kRender{"render", "render the projector image headless (offscreen)
                       "projbot render [--scene S.yaml] --out frame.png [--frames N] [--profile p.csv] [overrides]\n\n"
                       "Draws every target of the scene through the projector's intrinsics, with no window system, and\n"
                       "writes the last frame as an RGBA PNG: exactly the image the projector must show.\n",
-                      [] {
-                        auto o = scene_options();
-                        o.insert(o.begin(), {{"out", "FILE", "PNG to write (required)"},
-                                             {"frames", "N", "frames to draw, for timing (default 1)"},
-                                             {"profile", "FILE", "write one CSV row of timings per frame"}});
-                        return o;
-                      }(),
+                      with_scene_options({{"out", "FILE", "PNG to write (required)"},
+                                          {"frames", "N", "frames to draw, for timing (default 1)"},
+                                          {"profile", "FILE", "write one CSV row of timings per frame"}}),
                       [](const cli::Args& args) {
                         const auto out = args.get("out");
                         if (!out) throw cli::UsageError("--out FILE is required");
@@ -81,15 +77,11 @@ const Command kShow{
     "projbot show [--scene S.yaml] [--fullscreen] [--monitor N] [--present-mode fifo|mailbox|immediate]\n\n"
     "Opens a window showing the projector image and redraws it every frame until the window is closed\n"
     "(or --frames have been drawn). Without --fullscreen the window has the projector's size.\n",
-    [] {
-      auto o = scene_options();
-      o.insert(o.begin(), {{"fullscreen", "", "fullscreen on --monitor (the projector)"},
-                           {"monitor", "N", "monitor index for --fullscreen (default 0)"},
-                           {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
-                           {"frames", "N", "close after N frames (default: run until closed)"},
-                           {"profile", "FILE", "write one CSV row of timings per frame"}});
-      return o;
-    }(),
+    with_scene_options({{"fullscreen", "", "fullscreen on --monitor (the projector)"},
+                        {"monitor", "N", "monitor index for --fullscreen (default 0)"},
+                        {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
+                        {"frames", "N", "close after N frames (default: run until closed)"},
+                        {"profile", "FILE", "write one CSV row of timings per frame"}}),
     [](const cli::Args& args) {
       const config::Scene scene = scene_from_args(args);
       const int frames = args.get_int("frames", 0, 0, 100000000);

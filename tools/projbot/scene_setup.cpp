@@ -7,18 +7,20 @@
 
 namespace projbot::tools {
 
-std::vector<cli::OptionSpec> scene_options() {
-  return {
-      {"scene", "FILE", "scene YAML (default: the shipped demo scene)"},
-      {"model", "FILE", "glTF model for the scene's single target (without --scene: framed in view)"},
-      {"size", "WxH", "projector image size in pixels, e.g. 1920x1080"},
-      {"intrinsics", "fx,fy,cx,cy", "projector intrinsics in pixels (OpenCV pinhole)"},
-      {"near", "M", "near clipping distance, metres"},
-      {"far", "M", "far clipping distance, metres"},
-      {"pose-matrix", "m00,...,m33", "T_projector_target of the single target: 16 numbers, row-major, metres"},
-      {"device", "N", "Vulkan physical device index (default: best available)"},
-      {"validation", "", "enable the Vulkan validation layer and report its messages"},
-  };
+std::vector<cli::OptionSpec> with_scene_options(std::vector<cli::OptionSpec> own) {
+  own.insert(own.end(),
+             {
+                 {"scene", "FILE", "scene YAML (default: the shipped demo scene)"},
+                 {"model", "FILE", "glTF model for the scene's single target (without --scene: framed in view)"},
+                 {"size", "WxH", "projector image size in pixels, e.g. 1920x1080"},
+                 {"intrinsics", "fx,fy,cx,cy", "projector intrinsics in pixels (OpenCV pinhole)"},
+                 {"near", "M", "near clipping distance, metres"},
+                 {"far", "M", "far clipping distance, metres"},
+                 {"pose-matrix", "m00,...,m33", "T_projector_target of the single target: 16 numbers, row-major, metres"},
+                 {"device", "N", "Vulkan physical device index (default: best available)"},
+                 {"validation", "", "enable the Vulkan validation layer and report its messages"},
+             });
+  return own;
 }
 
 std::filesystem::path asset_dir() {

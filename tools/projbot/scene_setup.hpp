@@ -11,8 +11,8 @@
 
 namespace projbot::tools {
 
-/// Options every subcommand that draws a scene accepts.
-std::vector<cli::OptionSpec> scene_options();
+/// A subcommand's own options followed by those every subcommand that draws a scene accepts.
+std::vector<cli::OptionSpec> with_scene_options(std::vector<cli::OptionSpec> own);
 
 /// The folder holding the shipped demo assets (PROJBOT_ASSETS overrides the built-in path).
 std::filesystem::path asset_dir();
