@@ -33,6 +33,7 @@ class CliTest : public ::testing::Test {
   void SetUp() override {
     dir_ = fs::temp_directory_path() / ("projbot_cli_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
+    write("bad.pcd", "# .PCD v0.7\nFIELDS x y z\nthis is not a point cloud\n");
   }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path write(const std::string& name, const std::string& text) const {
@@ -86,6 +87,19 @@ TEST_F(CliTest, OverridesAndProfile) {
   ASSERT_EQ(behind.code, 0) << behind.output;
   const auto img = projbot::assets::read_image(out);
   for (std::size_t i = 0; i < img.rgba.size(); i += 4) ASSERT_EQ(img.rgba[i], 0);
+}
+
+TEST_F(CliTest, AlignPrintsJson) {
+  const std::string bunny = std::string(PROJBOT_SHARED_DATA) + "/bunny/";
+  const CliRun r = run_projbot("align --model " + bunny + "bun0.pcd --scan " + bunny +
+                               "bun4.pcd --no-crop --init \"0.03 0 0.03 0 -30 0\" --json");
+  ASSERT_EQ(r.code, 0) << r.output;
+  // One JSON object: T row-major with the reference's -34 degree turn about y, and the gate's numbers.
+  EXPECT_EQ(r.output.rfind("{\"T\":[[", 0), 0U) << r.output;
+  for (const char* key : {"\"converged\":true", "\"inlier_ratio\"", "\"rmse_mm\"", "\"iterations\"", "\"time_ms\""})
+    EXPECT_NE(r.output.find(key), std::string::npos) << key;
+  const double m00 = std::stod(r.output.substr(8));
+  EXPECT_NEAR(m00, 0.825, 0.02);  // cos(34.4 degrees)
 }
 
 struct BadRun {
@@ -155,5 +169,25 @@ INSTANTIATE_TEST_SUITE_P(
                "",
                1,
                {"/nonexistent-dir/a.png", "cannot write"}},
-        BadRun{"bench_without_target", "bench", "", 2, {"bench render"}}),
+        BadRun{"bench_without_target", "bench", "", 2, {"bench render"}},
+        BadRun{"align_no_model", "align --scan x.pcd", "", 2, {"--model FILE is required"}},
+        BadRun{"align_missing_scan",
+               "align --model " + kDuck + " --scan {dir}/none.pcd",
+               "",
+               1,
+               {"none.pcd", "no such point cloud"}},
+        BadRun{"align_bad_scan_type", "align --model " + kDuck + " --scan {dir}/bad.yaml", "a: 1\n", 2, {"--scan must be"}},
+        BadRun{"align_nan_init",
+               "align --model " + kDuck + " --scan {dir}/a.pcd --init \"0 0 nan 0 0 0\"",
+               "",
+               1,
+               {"--init", "finite"}},
+        BadRun{"align_both_inits",
+               "align --model " + kDuck + " --scan {dir}/a.pcd --init \"0 0 1 0 0 0\" --init-matrix 1",
+               "",
+               2,
+               {"not both"}},
+        BadRun{"align_empty_cloud", "align --model " + kDuck + " --scan {dir}/bad.pcd", "", 1, {"bad.pcd"}},
+        BadRun{
+            "align_missing_model", "align --model {dir}/none.glb --scan {dir}/a.pcd", "", 1, {"none.glb", "no such model file"}}),
     [](const ::testing::TestParamInfo<BadRun>& param_info) { return std::string(param_info.param.name); });

@@ -20,5 +20,6 @@ struct Command {
 extern const Command kRender;
 extern const Command kShow;
 extern const Command kBenchRender;
+extern const Command kAlign;
 
 }  // namespace projbot::tools

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "projbot/alignment/depth.hpp"
 #include "projbot/assets/image.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
@@ -14,7 +15,8 @@ namespace {
 using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
-  static const std::vector<const Command*> all{&projbot::tools::kRender, &projbot::tools::kShow, &projbot::tools::kBenchRender};
+  static const std::vector<const Command*> all{&projbot::tools::kRender, &projbot::tools::kShow, &projbot::tools::kBenchRender,
+                                               &projbot::tools::kAlign};
   return all;
 }
 
@@ -32,6 +34,7 @@ void print_help() {
                "  projbot render --out frame.png                    the demo scene, headless\n"
                "  projbot render --model duck.glb --out duck.png    one model, framed in view\n"
                "  projbot show --scene my.yaml --fullscreen --monitor 1\n"
+               "  projbot align --model bun0.pcd --scan bun4.pcd --init \"0 0 0 0 -30 0\" --json\n"
                "  projbot bench render\n";
 }
 
@@ -81,6 +84,9 @@ int main(int argc, char** argv) {
     std::cerr << "projbot " << name << ": " << e.what() << '\n';
     return 1;
   } catch (const projbot::assets::AssetError& e) {
+    std::cerr << "projbot " << name << ": " << e.what() << '\n';
+    return 1;
+  } catch (const projbot::alignment::AlignmentError& e) {
     std::cerr << "projbot " << name << ": " << e.what() << '\n';
     return 1;
   } catch (const projbot::engine::EngineError& e) {

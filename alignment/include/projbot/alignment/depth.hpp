@@ -1,0 +1,81 @@
+#pragma once
+// Depth input: images from files, point clouds from PCD / PLY, and depth -> organised cloud through the
+// camera intrinsics. Plain types only; PCL stays inside src/.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+namespace projbot::alignment {
+
+/// A bad depth file, cloud or request: the message names the file and what is wrong.
+class AlignmentError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Pinhole intrinsics of a depth camera, OpenCV convention (x right, y down, z forward), pixels.
+struct CameraIntrinsics {
+  int width_px = 640;
+  int height_px = 480;
+  double fx_px = 525.0;
+  double fy_px = 525.0;
+  double cx_px = 319.5;
+  double cy_px = 239.5;
+
+  /// Kinect v1 / PrimeSense depth camera defaults: 640x480, f = 525 px, principal point at the image
+  /// centre (the TUM RGB-D and Open3D defaults; PCL's OpenNI grabber reports cx 320, cy 240).
+  static CameraIntrinsics kinect_v1() { return {}; }
+};
+
+/// A depth image in metres, row-major, top row first; 0 or NaN marks a missing measurement.
+struct DepthImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> depth_m;
+  double capture_time_s = 0.0;  ///< when the frame was taken (steady clock or recording time)
+
+  float at(int x, int y) const { return depth_m[static_cast<std::size_t>(y) * width + x]; }
+};
+
+/// Points in the camera frame, metres. Organised when height > 1: one point per pixel, NaN where the
+/// pixel had no valid depth (like PCL's organised clouds). Unorganised: height 1, all finite.
+struct PointCloud {
+  std::vector<Eigen::Vector3f> points;
+  int width = 0;
+  int height = 0;
+
+  bool organised() const { return height > 1; }
+  std::size_t finite_count() const;
+};
+
+/// Reads a 16-bit PNG depth image; `units_per_metre` converts its values (1000 for mm, 5000 for TUM).
+DepthImage read_depth_png(const std::filesystem::path& path, double units_per_metre);
+
+/// Reads a 16-bit TIFF depth image (PCL's image grabber format); `metres_per_unit` converts its values
+/// (PCL's `z_multiplication_factor`, 0.001 for mm).
+DepthImage read_depth_tiff(const std::filesystem::path& path, double metres_per_unit);
+
+/// Reads the depth intrinsics and z factor from a PCL grabber XML file (<depth><focal_length_x>...).
+struct GrabberCalibration {
+  CameraIntrinsics intrinsics;
+  double metres_per_unit = 0.001;
+};
+GrabberCalibration read_pcl_grabber_xml(const std::filesystem::path& path, int width_px, int height_px);
+
+/// Back-projects a depth image: pixel (i, j) with depth z becomes ((i - cx) z / fx, (j - cy) z / fy, z).
+/// Zero, NaN and out-of-range (< min_m or > max_m) pixels become NaN points; zero is never valid. The
+/// result is organised.
+PointCloud depth_to_cloud(const DepthImage& depth, const CameraIntrinsics& k, double min_m = 0.3, double max_m = 8.0);
+
+/// Reads a PCD or PLY file (by extension) as x, y, z; keeps the organisation of organised PCDs.
+PointCloud read_cloud(const std::filesystem::path& path);
+
+/// Writes a cloud as binary PCD.
+void write_pcd(const std::filesystem::path& path, const PointCloud& cloud);
+
+/// Drops non-finite points: the result is unorganised.
+PointCloud finite_points(const PointCloud& cloud);
+
+}  // namespace projbot::alignment

@@ -1,0 +1,80 @@
+#pragma once
+// Acquisition: the target's pose from an initial guess, by ICP of its model against a captured cloud,
+// with a quality gate and a global re-initialisation (FPFH + SampleConsensusPrerejective) when the
+// gate fails. Not thread-safe: one Aligner per thread.
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "projbot/alignment/depth.hpp"
+
+namespace projbot::alignment {
+
+/// The target model as points with normals in the model frame, metres.
+struct ModelCloud {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<Eigen::Vector3f> normals;  ///< unit; estimated from the points when a file has none
+};
+
+/// Model points from a glTF (area-uniform surface samples) or a PCD / PLY file (normals estimated).
+ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t samples = 50000);
+
+/// Defaults suit a Kinect-class camera 0.5-3 m from a 10-50 cm object.
+struct AcquisitionConfig {
+  bool crop = true;                   ///< keep scan points near the expected target only
+  double crop_margin_m = 0.10;        ///< crop radius = model radius + this, around the initial guess
+  double voxel_m = 0.004;             ///< voxel grid leaf for scan and model
+  int outlier_neighbours = 16;        ///< statistical outlier removal: neighbours considered
+  double outlier_stddev = 2.5;        ///< ... and the distance threshold in standard deviations
+  int normal_neighbours = 16;         ///< scan normals from this many nearest neighbours
+  /// ICP stages, coarse to fine: correspondence distances, metres. The last stage should be about
+  /// inlier_distance_m so that parts of the model the scan does not see stop pulling the estimate.
+  std::vector<double> icp_distances_m{0.08, 0.02, 0.006};
+  int icp_iterations = 40;            ///< per stage
+  double inlier_distance_m = 0.006;   ///< a scan point within this of the model counts as explained
+  double min_inlier_ratio = 0.5;      ///< quality gate: share of cropped scan points explained
+  double max_rmse_mm = 4.0;           ///< quality gate: RMS distance of the inliers
+  bool reinitialise = true;           ///< try FPFH + SampleConsensusPrerejective when the gate fails
+  double reinit_crop_margin_m = 0.35; ///< re-initialisation searches model radius + this around the guess
+  double feature_radius_m = 0.03;     ///< FPFH support radius
+  int ransac_iterations = 20000;
+  std::size_t min_points = 30;        ///< fewer valid scan points than this is an error
+};
+
+/// One estimate with the numbers the quality gate judged it by.
+struct AlignmentResult {
+  Eigen::Matrix4d T_scan_model = Eigen::Matrix4d::Identity();  ///< maps model points into the scan frame
+  bool converged = false;        ///< ICP converged and the quality gate passed
+  double inlier_ratio = 0.0;     ///< share of cropped scan points within inlier_distance_m of the model
+  double rmse_mm = 0.0;          ///< RMS point-to-model distance of those inliers, millimetres
+  int iterations = 0;            ///< ICP iterations, all stages and attempts
+  double time_ms = 0.0;          ///< wall time of align()
+  bool reinitialised = false;    ///< the global re-initialisation produced this result
+  std::size_t scan_points = 0;   ///< scan points after cropping and filtering
+};
+
+class Aligner {
+ public:
+  /// Prepares the model (downsampling, search structures). Throws AlignmentError for an empty model.
+  Aligner(ModelCloud model, AcquisitionConfig config = {});
+  ~Aligner();
+  Aligner(Aligner&&) noexcept;
+  Aligner& operator=(Aligner&&) noexcept;
+
+  /// Refines T_init (model -> scan frame) against the scan. Throws AlignmentError when the scan has
+  /// fewer than min_points valid points (after cropping) or T_init is not finite.
+  AlignmentResult align(const PointCloud& scan, const Eigen::Matrix4d& T_init) const;
+
+  /// The quality-gate numbers of a given pose, without refining it (converged: the gate passes).
+  AlignmentResult score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const;
+
+  const AcquisitionConfig& config() const;
+  double model_radius_m() const;  ///< largest distance of a model point from the model origin
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace projbot::alignment

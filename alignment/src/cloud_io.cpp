@@ -1,0 +1,55 @@
+// PCD and PLY through PCL's readers: the only translation unit with pcl/io.
+
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <cctype>
+
+#include "projbot/alignment/depth.hpp"
+
+namespace projbot::alignment {
+
+PointCloud read_cloud(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw AlignmentError(path.string() + ": no such point cloud file");
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  int rc = -1;
+  // PCL prints its own complaints to stderr; ours, below, names the file and what to do.
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  try {
+    if (ext == ".pcd") rc = pcl::io::loadPCDFile(path.string(), cloud);
+    else if (ext == ".ply") rc = pcl::io::loadPLYFile(path.string(), cloud);
+    else throw AlignmentError(path.string() + ": unknown point cloud format (use .pcd or .ply)");
+  } catch (const pcl::PCLException& e) {
+    throw AlignmentError(path.string() + ": cannot read point cloud: " + e.what());
+  }
+  if (rc < 0) throw AlignmentError(path.string() + ": cannot read point cloud (malformed " + ext.substr(1) + " file?)");
+  if (cloud.empty()) throw AlignmentError(path.string() + ": the point cloud holds no points (malformed or empty file?)");
+  PointCloud out;
+  out.width = static_cast<int>(cloud.width);
+  out.height = static_cast<int>(cloud.height);
+  if (static_cast<std::size_t>(out.width) * static_cast<std::size_t>(std::max(out.height, 1)) != cloud.size()) {
+    out.width = static_cast<int>(cloud.size());
+    out.height = 1;
+  }
+  out.points.reserve(cloud.size());
+  for (const auto& p : cloud) out.points.emplace_back(p.x, p.y, p.z);
+  return out;
+}
+
+void write_pcd(const std::filesystem::path& path, const PointCloud& cloud) {
+  pcl::PointCloud<pcl::PointXYZ> pc;
+  pc.width = static_cast<std::uint32_t>(cloud.width);
+  pc.height = static_cast<std::uint32_t>(std::max(cloud.height, 1));
+  pc.is_dense = cloud.finite_count() == cloud.points.size();
+  for (const auto& p : cloud.points) pc.push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+  pc.width = static_cast<std::uint32_t>(cloud.width);
+  pc.height = static_cast<std::uint32_t>(std::max(cloud.height, 1));
+  if (pcl::io::savePCDFileBinary(path.string(), pc) < 0) throw AlignmentError(path.string() + ": cannot write PCD");
+}
+
+}  // namespace projbot::alignment

@@ -1,0 +1,121 @@
+// Depth images and their back-projection. PNG through stb, TIFF through libtiff, the grabber XML
+// through Boost.PropertyTree; no PCL here.
+
+#include <stb_image.h>
+#include <tiffio.h>
+
+#include <boost/property_tree/ptree.hpp>
+#include <boost/property_tree/xml_parser.hpp>
+#include <cmath>
+#include <memory>
+
+#include "projbot/alignment/depth.hpp"
+
+namespace projbot::alignment {
+
+std::size_t PointCloud::finite_count() const {
+  std::size_t n = 0;
+  for (const auto& p : points) n += p.allFinite() ? 1 : 0;
+  return n;
+}
+
+DepthImage read_depth_png(const std::filesystem::path& path, double units_per_metre) {
+  if (!(units_per_metre > 0.0) || !std::isfinite(units_per_metre))
+    throw AlignmentError(path.string() + ": depth scale must be a finite number > 0 units per metre");
+  int w = 0, h = 0, comps = 0;
+  if (!stbi_info(path.c_str(), &w, &h, &comps)) throw AlignmentError(path.string() + ": cannot read PNG: " + stbi_failure_reason());
+  if (!stbi_is_16_bit(path.c_str()) || comps != 1)
+    throw AlignmentError(path.string() + ": a depth PNG must be 16-bit single-channel (this one has " + std::to_string(comps) +
+                         " channel(s), " + (stbi_is_16_bit(path.c_str()) ? "16" : "8") + " bits)");
+  std::unique_ptr<stbi_us, void (*)(void*)> data(stbi_load_16(path.c_str(), &w, &h, &comps, 1), stbi_image_free);
+  if (!data) throw AlignmentError(path.string() + ": cannot decode PNG: " + stbi_failure_reason());
+  DepthImage d;
+  d.width = w;
+  d.height = h;
+  d.depth_m.resize(static_cast<std::size_t>(w) * h);
+  for (std::size_t i = 0; i < d.depth_m.size(); ++i) d.depth_m[i] = static_cast<float>(data.get()[i] / units_per_metre);
+  return d;
+}
+
+DepthImage read_depth_tiff(const std::filesystem::path& path, double metres_per_unit) {
+  if (!(metres_per_unit > 0.0) || !std::isfinite(metres_per_unit))
+    throw AlignmentError(path.string() + ": depth scale must be a finite number > 0 metres per unit");
+  TIFFSetWarningHandler(nullptr);  // libtiff warns on stderr about harmless private tags
+  TIFFSetErrorHandler(nullptr);
+  std::unique_ptr<TIFF, void (*)(TIFF*)> tif(TIFFOpen(path.c_str(), "r"), TIFFClose);
+  if (!tif) throw AlignmentError(path.string() + ": cannot open TIFF");
+  std::uint32_t w = 0, h = 0;
+  std::uint16_t bits = 0, samples = 1;
+  TIFFGetField(tif.get(), TIFFTAG_IMAGEWIDTH, &w);
+  TIFFGetField(tif.get(), TIFFTAG_IMAGELENGTH, &h);
+  TIFFGetFieldDefaulted(tif.get(), TIFFTAG_BITSPERSAMPLE, &bits);
+  TIFFGetFieldDefaulted(tif.get(), TIFFTAG_SAMPLESPERPIXEL, &samples);
+  if (bits != 16 || samples != 1 || w == 0 || h == 0 || w > 16384 || h > 16384)
+    throw AlignmentError(path.string() + ": a depth TIFF must be 16-bit single-channel (this one: " + std::to_string(bits) + " bits, " +
+                         std::to_string(samples) + " samples, " + std::to_string(w) + "x" + std::to_string(h) + ")");
+  DepthImage d;
+  d.width = static_cast<int>(w);
+  d.height = static_cast<int>(h);
+  d.depth_m.resize(static_cast<std::size_t>(w) * h);
+  std::vector<std::uint16_t> row(TIFFScanlineSize(tif.get()) / 2 + 1);
+  for (std::uint32_t y = 0; y < h; ++y) {
+    if (TIFFReadScanline(tif.get(), row.data(), y, 0) < 0) throw AlignmentError(path.string() + ": TIFF row " + std::to_string(y) + " is corrupt");
+    for (std::uint32_t x = 0; x < w; ++x) d.depth_m[static_cast<std::size_t>(y) * w + x] = static_cast<float>(row[x] * metres_per_unit);
+  }
+  return d;
+}
+
+GrabberCalibration read_pcl_grabber_xml(const std::filesystem::path& path, int width_px, int height_px) {
+  boost::property_tree::ptree tree;
+  try {
+    boost::property_tree::read_xml(path.string(), tree);
+    GrabberCalibration c;
+    c.intrinsics.width_px = width_px;
+    c.intrinsics.height_px = height_px;
+    c.intrinsics.fx_px = tree.get<double>("depth.focal_length_x");
+    c.intrinsics.fy_px = tree.get<double>("depth.focal_length_y");
+    c.intrinsics.cx_px = tree.get<double>("depth.principal_point_x");
+    c.intrinsics.cy_px = tree.get<double>("depth.principal_point_y");
+    c.metres_per_unit = tree.get<double>("depth.z_multiplication_factor", 0.001);
+    if (!(c.intrinsics.fx_px > 0) || !(c.intrinsics.fy_px > 0) || !(c.metres_per_unit > 0))
+      throw AlignmentError(path.string() + ": focal lengths and z_multiplication_factor must be > 0");
+    return c;
+  } catch (const boost::property_tree::ptree_error& e) {
+    throw AlignmentError(path.string() + ": not a PCL grabber calibration: " + e.what());
+  }
+}
+
+PointCloud depth_to_cloud(const DepthImage& depth, const CameraIntrinsics& k, double min_m, double max_m) {
+  if (depth.width != k.width_px || depth.height != k.height_px)
+    throw AlignmentError("depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) + " but the intrinsics are for " +
+                         std::to_string(k.width_px) + "x" + std::to_string(k.height_px));
+  if (!(k.fx_px > 0) || !(k.fy_px > 0)) throw AlignmentError("depth intrinsics need fx, fy > 0");
+  PointCloud c;
+  c.width = depth.width;
+  c.height = depth.height;
+  c.points.resize(depth.depth_m.size());
+  const float nan = std::nanf("");
+  for (int y = 0; y < depth.height; ++y)
+    for (int x = 0; x < depth.width; ++x) {
+      const float z = depth.at(x, y);
+      auto& p = c.points[static_cast<std::size_t>(y) * depth.width + x];
+      if (!(z > 0.0F && z >= min_m && z <= max_m)) {  // also false for NaN
+        p = {nan, nan, nan};
+        continue;
+      }
+      p = {static_cast<float>((x - k.cx_px) * z / k.fx_px), static_cast<float>((y - k.cy_px) * z / k.fy_px), z};
+    }
+  return c;
+}
+
+PointCloud finite_points(const PointCloud& cloud) {
+  PointCloud out;
+  out.points.reserve(cloud.points.size());
+  for (const auto& p : cloud.points)
+    if (p.allFinite()) out.points.push_back(p);
+  out.width = static_cast<int>(out.points.size());
+  out.height = 1;
+  return out;
+}
+
+}  // namespace projbot::alignment

@@ -1,0 +1,295 @@
+// Acquisition by PCL: filters, normals, point-to-plane ICP and FPFH + SampleConsensusPrerejective.
+// The only translation unit with PCL's filters, features and registration.
+
+#include <pcl/features/fpfh_omp.h>
+#include <pcl/features/normal_3d.h>
+#include <pcl/filters/statistical_outlier_removal.h>
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/registration/icp.h>
+#include <pcl/registration/sample_consensus_prerejective.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "projbot/alignment/equations.hpp"
+#include "projbot/alignment/registration.hpp"
+#include "projbot/assets/model.hpp"
+
+namespace projbot::alignment {
+namespace {
+
+using PointN = pcl::PointNormal;
+using CloudN = pcl::PointCloud<PointN>;
+using Features = pcl::PointCloud<pcl::FPFHSignature33>;
+
+// PCL keeps the iteration count protected; the result struct reports it.
+class CountingIcp : public pcl::IterativeClosestPointWithNormals<PointN, PointN> {
+ public:
+  int iterations() const { return nr_iterations_; }
+};
+
+CloudN::Ptr voxel_downsample(const CloudN::ConstPtr& in, double leaf) {
+  auto out = pcl::make_shared<CloudN>();
+  pcl::VoxelGrid<PointN> grid;
+  grid.setInputCloud(in);
+  grid.setLeafSize(static_cast<float>(leaf), static_cast<float>(leaf), static_cast<float>(leaf));
+  grid.filter(*out);
+  for (auto& p : *out) {  // averaged normals are no longer unit
+    Eigen::Map<Eigen::Vector3f> n(p.normal);
+    const float len = n.norm();
+    if (len > 1e-6F) n /= len;
+  }
+  return out;
+}
+
+// Normals from k nearest neighbours, oriented towards the sensor at the origin; points without a
+// well-defined normal are dropped.
+CloudN::Ptr with_normals(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& in, int k) {
+  pcl::PointCloud<pcl::Normal> normals;
+  pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+  ne.setInputCloud(in);
+  ne.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  ne.setKSearch(std::min<int>(k, static_cast<int>(in->size()) - 1));
+  ne.setViewPoint(0.0F, 0.0F, 0.0F);
+  ne.compute(normals);
+  auto out = pcl::make_shared<CloudN>();
+  out->reserve(in->size());
+  for (std::size_t i = 0; i < in->size(); ++i) {
+    if (!std::isfinite(normals[i].normal_x)) continue;
+    PointN p;
+    p.x = (*in)[i].x, p.y = (*in)[i].y, p.z = (*in)[i].z;
+    p.normal_x = normals[i].normal_x, p.normal_y = normals[i].normal_y, p.normal_z = normals[i].normal_z;
+    p.curvature = normals[i].curvature;
+    out->push_back(p);
+  }
+  return out;
+}
+
+Features::Ptr fpfh(const CloudN::ConstPtr& cloud, double radius) {
+  auto features = pcl::make_shared<Features>();
+  pcl::FPFHEstimationOMP<PointN, PointN, pcl::FPFHSignature33> est;
+  est.setInputCloud(cloud);
+  est.setInputNormals(cloud);
+  est.setSearchMethod(pcl::make_shared<pcl::search::KdTree<PointN>>());
+  est.setRadiusSearch(radius);
+  est.compute(*features);
+  return features;
+}
+
+}  // namespace
+
+struct Aligner::Impl {
+  AcquisitionConfig cfg;
+  CloudN::Ptr model;        // all model samples, model frame: for the quality metrics
+  CloudN::Ptr model_icp;    // voxel-downsampled: ICP source
+  CloudN::Ptr model_coarse; // coarser: re-initialisation
+  mutable Features::Ptr model_features;  // computed on the first re-initialisation
+  pcl::KdTreeFLANN<PointN> model_tree;
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  double radius = 0.0;
+
+  double coarse_leaf() const { return std::max(cfg.voxel_m * 2.0, 0.008); }
+
+  // Finite scan points within `crop_radius` of `centre` (all of them when crop_radius <= 0), downsampled,
+  // outliers removed, with normals.
+  CloudN::Ptr prepare(const PointCloud& scan, const Eigen::Vector3f& centre, double crop_radius, double leaf) const {
+    auto raw = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    const float r2 = static_cast<float>(crop_radius * crop_radius);
+    for (const auto& p : scan.points)
+      if (p.allFinite() && (crop_radius <= 0.0 || (p - centre).squaredNorm() <= r2)) raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    if (raw->size() < cfg.min_points) return pcl::make_shared<CloudN>();
+    auto down = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    pcl::VoxelGrid<pcl::PointXYZ> grid;
+    grid.setInputCloud(raw);
+    grid.setLeafSize(static_cast<float>(leaf), static_cast<float>(leaf), static_cast<float>(leaf));
+    grid.filter(*down);
+    if (down->size() > static_cast<std::size_t>(cfg.outlier_neighbours) * 2) {
+      auto kept = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+      pcl::StatisticalOutlierRemoval<pcl::PointXYZ> sor;
+      sor.setInputCloud(down);
+      sor.setMeanK(cfg.outlier_neighbours);
+      sor.setStddevMulThresh(cfg.outlier_stddev);
+      sor.filter(*kept);
+      down = kept;
+    }
+    if (down->size() < cfg.min_points) return pcl::make_shared<CloudN>();
+    return with_normals(down, cfg.normal_neighbours);
+  }
+
+  // Point-to-plane ICP, coarse then fine correspondence distance.
+  Eigen::Matrix4d icp(const CloudN::ConstPtr& scan, const Eigen::Matrix4d& T_init, int& iterations, bool& converged) const {
+    Eigen::Matrix4f T = T_init.cast<float>();
+    converged = true;
+    for (const double distance : cfg.icp_distances_m) {
+      CountingIcp icp;
+      icp.setInputSource(model_icp);
+      icp.setInputTarget(scan);
+      icp.setMaxCorrespondenceDistance(distance);
+      icp.setMaximumIterations(cfg.icp_iterations);
+      icp.setTransformationEpsilon(1e-10);
+      icp.setEuclideanFitnessEpsilon(1e-12);
+      CloudN aligned;
+      icp.align(aligned, T);
+      iterations += icp.iterations();
+      converged = converged && icp.hasConverged();
+      T = icp.getFinalTransformation();
+    }
+    return T.cast<double>();
+  }
+
+  // Quality of a pose: scan points near the posed model are inliers when their point-to-plane distance
+  // to the nearest model sample is under inlier_distance_m.
+  void evaluate(const PointCloud& scan, const Eigen::Matrix4d& T, AlignmentResult& r) const {
+    const Eigen::Vector3f centre = (T * centroid.cast<double>().homogeneous()).head<3>().cast<float>();
+    const CloudN::Ptr near = prepare(scan, centre, cfg.crop ? radius + cfg.crop_margin_m : 0.0, cfg.voxel_m);
+    r.scan_points = near->size();
+    if (near->empty()) {
+      r.inlier_ratio = 0.0;
+      r.rmse_mm = std::numeric_limits<double>::infinity();
+      return;
+    }
+    const Eigen::Matrix4f inv = rigid_inverse(T).cast<float>();
+    std::size_t inliers = 0;
+    double sum2 = 0.0;
+    pcl::Indices index(1);
+    std::vector<float> dist2(1);
+    for (const auto& p : *near) {
+      PointN q;
+      q.getVector3fMap() = (inv * Eigen::Vector4f(p.x, p.y, p.z, 1.0F)).head<3>();
+      if (model_tree.nearestKSearch(q, 1, index, dist2) < 1) continue;
+      if (dist2[0] > 4.0F * static_cast<float>(cfg.inlier_distance_m * cfg.inlier_distance_m)) continue;
+      const PointN& m = (*model)[static_cast<std::size_t>(index[0])];
+      const double d = std::abs((q.getVector3fMap() - m.getVector3fMap()).dot(m.getNormalVector3fMap()));
+      if (d > cfg.inlier_distance_m) continue;
+      ++inliers;
+      sum2 += d * d;
+    }
+    r.inlier_ratio = static_cast<double>(inliers) / static_cast<double>(near->size());
+    r.rmse_mm = inliers > 0 ? 1000.0 * std::sqrt(sum2 / static_cast<double>(inliers)) : std::numeric_limits<double>::infinity();
+  }
+
+  bool passes(const AlignmentResult& r) const { return r.inlier_ratio >= cfg.min_inlier_ratio && r.rmse_mm <= cfg.max_rmse_mm; }
+
+  // Global re-initialisation: FPFH correspondences and SampleConsensusPrerejective over a wide region.
+  std::optional<Eigen::Matrix4d> reinitialise(const PointCloud& scan, const Eigen::Matrix4d& T_init) const {
+    const Eigen::Vector3f centre = (T_init * centroid.cast<double>().homogeneous()).head<3>().cast<float>();
+    const CloudN::Ptr wide = prepare(scan, centre, cfg.crop ? radius + cfg.reinit_crop_margin_m : 0.0, coarse_leaf());
+    if (wide->size() < cfg.min_points) return std::nullopt;
+    if (!model_features) model_features = fpfh(model_coarse, cfg.feature_radius_m);
+    const Features::Ptr scan_features = fpfh(wide, cfg.feature_radius_m);
+    pcl::SampleConsensusPrerejective<PointN, PointN, pcl::FPFHSignature33> sac;
+    sac.setInputSource(model_coarse);
+    sac.setSourceFeatures(model_features);
+    sac.setInputTarget(wide);
+    sac.setTargetFeatures(scan_features);
+    sac.setMaximumIterations(cfg.ransac_iterations);
+    sac.setNumberOfSamples(3);
+    sac.setCorrespondenceRandomness(5);
+    sac.setSimilarityThreshold(0.85F);
+    sac.setMaxCorrespondenceDistance(2.0 * coarse_leaf());
+    sac.setInlierFraction(0.2F);
+    CloudN aligned;
+    sac.align(aligned);
+    if (!sac.hasConverged()) return std::nullopt;
+    return sac.getFinalTransformation().cast<double>();
+  }
+};
+
+ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t samples) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  ModelCloud m;
+  if (ext == ".gltf" || ext == ".glb") {
+    try {
+      const auto s = assets::sample_surface(assets::load_gltf(path), samples, 1);
+      m.points = s.points;
+      m.normals = s.normals;
+    } catch (const assets::AssetError& e) {
+      throw AlignmentError(e.what());
+    }
+    return m;
+  }
+  const PointCloud cloud = finite_points(read_cloud(path));
+  if (cloud.points.size() < 10) throw AlignmentError(path.string() + ": model cloud has " + std::to_string(cloud.points.size()) + " valid points");
+  auto xyz = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (const auto& p : cloud.points) xyz->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+  for (const auto& p : *with_normals(xyz, 16)) {
+    m.points.push_back(p.getVector3fMap());
+    m.normals.push_back(p.getNormalVector3fMap());
+  }
+  return m;
+}
+
+Aligner::Aligner(ModelCloud model, AcquisitionConfig config) : impl_(std::make_unique<Impl>()) {
+  impl_->cfg = config;
+  if (model.points.size() < 10 || model.normals.size() != model.points.size())
+    throw AlignmentError("model needs at least 10 points, each with a normal (got " + std::to_string(model.points.size()) + ")");
+  impl_->model = pcl::make_shared<CloudN>();
+  for (std::size_t i = 0; i < model.points.size(); ++i) {
+    if (!model.points[i].allFinite() || !model.normals[i].allFinite()) throw AlignmentError("model point " + std::to_string(i) + " is not finite");
+    PointN p;
+    p.getVector3fMap() = model.points[i];
+    p.getNormalVector3fMap() = model.normals[i];
+    impl_->model->push_back(p);
+    impl_->centroid += model.points[i];
+  }
+  impl_->centroid /= static_cast<float>(model.points.size());
+  for (const auto& p : model.points) impl_->radius = std::max(impl_->radius, static_cast<double>((p - impl_->centroid).norm()));
+  impl_->model_tree.setInputCloud(impl_->model);
+  impl_->model_icp = voxel_downsample(impl_->model, config.voxel_m);
+  impl_->model_coarse = voxel_downsample(impl_->model, impl_->coarse_leaf());
+}
+
+Aligner::~Aligner() = default;
+Aligner::Aligner(Aligner&&) noexcept = default;
+Aligner& Aligner::operator=(Aligner&&) noexcept = default;
+const AcquisitionConfig& Aligner::config() const { return impl_->cfg; }
+double Aligner::model_radius_m() const { return impl_->radius; }
+
+AlignmentResult Aligner::score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const {
+  AlignmentResult r;
+  r.T_scan_model = T_scan_model;
+  impl_->evaluate(scan, T_scan_model, r);
+  r.converged = impl_->passes(r);
+  return r;
+}
+
+AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_init) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Impl& m = *impl_;
+  if (!T_init.allFinite()) throw AlignmentError("initial guess is not finite");
+  const std::size_t valid = scan.finite_count();
+  if (valid < m.cfg.min_points)
+    throw AlignmentError("scan has " + std::to_string(valid) + " valid points; at least " + std::to_string(m.cfg.min_points) + " are needed");
+
+  AlignmentResult best;
+  best.T_scan_model = T_init;
+  best.inlier_ratio = 0.0;
+  best.rmse_mm = std::numeric_limits<double>::infinity();
+  const auto attempt = [&](const Eigen::Matrix4d& start, bool reinitialised) {
+    const Eigen::Vector3f centre = (start * m.centroid.cast<double>().homogeneous()).head<3>().cast<float>();
+    const CloudN::Ptr near = m.prepare(scan, centre, m.cfg.crop ? m.radius + m.cfg.crop_margin_m : 0.0, m.cfg.voxel_m);
+    if (near->size() < m.cfg.min_points) return;
+    AlignmentResult r;
+    bool icp_converged = false;
+    r.T_scan_model = m.icp(near, start, best.iterations, icp_converged);
+    r.reinitialised = reinitialised;
+    m.evaluate(scan, r.T_scan_model, r);
+    r.converged = icp_converged && m.passes(r);
+    r.iterations = best.iterations;
+    const bool better = (r.converged && !best.converged) ||
+                        (r.converged == best.converged && (r.inlier_ratio > best.inlier_ratio + 0.02 ||
+                                                           (r.inlier_ratio > best.inlier_ratio - 0.02 && r.rmse_mm < best.rmse_mm)));
+    if (better) best = r;
+  };
+  attempt(T_init, false);
+  if (!best.converged && m.cfg.reinitialise)
+    if (const auto T = m.reinitialise(scan, T_init)) attempt(*T, true);
+  best.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return best;
+}
+
+}  // namespace projbot::alignment

@@ -1,0 +1,126 @@
+// projbot align: one acquisition (ICP with quality gate and re-initialisation) of a model against a scan.
+
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/registration.hpp"
+#include "projbot/config/scene.hpp"
+
+namespace projbot::tools {
+namespace {
+
+std::string lower_extension(const std::filesystem::path& p) {
+  std::string ext = p.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+alignment::PointCloud load_scan(const cli::Args& args) {
+  const std::filesystem::path scan = *args.get("scan");
+  const std::string ext = lower_extension(scan);
+  if (ext == ".pcd" || ext == ".ply") {
+    if (args.get("intrinsics") || args.get("depth-scale"))
+      throw cli::UsageError("--intrinsics and --depth-scale apply to depth images, not to " + ext + " clouds");
+    return alignment::read_cloud(scan);
+  }
+  if (ext != ".png" && ext != ".tif" && ext != ".tiff")
+    throw cli::UsageError("--scan must be a .pcd or .ply cloud or a 16-bit .png / .tiff depth image, got '" + scan.string() + "'");
+  const double scale = args.get_double("depth-scale", 1000.0);
+  if (!(scale > 0.0)) throw cli::UsageError("--depth-scale must be > 0 depth units per metre");
+  const alignment::DepthImage depth =
+      ext == ".png" ? alignment::read_depth_png(scan, scale) : alignment::read_depth_tiff(scan, 1.0 / scale);
+  alignment::CameraIntrinsics k = alignment::CameraIntrinsics::kinect_v1();
+  if (const auto text = args.get("intrinsics")) {
+    const auto v = config::parse_number_list(*text, 4, "--intrinsics");
+    if (!(v[0] > 0.0) || !(v[1] > 0.0)) throw cli::UsageError("--intrinsics: fx and fy must be > 0");
+    k.fx_px = v[0], k.fy_px = v[1], k.cx_px = v[2], k.cy_px = v[3];
+  } else {
+    std::cerr << "projbot align: no --intrinsics, using the Kinect v1 defaults (fx = fy = 525, cx = 319.5, cy = 239.5)\n";
+  }
+  k.width_px = depth.width;
+  k.height_px = depth.height;
+  return alignment::depth_to_cloud(depth, k);
+}
+
+Eigen::Matrix4d initial_guess(const cli::Args& args) {
+  const auto matrix = args.get("init-matrix");
+  const auto xyz_rpy = args.get("init");
+  if (matrix && xyz_rpy) throw cli::UsageError("give --init-matrix or --init, not both");
+  if (matrix) {
+    const auto v = config::parse_number_list(*matrix, 16, "--init-matrix");
+    Eigen::Matrix4d T;
+    for (int i = 0; i < 16; ++i) T(i / 4, i % 4) = v[static_cast<std::size_t>(i)];
+    config::validate_rigid(T, "--init-matrix");
+    return T;
+  }
+  if (xyz_rpy) {
+    std::string text = *xyz_rpy;
+    for (auto& c : text)
+      if (c == ' ' || c == '\t') c = ',';
+    while (text.find(",,") != std::string::npos) text.replace(text.find(",,"), 2, ",");
+    if (!text.empty() && text.front() == ',') text.erase(0, 1);
+    if (!text.empty() && text.back() == ',') text.pop_back();
+    const auto v = config::parse_number_list(text, 6, "--init \"x y z roll pitch yaw\"");
+    return config::pose_from_xyz_rpy({v[0], v[1], v[2]}, {v[3], v[4], v[5]});
+  }
+  return Eigen::Matrix4d::Identity();
+}
+
+}  // namespace
+
+const Command kAlign{
+    "align", "estimate a target's pose: ICP of its model against a scan, with a quality gate",
+    "projbot align --model M --scan S [--init-matrix m00,...,m33 | --init \"x y z roll pitch yaw\"] [--json]\n\n"
+    "Refines the initial guess (default: identity) of T_scan_model, the transform mapping model points into\n"
+    "the scan's frame, by point-to-plane ICP; when the result fails the quality gate it re-initialises\n"
+    "globally (FPFH features, SampleConsensusPrerejective) and tries again. M is a glTF model or a PCD / PLY\n"
+    "cloud; S is a PCD / PLY cloud or a 16-bit PNG / TIFF depth image (then --intrinsics and --depth-scale).\n"
+    "Exit status: 0 when the pose passed the quality gate, 3 when it did not, 1 or 2 on bad input.\n",
+    {{"model", "FILE", "target model: .gltf / .glb (surface-sampled) or .pcd / .ply"},
+     {"scan", "FILE", "scan: .pcd / .ply cloud, or .png / .tiff 16-bit depth image"},
+     {"intrinsics", "fx,fy,cx,cy", "depth camera intrinsics in pixels (default: Kinect v1)"},
+     {"depth-scale", "K", "depth units per metre: 1000 for millimetres (default), 5000 for TUM"},
+     {"init-matrix", "m00,...,m33", "initial T_scan_model, 16 numbers, row-major, metres"},
+     {"init", "\"x y z r p y\"", "initial pose: metres and degrees, R = Rz(yaw) Ry(pitch) Rx(roll)"},
+     {"no-crop", "", "use the whole scan, not only the region around the initial guess"},
+     {"voxel", "M", "downsampling voxel size in metres (default 0.004)"},
+     {"json", "", "print one JSON object instead of text"}},
+    [](const cli::Args& args) {
+      if (!args.get("model")) throw cli::UsageError("--model FILE is required");
+      if (!args.get("scan")) throw cli::UsageError("--scan FILE is required");
+      const Eigen::Matrix4d T_init = initial_guess(args);
+      alignment::AcquisitionConfig cfg;
+      cfg.crop = !args.flag("no-crop");
+      cfg.voxel_m = args.get_double("voxel", cfg.voxel_m);
+      if (!(cfg.voxel_m > 0.0) || cfg.voxel_m > 0.1) throw cli::UsageError("--voxel must be in (0, 0.1] metres");
+      const alignment::Aligner aligner(alignment::load_model_cloud(*args.get("model")), cfg);
+      const alignment::PointCloud scan = load_scan(args);
+      if (const std::size_t valid = scan.finite_count(); valid < cfg.min_points)
+        throw alignment::AlignmentError(*args.get("scan") + ": " + std::to_string(valid) + " valid points; at least " +
+                                        std::to_string(cfg.min_points) + " are needed");
+      const alignment::AlignmentResult r = aligner.align(scan, T_init);
+      if (args.flag("json")) {
+        nlohmann::json T = nlohmann::json::array();
+        for (int i = 0; i < 4; ++i) T.push_back({r.T_scan_model(i, 0), r.T_scan_model(i, 1), r.T_scan_model(i, 2), r.T_scan_model(i, 3)});
+        const nlohmann::json out = {{"T", T},
+                                    {"converged", r.converged},
+                                    {"inlier_ratio", r.inlier_ratio},
+                                    {"rmse_mm", std::isfinite(r.rmse_mm) ? nlohmann::json(r.rmse_mm) : nlohmann::json(nullptr)},
+                                    {"iterations", r.iterations},
+                                    {"time_ms", r.time_ms},
+                                    {"reinitialised", r.reinitialised}};
+        std::cout << out.dump() << '\n';
+      } else {
+        std::cout << "T_scan_model (row-major, metres):\n";
+        for (int i = 0; i < 4; ++i)
+          std::printf("  % .6f % .6f % .6f % .6f\n", r.T_scan_model(i, 0), r.T_scan_model(i, 1), r.T_scan_model(i, 2), r.T_scan_model(i, 3));
+        std::printf("%s: inlier ratio %.3f, rmse %.2f mm, %d iterations, %.1f ms%s\n", r.converged ? "converged" : "NOT converged",
+                    r.inlier_ratio, r.rmse_mm, r.iterations, r.time_ms, r.reinitialised ? " (after global re-initialisation)" : "");
+      }
+      return r.converged ? 0 : 3;
+    }};
+
+}  // namespace projbot::tools
