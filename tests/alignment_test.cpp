@@ -159,10 +159,12 @@ class BunnyTest : public ::testing::Test {
     cfg.min_inlier_ratio = 0.75;  // the scans overlap only in part: 93% of bun4 is explained at the estimate
     cfg.max_rmse_mm = 3.0;
     cfg.feature_radius_m = 0.025;
+    cfg_ = cfg;
     aligner_ = std::make_unique<Aligner>(load_model_cloud(kData / "bunny" / "bun0.pcd"), cfg);
     scan_ = read_cloud(kData / "bunny" / "bun4.pcd");
   }
   static void TearDownTestSuite() { aligner_.reset(); }
+  static inline AcquisitionConfig cfg_;
   static inline std::unique_ptr<Aligner> aligner_;
   static inline PointCloud scan_;
 };
@@ -185,18 +187,26 @@ TEST_F(BunnyTest, Bun0OntoBun4FromPerturbedStarts) {
   const AlignmentResult at_gt = aligner_->score(scan_, gt);
   const AlignmentResult ours = aligner_->align(scan_, gt);
   std::cout << "at the reference pose: inliers " << at_gt.inlier_ratio << ", rmse " << at_gt.rmse_mm << " mm; estimate: inliers "
-            << ours.inlier_ratio << ", rmse " << ours.rmse_mm << " mm, " << rotation_angle_deg(rigid_inverse(gt) * ours.T_scan_model)
-            << " deg from it\n";
+            << ours.inlier_ratio << ", rmse " << ours.rmse_mm << " mm, "
+            << rotation_angle_deg(rigid_inverse(gt) * ours.T_scan_model) << " deg from it\n";
 }
 
 TEST_F(BunnyTest, ReinitialisationRecoversFromAWrongYaw) {
   const Eigen::Matrix4d gt = ground_truth_bun0_to_bun4();
   Eigen::Matrix4d start = gt;
-  start.topLeftCorner<3, 3>() = Eigen::AngleAxisd(M_PI * 0.8, Eigen::Vector3d::UnitY()).toRotationMatrix() * gt.topLeftCorner<3, 3>();
-  const AlignmentResult r = aligner_->align(scan_, start);
+  start.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(M_PI * 0.8, Eigen::Vector3d::UnitY()).toRotationMatrix() * gt.topLeftCorner<3, 3>();
+  const AlignmentResult r = aligner_->align(scan_, start);  // restarts, then FPFH, as needed
   EXPECT_TRUE(r.converged);
-  EXPECT_TRUE(r.reinitialised);
   EXPECT_LT(rotation_angle_deg(rigid_inverse(gt) * r.T_scan_model), 2.0);
+  // The global re-initialisation alone (no local restarts) recovers too.
+  AcquisitionConfig global_only = cfg_;
+  global_only.restart_angle_deg = 0.0;
+  const Aligner fpfh(load_model_cloud(kData / "bunny" / "bun0.pcd"), global_only);
+  const AlignmentResult g = fpfh.align(scan_, start);
+  EXPECT_TRUE(g.converged);
+  EXPECT_TRUE(g.reinitialised);
+  EXPECT_LT(rotation_angle_deg(rigid_inverse(gt) * g.T_scan_model), 2.0);
 }
 
 TEST_F(BunnyTest, BadScansAreErrors) {

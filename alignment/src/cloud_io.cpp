@@ -21,9 +21,12 @@ PointCloud read_cloud(const std::filesystem::path& path) {
   // PCL prints its own complaints to stderr; ours, below, names the file and what to do.
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   try {
-    if (ext == ".pcd") rc = pcl::io::loadPCDFile(path.string(), cloud);
-    else if (ext == ".ply") rc = pcl::io::loadPLYFile(path.string(), cloud);
-    else throw AlignmentError(path.string() + ": unknown point cloud format (use .pcd or .ply)");
+    if (ext == ".pcd")
+      rc = pcl::io::loadPCDFile(path.string(), cloud);
+    else if (ext == ".ply")
+      rc = pcl::io::loadPLYFile(path.string(), cloud);
+    else
+      throw AlignmentError(path.string() + ": unknown point cloud format (use .pcd or .ply)");
   } catch (const pcl::PCLException& e) {
     throw AlignmentError(path.string() + ": cannot read point cloud: " + e.what());
   }

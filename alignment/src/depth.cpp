@@ -1,6 +1,8 @@
 // Depth images and their back-projection. PNG through stb, TIFF through libtiff, the grabber XML
 // through Boost.PropertyTree; no PCL here.
 
+#include "projbot/alignment/depth.hpp"
+
 #include <stb_image.h>
 #include <tiffio.h>
 
@@ -8,8 +10,6 @@
 #include <boost/property_tree/xml_parser.hpp>
 #include <cmath>
 #include <memory>
-
-#include "projbot/alignment/depth.hpp"
 
 namespace projbot::alignment {
 
@@ -23,7 +23,8 @@ DepthImage read_depth_png(const std::filesystem::path& path, double units_per_me
   if (!(units_per_metre > 0.0) || !std::isfinite(units_per_metre))
     throw AlignmentError(path.string() + ": depth scale must be a finite number > 0 units per metre");
   int w = 0, h = 0, comps = 0;
-  if (!stbi_info(path.c_str(), &w, &h, &comps)) throw AlignmentError(path.string() + ": cannot read PNG: " + stbi_failure_reason());
+  if (!stbi_info(path.c_str(), &w, &h, &comps))
+    throw AlignmentError(path.string() + ": cannot read PNG: " + stbi_failure_reason());
   if (!stbi_is_16_bit(path.c_str()) || comps != 1)
     throw AlignmentError(path.string() + ": a depth PNG must be 16-bit single-channel (this one has " + std::to_string(comps) +
                          " channel(s), " + (stbi_is_16_bit(path.c_str()) ? "16" : "8") + " bits)");
@@ -51,16 +52,18 @@ DepthImage read_depth_tiff(const std::filesystem::path& path, double metres_per_
   TIFFGetFieldDefaulted(tif.get(), TIFFTAG_BITSPERSAMPLE, &bits);
   TIFFGetFieldDefaulted(tif.get(), TIFFTAG_SAMPLESPERPIXEL, &samples);
   if (bits != 16 || samples != 1 || w == 0 || h == 0 || w > 16384 || h > 16384)
-    throw AlignmentError(path.string() + ": a depth TIFF must be 16-bit single-channel (this one: " + std::to_string(bits) + " bits, " +
-                         std::to_string(samples) + " samples, " + std::to_string(w) + "x" + std::to_string(h) + ")");
+    throw AlignmentError(path.string() + ": a depth TIFF must be 16-bit single-channel (this one: " + std::to_string(bits) +
+                         " bits, " + std::to_string(samples) + " samples, " + std::to_string(w) + "x" + std::to_string(h) + ")");
   DepthImage d;
   d.width = static_cast<int>(w);
   d.height = static_cast<int>(h);
   d.depth_m.resize(static_cast<std::size_t>(w) * h);
   std::vector<std::uint16_t> row(TIFFScanlineSize(tif.get()) / 2 + 1);
   for (std::uint32_t y = 0; y < h; ++y) {
-    if (TIFFReadScanline(tif.get(), row.data(), y, 0) < 0) throw AlignmentError(path.string() + ": TIFF row " + std::to_string(y) + " is corrupt");
-    for (std::uint32_t x = 0; x < w; ++x) d.depth_m[static_cast<std::size_t>(y) * w + x] = static_cast<float>(row[x] * metres_per_unit);
+    if (TIFFReadScanline(tif.get(), row.data(), y, 0) < 0)
+      throw AlignmentError(path.string() + ": TIFF row " + std::to_string(y) + " is corrupt");
+    for (std::uint32_t x = 0; x < w; ++x)
+      d.depth_m[static_cast<std::size_t>(y) * w + x] = static_cast<float>(row[x] * metres_per_unit);
   }
   return d;
 }
@@ -87,8 +90,8 @@ GrabberCalibration read_pcl_grabber_xml(const std::filesystem::path& path, int w
 
 PointCloud depth_to_cloud(const DepthImage& depth, const CameraIntrinsics& k, double min_m, double max_m) {
   if (depth.width != k.width_px || depth.height != k.height_px)
-    throw AlignmentError("depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) + " but the intrinsics are for " +
-                         std::to_string(k.width_px) + "x" + std::to_string(k.height_px));
+    throw AlignmentError("depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) +
+                         " but the intrinsics are for " + std::to_string(k.width_px) + "x" + std::to_string(k.height_px));
   if (!(k.fx_px > 0) || !(k.fy_px > 0)) throw AlignmentError("depth intrinsics need fx, fy > 0");
   PointCloud c;
   c.width = depth.width;

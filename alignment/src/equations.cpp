@@ -27,8 +27,8 @@ Eigen::Matrix4d projector_from_target(const Eigen::Matrix4d& T_projector_camera,
   // Eq. 2: R_p = R_cp R_c, X_p = R_cp X_c + T_cp.
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
   T.topLeftCorner<3, 3>() = T_projector_camera.topLeftCorner<3, 3>() * T_camera_target.topLeftCorner<3, 3>();
-  T.topRightCorner<3, 1>() =
-      T_projector_camera.topLeftCorner<3, 3>() * T_camera_target.topRightCorner<3, 1>() + T_projector_camera.topRightCorner<3, 1>();
+  T.topRightCorner<3, 1>() = T_projector_camera.topLeftCorner<3, 3>() * T_camera_target.topRightCorner<3, 1>() +
+                             T_projector_camera.topRightCorner<3, 1>();
   return T;
 }
 

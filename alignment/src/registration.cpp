@@ -1,6 +1,8 @@
 // Acquisition by PCL: filters, normals, point-to-plane ICP and FPFH + SampleConsensusPrerejective.
 // The only translation unit with PCL's filters, features and registration.
 
+#include "projbot/alignment/registration.hpp"
+
 #include <pcl/features/fpfh_omp.h>
 #include <pcl/features/normal_3d.h>
 #include <pcl/filters/statistical_outlier_removal.h>
@@ -15,7 +17,6 @@
 #include <optional>
 
 #include "projbot/alignment/equations.hpp"
-#include "projbot/alignment/registration.hpp"
 #include "projbot/assets/model.hpp"
 
 namespace projbot::alignment {
@@ -83,24 +84,27 @@ Features::Ptr fpfh(const CloudN::ConstPtr& cloud, double radius) {
 
 struct Aligner::Impl {
   AcquisitionConfig cfg;
-  CloudN::Ptr model;        // all model samples, model frame: for the quality metrics
-  CloudN::Ptr model_icp;    // voxel-downsampled: ICP source
-  CloudN::Ptr model_coarse; // coarser: re-initialisation
+  CloudN::Ptr model;                     // all model samples, model frame: for the quality metrics
+  CloudN::Ptr model_icp;                 // voxel-downsampled: ICP source
+  CloudN::Ptr model_coarse;              // coarser: re-initialisation
   mutable Features::Ptr model_features;  // computed on the first re-initialisation
   pcl::KdTreeFLANN<PointN> model_tree;
+  pcl::search::KdTree<PointN>::Ptr model_icp_tree;
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
   double radius = 0.0;
 
   double coarse_leaf() const { return std::max(cfg.voxel_m * 2.0, 0.008); }
 
   // Finite scan points within `crop_radius` of `centre` (all of them when crop_radius <= 0), downsampled,
-  // outliers removed, with normals.
-  CloudN::Ptr prepare(const PointCloud& scan, const Eigen::Vector3f& centre, double crop_radius, double leaf) const {
+  // outliers removed. Empty when fewer than min_points remain.
+  pcl::PointCloud<pcl::PointXYZ>::Ptr prepare(const PointCloud& scan, const Eigen::Vector3f& centre, double crop_radius,
+                                              double leaf) const {
     auto raw = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     const float r2 = static_cast<float>(crop_radius * crop_radius);
     for (const auto& p : scan.points)
-      if (p.allFinite() && (crop_radius <= 0.0 || (p - centre).squaredNorm() <= r2)) raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-    if (raw->size() < cfg.min_points) return pcl::make_shared<CloudN>();
+      if (p.allFinite() && (crop_radius <= 0.0 || (p - centre).squaredNorm() <= r2))
+        raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    if (raw->size() < cfg.min_points) return pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     auto down = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     pcl::VoxelGrid<pcl::PointXYZ> grid;
     grid.setInputCloud(raw);
@@ -115,38 +119,49 @@ struct Aligner::Impl {
       sor.filter(*kept);
       down = kept;
     }
-    if (down->size() < cfg.min_points) return pcl::make_shared<CloudN>();
-    return with_normals(down, cfg.normal_neighbours);
+    if (down->size() < cfg.min_points) down->clear();
+    return down;
   }
 
-  // Point-to-plane ICP, coarse then fine correspondence distance.
-  Eigen::Matrix4d icp(const CloudN::ConstPtr& scan, const Eigen::Matrix4d& T_init, int& iterations, bool& converged) const {
-    Eigen::Matrix4f T = T_init.cast<float>();
+  // Point-to-plane ICP, coarse then fine correspondence distance. The scan is the source: every scan
+  // point has a true match on the complete model, while the model's unseen side has none in the scan and
+  // would pull the estimate. The planes are the model's exact surface normals, and the model's search
+  // tree is built once, in the constructor.
+  Eigen::Matrix4d icp(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& scan, const Eigen::Matrix4d& T_scan_model_init,
+                      int& iterations, bool& converged) const {
+    auto source = pcl::make_shared<CloudN>();
+    source->reserve(scan->size());
+    for (const auto& p : *scan) {
+      PointN q;
+      q.x = p.x, q.y = p.y, q.z = p.z;
+      q.normal_x = q.normal_y = q.normal_z = 0.0F;
+      source->push_back(q);
+    }
+    Eigen::Matrix4f T_model_scan = rigid_inverse(T_scan_model_init).cast<float>();
     converged = true;
     for (const double distance : cfg.icp_distances_m) {
       CountingIcp icp;
-      icp.setInputSource(model_icp);
-      icp.setInputTarget(scan);
+      icp.setInputSource(source);
+      icp.setInputTarget(model_icp);
+      icp.setSearchMethodTarget(model_icp_tree, true);
       icp.setMaxCorrespondenceDistance(distance);
       icp.setMaximumIterations(cfg.icp_iterations);
       icp.setTransformationEpsilon(1e-10);
       icp.setEuclideanFitnessEpsilon(1e-12);
       CloudN aligned;
-      icp.align(aligned, T);
+      icp.align(aligned, T_model_scan);
       iterations += icp.iterations();
       converged = converged && icp.hasConverged();
-      T = icp.getFinalTransformation();
+      T_model_scan = icp.getFinalTransformation();
     }
-    return T.cast<double>();
+    return rigid_inverse(T_model_scan.cast<double>());
   }
 
   // Quality of a pose: scan points near the posed model are inliers when their point-to-plane distance
   // to the nearest model sample is under inlier_distance_m.
-  void evaluate(const PointCloud& scan, const Eigen::Matrix4d& T, AlignmentResult& r) const {
-    const Eigen::Vector3f centre = (T * centroid.cast<double>().homogeneous()).head<3>().cast<float>();
-    const CloudN::Ptr near = prepare(scan, centre, cfg.crop ? radius + cfg.crop_margin_m : 0.0, cfg.voxel_m);
-    r.scan_points = near->size();
-    if (near->empty()) {
+  void evaluate(const pcl::PointCloud<pcl::PointXYZ>& near, const Eigen::Matrix4d& T, AlignmentResult& r) const {
+    r.scan_points = near.size();
+    if (near.empty()) {
       r.inlier_ratio = 0.0;
       r.rmse_mm = std::numeric_limits<double>::infinity();
       return;
@@ -156,7 +171,7 @@ struct Aligner::Impl {
     double sum2 = 0.0;
     pcl::Indices index(1);
     std::vector<float> dist2(1);
-    for (const auto& p : *near) {
+    for (const auto& p : near) {
       PointN q;
       q.getVector3fMap() = (inv * Eigen::Vector4f(p.x, p.y, p.z, 1.0F)).head<3>();
       if (model_tree.nearestKSearch(q, 1, index, dist2) < 1) continue;
@@ -167,7 +182,7 @@ struct Aligner::Impl {
       ++inliers;
       sum2 += d * d;
     }
-    r.inlier_ratio = static_cast<double>(inliers) / static_cast<double>(near->size());
+    r.inlier_ratio = static_cast<double>(inliers) / static_cast<double>(near.size());
     r.rmse_mm = inliers > 0 ? 1000.0 * std::sqrt(sum2 / static_cast<double>(inliers)) : std::numeric_limits<double>::infinity();
   }
 
@@ -176,8 +191,9 @@ struct Aligner::Impl {
   // Global re-initialisation: FPFH correspondences and SampleConsensusPrerejective over a wide region.
   std::optional<Eigen::Matrix4d> reinitialise(const PointCloud& scan, const Eigen::Matrix4d& T_init) const {
     const Eigen::Vector3f centre = (T_init * centroid.cast<double>().homogeneous()).head<3>().cast<float>();
-    const CloudN::Ptr wide = prepare(scan, centre, cfg.crop ? radius + cfg.reinit_crop_margin_m : 0.0, coarse_leaf());
-    if (wide->size() < cfg.min_points) return std::nullopt;
+    const auto wide_points = prepare(scan, centre, cfg.crop ? radius + cfg.reinit_crop_margin_m : 0.0, coarse_leaf());
+    if (wide_points->size() < cfg.min_points) return std::nullopt;
+    const CloudN::Ptr wide = with_normals(wide_points, cfg.normal_neighbours);
     if (!model_features) model_features = fpfh(model_coarse, cfg.feature_radius_m);
     const Features::Ptr scan_features = fpfh(wide, cfg.feature_radius_m);
     pcl::SampleConsensusPrerejective<PointN, PointN, pcl::FPFHSignature33> sac;
@@ -198,22 +214,26 @@ struct Aligner::Impl {
   }
 };
 
+ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
+  const auto s = assets::sample_surface(model, samples, 1);
+  return {s.points, s.normals};
+}
+
 ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t samples) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   ModelCloud m;
   if (ext == ".gltf" || ext == ".glb") {
     try {
-      const auto s = assets::sample_surface(assets::load_gltf(path), samples, 1);
-      m.points = s.points;
-      m.normals = s.normals;
+      return model_cloud_from(assets::load_gltf(path), samples);
     } catch (const assets::AssetError& e) {
       throw AlignmentError(e.what());
     }
     return m;
   }
   const PointCloud cloud = finite_points(read_cloud(path));
-  if (cloud.points.size() < 10) throw AlignmentError(path.string() + ": model cloud has " + std::to_string(cloud.points.size()) + " valid points");
+  if (cloud.points.size() < 10)
+    throw AlignmentError(path.string() + ": model cloud has " + std::to_string(cloud.points.size()) + " valid points");
   auto xyz = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   for (const auto& p : cloud.points) xyz->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
   for (const auto& p : *with_normals(xyz, 16)) {
@@ -229,7 +249,8 @@ Aligner::Aligner(ModelCloud model, AcquisitionConfig config) : impl_(std::make_u
     throw AlignmentError("model needs at least 10 points, each with a normal (got " + std::to_string(model.points.size()) + ")");
   impl_->model = pcl::make_shared<CloudN>();
   for (std::size_t i = 0; i < model.points.size(); ++i) {
-    if (!model.points[i].allFinite() || !model.normals[i].allFinite()) throw AlignmentError("model point " + std::to_string(i) + " is not finite");
+    if (!model.points[i].allFinite() || !model.normals[i].allFinite())
+      throw AlignmentError("model point " + std::to_string(i) + " is not finite");
     PointN p;
     p.getVector3fMap() = model.points[i];
     p.getNormalVector3fMap() = model.normals[i];
@@ -240,6 +261,8 @@ Aligner::Aligner(ModelCloud model, AcquisitionConfig config) : impl_(std::make_u
   for (const auto& p : model.points) impl_->radius = std::max(impl_->radius, static_cast<double>((p - impl_->centroid).norm()));
   impl_->model_tree.setInputCloud(impl_->model);
   impl_->model_icp = voxel_downsample(impl_->model, config.voxel_m);
+  impl_->model_icp_tree = pcl::make_shared<pcl::search::KdTree<PointN>>();
+  impl_->model_icp_tree->setInputCloud(impl_->model_icp);
   impl_->model_coarse = voxel_downsample(impl_->model, impl_->coarse_leaf());
 }
 
@@ -252,7 +275,10 @@ double Aligner::model_radius_m() const { return impl_->radius; }
 AlignmentResult Aligner::score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const {
   AlignmentResult r;
   r.T_scan_model = T_scan_model;
-  impl_->evaluate(scan, T_scan_model, r);
+  const Eigen::Vector3f centre = (T_scan_model * impl_->centroid.cast<double>().homogeneous()).head<3>().cast<float>();
+  impl_->evaluate(
+      *impl_->prepare(scan, centre, impl_->cfg.crop ? impl_->radius + impl_->cfg.crop_margin_m : 0.0, impl_->cfg.voxel_m),
+      T_scan_model, r);
   r.converged = impl_->passes(r);
   return r;
 }
@@ -263,7 +289,8 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   if (!T_init.allFinite()) throw AlignmentError("initial guess is not finite");
   const std::size_t valid = scan.finite_count();
   if (valid < m.cfg.min_points)
-    throw AlignmentError("scan has " + std::to_string(valid) + " valid points; at least " + std::to_string(m.cfg.min_points) + " are needed");
+    throw AlignmentError("scan has " + std::to_string(valid) + " valid points; at least " + std::to_string(m.cfg.min_points) +
+                         " are needed");
 
   AlignmentResult best;
   best.T_scan_model = T_init;
@@ -271,21 +298,35 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   best.rmse_mm = std::numeric_limits<double>::infinity();
   const auto attempt = [&](const Eigen::Matrix4d& start, bool reinitialised) {
     const Eigen::Vector3f centre = (start * m.centroid.cast<double>().homogeneous()).head<3>().cast<float>();
-    const CloudN::Ptr near = m.prepare(scan, centre, m.cfg.crop ? m.radius + m.cfg.crop_margin_m : 0.0, m.cfg.voxel_m);
+    const auto near = m.prepare(scan, centre, m.cfg.crop ? m.radius + m.cfg.crop_margin_m : 0.0, m.cfg.voxel_m);
     if (near->size() < m.cfg.min_points) return;
     AlignmentResult r;
     bool icp_converged = false;
     r.T_scan_model = m.icp(near, start, best.iterations, icp_converged);
     r.reinitialised = reinitialised;
-    m.evaluate(scan, r.T_scan_model, r);
+    m.evaluate(*near, r.T_scan_model, r);
     r.converged = icp_converged && m.passes(r);
     r.iterations = best.iterations;
-    const bool better = (r.converged && !best.converged) ||
-                        (r.converged == best.converged && (r.inlier_ratio > best.inlier_ratio + 0.02 ||
-                                                           (r.inlier_ratio > best.inlier_ratio - 0.02 && r.rmse_mm < best.rmse_mm)));
+    const bool better =
+        (r.converged && !best.converged) ||
+        (r.converged == best.converged &&
+         (r.inlier_ratio > best.inlier_ratio + 0.02 || (r.inlier_ratio > best.inlier_ratio - 0.02 && r.rmse_mm < best.rmse_mm)));
     if (better) best = r;
   };
   attempt(T_init, false);
+  if (!best.converged && m.cfg.restart_angle_deg > 0.0) {
+    // Local restarts: the guess turned about the target's centre, which ICP alone cannot leave.
+    const Eigen::Vector3d c = (T_init * m.centroid.cast<double>().homogeneous()).head<3>();
+    for (int axis = 0; axis < 3 && !best.converged; ++axis)
+      for (const double sign : {1.0, -1.0}) {
+        Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
+        turn.topLeftCorner<3, 3>() =
+            Eigen::AngleAxisd(sign * m.cfg.restart_angle_deg * M_PI / 180.0, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
+        turn.topRightCorner<3, 1>() = c - turn.topLeftCorner<3, 3>() * c;
+        attempt(turn * T_init, false);
+        if (best.converged) break;
+      }
+  }
   if (!best.converged && m.cfg.reinitialise)
     if (const auto T = m.reinitialise(scan, T_init)) attempt(*T, true);
   best.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

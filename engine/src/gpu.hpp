@@ -110,9 +110,12 @@ class TargetBackend {
   virtual bool poll_close() { return false; }
   virtual std::uint64_t native_window() const { return 0; }
   virtual assets::Image read_back() = 0;
+  /// True for a depth camera target: R32 float colour holding camera-frame depth, 0 where no surface.
+  virtual bool depth_output() const { return false; }
+  virtual DepthMap read_back_depth() { throw EngineError("read_back_depth: this target renders colour, not depth"); }
 };
 
-std::unique_ptr<TargetBackend> make_offscreen_backend(std::shared_ptr<Gpu> gpu, vk::Extent2D extent);
+std::unique_ptr<TargetBackend> make_offscreen_backend(std::shared_ptr<Gpu> gpu, vk::Extent2D extent, bool depth_output);
 std::unique_ptr<TargetBackend> make_window_backend(std::shared_ptr<Gpu> gpu, const WindowOptions& options);
 
 constexpr vk::Format kDepthFormat = vk::Format::eD32Sfloat;

@@ -2,6 +2,7 @@
 
 #include "projbot/engine/renderer.hpp"
 
+#include <projbot/shaders/depth.frag.spv.h>
 #include <projbot/shaders/mesh.frag.spv.h>
 #include <projbot/shaders/mesh.vert.spv.h>
 
@@ -90,8 +91,10 @@ struct Renderer::Impl {
   vk::raii::PipelineLayout pipeline_layout{nullptr};
   vk::raii::ShaderModule vert{nullptr};
   vk::raii::ShaderModule frag{nullptr};
-  std::map<std::tuple<vk::Format, bool, std::int32_t>, vk::raii::Pipeline> pipelines;  // (format, cull back, alpha mode)
-  detail::Image white;                                                                 // bound where a material has no texture
+  vk::raii::ShaderModule depth_frag{nullptr};
+  // (format, cull back, alpha mode, depth camera)
+  std::map<std::tuple<vk::Format, bool, std::int32_t, bool>, vk::raii::Pipeline> pipelines;
+  detail::Image white;  // bound where a material has no texture
   std::vector<GpuModel> models;
   std::vector<DrawItem> items;
   std::uint64_t frame_index = 0;
@@ -104,6 +107,7 @@ struct Renderer::Impl {
     pipeline_layout = vk::raii::PipelineLayout(gpu->device, vk::PipelineLayoutCreateInfo({}, layouts, push));
     vert = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_vert_spv), k_mesh_vert_spv));
     frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_frag_spv), k_mesh_frag_spv));
+    depth_frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_depth_frag_spv), k_depth_frag_spv));
     assets::Image w;
     w.width = w.height = 1;
     w.rgba = {255, 255, 255, 255};
@@ -139,14 +143,18 @@ struct Renderer::Impl {
   }
 
   // One pipeline builder: every variant differs only in target format, culling and blending.
-  const vk::raii::Pipeline& pipeline(vk::Format format, bool cull_back, std::int32_t alpha_mode) {
-    const auto key = std::make_tuple(format, cull_back, alpha_mode);
+  const vk::raii::Pipeline& pipeline(vk::Format format, bool cull_back, std::int32_t alpha_mode, bool depth_camera) {
+    const auto key = std::make_tuple(format, cull_back, alpha_mode, depth_camera);
     if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
     const bool blend = alpha_mode == 2;
     const vk::SpecializationMapEntry entry(0, 0, sizeof(std::int32_t));
     const vk::SpecializationInfo specialization(1, &entry, sizeof(alpha_mode), &alpha_mode);
     const vk::PipelineShaderStageCreateInfo stages[] = {{{}, vk::ShaderStageFlagBits::eVertex, *vert, "main"},
-                                                        {{}, vk::ShaderStageFlagBits::eFragment, *frag, "main", &specialization}};
+                                                        {{},
+                                                         vk::ShaderStageFlagBits::eFragment,
+                                                         depth_camera ? *depth_frag : *frag,
+                                                         "main",
+                                                         depth_camera ? nullptr : &specialization}};
     vk::VertexInputBindingDescription binding(0, sizeof(GpuVertex), vk::VertexInputRate::eVertex);
     const vk::VertexInputAttributeDescription attributes[] = {{0, 0, vk::Format::eR32G32B32Sfloat, offsetof(GpuVertex, position)},
                                                               {1, 0, vk::Format::eR32G32Sfloat, offsetof(GpuVertex, uv)},
@@ -255,10 +263,13 @@ struct Renderer::Impl {
     slot.profiler->add(slot.record);
   }
 
-  void record_draws(const vk::raii::CommandBuffer& cmd, vk::Format format, const config::ProjectorConfig& projector) {
+  void record_draws(const vk::raii::CommandBuffer& cmd, vk::Format format, const config::ProjectorConfig& projector,
+                    bool depth_camera) {
     const Eigen::Matrix4d clip_from_projector_m = clip_from_projector(projector);
     // Opaque and masked first, blended after them so they blend over what is behind.
-    for (const bool blend_pass : {false, true})
+    // A depth camera sees every surface, whatever its material: one opaque pass.
+    static constexpr bool kPasses[] = {false, true};
+    for (const bool blend_pass : std::span<const bool>(kPasses, depth_camera ? 1 : 2))
       for (const DrawItem& item : items) {
         const GpuModel& m = models[item.model];
         const vk::Buffer vb = *m.vertices.buffer;
@@ -268,8 +279,9 @@ struct Renderer::Impl {
         c.clip_from_model = to_gpu_matrix(clip_from_projector_m * item.T_projector_target);  // Eq. 3
         for (const auto& part : m.parts) {
           const assets::Material& mat = m.materials[part.material];
-          if ((mat.alpha_mode == assets::AlphaMode::kBlend) != blend_pass) continue;
-          cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline(format, !mat.double_sided, alpha_mode_id(mat.alpha_mode)));
+          if (!depth_camera && (mat.alpha_mode == assets::AlphaMode::kBlend) != blend_pass) continue;
+          cmd.bindPipeline(vk::PipelineBindPoint::eGraphics,
+                           *pipeline(format, !mat.double_sided, depth_camera ? 0 : alpha_mode_id(mat.alpha_mode), depth_camera));
           cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout, 0, *m.sets[part.material], {});
           c.base_color_factor = mat.base_color_factor;
           c.alpha_cutoff = mat.alpha_cutoff;
@@ -320,9 +332,10 @@ struct Renderer::Impl {
                        vk::ImageLayout::eDepthAttachmentOptimal, vk::PipelineStageFlagBits2::eLateFragmentTests,
                        vk::AccessFlagBits2::eDepthStencilAttachmentWrite, vk::PipelineStageFlagBits2::eEarlyFragmentTests,
                        vk::AccessFlagBits2::eDepthStencilAttachmentWrite | vk::AccessFlagBits2::eDepthStencilAttachmentRead);
-    vk::RenderingAttachmentInfo color_att(frame->color_view, vk::ImageLayout::eColorAttachmentOptimal, {}, {}, {},
-                                          vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eStore,
-                                          vk::ClearColorValue(std::array<float, 4>{0.0F, 0.0F, 0.0F, 1.0F}));
+    vk::RenderingAttachmentInfo color_att(
+        frame->color_view, vk::ImageLayout::eColorAttachmentOptimal, {}, {}, {}, vk::AttachmentLoadOp::eClear,
+        vk::AttachmentStoreOp::eStore,
+        vk::ClearColorValue(std::array<float, 4>{0.0F, 0.0F, 0.0F, t.depth_output() ? 0.0F : 1.0F}));
     vk::RenderingAttachmentInfo depth_att(*t.depth().view, vk::ImageLayout::eDepthAttachmentOptimal, {}, {}, {},
                                           vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eDontCare,
                                           vk::ClearDepthStencilValue(1.0F, 0));
@@ -330,7 +343,7 @@ struct Renderer::Impl {
     // The projector image (width x height of the intrinsics) is stretched onto the target.
     cmd.setViewport(0, vk::Viewport(0.0F, 0.0F, static_cast<float>(extent.width), static_cast<float>(extent.height), 0.0F, 1.0F));
     cmd.setScissor(0, vk::Rect2D({0, 0}, extent));
-    record_draws(cmd, t.color_format(), projector);
+    record_draws(cmd, t.color_format(), projector, t.depth_output());
     cmd.endRendering();
     const bool to_present = frame->color_final_layout == vk::ImageLayout::ePresentSrcKHR;
     detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eColorAttachmentOptimal,
@@ -368,6 +381,7 @@ int RenderTarget::height() const { return static_cast<int>(backend_->extent().he
 bool RenderTarget::poll_close() { return backend_->poll_close(); }
 std::uint64_t RenderTarget::native_window() const { return backend_->native_window(); }
 assets::Image RenderTarget::read_back() { return backend_->read_back(); }
+DepthMap RenderTarget::read_back_depth() { return backend_->read_back_depth(); }
 
 Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl>(options)) {}
 Renderer::~Renderer() = default;
@@ -377,7 +391,13 @@ std::size_t Renderer::add_model(const assets::Model& model) { return impl_->add_
 std::unique_ptr<RenderTarget> Renderer::make_offscreen(int width_px, int height_px) {
   if (width_px <= 0 || height_px <= 0) throw EngineError("offscreen target size must be positive");
   return std::make_unique<RenderTarget>(detail::make_offscreen_backend(
-      impl_->gpu, vk::Extent2D(static_cast<std::uint32_t>(width_px), static_cast<std::uint32_t>(height_px))));
+      impl_->gpu, vk::Extent2D(static_cast<std::uint32_t>(width_px), static_cast<std::uint32_t>(height_px)), false));
+}
+
+std::unique_ptr<RenderTarget> Renderer::make_depth_camera(int width_px, int height_px) {
+  if (width_px <= 0 || height_px <= 0) throw EngineError("depth camera size must be positive");
+  return std::make_unique<RenderTarget>(detail::make_offscreen_backend(
+      impl_->gpu, vk::Extent2D(static_cast<std::uint32_t>(width_px), static_cast<std::uint32_t>(height_px)), true));
 }
 
 std::unique_ptr<RenderTarget> Renderer::make_window(const WindowOptions& options) {

@@ -16,8 +16,6 @@ std::uint64_t x11_window_of(GLFWwindow* window);  // x11_window.cpp: X11's macro
 
 namespace {
 
-constexpr vk::Format kOffscreenFormat = vk::Format::eR8G8B8A8Unorm;
-
 void check_extent(std::uint32_t w, std::uint32_t h, const char* what) {
   if (w == 0 || h == 0 || w > 16384 || h > 16384)
     throw EngineError(std::string(what) + " size " + std::to_string(w) + "x" + std::to_string(h) + " must be 1..16384 each way");
@@ -29,11 +27,13 @@ Image make_depth(Gpu& gpu, vk::Extent2D extent) {
 
 class OffscreenBackend final : public TargetBackend {
  public:
-  OffscreenBackend(std::shared_ptr<Gpu> shared, vk::Extent2D extent) : TargetBackend(std::move(shared)) {
+  OffscreenBackend(std::shared_ptr<Gpu> shared, vk::Extent2D extent, bool depth_output)
+      : TargetBackend(std::move(shared)),
+        depth_output_(depth_output),
+        format_(depth_output ? vk::Format::eR32Sfloat : vk::Format::eR8G8B8A8Unorm) {
     check_extent(extent.width, extent.height, "offscreen target");
-    color_ =
-        gpu->make_image(extent, kOffscreenFormat, vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
-                        vk::ImageAspectFlagBits::eColor);
+    color_ = gpu->make_image(extent, format_, vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
+                             vk::ImageAspectFlagBits::eColor);
     depth_ = make_depth(*gpu, extent);
     readback_ = gpu->make_buffer(vk::DeviceSize(extent.width) * extent.height * 4, vk::BufferUsageFlagBits::eTransferDst,
                                  vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
@@ -45,7 +45,8 @@ class OffscreenBackend final : public TargetBackend {
   }
 
   vk::Extent2D extent() const override { return color_.extent; }
-  vk::Format color_format() const override { return kOffscreenFormat; }
+  vk::Format color_format() const override { return format_; }
+  bool depth_output() const override { return depth_output_; }
   const Image& depth() const override { return depth_; }
 
   std::optional<FrameImage> acquire(vk::Semaphore /*acquired*/) override {
@@ -54,6 +55,28 @@ class OffscreenBackend final : public TargetBackend {
   void present(const FrameImage& /*frame*/) override { drawn_ = true; }  // a frame was submitted
 
   assets::Image read_back() override {
+    if (depth_output_) throw EngineError("read_back: this target renders depth; use read_back_depth");
+    assets::Image out;
+    out.width = static_cast<int>(color_.extent.width);
+    out.height = static_cast<int>(color_.extent.height);
+    const auto* bytes = static_cast<const std::uint8_t*>(copy_to_host());
+    out.rgba.assign(bytes, bytes + readback_.size);
+    return out;
+  }
+
+  DepthMap read_back_depth() override {
+    if (!depth_output_) throw EngineError("read_back_depth: this target renders colour; use read_back");
+    DepthMap out;
+    out.width = static_cast<int>(color_.extent.width);
+    out.height = static_cast<int>(color_.extent.height);
+    const auto* z = static_cast<const float*>(copy_to_host());
+    out.z_m.assign(z, z + static_cast<std::size_t>(out.width) * out.height);
+    return out;
+  }
+
+ private:
+  // Waits for the last frame and copies its image into the host-visible readback buffer.
+  const void* copy_to_host() {
     if (!drawn_) throw EngineError("read_back: nothing has been drawn into this target yet");
     gpu->queue.waitIdle();  // the last frame wrote the image
     const vk::Extent2D e = color_.extent;
@@ -62,15 +85,11 @@ class OffscreenBackend final : public TargetBackend {
                             vk::BufferImageCopy(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, 1),
                                                 {0, 0, 0}, vk::Extent3D(e, 1)));
     });
-    assets::Image out;
-    out.width = static_cast<int>(e.width);
-    out.height = static_cast<int>(e.height);
-    const auto* bytes = static_cast<const std::uint8_t*>(readback_.mapped);
-    out.rgba.assign(bytes, bytes + readback_.size);
-    return out;
+    return readback_.mapped;
   }
 
- private:
+  bool depth_output_;
+  vk::Format format_;
   Image color_;
   Image depth_;
   Buffer readback_;
@@ -255,8 +274,8 @@ class WindowBackend final : public TargetBackend {
 
 }  // namespace
 
-std::unique_ptr<TargetBackend> make_offscreen_backend(std::shared_ptr<Gpu> gpu, vk::Extent2D extent) {
-  return std::make_unique<OffscreenBackend>(std::move(gpu), extent);
+std::unique_ptr<TargetBackend> make_offscreen_backend(std::shared_ptr<Gpu> gpu, vk::Extent2D extent, bool depth_output) {
+  return std::make_unique<OffscreenBackend>(std::move(gpu), extent, depth_output);
 }
 
 std::unique_ptr<TargetBackend> make_window_backend(std::shared_ptr<Gpu> gpu, const WindowOptions& options) {

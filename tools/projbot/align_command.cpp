@@ -27,7 +27,8 @@ alignment::PointCloud load_scan(const cli::Args& args) {
     return alignment::read_cloud(scan);
   }
   if (ext != ".png" && ext != ".tif" && ext != ".tiff")
-    throw cli::UsageError("--scan must be a .pcd or .ply cloud or a 16-bit .png / .tiff depth image, got '" + scan.string() + "'");
+    throw cli::UsageError("--scan must be a .pcd or .ply cloud or a 16-bit .png / .tiff depth image, got '" + scan.string() +
+                          "'");
   const double scale = args.get_double("depth-scale", 1000.0);
   if (!(scale > 0.0)) throw cli::UsageError("--depth-scale must be > 0 depth units per metre");
   const alignment::DepthImage depth =
@@ -72,7 +73,8 @@ Eigen::Matrix4d initial_guess(const cli::Args& args) {
 }  // namespace
 
 const Command kAlign{
-    "align", "estimate a target's pose: ICP of its model against a scan, with a quality gate",
+    "align",
+    "estimate a target's pose: ICP of its model against a scan, with a quality gate",
     "projbot align --model M --scan S [--init-matrix m00,...,m33 | --init \"x y z roll pitch yaw\"] [--json]\n\n"
     "Refines the initial guess (default: identity) of T_scan_model, the transform mapping model points into\n"
     "the scan's frame, by point-to-plane ICP; when the result fails the quality gate it re-initialises\n"
@@ -104,7 +106,8 @@ const Command kAlign{
       const alignment::AlignmentResult r = aligner.align(scan, T_init);
       if (args.flag("json")) {
         nlohmann::json T = nlohmann::json::array();
-        for (int i = 0; i < 4; ++i) T.push_back({r.T_scan_model(i, 0), r.T_scan_model(i, 1), r.T_scan_model(i, 2), r.T_scan_model(i, 3)});
+        for (int i = 0; i < 4; ++i)
+          T.push_back({r.T_scan_model(i, 0), r.T_scan_model(i, 1), r.T_scan_model(i, 2), r.T_scan_model(i, 3)});
         const nlohmann::json out = {{"T", T},
                                     {"converged", r.converged},
                                     {"inlier_ratio", r.inlier_ratio},
@@ -116,9 +119,11 @@ const Command kAlign{
       } else {
         std::cout << "T_scan_model (row-major, metres):\n";
         for (int i = 0; i < 4; ++i)
-          std::printf("  % .6f % .6f % .6f % .6f\n", r.T_scan_model(i, 0), r.T_scan_model(i, 1), r.T_scan_model(i, 2), r.T_scan_model(i, 3));
-        std::printf("%s: inlier ratio %.3f, rmse %.2f mm, %d iterations, %.1f ms%s\n", r.converged ? "converged" : "NOT converged",
-                    r.inlier_ratio, r.rmse_mm, r.iterations, r.time_ms, r.reinitialised ? " (after global re-initialisation)" : "");
+          std::printf("  % .6f % .6f % .6f % .6f\n", r.T_scan_model(i, 0), r.T_scan_model(i, 1), r.T_scan_model(i, 2),
+                      r.T_scan_model(i, 3));
+        std::printf("%s: inlier ratio %.3f, rmse %.2f mm, %d iterations, %.1f ms%s\n",
+                    r.converged ? "converged" : "NOT converged", r.inlier_ratio, r.rmse_mm, r.iterations, r.time_ms,
+                    r.reinitialised ? " (after global re-initialisation)" : "");
       }
       return r.converged ? 0 : 3;
     }};

@@ -52,6 +52,14 @@ struct WindowOptions {
   PresentMode present_mode = PresentMode::kFifo;  ///< falls back to FIFO where unsupported
 };
 
+/// A simulated depth camera's image: camera-frame depth Z of the nearest surface, metres, row-major,
+/// top row first; 0 where no surface was hit (as a Kinect reports missing depth).
+struct DepthMap {
+  int width = 0;
+  int height = 0;
+  std::vector<float> z_m;
+};
+
 /// One target to draw: which uploaded model, and T_projector_target (model frame -> projector frame).
 struct DrawItem {
   std::size_t model = 0;
@@ -80,8 +88,10 @@ class RenderTarget {
   bool poll_close();
   /// X11 window id of a window target (for screenshots), 0 otherwise.
   std::uint64_t native_window() const;
-  /// Offscreen: the last drawn frame as RGBA8 (waits for it). Windows: throws EngineError.
+  /// Offscreen: the last drawn frame as RGBA8 (waits for it). Windows and depth cameras: throws EngineError.
   assets::Image read_back();
+  /// Depth cameras: the last drawn frame's depth (waits for it). Other targets: throws EngineError.
+  DepthMap read_back_depth();
 
   detail::TargetBackend& backend() { return *backend_; }
 
@@ -104,6 +114,9 @@ class Renderer {
 
   /// An offscreen RGBA8 target of the given size.
   std::unique_ptr<RenderTarget> make_offscreen(int width_px, int height_px);
+  /// A depth camera of the given size: draw_frame() with the camera's pinhole model (a ProjectorConfig)
+  /// and T_camera_target poses renders the depth of every surface, whatever its material.
+  std::unique_ptr<RenderTarget> make_depth_camera(int width_px, int height_px);
   /// A window with a swapchain. Needs RendererOptions::windowing.
   std::unique_ptr<RenderTarget> make_window(const WindowOptions& options);
 
