@@ -8,6 +8,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/alignment/registration.hpp"
+#include "projbot/alignment/tracker.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
 
@@ -28,7 +29,8 @@ projbot::config::ProjectorConfig as_pinhole(const CameraIntrinsics& k) {
 Eigen::Matrix4d perturb(const Eigen::Matrix4d& T, double angle_deg, double shift_m, std::mt19937& rng) {
   std::normal_distribution<double> g;
   Eigen::Matrix4d D = Eigen::Matrix4d::Identity();
-  D.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized()).toRotationMatrix();
+  D.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(angle_deg * M_PI / 180.0, Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized()).toRotationMatrix();
   // Rotate about the target's own centre (its origin after recentring), then shift.
   Eigen::Matrix4d out = T;
   out.topLeftCorner<3, 3>() = D.topLeftCorner<3, 3>() * T.topLeftCorner<3, 3>();
@@ -130,8 +132,8 @@ TEST_F(SyntheticDepthTest, ConvergesFromPoorInitialGuesses) {
       good += ok ? 1 : 0;
       if (!ok)
         std::cout << "miss at z " << T(2, 3) << ": converged " << r.converged << " reinit " << r.reinitialised << " err "
-                  << translation_norm_m(err) * 1000 << " mm " << rotation_angle_deg(err) << " deg, inliers " << r.inlier_ratio << " rmse "
-                  << r.rmse_mm << "\n";
+                  << translation_norm_m(err) * 1000 << " mm " << rotation_angle_deg(err) << " deg, inliers " << r.inlier_ratio
+                  << " rmse " << r.rmse_mm << "\n";
     }
   }
   std::cout << good << " of " << trials << " converged\n";
@@ -162,4 +164,40 @@ TEST_F(SyntheticDepthTest, NoiseModelShape) {
   EXPECT_LT(std::abs(sum / static_cast<double>(noisy_n)), 0.0005);  // unbiased
   const DepthImage none = apply_kinect_v1_noise(clean, k_, KinectNoiseConfig::none(), 7);
   EXPECT_EQ(none.depth_m, clean.depth_m);
+}
+
+TEST_F(SyntheticDepthTest, TrackerFollowsAMovingTarget) {
+  // 30 frames, each moving the duck 1 cm and turning it 2 degrees (30 cm/s and 60 deg/s at 30 Hz).
+  const projbot::alignment::ProjectiveTracker tracker(*model_, k_);
+  Eigen::Matrix4d truth = projbot::config::pose_from_xyz_rpy({-0.05, 0.0, 1.2}, {180, 10, 30});
+  Eigen::Matrix4d estimate = truth;
+  double worst_mm = 0, worst_deg = 0, total_ms = 0;
+  for (int f = 0; f < 30; ++f) {
+    Eigen::Matrix4d step = projbot::config::pose_from_xyz_rpy({0.01 * std::cos(f * 0.2), 0.005, 0.003}, {1.0, 0.5, 2.0});
+    truth.topLeftCorner<3, 3>() = step.topLeftCorner<3, 3>() * truth.topLeftCorner<3, 3>();
+    truth.topRightCorner<3, 1>() += step.topRightCorner<3, 1>();
+    const DepthImage frame = apply_kinect_v1_noise(render(truth), k_, KinectNoiseConfig{}, static_cast<std::uint32_t>(f));
+    const auto r = tracker.track(frame, estimate);
+    ASSERT_TRUE(r.accepted) << "frame " << f << ": inliers " << r.inlier_ratio << " rmse " << r.rmse_mm;
+    estimate = r.T_camera_target;
+    const Eigen::Matrix4d err = rigid_inverse(truth) * estimate;
+    worst_mm = std::max(worst_mm, translation_norm_m(err) * 1000);
+    worst_deg = std::max(worst_deg, rotation_angle_deg(err));
+    total_ms += r.time_ms;
+  }
+  std::cout << "tracked 30 frames: worst " << worst_mm << " mm, " << worst_deg << " deg, mean " << total_ms / 30 << " ms\n";
+  EXPECT_LT(worst_mm, 3.0);
+  EXPECT_LT(worst_deg, 0.5);
+}
+
+TEST_F(SyntheticDepthTest, TrackerRejectsAFrameWithoutTheTarget) {
+  const projbot::alignment::ProjectiveTracker tracker(*model_, k_);
+  const Eigen::Matrix4d T = poses()[1];
+  DepthImage empty = render(T);
+  std::fill(empty.depth_m.begin(), empty.depth_m.end(), 0.0F);
+  EXPECT_FALSE(tracker.track(empty, T).accepted);
+  // A wall 30 cm behind where the target was: no support for the model.
+  std::fill(empty.depth_m.begin(), empty.depth_m.end(), static_cast<float>(T(2, 3) + 0.3));
+  EXPECT_FALSE(tracker.track(empty, T).accepted);
+  EXPECT_THROW(tracker.track(DepthImage{}, T), AlignmentError);
 }

@@ -5,8 +5,10 @@
 
 namespace projbot::alignment {
 
-DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics& k, const KinectNoiseConfig& cfg, std::uint32_t seed) {
-  if (clean.width != k.width_px || clean.height != k.height_px) throw AlignmentError("noise model: depth image and intrinsics differ in size");
+DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics& k, const KinectNoiseConfig& cfg,
+                                 std::uint32_t seed) {
+  if (clean.width != k.width_px || clean.height != k.height_px)
+    throw AlignmentError("noise model: depth image and intrinsics differ in size");
   DepthImage out = clean;
   const int w = clean.width, h = clean.height;
   const auto valid = [&](int x, int y) {

@@ -214,6 +214,68 @@ struct Aligner::Impl {
   }
 };
 
+struct PclIcpBaseline::Impl {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr model;
+  pcl::search::KdTree<pcl::PointXYZ>::Ptr model_tree;
+  double voxel = 0.004;
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  double radius = 0.0;
+  int iterations = 30;
+  double max_distance = 0.04;
+};
+
+PclIcpBaseline::PclIcpBaseline(const ModelCloud& model, double voxel_m, int iterations, double max_distance_m)
+    : impl_(std::make_unique<Impl>()) {
+  auto raw = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (const auto& p : model.points) {
+    raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    impl_->centroid += p;
+  }
+  if (raw->empty()) throw AlignmentError("baseline: empty model");
+  impl_->centroid /= static_cast<float>(raw->size());
+  for (const auto& p : model.points) impl_->radius = std::max(impl_->radius, static_cast<double>((p - impl_->centroid).norm()));
+  impl_->model = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  pcl::VoxelGrid<pcl::PointXYZ> grid;
+  grid.setInputCloud(raw);
+  grid.setLeafSize(static_cast<float>(voxel_m), static_cast<float>(voxel_m), static_cast<float>(voxel_m));
+  grid.filter(*impl_->model);
+  impl_->model_tree = pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+  impl_->model_tree->setInputCloud(impl_->model);
+  impl_->voxel = voxel_m;
+  impl_->iterations = iterations;
+  impl_->max_distance = max_distance_m;
+}
+PclIcpBaseline::~PclIcpBaseline() = default;
+PclIcpBaseline::PclIcpBaseline(PclIcpBaseline&&) noexcept = default;
+PclIcpBaseline& PclIcpBaseline::operator=(PclIcpBaseline&&) noexcept = default;
+
+Eigen::Matrix4d PclIcpBaseline::track(const PointCloud& scan, const Eigen::Matrix4d& T_init) const {
+  const Eigen::Vector3f c = (T_init * impl_->centroid.cast<double>().homogeneous()).head<3>().cast<float>();
+  const float r2 = static_cast<float>(std::pow(impl_->radius + 0.1, 2));
+  auto raw = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (const auto& p : scan.points)
+    if (p.allFinite() && (p - c).squaredNorm() <= r2) raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+  if (raw->size() < 10) return T_init;
+  // PCL at its best for tracking: the downsampled scan as source (all of it lies on the model), the
+  // model as target with its search tree built once.
+  auto source = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  pcl::VoxelGrid<pcl::PointXYZ> grid;
+  grid.setInputCloud(raw);
+  const auto leaf = static_cast<float>(impl_->voxel);
+  grid.setLeafSize(leaf, leaf, leaf);
+  grid.filter(*source);
+  pcl::IterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> icp;
+  icp.setInputSource(source);
+  icp.setInputTarget(impl_->model);
+  icp.setSearchMethodTarget(impl_->model_tree, true);
+  icp.setMaxCorrespondenceDistance(impl_->max_distance);
+  icp.setMaximumIterations(impl_->iterations);
+  icp.setTransformationEpsilon(1e-10);
+  pcl::PointCloud<pcl::PointXYZ> aligned;
+  icp.align(aligned, rigid_inverse(T_init).cast<float>());
+  return rigid_inverse(icp.getFinalTransformation().cast<double>());
+}
+
 ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
   const auto s = assets::sample_surface(model, samples, 1);
   return {s.points, s.normals};

@@ -21,5 +21,6 @@ extern const Command kRender;
 extern const Command kShow;
 extern const Command kBenchRender;
 extern const Command kAlign;
+extern const Command kBenchTrack;
 
 }  // namespace projbot::tools

@@ -16,7 +16,7 @@ using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
   static const std::vector<const Command*> all{&projbot::tools::kRender, &projbot::tools::kShow, &projbot::tools::kBenchRender,
-                                               &projbot::tools::kAlign};
+                                               &projbot::tools::kAlign, &projbot::tools::kBenchTrack};
   return all;
 }
 
@@ -53,12 +53,12 @@ int main(int argc, char** argv) {
   }
   std::string name = argv[1];
   int first = 2;
-  if (name == "bench") {  // "bench render": the benchmark of a subsystem
-    if (argc < 3 || std::string(argv[2]) != "render") {
-      std::cerr << "projbot bench: say what to benchmark: projbot bench render\n";
+  if (name == "bench") {  // "bench render", "bench track": the benchmark of a subsystem
+    if (argc < 3 || (std::string(argv[2]) != "render" && std::string(argv[2]) != "track")) {
+      std::cerr << "projbot bench: say what to benchmark: projbot bench render | projbot bench track\n";
       return 2;
     }
-    name = "bench render";
+    name = std::string("bench ") + argv[2];
     first = 3;
   }
   const Command* cmd = nullptr;

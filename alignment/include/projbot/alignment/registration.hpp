@@ -86,4 +86,21 @@ class Aligner {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The baseline the tracker is measured against: PCL's IterativeClosestPoint (point-to-point, kd-tree) in
+/// its best set-up for tracking: the scan's points near the guess, voxel-downsampled, as source; the
+/// model (voxel-downsampled) as target, its search tree built once. Frame-to-frame use, as a tracker.
+class PclIcpBaseline {
+ public:
+  PclIcpBaseline(const ModelCloud& model, double voxel_m = 0.004, int iterations = 30, double max_distance_m = 0.04);
+  ~PclIcpBaseline();
+  PclIcpBaseline(PclIcpBaseline&&) noexcept;
+  PclIcpBaseline& operator=(PclIcpBaseline&&) noexcept;
+  /// T_scan_model refined from T_init; the scan is cropped to the model's radius + 10 cm around T_init.
+  Eigen::Matrix4d track(const PointCloud& scan, const Eigen::Matrix4d& T_init) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 }  // namespace projbot::alignment

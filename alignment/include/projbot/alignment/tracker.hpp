@@ -1,0 +1,61 @@
+#pragma once
+// Frame-to-frame tracking at camera rate: the previous pose refined against each new depth frame by
+// projective data association (model points projected into the depth image; no search tree),
+// point-to-plane Gauss-Newton with a robust weight, coarse to fine over an image pyramid. Eigen only.
+// Not thread-safe: one tracker per worker thread.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/registration.hpp"
+
+namespace projbot::alignment {
+
+struct TrackerConfig {
+  int pyramid_levels = 3;                     ///< 640x480, 320x240, 160x120
+  std::vector<int> iterations{6, 5, 4};       ///< Gauss-Newton iterations per level, coarsest first
+  std::vector<std::size_t> model_points{3000, 8000, 20000};  ///< model points used per level, coarsest first
+  double max_distance_m = 0.04;               ///< correspondences farther apart are ignored
+  double huber_sigmas = 2.0;                  ///< Huber threshold in sensor sigmas (1.425e-3 z^2, at least 1 mm)
+  double occlusion_margin_m = 0.03;           ///< scan depth this much nearer than the model: occluded, not counted
+  double inlier_distance_m = 0.01;            ///< for the quality numbers
+  double min_inlier_ratio = 0.6;              ///< quality gate
+  double max_rmse_mm = 6.0;
+  std::size_t min_correspondences = 200;
+};
+
+/// One tracked frame.
+struct TrackResult {
+  Eigen::Matrix4d T_camera_target = Eigen::Matrix4d::Identity();
+  bool accepted = false;     ///< passed the quality gate
+  double inlier_ratio = 0.0; ///< of model points that are visible, in the image and not occluded
+  double rmse_mm = 0.0;      ///< point-to-plane RMS of the inliers
+  std::size_t correspondences = 0;
+  int iterations = 0;
+  double time_ms = 0.0;      ///< including the pyramid
+};
+
+class ProjectiveTracker {
+ public:
+  /// Throws AlignmentError for an empty model or bad intrinsics.
+  ProjectiveTracker(ModelCloud model, CameraIntrinsics intrinsics, TrackerConfig config = {});
+
+  /// Refines T_prev (target -> camera) against `depth` (metres, 0 = missing).
+  TrackResult track(const DepthImage& depth, const Eigen::Matrix4d& T_prev) const;
+
+  const TrackerConfig& config() const { return cfg_; }
+
+ private:
+  struct Level {
+    CameraIntrinsics k;
+    std::vector<float> z;  // metres, 0 = missing
+  };
+  std::vector<Level> pyramid(const DepthImage& depth) const;
+
+  ModelCloud model_;  // shuffled once, so any prefix is a uniform subsample
+  CameraIntrinsics k_;
+  TrackerConfig cfg_;
+};
+
+}  // namespace projbot::alignment

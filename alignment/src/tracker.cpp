@@ -1,0 +1,161 @@
+#include "projbot/alignment/tracker.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+namespace projbot::alignment {
+namespace {
+
+// exp of a twist (v, w) as a rigid transform (first order in the rotation's axis-angle, exact rotation).
+Eigen::Matrix4d twist_to_transform(const Eigen::Matrix<double, 6, 1>& xi) {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  const Eigen::Vector3d w = xi.tail<3>();
+  const double angle = w.norm();
+  if (angle > 1e-12) T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+  T.topRightCorner<3, 1>() = xi.head<3>();
+  return T;
+}
+
+double sensor_sigma(double z) { return std::max(1.425e-3 * z * z, 0.001); }
+
+}  // namespace
+
+ProjectiveTracker::ProjectiveTracker(ModelCloud model, CameraIntrinsics intrinsics, TrackerConfig config)
+    : model_(std::move(model)), k_(intrinsics), cfg_(std::move(config)) {
+  if (model_.points.size() < 10 || model_.normals.size() != model_.points.size())
+    throw AlignmentError("tracker: the model needs at least 10 points with normals");
+  if (!(k_.fx_px > 0) || !(k_.fy_px > 0) || k_.width_px <= 0 || k_.height_px <= 0) throw AlignmentError("tracker: bad intrinsics");
+  if (cfg_.pyramid_levels < 1 || cfg_.iterations.size() != static_cast<std::size_t>(cfg_.pyramid_levels) ||
+      cfg_.model_points.size() != static_cast<std::size_t>(cfg_.pyramid_levels))
+    throw AlignmentError("tracker: iterations and model_points need one entry per pyramid level");
+  // A fixed shuffle: the first n points are a uniform subsample for every n.
+  std::vector<std::size_t> order(model_.points.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937(7));
+  ModelCloud shuffled;
+  for (auto i : order) {
+    shuffled.points.push_back(model_.points[i]);
+    shuffled.normals.push_back(model_.normals[i]);
+  }
+  model_ = std::move(shuffled);
+}
+
+std::vector<ProjectiveTracker::Level> ProjectiveTracker::pyramid(const DepthImage& depth) const {
+  if (depth.width != k_.width_px || depth.height != k_.height_px)
+    throw AlignmentError("tracker: depth frame is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) +
+                         ", the camera " + std::to_string(k_.width_px) + "x" + std::to_string(k_.height_px));
+  std::vector<Level> levels(static_cast<std::size_t>(cfg_.pyramid_levels));
+  levels[0].k = k_;
+  levels[0].z.resize(depth.depth_m.size());
+  for (std::size_t i = 0; i < depth.depth_m.size(); ++i) {
+    const float z = depth.depth_m[i];
+    levels[0].z[i] = (z > 0.0F && std::isfinite(z)) ? z : 0.0F;
+  }
+  for (std::size_t l = 1; l < levels.size(); ++l) {
+    const Level& fine = levels[l - 1];
+    Level& coarse = levels[l];
+    coarse.k = fine.k;
+    coarse.k.width_px = fine.k.width_px / 2;
+    coarse.k.height_px = fine.k.height_px / 2;
+    coarse.k.fx_px = fine.k.fx_px / 2, coarse.k.fy_px = fine.k.fy_px / 2;
+    coarse.k.cx_px = (fine.k.cx_px + 0.5) / 2 - 0.5, coarse.k.cy_px = (fine.k.cy_px + 0.5) / 2 - 0.5;
+    coarse.z.assign(static_cast<std::size_t>(coarse.k.width_px) * coarse.k.height_px, 0.0F);
+    for (int y = 0; y < coarse.k.height_px; ++y)
+      for (int x = 0; x < coarse.k.width_px; ++x) {
+        // Mean of the valid 2x2 block, unless it straddles a depth edge (then no depth, not a blend).
+        float sum = 0, lo = 1e9F, hi = 0;
+        int n = 0;
+        for (int dy = 0; dy < 2; ++dy)
+          for (int dx = 0; dx < 2; ++dx) {
+            const float z = fine.z[static_cast<std::size_t>(2 * y + dy) * fine.k.width_px + 2 * x + dx];
+            if (z <= 0.0F) continue;
+            sum += z, lo = std::min(lo, z), hi = std::max(hi, z), ++n;
+          }
+        if (n >= 2 && hi - lo < 3.0F * static_cast<float>(sensor_sigma(lo)) + 0.01F)
+          coarse.z[static_cast<std::size_t>(y) * coarse.k.width_px + x] = sum / static_cast<float>(n);
+      }
+  }
+  return levels;
+}
+
+TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matrix4d& T_prev) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!T_prev.allFinite()) throw AlignmentError("tracker: previous pose is not finite");
+  const std::vector<Level> levels = pyramid(depth);
+  TrackResult out;
+  Eigen::Matrix4d T = T_prev;
+
+  // One pass over the model points of a level: the normal equations, or the quality numbers.
+  struct Pass {
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    std::size_t used = 0, candidates = 0, inliers = 0;
+    double inlier_sq = 0.0;
+  };
+  const auto run = [&](const Level& lv, std::size_t count, const Eigen::Matrix4d& T_cur) {
+    Pass p;
+    const Eigen::Matrix3d R = T_cur.topLeftCorner<3, 3>();
+    const Eigen::Vector3d t = T_cur.topRightCorner<3, 1>();
+    const std::size_t n = std::min(count, model_.points.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d x = R * model_.points[i].cast<double>() + t;
+      const Eigen::Vector3d nrm = R * model_.normals[i].cast<double>();
+      if (x.z() <= 0.05 || nrm.dot(x) >= 0.0) continue;  // behind the camera, or facing away
+      const int u = static_cast<int>(std::lround(lv.k.fx_px * x.x() / x.z() + lv.k.cx_px));
+      const int v = static_cast<int>(std::lround(lv.k.fy_px * x.y() / x.z() + lv.k.cy_px));
+      if (u < 0 || v < 0 || u >= lv.k.width_px || v >= lv.k.height_px) continue;
+      const float zs = lv.z[static_cast<std::size_t>(v) * lv.k.width_px + u];
+      if (zs <= 0.0F) continue;
+      if (zs < x.z() - cfg_.occlusion_margin_m) continue;  // something in front of the model: occluded
+      ++p.candidates;
+      const Eigen::Vector3d q((u - lv.k.cx_px) * zs / lv.k.fx_px, (v - lv.k.cy_px) * zs / lv.k.fy_px, zs);
+      const Eigen::Vector3d d = x - q;
+      if (d.squaredNorm() > cfg_.max_distance_m * cfg_.max_distance_m) continue;
+      const double r = nrm.dot(d);  // point-to-plane, the plane of the model's exact normal
+      if (std::abs(r) <= cfg_.inlier_distance_m) {
+        ++p.inliers;
+        p.inlier_sq += r * r;
+      }
+      // Huber weight with a threshold that grows with the sensor's noise at this depth.
+      const double delta = cfg_.huber_sigmas * sensor_sigma(zs);
+      const double w = std::abs(r) <= delta ? 1.0 : delta / std::abs(r);
+      Eigen::Matrix<double, 6, 1> J;
+      J.head<3>() = nrm;            // d r / d v
+      J.tail<3>() = x.cross(nrm);   // d r / d w, for x -> x + w x x + v
+      p.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
+      p.g += w * r * J;
+      ++p.used;
+    }
+    return p;
+  };
+
+  for (int l = cfg_.pyramid_levels - 1; l >= 0; --l) {
+    const auto li = static_cast<std::size_t>(cfg_.pyramid_levels - 1 - l);  // coarsest first in the config
+    const Level& lv = levels[static_cast<std::size_t>(l)];
+    for (int it = 0; it < cfg_.iterations[li]; ++it) {
+      Pass p = run(lv, cfg_.model_points[li], T);
+      ++out.iterations;
+      if (p.used < 6 * 3) break;
+      p.H.triangularView<Eigen::Lower>() = p.H.transpose();
+      const Eigen::Matrix<double, 6, 1> xi = p.H.ldlt().solve(-p.g);
+      if (!xi.allFinite()) break;
+      T = twist_to_transform(xi) * T;
+      if (xi.head<3>().norm() < 1e-6 && xi.tail<3>().norm() < 1e-6) break;
+    }
+  }
+  const Pass q = run(levels[0], cfg_.model_points.back(), T);
+  out.T_camera_target = T;
+  out.correspondences = q.used;
+  out.inlier_ratio = q.candidates > 0 ? static_cast<double>(q.inliers) / static_cast<double>(q.candidates) : 0.0;
+  out.rmse_mm = q.inliers > 0 ? 1000.0 * std::sqrt(q.inlier_sq / static_cast<double>(q.inliers)) : std::numeric_limits<double>::infinity();
+  out.accepted = q.used >= cfg_.min_correspondences && out.inlier_ratio >= cfg_.min_inlier_ratio && out.rmse_mm <= cfg_.max_rmse_mm;
+  out.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace projbot::alignment
