@@ -29,7 +29,8 @@ ProjectiveTracker::ProjectiveTracker(ModelCloud model, CameraIntrinsics intrinsi
     : model_(std::move(model)), k_(intrinsics), cfg_(std::move(config)) {
   if (model_.points.size() < 10 || model_.normals.size() != model_.points.size())
     throw AlignmentError("tracker: the model needs at least 10 points with normals");
-  if (!(k_.fx_px > 0) || !(k_.fy_px > 0) || k_.width_px <= 0 || k_.height_px <= 0) throw AlignmentError("tracker: bad intrinsics");
+  if (!(k_.fx_px > 0) || !(k_.fy_px > 0) || k_.width_px <= 0 || k_.height_px <= 0)
+    throw AlignmentError("tracker: bad intrinsics");
   if (cfg_.pyramid_levels < 1 || cfg_.iterations.size() != static_cast<std::size_t>(cfg_.pyramid_levels) ||
       cfg_.model_points.size() != static_cast<std::size_t>(cfg_.pyramid_levels))
     throw AlignmentError("tracker: iterations and model_points need one entry per pyramid level");
@@ -125,8 +126,8 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       const double delta = cfg_.huber_sigmas * sensor_sigma(zs);
       const double w = std::abs(r) <= delta ? 1.0 : delta / std::abs(r);
       Eigen::Matrix<double, 6, 1> J;
-      J.head<3>() = nrm;            // d r / d v
-      J.tail<3>() = x.cross(nrm);   // d r / d w, for x -> x + w x x + v
+      J.head<3>() = nrm;           // d r / d v
+      J.tail<3>() = x.cross(nrm);  // d r / d w, for x -> x + w x x + v
       p.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
       p.g += w * r * J;
       ++p.used;
@@ -152,8 +153,10 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
   out.T_camera_target = T;
   out.correspondences = q.used;
   out.inlier_ratio = q.candidates > 0 ? static_cast<double>(q.inliers) / static_cast<double>(q.candidates) : 0.0;
-  out.rmse_mm = q.inliers > 0 ? 1000.0 * std::sqrt(q.inlier_sq / static_cast<double>(q.inliers)) : std::numeric_limits<double>::infinity();
-  out.accepted = q.used >= cfg_.min_correspondences && out.inlier_ratio >= cfg_.min_inlier_ratio && out.rmse_mm <= cfg_.max_rmse_mm;
+  out.rmse_mm =
+      q.inliers > 0 ? 1000.0 * std::sqrt(q.inlier_sq / static_cast<double>(q.inliers)) : std::numeric_limits<double>::infinity();
+  out.accepted =
+      q.used >= cfg_.min_correspondences && out.inlier_ratio >= cfg_.min_inlier_ratio && out.rmse_mm <= cfg_.max_rmse_mm;
   out.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

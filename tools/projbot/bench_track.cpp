@@ -36,7 +36,8 @@ struct Stats {
 }  // namespace
 
 const Command kBenchTrack{
-    "bench track", "benchmark frame-to-frame tracking against PCL's IterativeClosestPoint",
+    "bench track",
+    "benchmark frame-to-frame tracking against PCL's IterativeClosestPoint",
     "projbot bench track [--frames N] [--distance M]\n\n"
     "Renders N synthetic 640x480 Kinect v1 depth frames (the engine's depth camera plus the Kinect noise model)\n"
     "of the Duck (32 cm) moving up to 1 cm and 2 degrees per frame, then tracks it frame to frame with the\n"
@@ -67,13 +68,14 @@ const Command kBenchTrack{
       std::vector<alignment::DepthImage> depth;
       for (int f = 0; f < frames; ++f) {
         const double t = f / 30.0;  // a smooth path: up to 1 cm and 2 degrees per frame at 30 Hz
-        const Eigen::Matrix4d T = config::pose_from_xyz_rpy(
-            {0.12 * std::sin(2.0 * t), 0.06 * std::sin(1.3 * t), distance + 0.1 * std::sin(0.9 * t)},
-            {180.0 + 15.0 * std::sin(1.1 * t), 20.0 * std::sin(0.8 * t), 40.0 * std::sin(1.5 * t)});
+        const Eigen::Matrix4d T =
+            config::pose_from_xyz_rpy({0.12 * std::sin(2.0 * t), 0.06 * std::sin(1.3 * t), distance + 0.1 * std::sin(0.9 * t)},
+                                      {180.0 + 15.0 * std::sin(1.1 * t), 20.0 * std::sin(0.8 * t), 40.0 * std::sin(1.5 * t)});
         const std::vector<engine::DrawItem> items{{id, T}};
         renderer.draw_frame(*camera, pinhole, items);
         const engine::DepthMap map = camera->read_back_depth();
-        depth.push_back(alignment::apply_kinect_v1_noise({map.width, map.height, map.z_m, t}, k, {}, static_cast<std::uint32_t>(f)));
+        depth.push_back(
+            alignment::apply_kinect_v1_noise({map.width, map.height, map.z_m, t}, k, {}, static_cast<std::uint32_t>(f)));
         truth.push_back(T);
       }
 
@@ -90,23 +92,28 @@ const Command kBenchTrack{
         }
         return s;
       };
-      std::printf("%-26s %7s %8s %8s %8s %8s %9s %9s %9s\n", "method", "fps", "mean_ms", "p50_ms", "p95_ms", "max_ms", "mean_mm", "max_mm",
-                  "max_deg");
+      std::printf("%-26s %7s %8s %8s %8s %8s %9s %9s %9s\n", "method", "fps", "mean_ms", "p50_ms", "p95_ms", "max_ms", "mean_mm",
+                  "max_mm", "max_deg");
       const alignment::ProjectiveTracker tracker(model, k);
-      const Stats ours = measure([&](int f, const Eigen::Matrix4d& prev) { return tracker.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target; });
+      const Stats ours = measure([&](int f, const Eigen::Matrix4d& prev) {
+        return tracker.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target;
+      });
       ours.print("projective (20k of 50k)");
       alignment::TrackerConfig all_points;
       all_points.model_points = {5000, 15000, 50000};
       const alignment::ProjectiveTracker tracker_all(model, k, all_points);
-      const Stats ours_all =
-          measure([&](int f, const Eigen::Matrix4d& prev) { return tracker_all.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target; });
+      const Stats ours_all = measure([&](int f, const Eigen::Matrix4d& prev) {
+        return tracker_all.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target;
+      });
       ours_all.print("projective (all 50k)");
       const alignment::PclIcpBaseline pcl_icp(model);
       const Stats base = measure([&](int f, const Eigen::Matrix4d& prev) {
         return pcl_icp.track(alignment::depth_to_cloud(depth[static_cast<std::size_t>(f)], k), prev);
       });
       base.print("pcl IterativeClosestPoint");
-      const auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); };
+      const auto mean = [](const std::vector<double>& v) {
+        return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+      };
       std::printf("speed-up over PCL (mean time): %.1fx (20k points), %.1fx (all 50k)\n", mean(base.ms) / mean(ours.ms),
                   mean(base.ms) / mean(ours_all.ms));
       return 0;

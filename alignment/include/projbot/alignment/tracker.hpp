@@ -13,14 +13,14 @@
 namespace projbot::alignment {
 
 struct TrackerConfig {
-  int pyramid_levels = 3;                     ///< 640x480, 320x240, 160x120
-  std::vector<int> iterations{6, 5, 4};       ///< Gauss-Newton iterations per level, coarsest first
+  int pyramid_levels = 3;                                    ///< 640x480, 320x240, 160x120
+  std::vector<int> iterations{6, 5, 4};                      ///< Gauss-Newton iterations per level, coarsest first
   std::vector<std::size_t> model_points{3000, 8000, 20000};  ///< model points used per level, coarsest first
-  double max_distance_m = 0.04;               ///< correspondences farther apart are ignored
-  double huber_sigmas = 2.0;                  ///< Huber threshold in sensor sigmas (1.425e-3 z^2, at least 1 mm)
-  double occlusion_margin_m = 0.03;           ///< scan depth this much nearer than the model: occluded, not counted
-  double inlier_distance_m = 0.01;            ///< for the quality numbers
-  double min_inlier_ratio = 0.6;              ///< quality gate
+  double max_distance_m = 0.04;                              ///< correspondences farther apart are ignored
+  double huber_sigmas = 2.0;                                 ///< Huber threshold in sensor sigmas (1.425e-3 z^2, at least 1 mm)
+  double occlusion_margin_m = 0.03;  ///< scan depth this much nearer than the model: occluded, not counted
+  double inlier_distance_m = 0.01;   ///< for the quality numbers
+  double min_inlier_ratio = 0.6;     ///< quality gate
   double max_rmse_mm = 6.0;
   std::size_t min_correspondences = 200;
 };
@@ -28,12 +28,12 @@ struct TrackerConfig {
 /// One tracked frame.
 struct TrackResult {
   Eigen::Matrix4d T_camera_target = Eigen::Matrix4d::Identity();
-  bool accepted = false;     ///< passed the quality gate
-  double inlier_ratio = 0.0; ///< of model points that are visible, in the image and not occluded
-  double rmse_mm = 0.0;      ///< point-to-plane RMS of the inliers
+  bool accepted = false;      ///< passed the quality gate
+  double inlier_ratio = 0.0;  ///< of model points that are visible, in the image and not occluded
+  double rmse_mm = 0.0;       ///< point-to-plane RMS of the inliers
   std::size_t correspondences = 0;
   int iterations = 0;
-  double time_ms = 0.0;      ///< including the pyramid
+  double time_ms = 0.0;  ///< including the pyramid
 };
 
 class ProjectiveTracker {

@@ -1,0 +1,166 @@
+// The tracker worker and its hand-off, also built with ThreadSanitizer (tracker_worker_tsan_test).
+// Frames come from a CPU ray-caster of a cube so that no GPU driver threads take part.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <thread>
+
+#include "projbot/alignment/equations.hpp"
+#include "projbot/alignment/tracker_worker.hpp"
+#include "projbot/assets/model.hpp"
+#include "projbot/config/scene.hpp"
+
+using namespace projbot::alignment;
+
+namespace {
+
+constexpr double kHalf = 0.1;  // a 20 cm cube
+
+// Depth of an axis-aligned cube [-kHalf, kHalf]^3 posed by T_camera_cube, by slab intersection per pixel.
+std::shared_ptr<DepthImage> cube_depth(const Eigen::Matrix4d& T, const CameraIntrinsics& k, double capture_time_s) {
+  auto d = std::make_shared<DepthImage>();
+  d->width = k.width_px, d->height = k.height_px, d->capture_time_s = capture_time_s;
+  d->depth_m.assign(static_cast<std::size_t>(k.width_px) * k.height_px, 0.0F);
+  const Eigen::Matrix3d Rt = T.topLeftCorner<3, 3>().transpose();
+  const Eigen::Vector3d o = -Rt * T.topRightCorner<3, 1>();  // camera centre in the cube frame
+  for (int y = 0; y < k.height_px; ++y)
+    for (int x = 0; x < k.width_px; ++x) {
+      const Eigen::Vector3d dir = Rt * Eigen::Vector3d((x - k.cx_px) / k.fx_px, (y - k.cy_px) / k.fy_px, 1.0);  // z = 1 in camera
+      double t0 = 0.0, t1 = 1e9;
+      for (int a = 0; a < 3; ++a) {
+        if (std::abs(dir[a]) < 1e-12) {
+          if (std::abs(o[a]) > kHalf) t0 = 1e9;
+          continue;
+        }
+        double ta = (-kHalf - o[a]) / dir[a], tb = (kHalf - o[a]) / dir[a];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta), t1 = std::min(t1, tb);
+      }
+      if (t0 < t1 && t0 > 0.0) d->depth_m[static_cast<std::size_t>(y) * k.width_px + x] = static_cast<float>(t0);  // z = t for z = 1
+    }
+  return d;
+}
+
+ModelCloud cube_model() {
+  projbot::assets::Model box = projbot::assets::load_gltf(std::string(PROJBOT_SHARED_DATA) + "/gltf/BoxTextured/glTF-Embedded/BoxTextured.gltf");
+  projbot::assets::scale_and_recenter(box, 2 * kHalf, false);
+  return model_cloud_from(box, 20000);
+}
+
+// Polls the reader side until `done` holds or 20 s pass (a deadlock guard, not a speed check).
+template <typename Pred>
+bool poll(TrackerWorker& w, PoseSample& s, Pred done) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (std::chrono::steady_clock::now() < end) {
+    if (w.latest(s) && done(s)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST(LatestValueTest, ReaderNeverSeesATornOrOlderValue) {
+  struct Pair {
+    std::uint64_t a = 0, b = ~0ULL;
+  };
+  LatestValue<Pair> slot;
+  constexpr std::uint64_t kLast = 200000;
+  std::jthread writer([&] {
+    for (std::uint64_t i = 1; i <= kLast; ++i) slot.publish({i, ~i});
+  });
+  Pair p;
+  std::uint64_t seen = 0, reads = 0;
+  while (seen < kLast) {
+    if (!slot.read(p)) continue;
+    ++reads;
+    ASSERT_EQ(p.b, ~p.a) << "torn value";
+    ASSERT_GE(p.a, seen) << "went back in time";
+    seen = p.a;
+  }
+  writer.join();
+  EXPECT_EQ(seen, kLast);
+  EXPECT_GT(reads, 0U);
+}
+
+TEST(TrackerWorkerTest, AcquiresTracksAndReportsLost) {
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  WorkerConfig cfg;
+  cfg.lost_after = 3;
+  cfg.acquisition.reinitialise = false;  // FPFH's OpenMP threads are outside ThreadSanitizer's view
+  TrackerWorker worker(cube_model(), k, cfg);
+  const auto truth = [](int f) {
+    return projbot::config::pose_from_xyz_rpy({0.05 + 0.003 * f, -0.02, 1.0 + 0.002 * f}, {20 + 0.5 * f, 30, 10});
+  };
+  std::vector<std::shared_ptr<DepthImage>> frames;
+  for (int f = 0; f < 40; ++f) frames.push_back(cube_depth(truth(f), k, f));
+  // Eq. 1's guess, 1 cm and 3 degrees off.
+  worker.set_initial_guess(projbot::config::pose_from_xyz_rpy({0.06, -0.02, 1.0}, {23, 30, 10}));
+
+  std::jthread sensor([&] {  // the camera: frames at 200 Hz, faster than needed, so some are dropped
+    for (const auto& f : frames) {
+      worker.submit(f);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  });
+  PoseSample s;
+  std::uint64_t last_sequence = 0;
+  ASSERT_TRUE(poll(worker, s, [&](const PoseSample& p) {
+    EXPECT_GE(p.sequence, last_sequence);
+    last_sequence = p.sequence;
+    return p.capture_time_s >= 39.0;
+  })) << "the worker never reached the last frame: " << worker.frames_processed() << " frames processed, last sample at "
+         << s.capture_time_s << (s.lost ? " (lost)" : "") << ", sequence " << s.sequence;
+  sensor.join();
+  EXPECT_FALSE(s.lost);
+  const Eigen::Matrix4d err = rigid_inverse(truth(39)) * s.T_camera_target;
+  EXPECT_LT(translation_norm_m(err), 0.002);
+  EXPECT_LT(rotation_angle_deg(err), 0.5);
+  EXPECT_GE(worker.frames_processed(), 2U);  // acquired one frame, then tracked at least one more
+
+  // The target disappears: after lost_after rejected frames the worker says so.
+  auto empty = cube_depth(truth(39), k, 40.0);
+  std::fill(empty->depth_m.begin(), empty->depth_m.end(), 1.5F);  // a wall behind it
+  std::jthread gone([&](std::stop_token stop) {  // the camera keeps streaming the empty view
+    while (!stop.stop_requested()) {
+      worker.submit(empty);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  });
+  const std::uint64_t before = worker.frames_processed();
+  EXPECT_TRUE(poll(worker, s, [](const PoseSample& p) { return p.lost; }))
+      << "never reported lost: " << worker.frames_processed() - before << " empty frames processed, last sample at " << s.capture_time_s;
+  EXPECT_GE(worker.frames_processed() - before, 3U);  // lost_after frames without the target
+  gone.request_stop();
+  gone.join();
+  EXPECT_EQ(worker.error(), nullptr);
+}
+
+TEST(TrackerWorkerTest, StopsWithFramesPendingAndRejectsBadGuesses) {
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  auto worker = std::make_unique<TrackerWorker>(cube_model(), k);
+  Eigen::Matrix4d bad = Eigen::Matrix4d::Identity();
+  bad(1, 1) = std::nan("");
+  EXPECT_THROW(worker->set_initial_guess(bad), AlignmentError);
+  worker->set_initial_guess(projbot::config::pose_from_xyz_rpy({0, 0, 1}, {0, 0, 0}));
+  worker->submit(cube_depth(projbot::config::pose_from_xyz_rpy({0, 0, 1}, {0, 0, 0}), k, 0.0));
+  worker.reset();  // must return: the destructor stops and joins the thread
+  SUCCEED();
+}
+
+TEST(TrackerWorkerTest, AWrongSizedFrameEndsTheWorkerWithAnErrorAndLost) {
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  TrackerWorker worker(cube_model(), k);
+  worker.set_initial_guess(projbot::config::pose_from_xyz_rpy({0, 0, 1}, {20, 30, 10}));
+  worker.submit(cube_depth(projbot::config::pose_from_xyz_rpy({0, 0, 1}, {20, 30, 10}), k, 0.0));
+  PoseSample s;
+  ASSERT_TRUE(poll(worker, s, [](const PoseSample& p) { return !p.lost; }));
+  auto small = std::make_shared<DepthImage>();
+  small->width = 4, small->height = 4, small->depth_m.assign(16, 1.0F);
+  worker.submit(small);
+  ASSERT_TRUE(poll(worker, s, [](const PoseSample& p) { return p.lost; }));
+  ASSERT_NE(worker.error(), nullptr);
+  EXPECT_THROW(std::rethrow_exception(worker.error()), AlignmentError);
+}
