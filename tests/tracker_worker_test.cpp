@@ -123,13 +123,13 @@ TEST(TrackerWorkerTest, AcquiresTracksAndReportsLost) {
   // The target disappears: after lost_after rejected frames the worker says so.
   auto empty = cube_depth(truth(39), k, 40.0);
   std::fill(empty->depth_m.begin(), empty->depth_m.end(), 1.5F);  // a wall behind it
+  const std::uint64_t before = worker.frames_processed();  // before the first empty frame can be taken
   std::jthread gone([&](std::stop_token stop) {  // the camera keeps streaming the empty view
     while (!stop.stop_requested()) {
       worker.submit(empty);
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
   });
-  const std::uint64_t before = worker.frames_processed();
   EXPECT_TRUE(poll(worker, s, [](const PoseSample& p) { return p.lost; }))
       << "never reported lost: " << worker.frames_processed() - before << " empty frames processed, last sample at " << s.capture_time_s;
   EXPECT_GE(worker.frames_processed() - before, 3U);  // lost_after frames without the target
