@@ -1,6 +1,8 @@
 // The tracker worker and its hand-off, also built with ThreadSanitizer (tracker_worker_tsan_test).
 // Frames come from a CPU ray-caster of a cube so that no GPU driver threads take part.
 
+#include "projbot/alignment/tracker_worker.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -8,7 +10,6 @@
 #include <thread>
 
 #include "projbot/alignment/equations.hpp"
-#include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/scene.hpp"
 
@@ -38,13 +39,15 @@ std::shared_ptr<DepthImage> cube_depth(const Eigen::Matrix4d& T, const CameraInt
         if (ta > tb) std::swap(ta, tb);
         t0 = std::max(t0, ta), t1 = std::min(t1, tb);
       }
-      if (t0 < t1 && t0 > 0.0) d->depth_m[static_cast<std::size_t>(y) * k.width_px + x] = static_cast<float>(t0);  // z = t for z = 1
+      if (t0 < t1 && t0 > 0.0)
+        d->depth_m[static_cast<std::size_t>(y) * k.width_px + x] = static_cast<float>(t0);  // z = t for z = 1
     }
   return d;
 }
 
 ModelCloud cube_model() {
-  projbot::assets::Model box = projbot::assets::load_gltf(std::string(PROJBOT_SHARED_DATA) + "/gltf/BoxTextured/glTF-Embedded/BoxTextured.gltf");
+  projbot::assets::Model box =
+      projbot::assets::load_gltf(std::string(PROJBOT_SHARED_DATA) + "/gltf/BoxTextured/glTF-Embedded/BoxTextured.gltf");
   projbot::assets::scale_and_recenter(box, 2 * kHalf, false);
   return model_cloud_from(box, 20000);
 }
@@ -107,12 +110,14 @@ TEST(TrackerWorkerTest, AcquiresTracksAndReportsLost) {
   });
   PoseSample s;
   std::uint64_t last_sequence = 0;
-  ASSERT_TRUE(poll(worker, s, [&](const PoseSample& p) {
-    EXPECT_GE(p.sequence, last_sequence);
-    last_sequence = p.sequence;
-    return p.capture_time_s >= 39.0;
-  })) << "the worker never reached the last frame: " << worker.frames_processed() << " frames processed, last sample at "
-         << s.capture_time_s << (s.lost ? " (lost)" : "") << ", sequence " << s.sequence;
+  ASSERT_TRUE(poll(worker, s,
+                   [&](const PoseSample& p) {
+                     EXPECT_GE(p.sequence, last_sequence);
+                     last_sequence = p.sequence;
+                     return p.capture_time_s >= 39.0;
+                   }))
+      << "the worker never reached the last frame: " << worker.frames_processed() << " frames processed, last sample at "
+      << s.capture_time_s << (s.lost ? " (lost)" : "") << ", sequence " << s.sequence;
   sensor.join();
   EXPECT_FALSE(s.lost);
   const Eigen::Matrix4d err = rigid_inverse(truth(39)) * s.T_camera_target;
@@ -123,15 +128,16 @@ TEST(TrackerWorkerTest, AcquiresTracksAndReportsLost) {
   // The target disappears: after lost_after rejected frames the worker says so.
   auto empty = cube_depth(truth(39), k, 40.0);
   std::fill(empty->depth_m.begin(), empty->depth_m.end(), 1.5F);  // a wall behind it
-  const std::uint64_t before = worker.frames_processed();  // before the first empty frame can be taken
-  std::jthread gone([&](std::stop_token stop) {  // the camera keeps streaming the empty view
+  const std::uint64_t before = worker.frames_processed();         // before the first empty frame can be taken
+  std::jthread gone([&](std::stop_token stop) {                   // the camera keeps streaming the empty view
     while (!stop.stop_requested()) {
       worker.submit(empty);
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
   });
   EXPECT_TRUE(poll(worker, s, [](const PoseSample& p) { return p.lost; }))
-      << "never reported lost: " << worker.frames_processed() - before << " empty frames processed, last sample at " << s.capture_time_s;
+      << "never reported lost: " << worker.frames_processed() - before << " empty frames processed, last sample at "
+      << s.capture_time_s;
   EXPECT_GE(worker.frames_processed() - before, 3U);  // lost_after frames without the target
   gone.request_stop();
   gone.join();

@@ -33,10 +33,10 @@ class LatestValue {
   static constexpr std::uint8_t kIndex = 0x3;
   static constexpr std::uint8_t kFresh = 0x4;
   T slots_[3]{};
-  std::uint8_t back_ = 0;                  // writer's slot
-  std::atomic<std::uint8_t> middle_{1};    // the swap slot, with a fresh flag
-  std::uint8_t front_ = 2;                 // reader's slot
-  bool has_value_ = false;                 // reader's
+  std::uint8_t back_ = 0;                // writer's slot
+  std::atomic<std::uint8_t> middle_{1};  // the swap slot, with a fresh flag
+  std::uint8_t front_ = 2;               // reader's slot
+  bool has_value_ = false;               // reader's
 };
 
 }  // namespace projbot::alignment
