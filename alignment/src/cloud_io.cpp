@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "file_kind.hpp"
 #include "projbot/alignment/depth.hpp"
 
 namespace projbot::alignment {
@@ -14,8 +15,7 @@ namespace projbot::alignment {
 PointCloud read_cloud(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw AlignmentError(path.string() + ": no such point cloud file");
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = detail::lower_extension(path);
   pcl::PointCloud<pcl::PointXYZ> cloud;
   int rc = -1;
   // PCL prints its own complaints to stderr; ours, below, names the file and what to do.

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <optional>
 
+#include "file_kind.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/assets/model.hpp"
 
@@ -282,8 +283,7 @@ ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
 }
 
 ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t samples) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = detail::lower_extension(path);
   ModelCloud m;
   if (ext == ".gltf" || ext == ".glb") {
     try {

@@ -5,10 +5,6 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "projbot/alignment/depth.hpp"
-#include "projbot/assets/image.hpp"
-#include "projbot/config/scene.hpp"
-#include "projbot/engine/renderer.hpp"
 
 namespace {
 
@@ -80,19 +76,7 @@ int main(int argc, char** argv) {
   } catch (const projbot::cli::UsageError& e) {
     std::cerr << "projbot " << name << ": " << e.what() << " (see projbot " << name << " --help)\n";
     return 2;
-  } catch (const projbot::config::ConfigError& e) {
-    std::cerr << "projbot " << name << ": " << e.what() << '\n';
-    return 1;
-  } catch (const projbot::assets::AssetError& e) {
-    std::cerr << "projbot " << name << ": " << e.what() << '\n';
-    return 1;
-  } catch (const projbot::alignment::AlignmentError& e) {
-    std::cerr << "projbot " << name << ": " << e.what() << '\n';
-    return 1;
-  } catch (const projbot::engine::EngineError& e) {
-    std::cerr << "projbot " << name << ": " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // ConfigError, AssetError, AlignmentError, EngineError: one clear line
     std::cerr << "projbot " << name << ": " << e.what() << '\n';
     return 1;
   }
