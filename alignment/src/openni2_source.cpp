@@ -1,0 +1,105 @@
+// The only translation unit with OpenNI2.
+
+#include "projbot/alignment/openni2_source.hpp"
+
+#include <OpenNI.h>
+
+#include <cmath>
+
+namespace projbot::alignment {
+namespace {
+
+std::string describe(const std::string& uri) { return uri.empty() ? std::string("the first OpenNI2 device") : "OpenNI2 device '" + uri + "'"; }
+
+[[noreturn]] void fail(const std::string& uri, const std::string& what) {
+  throw AlignmentError(describe(uri) + ": " + what + ": " + openni::OpenNI::getExtendedError());
+}
+
+}  // namespace
+
+struct OpenNi2Source::Impl {
+  OpenNi2Options options;
+  openni::Device device;
+  openni::VideoStream depth;
+  openni::Recorder recorder;
+  double metres_per_unit = 0.001;
+};
+
+OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.options = options;
+  // OpenNI2 keeps one process-wide context; initialize() is safe to call again and is never shut down
+  // here, because another source may still use it.
+  if (openni::OpenNI::initialize() != openni::STATUS_OK) fail(options.uri, "cannot initialise OpenNI2");
+  const bool is_file = options.uri.size() > 4 && options.uri.substr(options.uri.size() - 4) == ".oni";
+  if (is_file && !std::filesystem::is_regular_file(options.uri)) throw AlignmentError(options.uri + ": no such .oni recording");
+  if (m.device.open(options.uri.empty() ? openni::ANY_DEVICE : options.uri.c_str()) != openni::STATUS_OK) fail(options.uri, "cannot open");
+  if (!m.device.hasSensor(openni::SENSOR_DEPTH)) throw AlignmentError(describe(options.uri) + ": has no depth sensor");
+  if (m.depth.create(m.device, openni::SENSOR_DEPTH) != openni::STATUS_OK) fail(options.uri, "cannot create the depth stream");
+  const openni::PixelFormat format = m.depth.getVideoMode().getPixelFormat();
+  if (format == openni::PIXEL_FORMAT_DEPTH_1_MM) m.metres_per_unit = 0.001;
+  else if (format == openni::PIXEL_FORMAT_DEPTH_100_UM) m.metres_per_unit = 0.0001;
+  else throw AlignmentError(describe(options.uri) + ": depth pixel format " + std::to_string(static_cast<int>(format)) + " is not in mm or 100 um");
+  if (m.depth.start() != openni::STATUS_OK) fail(options.uri, "cannot start the depth stream");
+  if (!options.record_to.empty()) {
+    if (m.recorder.create(options.record_to.c_str()) != openni::STATUS_OK || m.recorder.attach(m.depth) != openni::STATUS_OK ||
+        m.recorder.start() != openni::STATUS_OK)
+      fail(options.uri, "cannot record to " + options.record_to.string());
+  }
+}
+
+OpenNi2Source::~OpenNi2Source() {
+  Impl& m = *impl_;
+  if (m.recorder.isValid()) {
+    m.recorder.stop();
+    m.recorder.destroy();
+  }
+  m.depth.stop();
+  m.depth.destroy();
+  m.device.close();
+}
+
+DepthImage OpenNi2Source::next() {
+  Impl& m = *impl_;
+  openni::VideoStream* streams[] = {&m.depth};
+  int ready = -1;
+  if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, m.options.timeout_ms) != openni::STATUS_OK)
+    throw AlignmentError(describe(m.options.uri) + ": no depth frame within " + std::to_string(m.options.timeout_ms) + " ms" +
+                         (recorded_frames() >= 0 ? " (playback of this recording delivers no frames with the installed OpenNI2)" : ""));
+  openni::VideoFrameRef frame;
+  if (m.depth.readFrame(&frame) != openni::STATUS_OK || !frame.isValid()) fail(m.options.uri, "cannot read a depth frame");
+  DepthImage out;
+  out.width = frame.getWidth();
+  out.height = frame.getHeight();
+  out.capture_time_s = static_cast<double>(frame.getTimestamp()) * 1e-6;  // OpenNI timestamps are microseconds
+  out.depth_m.resize(static_cast<std::size_t>(out.width) * out.height);
+  const auto* data = static_cast<const std::uint8_t*>(frame.getData());
+  for (int y = 0; y < out.height; ++y) {
+    const auto* row = reinterpret_cast<const openni::DepthPixel*>(data + static_cast<std::size_t>(y) * frame.getStrideInBytes());
+    for (int x = 0; x < out.width; ++x)
+      out.depth_m[static_cast<std::size_t>(y) * out.width + x] = static_cast<float>(row[x] * m.metres_per_unit);
+  }
+  return out;
+}
+
+std::optional<CameraIntrinsics> OpenNi2Source::intrinsics() const {
+  const Impl& m = *impl_;
+  const openni::VideoMode mode = m.depth.getVideoMode();
+  CameraIntrinsics k;
+  k.width_px = mode.getResolutionX();
+  k.height_px = mode.getResolutionY();
+  const double hfov = m.depth.getHorizontalFieldOfView(), vfov = m.depth.getVerticalFieldOfView();
+  if (!(hfov > 0.0) || !(vfov > 0.0)) return std::nullopt;
+  k.fx_px = k.width_px / (2.0 * std::tan(hfov / 2.0));
+  k.fy_px = k.height_px / (2.0 * std::tan(vfov / 2.0));
+  k.cx_px = (k.width_px - 1) / 2.0;
+  k.cy_px = (k.height_px - 1) / 2.0;
+  return k;
+}
+
+int OpenNi2Source::recorded_frames() const {
+  auto* playback = impl_->device.getPlaybackControl();
+  return playback != nullptr && playback->isValid() ? playback->getNumberOfFrames(impl_->depth) : -1;
+}
+
+}  // namespace projbot::alignment
