@@ -11,7 +11,7 @@ using namespace projbot::alignment;
 TEST(OpenNi2Test, DummyDeviceStreamsDepth) {
   OpenNi2Source source({"Dummy", {}, 3000});
   EXPECT_FALSE(source.intrinsics().has_value());  // the Dummy device reports no field of view
-  EXPECT_EQ(source.recorded_frames(), -1);  // live
+  EXPECT_EQ(source.recorded_frames(), -1);        // live
   double last = -1.0;
   for (int i = 0; i < 5; ++i) {
     const DepthImage d = source.next();

@@ -9,7 +9,9 @@
 namespace projbot::alignment {
 namespace {
 
-std::string describe(const std::string& uri) { return uri.empty() ? std::string("the first OpenNI2 device") : "OpenNI2 device '" + uri + "'"; }
+std::string describe(const std::string& uri) {
+  return uri.empty() ? std::string("the first OpenNI2 device") : "OpenNI2 device '" + uri + "'";
+}
 
 [[noreturn]] void fail(const std::string& uri, const std::string& what) {
   throw AlignmentError(describe(uri) + ": " + what + ": " + openni::OpenNI::getExtendedError());
@@ -33,13 +35,18 @@ OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_un
   if (openni::OpenNI::initialize() != openni::STATUS_OK) fail(options.uri, "cannot initialise OpenNI2");
   const bool is_file = options.uri.size() > 4 && options.uri.substr(options.uri.size() - 4) == ".oni";
   if (is_file && !std::filesystem::is_regular_file(options.uri)) throw AlignmentError(options.uri + ": no such .oni recording");
-  if (m.device.open(options.uri.empty() ? openni::ANY_DEVICE : options.uri.c_str()) != openni::STATUS_OK) fail(options.uri, "cannot open");
+  if (m.device.open(options.uri.empty() ? openni::ANY_DEVICE : options.uri.c_str()) != openni::STATUS_OK)
+    fail(options.uri, "cannot open");
   if (!m.device.hasSensor(openni::SENSOR_DEPTH)) throw AlignmentError(describe(options.uri) + ": has no depth sensor");
   if (m.depth.create(m.device, openni::SENSOR_DEPTH) != openni::STATUS_OK) fail(options.uri, "cannot create the depth stream");
   const openni::PixelFormat format = m.depth.getVideoMode().getPixelFormat();
-  if (format == openni::PIXEL_FORMAT_DEPTH_1_MM) m.metres_per_unit = 0.001;
-  else if (format == openni::PIXEL_FORMAT_DEPTH_100_UM) m.metres_per_unit = 0.0001;
-  else throw AlignmentError(describe(options.uri) + ": depth pixel format " + std::to_string(static_cast<int>(format)) + " is not in mm or 100 um");
+  if (format == openni::PIXEL_FORMAT_DEPTH_1_MM)
+    m.metres_per_unit = 0.001;
+  else if (format == openni::PIXEL_FORMAT_DEPTH_100_UM)
+    m.metres_per_unit = 0.0001;
+  else
+    throw AlignmentError(describe(options.uri) + ": depth pixel format " + std::to_string(static_cast<int>(format)) +
+                         " is not in mm or 100 um");
   if (m.depth.start() != openni::STATUS_OK) fail(options.uri, "cannot start the depth stream");
   if (!options.record_to.empty()) {
     if (m.recorder.create(options.record_to.c_str()) != openni::STATUS_OK || m.recorder.attach(m.depth) != openni::STATUS_OK ||
@@ -64,8 +71,9 @@ DepthImage OpenNi2Source::next() {
   openni::VideoStream* streams[] = {&m.depth};
   int ready = -1;
   if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, m.options.timeout_ms) != openni::STATUS_OK)
-    throw AlignmentError(describe(m.options.uri) + ": no depth frame within " + std::to_string(m.options.timeout_ms) + " ms" +
-                         (recorded_frames() >= 0 ? " (playback of this recording delivers no frames with the installed OpenNI2)" : ""));
+    throw AlignmentError(
+        describe(m.options.uri) + ": no depth frame within " + std::to_string(m.options.timeout_ms) + " ms" +
+        (recorded_frames() >= 0 ? " (playback of this recording delivers no frames with the installed OpenNI2)" : ""));
   openni::VideoFrameRef frame;
   if (m.depth.readFrame(&frame) != openni::STATUS_OK || !frame.isValid()) fail(m.options.uri, "cannot read a depth frame");
   DepthImage out;

@@ -13,9 +13,9 @@
 namespace projbot::alignment {
 
 struct OpenNi2Options {
-  std::string uri;                        ///< "" for the first device, "Dummy", a device URI, or an .oni path
-  std::filesystem::path record_to;        ///< record the depth stream to this .oni while reading (empty: no)
-  int timeout_ms = 2000;                  ///< next() gives up after this long without a frame
+  std::string uri;                  ///< "" for the first device, "Dummy", a device URI, or an .oni path
+  std::filesystem::path record_to;  ///< record the depth stream to this .oni while reading (empty: no)
+  int timeout_ms = 2000;            ///< next() gives up after this long without a frame
 };
 
 class OpenNi2Source {
