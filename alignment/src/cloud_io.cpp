@@ -44,15 +44,4 @@ PointCloud read_cloud(const std::filesystem::path& path) {
   return out;
 }
 
-void write_pcd(const std::filesystem::path& path, const PointCloud& cloud) {
-  pcl::PointCloud<pcl::PointXYZ> pc;
-  pc.width = static_cast<std::uint32_t>(cloud.width);
-  pc.height = static_cast<std::uint32_t>(std::max(cloud.height, 1));
-  pc.is_dense = cloud.finite_count() == cloud.points.size();
-  for (const auto& p : cloud.points) pc.push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-  pc.width = static_cast<std::uint32_t>(cloud.width);
-  pc.height = static_cast<std::uint32_t>(std::max(cloud.height, 1));
-  if (pcl::io::savePCDFileBinary(path.string(), pc) < 0) throw AlignmentError(path.string() + ": cannot write PCD");
-}
-
 }  // namespace projbot::alignment

@@ -81,6 +81,23 @@ Features::Ptr fpfh(const CloudN::ConstPtr& cloud, double radius) {
   return features;
 }
 
+// Where a model sits: the centroid of its points and the largest distance of a point from it.
+struct Extent {
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  double radius = 0.0;
+
+  Extent() = default;
+  explicit Extent(const std::vector<Eigen::Vector3f>& points) {
+    for (const auto& p : points) centroid += p;
+    if (!points.empty()) centroid /= static_cast<float>(points.size());
+    for (const auto& p : points) radius = std::max(radius, static_cast<double>((p - centroid).norm()));
+  }
+  /// The centroid in the scan frame when the model is posed by T_scan_model.
+  Eigen::Vector3d centre_in(const Eigen::Matrix4d& T_scan_model) const {
+    return (T_scan_model * centroid.cast<double>().homogeneous()).head<3>();
+  }
+};
+
 }  // namespace
 
 struct Aligner::Impl {
@@ -91,8 +108,7 @@ struct Aligner::Impl {
   mutable Features::Ptr model_features;  // computed on the first re-initialisation
   pcl::KdTreeFLANN<PointN> model_tree;
   pcl::search::KdTree<PointN>::Ptr model_icp_tree;
-  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
-  double radius = 0.0;
+  Extent extent;
 
   double coarse_leaf() const { return std::max(cfg.voxel_m * 2.0, 0.008); }
 
@@ -122,6 +138,12 @@ struct Aligner::Impl {
     }
     if (down->size() < cfg.min_points) down->clear();
     return down;
+  }
+
+  // The scan prepared around where the model sits under T_scan_model: what ICP and the gate work on.
+  pcl::PointCloud<pcl::PointXYZ>::Ptr near_scan(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const {
+    return prepare(scan, extent.centre_in(T_scan_model).cast<float>(), cfg.crop ? extent.radius + cfg.crop_margin_m : 0.0,
+                   cfg.voxel_m);
   }
 
   // Point-to-plane ICP, coarse then fine correspondence distance. The scan is the source: every scan
@@ -191,8 +213,8 @@ struct Aligner::Impl {
 
   // Global re-initialisation: FPFH correspondences and SampleConsensusPrerejective over a wide region.
   std::optional<Eigen::Matrix4d> reinitialise(const PointCloud& scan, const Eigen::Matrix4d& T_init) const {
-    const Eigen::Vector3f centre = (T_init * centroid.cast<double>().homogeneous()).head<3>().cast<float>();
-    const auto wide_points = prepare(scan, centre, cfg.crop ? radius + cfg.reinit_crop_margin_m : 0.0, coarse_leaf());
+    const auto wide_points = prepare(scan, extent.centre_in(T_init).cast<float>(),
+                                     cfg.crop ? extent.radius + cfg.reinit_crop_margin_m : 0.0, coarse_leaf());
     if (wide_points->size() < cfg.min_points) return std::nullopt;
     const CloudN::Ptr wide = with_normals(wide_points, cfg.normal_neighbours);
     if (!model_features) model_features = fpfh(model_coarse, cfg.feature_radius_m);
@@ -216,25 +238,20 @@ struct Aligner::Impl {
 };
 
 struct PclIcpBaseline::Impl {
+  explicit Impl(const ModelCloud& m) : extent(m.points) {}
+  Extent extent;
   pcl::PointCloud<pcl::PointXYZ>::Ptr model;
   pcl::search::KdTree<pcl::PointXYZ>::Ptr model_tree;
   double voxel = 0.004;
-  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
-  double radius = 0.0;
   int iterations = 30;
   double max_distance = 0.04;
 };
 
 PclIcpBaseline::PclIcpBaseline(const ModelCloud& model, double voxel_m, int iterations, double max_distance_m)
-    : impl_(std::make_unique<Impl>()) {
+    : impl_(std::make_unique<Impl>(model)) {
   auto raw = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  for (const auto& p : model.points) {
-    raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-    impl_->centroid += p;
-  }
+  for (const auto& p : model.points) raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
   if (raw->empty()) throw AlignmentError("baseline: empty model");
-  impl_->centroid /= static_cast<float>(raw->size());
-  for (const auto& p : model.points) impl_->radius = std::max(impl_->radius, static_cast<double>((p - impl_->centroid).norm()));
   impl_->model = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   pcl::VoxelGrid<pcl::PointXYZ> grid;
   grid.setInputCloud(raw);
@@ -251,8 +268,8 @@ PclIcpBaseline::PclIcpBaseline(PclIcpBaseline&&) noexcept = default;
 PclIcpBaseline& PclIcpBaseline::operator=(PclIcpBaseline&&) noexcept = default;
 
 Eigen::Matrix4d PclIcpBaseline::track(const PointCloud& scan, const Eigen::Matrix4d& T_init) const {
-  const Eigen::Vector3f c = (T_init * impl_->centroid.cast<double>().homogeneous()).head<3>().cast<float>();
-  const float r2 = static_cast<float>(std::pow(impl_->radius + 0.1, 2));
+  const Eigen::Vector3f c = impl_->extent.centre_in(T_init).cast<float>();
+  const float r2 = static_cast<float>(std::pow(impl_->extent.radius + 0.1, 2));
   auto raw = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   for (const auto& p : scan.points)
     if (p.allFinite() && (p - c).squaredNorm() <= r2) raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
@@ -307,6 +324,7 @@ ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t sampl
 
 Aligner::Aligner(ModelCloud model, AcquisitionConfig config) : impl_(std::make_unique<Impl>()) {
   impl_->cfg = config;
+  impl_->extent = Extent(model.points);
   if (model.points.size() < 10 || model.normals.size() != model.points.size())
     throw AlignmentError("model needs at least 10 points, each with a normal (got " + std::to_string(model.points.size()) + ")");
   impl_->model = pcl::make_shared<CloudN>();
@@ -317,10 +335,7 @@ Aligner::Aligner(ModelCloud model, AcquisitionConfig config) : impl_(std::make_u
     p.getVector3fMap() = model.points[i];
     p.getNormalVector3fMap() = model.normals[i];
     impl_->model->push_back(p);
-    impl_->centroid += model.points[i];
   }
-  impl_->centroid /= static_cast<float>(model.points.size());
-  for (const auto& p : model.points) impl_->radius = std::max(impl_->radius, static_cast<double>((p - impl_->centroid).norm()));
   impl_->model_tree.setInputCloud(impl_->model);
   impl_->model_icp = voxel_downsample(impl_->model, config.voxel_m);
   impl_->model_icp_tree = pcl::make_shared<pcl::search::KdTree<PointN>>();
@@ -332,15 +347,11 @@ Aligner::~Aligner() = default;
 Aligner::Aligner(Aligner&&) noexcept = default;
 Aligner& Aligner::operator=(Aligner&&) noexcept = default;
 const AcquisitionConfig& Aligner::config() const { return impl_->cfg; }
-double Aligner::model_radius_m() const { return impl_->radius; }
 
 AlignmentResult Aligner::score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const {
   AlignmentResult r;
   r.T_scan_model = T_scan_model;
-  const Eigen::Vector3f centre = (T_scan_model * impl_->centroid.cast<double>().homogeneous()).head<3>().cast<float>();
-  impl_->evaluate(
-      *impl_->prepare(scan, centre, impl_->cfg.crop ? impl_->radius + impl_->cfg.crop_margin_m : 0.0, impl_->cfg.voxel_m),
-      T_scan_model, r);
+  impl_->evaluate(*impl_->near_scan(scan, T_scan_model), T_scan_model, r);
   r.converged = impl_->passes(r);
   return r;
 }
@@ -359,8 +370,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   best.inlier_ratio = 0.0;
   best.rmse_mm = std::numeric_limits<double>::infinity();
   const auto attempt = [&](const Eigen::Matrix4d& start, bool reinitialised) {
-    const Eigen::Vector3f centre = (start * m.centroid.cast<double>().homogeneous()).head<3>().cast<float>();
-    const auto near = m.prepare(scan, centre, m.cfg.crop ? m.radius + m.cfg.crop_margin_m : 0.0, m.cfg.voxel_m);
+    const auto near = m.near_scan(scan, start);
     if (near->size() < m.cfg.min_points) return;
     AlignmentResult r;
     bool icp_converged = false;
@@ -378,7 +388,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   attempt(T_init, false);
   if (!best.converged && m.cfg.restart_angle_deg > 0.0) {
     // Local restarts: the guess turned about the target's centre, which ICP alone cannot leave.
-    const Eigen::Vector3d c = (T_init * m.centroid.cast<double>().homogeneous()).head<3>();
+    const Eigen::Vector3d c = m.extent.centre_in(T_init);
     for (int axis = 0; axis < 3 && !best.converged; ++axis)
       for (const double sign : {1.0, -1.0}) {
         Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();

@@ -8,6 +8,8 @@
 #include <numeric>
 #include <random>
 
+#include "projbot/alignment/kinect_noise.hpp"
+
 namespace projbot::alignment {
 namespace {
 
@@ -21,7 +23,7 @@ Eigen::Matrix4d twist_to_transform(const Eigen::Matrix<double, 6, 1>& xi) {
   return T;
 }
 
-double sensor_sigma(double z) { return std::max(1.425e-3 * z * z, 0.001); }
+double sensor_sigma(double z) { return std::max(kKinectV1SigmaZCoeff * z * z, 0.001); }
 
 }  // namespace
 

@@ -72,9 +72,6 @@ PointCloud depth_to_cloud(const DepthImage& depth, const CameraIntrinsics& k, do
 /// Reads a PCD or PLY file (by extension) as x, y, z; keeps the organisation of organised PCDs.
 PointCloud read_cloud(const std::filesystem::path& path);
 
-/// Writes a cloud as binary PCD.
-void write_pcd(const std::filesystem::path& path, const PointCloud& cloud);
-
 /// Drops non-finite points: the result is unorganised.
 PointCloud finite_points(const PointCloud& cloud);
 

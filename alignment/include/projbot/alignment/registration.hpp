@@ -79,7 +79,6 @@ class Aligner {
   AlignmentResult score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const;
 
   const AcquisitionConfig& config() const;
-  double model_radius_m() const;  ///< largest distance of a model point from the model origin
 
  private:
   struct Impl;
