@@ -77,8 +77,9 @@ const Command kAlign{
     "estimate a target's pose: ICP of its model against a scan, with a quality gate",
     "projbot align --model M --scan S [--init-matrix m00,...,m33 | --init \"x y z roll pitch yaw\"] [--json]\n\n"
     "Refines the initial guess (default: identity) of T_scan_model, the transform mapping model points into\n"
-    "the scan's frame, by point-to-plane ICP; when the result fails the quality gate it re-initialises\n"
-    "globally (FPFH features, SampleConsensusPrerejective) and tries again. M is a glTF model or a PCD / PLY\n"
+    "the scan's frame, by point-to-plane ICP; when the result fails the quality gate it restarts ICP from the\n"
+    "guess turned +-25 degrees about each axis, then re-initialises globally (FPFH features,\n"
+    "SampleConsensusPrerejective) and tries again. M is a glTF model or a PCD / PLY\n"
     "cloud; S is a PCD / PLY cloud or a 16-bit PNG / TIFF depth image (then --intrinsics and --depth-scale).\n"
     "Exit status: 0 when the pose passed the quality gate, 3 when it did not, 1 or 2 on bad input.\n",
     {{"model", "FILE", "target model: .gltf / .glb (surface-sampled) or .pcd / .ply"},
