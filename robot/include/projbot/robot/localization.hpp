@@ -1,0 +1,94 @@
+#pragma once
+// MRPT ICP-SLAM (building the environment map) and scan-to-map ICP localisation with odometry
+// prediction; rawlogs and trajectories on disk.
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "projbot/robot/laser.hpp"
+
+namespace projbot::robot {
+
+/// One step of a rawlog: an odometry increment (in the previous base frame) and a scan.
+struct RawlogStep {
+  double timestamp_s = 0.0;
+  std::optional<Pose2D> odometry_increment;
+  LaserScan scan;
+};
+
+/// Reads an MRPT rawlog (actions-observations format, plain or gzip). The first
+/// CObservation2DRangeScan of each sensory frame is taken. Throws RobotError naming the file.
+std::vector<RawlogStep> read_rawlog(const std::filesystem::path& path);
+/// Writes steps as an MRPT rawlog (gzip), readable by MRPT's own tools.
+void write_rawlog(const std::filesystem::path& path, const std::vector<RawlogStep>& steps);
+
+/// A trajectory sample: `timestamp x y phi` per line on disk (seconds, metres, radians).
+struct TrajectoryPoint {
+  double timestamp_s = 0.0;
+  Pose2D pose;
+};
+void write_trajectory(const std::filesystem::path& path, const std::vector<TrajectoryPoint>& trajectory);
+/// Reads `timestamp x y phi` lines; throws RobotError naming file:line on anything else.
+std::vector<TrajectoryPoint> read_trajectory(const std::filesystem::path& path);
+
+/// Result of a mapping run.
+struct SlamResult {
+  std::vector<TrajectoryPoint> trajectory;  ///< the corrected pose after every step
+  std::size_t keyframes = 0;                ///< scans inserted into the map
+  double seconds = 0.0;                     ///< wall time of the run
+};
+
+/// Builds the map with mrpt::slam::CMetricMapBuilderICP from rawlog steps. `ini` is an icp-slam
+/// configuration ([MappingApplication] and [ICP] sections, as MRPT's icp-slam app reads);
+/// without one, the defaults of MRPT's icp-slam_demo_classic.ini apply. Writes to `out_dir`:
+/// map.simplemap.gz (keyframes: poses and scans), grid.png and grid.yaml (ROS map_server form).
+SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,
+                     const std::filesystem::path& out_dir);
+
+/// Localiser settings.
+struct LocalizerConfig {
+  double icp_threshold_m = 0.3;  ///< initial correspondence distance (shrinks by alfa)
+  double icp_smallest_threshold_m = 0.02;
+  double min_goodness = 0.5;  ///< share of scan points paired; below it the scan is rejected
+  unsigned max_iterations = 80;
+  double max_correction_m = 0.5;  ///< a jump larger than this from the prediction is rejected
+};
+
+/// The outcome of one correction.
+struct LocalizationUpdate {
+  Pose2D pose;            ///< T_world_base after the update
+  bool accepted = false;  ///< false: the scan did not match; `pose` is the odometry prediction
+  double goodness = 0.0;  ///< CICP's share of paired points, [0, 1]
+  unsigned iterations = 0;
+  double time_ms = 0.0;
+};
+
+/// Scan-to-map localisation: the pose follows odometry between scans (predict) and is corrected
+/// by mrpt::slam::CICP of each scan against the map's points (correct). Not thread-safe.
+class Localizer {
+ public:
+  /// A map from keyframes: scans taken at known T_world_base poses.
+  Localizer(const std::vector<std::pair<Pose2D, LaserScan>>& keyframes, const LocalizerConfig& config = {});
+  /// Loads map.simplemap.gz from a directory written by build_map(). Throws RobotError.
+  static Localizer load(const std::filesystem::path& map_dir, const LocalizerConfig& config = {});
+  Localizer(Localizer&&) noexcept;
+  Localizer& operator=(Localizer&&) noexcept;
+  ~Localizer();
+
+  void reset(const Pose2D& T_world_base);
+  /// Moves the estimate by an odometry increment (in the current base frame).
+  void predict(const Pose2D& odometry_increment);
+  LocalizationUpdate correct(const LaserScan& scan);
+  const Pose2D& pose() const;
+  /// Number of points in the map.
+  std::size_t map_points() const;
+
+ private:
+  struct Impl;
+  explicit Localizer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace projbot::robot

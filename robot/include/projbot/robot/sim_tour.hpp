@@ -1,0 +1,54 @@
+#pragma once
+// A simulated tour of stops: the base drives from stop to stop under the controller, closing the
+// loop on MRPT localisation (or on odometry alone, the paper's set-up), and every arrival is
+// compared with the ground truth. Used by the tests, `projbot bench localize` and the twin.
+
+#include <cstdint>
+#include <vector>
+
+#include "projbot/robot/base.hpp"
+#include "projbot/robot/laser.hpp"
+#include "projbot/robot/localization.hpp"
+#include "projbot/robot/sim_base.hpp"
+
+namespace projbot::robot {
+
+/// What closes the loop.
+enum class PoseSource { odometry, localized };
+
+struct SimTourConfig {
+  RoomConfig room;
+  std::vector<Pose2D> stops;  ///< visited in order, `stop_count` in all (cycling)
+  int stop_count = 10;
+  Pose2D start;  ///< true and believed start pose
+  BaseErrorModel errors;
+  LaserConfig laser;
+  ControllerConfig controller;
+  LocalizerConfig localizer;
+  PoseSource source = PoseSource::localized;
+  double control_dt_s = 0.025;  ///< control period (the laser's 40 Hz)
+  int localize_every = 4;       ///< correct with every n-th scan while driving (10 Hz)
+  int settle_scans = 3;         ///< scans matched at rest after arrival
+  double max_seconds_per_stop = 120.0;
+  double survey_spacing_m = 1.0;  ///< the map: scans at true poses on this grid over free space
+};
+
+struct StopReport {
+  int index = 0;
+  Pose2D goal, truth, estimate, odometry;
+  double error_m = 0.0, error_rad = 0.0;                    ///< estimate (what the robot believes) vs truth
+  double odometry_error_m = 0.0, odometry_error_rad = 0.0;  ///< raw wheel odometry vs truth
+  double arrival_error_m = 0.0;                             ///< truth vs goal
+  bool arrived = false;
+  double drive_seconds = 0.0;  ///< simulated time to reach the stop
+  int corrections = 0, rejected = 0;
+  double correct_ms_mean = 0.0;  ///< wall time per localisation update
+};
+
+/// Runs the tour. Deterministic for a given config (all noise is seeded).
+std::vector<StopReport> run_sim_tour(const SimTourConfig& config);
+
+/// The built-in demo room (8 x 6 m with furniture) and a ring of stops in it.
+SimTourConfig default_sim_tour();
+
+}  // namespace projbot::robot
