@@ -44,6 +44,7 @@ class CliTest : public ::testing::Test {
 };
 
 const std::string kDuck = std::string(PROJBOT_SHARED_DATA) + "/gltf/Duck/glTF-Binary/Duck.glb";
+const std::string kRawlog = std::string(PROJBOT_SHARED_DATA) + "/mrpt/localization_demo.rawlog";
 
 }  // namespace
 
@@ -87,6 +88,29 @@ TEST_F(CliTest, OverridesAndProfile) {
   ASSERT_EQ(behind.code, 0) << behind.output;
   const auto img = projbot::assets::read_image(out);
   for (std::size_t i = 0; i < img.rgba.size(); i += 4) ASSERT_EQ(img.rgba[i], 0);
+}
+
+TEST_F(CliTest, SlamThenLocalize) {
+  const std::string rawlog = std::string(PROJBOT_SHARED_DATA) + "/mrpt/2006-01ENE-21-SENA_Telecom_Faculty_one_loop_only.rawlog";
+  const CliRun slam = run_projbot("slam --rawlog " + rawlog + " --out-map " + (dir_ / "map").string() + " --out-trajectory " +
+                                  (dir_ / "slam.txt").string());
+  ASSERT_EQ(slam.code, 0) << slam.output;
+  EXPECT_NE(slam.output.find("225 scans"), std::string::npos) << slam.output;
+  for (const char* f : {"map/map.simplemap.gz", "map/grid.png", "map/grid.yaml", "slam.txt"})
+    EXPECT_TRUE(fs::exists(dir_ / f)) << f;
+  const CliRun loc = run_projbot("localize --map " + (dir_ / "map").string() + " --rawlog " + rawlog + " --out-trajectory " +
+                                 (dir_ / "loc.txt").string() + " --ground-truth " + (dir_ / "slam.txt").string());
+  ASSERT_EQ(loc.code, 0) << loc.output;
+  EXPECT_NE(loc.output.find("localisation vs ground truth"), std::string::npos) << loc.output;
+  std::ifstream t(dir_ / "loc.txt");
+  std::string line;
+  int lines = 0;
+  while (std::getline(t, line)) {
+    double ts, x, y, phi;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf %lf", &ts, &x, &y, &phi), 4) << line;
+    ++lines;
+  }
+  EXPECT_EQ(lines, 225);
 }
 
 TEST_F(CliTest, AlignPrintsJson) {
@@ -189,5 +213,32 @@ INSTANTIATE_TEST_SUITE_P(
                {"not both"}},
         BadRun{"align_empty_cloud", "align --model " + kDuck + " --scan {dir}/bad.pcd", "", 1, {"bad.pcd"}},
         BadRun{
-            "align_missing_model", "align --model {dir}/none.glb --scan {dir}/a.pcd", "", 1, {"none.glb", "no such model file"}}),
+            "align_missing_model", "align --model {dir}/none.glb --scan {dir}/a.pcd", "", 1, {"none.glb", "no such model file"}},
+        BadRun{"slam_no_rawlog", "slam --out-map {dir}/m --out-trajectory {dir}/t.txt", "", 2, {"--rawlog is required"}},
+        BadRun{"slam_missing_rawlog",
+               "slam --rawlog {dir}/none.rawlog --out-map {dir}/m --out-trajectory {dir}/t.txt",
+               "",
+               1,
+               {"none.rawlog", "no such rawlog"}},
+        BadRun{"slam_corrupt_rawlog",
+               "slam --rawlog {dir}/bad.yaml --out-map {dir}/m --out-trajectory {dir}/t.txt",
+               "not: a rawlog\n",
+               1,
+               {"bad.yaml", "not a readable MRPT rawlog"}},
+        BadRun{"slam_bad_config",
+               "slam --rawlog " + kRawlog + " --config {dir}/bad.yaml --out-map {dir}/m --out-trajectory {dir}/t.txt",
+               "a: 1\n",
+               1,
+               {"bad.yaml", "[MappingApplication]"}},
+        BadRun{"localize_missing_map",
+               "localize --map {dir}/nomap --rawlog " + kRawlog + " --out-trajectory {dir}/t.txt",
+               "",
+               1,
+               {"nomap", "no such map"}},
+        BadRun{"localize_bad_initial",
+               "localize --map {dir} --rawlog " + kRawlog + " --out-trajectory {dir}/t.txt --initial \"1 2\"",
+               "",
+               1,
+               {"--initial"}},
+        BadRun{"bench_localize_bad_stops", "bench localize --stops 3,x", "", 2, {"--stops"}}),
     [](const ::testing::TestParamInfo<BadRun>& param_info) { return std::string(param_info.param.name); });

@@ -17,11 +17,13 @@
 #include <mrpt/poses/CPosePDF.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
 #include <mrpt/serialization/CArchive.h>
+#include <mrpt/serialization/CSerializable.h>
 #include <mrpt/slam/CICP.h>
 #include <mrpt/slam/CMetricMapBuilderICP.h>
 
 #include <chrono>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 
 #include "mrpt_convert.hpp"
@@ -65,8 +67,9 @@ ICP_algorithm = icpClassic
 corresponding_points_decimation = 5
 )ini";
 
-mrpt::obs::CActionCollection::Ptr odometry_action(const Pose2D& increment) {
+mrpt::obs::CActionCollection::Ptr odometry_action(const Pose2D& increment, double timestamp_s) {
   mrpt::obs::CActionRobotMovement2D move;
+  move.timestamp = mrpt::Clock::fromDouble(timestamp_s);  // CMetricMapBuilderICP asserts one
   mrpt::obs::CActionRobotMovement2D::TMotionModelOptions model;
   move.computeFromOdometry(detail::to_mrpt(increment), model);
   auto actions = mrpt::obs::CActionCollection::Create();
@@ -88,28 +91,31 @@ std::vector<RawlogStep> read_rawlog(const std::filesystem::path& path) {
   try {
     mrpt::io::CFileGZInputStream in(path.string());
     auto archive = mrpt::serialization::archiveFrom(in);
-    mrpt::obs::CActionCollection::Ptr actions;
-    mrpt::obs::CSensoryFrame::Ptr frame;
-    mrpt::obs::CObservation::Ptr observation;
-    std::size_t entry = 0;
     std::optional<Pose2D> pending_odometry;             // action-observation format
     std::optional<mrpt::poses::CPose2D> last_absolute;  // observation-only format
-    while (mrpt::obs::CRawlog::getActionObservationPairOrObservation(archive, actions, frame, observation, entry)) {
-      if (actions) {
-        if (auto move = actions->getBestMovementEstimation())
-          pending_odometry = detail::from_mrpt(move->poseChange->getMeanVal());
+    // Object by object (not CRawlog's pair reader, which drops a sensory frame that comes before
+    // the first action) until the end of the file.
+    for (;;) {
+      mrpt::serialization::CSerializable::Ptr object;
+      try {
+        object = archive.ReadObject();
+      } catch (const mrpt::serialization::CExceptionEOF&) {
+        break;
       }
       mrpt::obs::CObservation2DRangeScan::Ptr scan;
-      if (frame) scan = frame->getObservationByClass<mrpt::obs::CObservation2DRangeScan>();
-      if (observation) {
-        if (auto odo = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(observation)) {
-          if (last_absolute) {
-            const Pose2D inc = detail::from_mrpt(odo->odometry - *last_absolute);
-            pending_odometry = pending_odometry ? compose(*pending_odometry, inc) : inc;
-          }
-          last_absolute = odo->odometry;
+      if (auto actions = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(object)) {
+        if (auto move = actions->getBestMovementEstimation())
+          pending_odometry = detail::from_mrpt(move->poseChange->getMeanVal());
+      } else if (auto frame = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(object)) {
+        scan = frame->getObservationByClass<mrpt::obs::CObservation2DRangeScan>();
+      } else if (auto odo = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(object)) {
+        if (last_absolute) {
+          const Pose2D inc = detail::from_mrpt(odo->odometry - *last_absolute);
+          pending_odometry = pending_odometry ? compose(*pending_odometry, inc) : inc;
         }
-        scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(observation);
+        last_absolute = odo->odometry;
+      } else {
+        scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(object);
       }
       if (!scan) continue;
       RawlogStep step;
@@ -133,7 +139,7 @@ void write_rawlog(const std::filesystem::path& path, const std::vector<RawlogSte
   if (!out.open(path.string())) throw RobotError(path.string() + ": cannot write the rawlog");
   auto archive = mrpt::serialization::archiveFrom(out);
   for (const RawlogStep& step : steps) {
-    archive << *odometry_action(step.odometry_increment.value_or(Pose2D{}));
+    archive << *odometry_action(step.odometry_increment.value_or(Pose2D{}), step.timestamp_s);
     mrpt::obs::CSensoryFrame frame;
     frame.insert(detail::to_mrpt(step.scan));
     archive << frame;
@@ -143,9 +149,10 @@ void write_rawlog(const std::filesystem::path& path, const std::vector<RawlogSte
 void write_trajectory(const std::filesystem::path& path, const std::vector<TrajectoryPoint>& trajectory) {
   std::ofstream out(path);
   if (!out) throw RobotError(path.string() + ": cannot write the trajectory");
-  out.precision(9);
+  out << std::fixed;
   for (const auto& p : trajectory)
-    out << p.timestamp_s << ' ' << p.pose.x_m << ' ' << p.pose.y_m << ' ' << p.pose.theta_rad << '\n';
+    out << std::setprecision(6) << p.timestamp_s << ' ' << std::setprecision(5) << p.pose.x_m << ' ' << p.pose.y_m << ' '
+        << p.pose.theta_rad << '\n';
   if (!out) throw RobotError(path.string() + ": write failed");
 }
 
@@ -199,7 +206,7 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
   for (const RawlogStep& step : steps) {
     mrpt::obs::CSensoryFrame frame;
     frame.insert(detail::to_mrpt(step.scan));
-    builder.processActionObservation(*odometry_action(step.odometry_increment.value_or(Pose2D{})), frame);
+    builder.processActionObservation(*odometry_action(step.odometry_increment.value_or(Pose2D{}), step.timestamp_s), frame);
     result.trajectory.push_back({step.timestamp_s, detail::from_mrpt(mean2d(*builder.getCurrentPoseEstimation()))});
   }
   mrpt::maps::CSimpleMap keyframes;

@@ -22,5 +22,8 @@ extern const Command kShow;
 extern const Command kBenchRender;
 extern const Command kAlign;
 extern const Command kBenchTrack;
+extern const Command kSlam;
+extern const Command kLocalize;
+extern const Command kBenchLocalize;
 
 }  // namespace projbot::tools

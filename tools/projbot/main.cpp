@@ -11,8 +11,9 @@ namespace {
 using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
-  static const std::vector<const Command*> all{&projbot::tools::kRender, &projbot::tools::kShow, &projbot::tools::kBenchRender,
-                                               &projbot::tools::kAlign, &projbot::tools::kBenchTrack};
+  static const std::vector<const Command*> all{
+      &projbot::tools::kRender,     &projbot::tools::kShow, &projbot::tools::kBenchRender, &projbot::tools::kAlign,
+      &projbot::tools::kBenchTrack, &projbot::tools::kSlam, &projbot::tools::kLocalize,    &projbot::tools::kBenchLocalize};
   return all;
 }
 
@@ -31,6 +32,8 @@ void print_help() {
                "  projbot render --model duck.glb --out duck.png    one model, framed in view\n"
                "  projbot show --scene my.yaml --fullscreen --monitor 1\n"
                "  projbot align --model bun0.pcd --scan bun4.pcd --init \"0 0 0 0 -30 0\" --json\n"
+               "  projbot slam --rawlog run.rawlog --out-map map --out-trajectory slam.txt\n"
+               "  projbot localize --map map --rawlog run2.rawlog --out-trajectory loc.txt\n"
                "  projbot bench render\n";
 }
 
@@ -49,9 +52,9 @@ int main(int argc, char** argv) {
   }
   std::string name = argv[1];
   int first = 2;
-  if (name == "bench") {  // "bench render", "bench track": the benchmark of a subsystem
-    if (argc < 3 || (std::string(argv[2]) != "render" && std::string(argv[2]) != "track")) {
-      std::cerr << "projbot bench: say what to benchmark: projbot bench render | projbot bench track\n";
+  if (name == "bench") {  // "bench render", "bench track", "bench localize": the benchmark of a subsystem
+    if (argc < 3 || (std::string(argv[2]) != "render" && std::string(argv[2]) != "track" && std::string(argv[2]) != "localize")) {
+      std::cerr << "projbot bench: say what to benchmark: projbot bench render | track | localize\n";
       return 2;
     }
     name = std::string("bench ") + argv[2];

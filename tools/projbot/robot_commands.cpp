@@ -1,0 +1,227 @@
+// projbot slam / localize / bench localize: the robot's map, its self-localisation, and how well
+// localisation holds up over simulated tours.
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <numbers>
+#include <sstream>
+
+#include "commands.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/robot/localization.hpp"
+#include "projbot/robot/sim_tour.hpp"
+
+namespace projbot::tools {
+namespace {
+
+namespace fs = std::filesystem;
+using robot::Pose2D;
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+struct ErrorStats {
+  double mean_m = 0, max_m = 0, mean_deg = 0, max_deg = 0;
+  std::size_t n = 0;
+};
+
+// Pose errors of an estimated trajectory against ground truth, matched by timestamp (nearest,
+// within 1 ms), or by index when the timestamps do not match at all.
+ErrorStats compare(const std::vector<robot::TrajectoryPoint>& est, const std::vector<robot::TrajectoryPoint>& truth) {
+  ErrorStats s;
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < est.size(); ++i) {
+    while (j + 1 < truth.size() && truth[j + 1].timestamp_s <= est[i].timestamp_s + 1e-3) ++j;
+    const bool by_time = std::abs(truth[j].timestamp_s - est[i].timestamp_s) < 1e-3;
+    const robot::TrajectoryPoint* t = by_time ? &truth[j] : (i < truth.size() ? &truth[i] : nullptr);
+    if (t == nullptr) continue;
+    const double e = robot::distance_m(est[i].pose, t->pose), a = robot::heading_error_rad(est[i].pose, t->pose) * kDeg;
+    s.mean_m += e, s.mean_deg += a, s.max_m = std::max(s.max_m, e), s.max_deg = std::max(s.max_deg, a), ++s.n;
+  }
+  if (s.n > 0) s.mean_m /= static_cast<double>(s.n), s.mean_deg /= static_cast<double>(s.n);
+  return s;
+}
+
+std::vector<robot::TrajectoryPoint> dead_reckoning(const std::vector<robot::RawlogStep>& steps, const Pose2D& start) {
+  std::vector<robot::TrajectoryPoint> out;
+  Pose2D p = start;
+  for (const auto& s : steps) {
+    if (s.odometry_increment) p = robot::compose(p, *s.odometry_increment);
+    out.push_back({s.timestamp_s, p});
+  }
+  return out;
+}
+
+void print_errors(const std::string& what, const ErrorStats& s) {
+  std::cout << std::fixed << std::setprecision(2) << "  " << what << ": mean " << s.mean_m * 100 << " cm / " << s.mean_deg
+            << " deg, max " << s.max_m * 100 << " cm / " << s.max_deg << " deg over " << s.n << " poses\n";
+}
+
+Pose2D parse_pose(const std::string& text, const std::string& what) {
+  std::string commas = text;
+  for (char& c : commas)
+    if (c == ' ') c = ',';
+  const auto v = config::parse_number_list(commas, 3, what);
+  return {v[0], v[1], v[2]};
+}
+
+const fs::path kDefaultGtRawlog = fs::path(PROJBOT_SHARED_DATA) / "mrpt" / "range_030_bearing_015.rawlog";
+
+}  // namespace
+
+const Command kSlam{
+    "slam",
+    "build the environment map from a laser rawlog (MRPT ICP-SLAM)",
+    "projbot slam --rawlog R [--config icp-slam.ini] --out-map DIR --out-trajectory T.txt [--ground-truth GT.txt]\n\n"
+    "Runs mrpt::slam::CMetricMapBuilderICP over an MRPT rawlog of 2-D laser scans and odometry. DIR receives\n"
+    "map.simplemap.gz (keyframes, what `projbot localize` reads), grid.png and grid.yaml (occupancy grid,\n"
+    "ROS map_server form). T.txt gets one line per step: timestamp x y phi (s, m, m, rad). Without --config the\n"
+    "settings of MRPT's icp-slam_demo_classic.ini apply. With --ground-truth (same line format) it prints the\n"
+    "trajectory error; without, the gap between the first and last pose for SLAM and for odometry alone.\n",
+    {{"rawlog", "FILE", "MRPT rawlog (.rawlog, plain or gzip)"},
+     {"config", "FILE", "icp-slam .ini with [MappingApplication] and [ICP] sections"},
+     {"out-map", "DIR", "directory for the map (created)"},
+     {"out-trajectory", "FILE", "where to write the corrected trajectory"},
+     {"ground-truth", "FILE", "true trajectory to compare with (timestamp x y phi lines)"}},
+    [](const cli::Args& args) {
+      for (const char* required : {"rawlog", "out-map", "out-trajectory"})
+        if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
+      const auto steps = robot::read_rawlog(*args.get("rawlog"));
+      std::optional<fs::path> ini;
+      if (const auto c = args.get("config")) ini = *c;
+      const robot::SlamResult r = robot::build_map(steps, ini, *args.get("out-map"));
+      robot::write_trajectory(*args.get("out-trajectory"), r.trajectory);
+      std::cout << std::fixed << std::setprecision(2) << "ICP-SLAM: " << steps.size() << " scans, " << r.keyframes
+                << " keyframes, " << r.seconds << " s (" << r.seconds * 1000 / static_cast<double>(steps.size())
+                << " ms per scan)\n";
+      const auto odometry = dead_reckoning(steps, r.trajectory.front().pose);
+      if (const auto gt = args.get("ground-truth")) {
+        const auto truth = robot::read_trajectory(*gt);
+        print_errors("ICP-SLAM vs ground truth", compare(r.trajectory, truth));
+        print_errors("odometry vs ground truth", compare(odometry, truth));
+      } else {
+        const auto gap = [](const std::vector<robot::TrajectoryPoint>& t) {
+          return robot::distance_m(t.front().pose, t.back().pose);
+        };
+        std::cout << "  first-to-last pose gap: ICP-SLAM " << gap(r.trajectory) << " m, odometry alone " << gap(odometry)
+                  << " m\n";
+      }
+      std::cout << "  wrote " << *args.get("out-map") << "/{map.simplemap.gz,grid.png,grid.yaml} and "
+                << *args.get("out-trajectory") << '\n';
+      return 0;
+    }};
+
+const Command kLocalize{
+    "localize",
+    "localise a rawlog against a saved map (scan-to-map ICP with odometry)",
+    "projbot localize --map DIR --rawlog R --out-trajectory T.txt [--initial \"x y phi\"] [--ground-truth GT.txt]\n\n"
+    "Follows odometry between scans and corrects each scan by ICP (mrpt::slam::CICP) against the map that\n"
+    "`projbot slam` wrote to DIR. The robot starts at --initial (metres, metres, radians; default 0 0 0).\n",
+    {{"map", "DIR", "map directory written by projbot slam"},
+     {"rawlog", "FILE", "MRPT rawlog of 2-D laser scans and odometry"},
+     {"out-trajectory", "FILE", "where to write the trajectory (timestamp x y phi)"},
+     {"initial", "\"x y phi\"", "start pose in the map (default 0 0 0)"},
+     {"ground-truth", "FILE", "true trajectory to compare with"}},
+    [](const cli::Args& args) {
+      for (const char* required : {"map", "rawlog", "out-trajectory"})
+        if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
+      const Pose2D start = parse_pose(args.get_or("initial", "0 0 0"), "--initial");
+      robot::Localizer loc = robot::Localizer::load(*args.get("map"));
+      const auto steps = robot::read_rawlog(*args.get("rawlog"));
+      loc.reset(start);
+      std::vector<robot::TrajectoryPoint> out;
+      int accepted = 0;
+      double ms = 0;
+      for (const auto& s : steps) {
+        if (s.odometry_increment) loc.predict(*s.odometry_increment);
+        const auto u = loc.correct(s.scan);
+        accepted += u.accepted;
+        ms += u.time_ms;
+        out.push_back({s.timestamp_s, loc.pose()});
+      }
+      robot::write_trajectory(*args.get("out-trajectory"), out);
+      std::cout << std::fixed << std::setprecision(2) << "localised " << steps.size() << " scans against " << loc.map_points()
+                << " map points: " << accepted << " accepted, " << ms / static_cast<double>(steps.size()) << " ms per scan\n";
+      if (const auto gt = args.get("ground-truth")) {
+        const auto truth = robot::read_trajectory(*gt);
+        print_errors("localisation vs ground truth", compare(out, truth));
+        print_errors("odometry vs ground truth", compare(dead_reckoning(steps, start), truth));
+      }
+      return 0;
+    }};
+
+const Command kBenchLocalize{
+    "bench localize",
+    "benchmark: localisation error at the stops of simulated tours, and ICP-SLAM vs ground truth",
+    "projbot bench localize [--stops 3,10,30] [--seed K] [--rawlog R --ground-truth GT]\n\n"
+    "Drives the simulated youBot (wheel slip, wheel-radius and heading bias) through tours of the built-in\n"
+    "8 x 6 m room, once closing the loop on MRPT localisation and once on odometry alone, and prints the\n"
+    "pose error at the stops. Then runs ICP-SLAM on a rawlog with ground truth (default: the simulated\n"
+    "range_030_bearing_015 dataset in ../shared/data/mrpt) and prints its trajectory error.\n",
+    {{"stops", "N,N,...", "tour lengths (default 3,10,30)"},
+     {"seed", "K", "random seed of the base's errors and the laser noise (default 1)"},
+     {"rawlog", "FILE", "rawlog with ground truth for the ICP-SLAM part"},
+     {"ground-truth", "FILE", "its true trajectory"}},
+    [](const cli::Args& args) {
+      std::vector<int> counts;
+      {
+        std::stringstream ss(args.get_or("stops", "3,10,30"));
+        std::string item;
+        while (std::getline(ss, item, ',')) {
+          int n = 0;
+          try {
+            n = std::stoi(item);
+          } catch (const std::exception&) {
+            n = 0;
+          }
+          if (n < 1 || n > 1000) throw cli::UsageError("--stops: each tour length must be 1..1000, got '" + item + "'");
+          counts.push_back(n);
+        }
+      }
+      const int seed = args.get_int("seed", 1, 0, 1 << 30);
+      std::cout << "Simulated tours (youBot with 2 % slip, 1 % wheel radii, 0.01 rad/m heading bias; UTM-30LX 1 cm noise)\n"
+                << "| stops | closes the loop on | mean cm | max cm | mean deg | max deg | odometry drift at last stop cm / deg "
+                   "| ms per scan |\n"
+                << "|---|---|---|---|---|---|---|---|\n";
+      for (const int n : counts) {
+        for (const auto source : {robot::PoseSource::localized, robot::PoseSource::odometry}) {
+          robot::SimTourConfig cfg = robot::default_sim_tour();
+          cfg.stop_count = n;
+          cfg.source = source;
+          cfg.errors.seed = static_cast<std::uint64_t>(seed);
+          const auto reports = robot::run_sim_tour(cfg);
+          double mean_m = 0, max_m = 0, mean_r = 0, max_r = 0, ms = 0;
+          // The error of what the robot believes: with odometry alone that is the odometry's drift.
+          for (const auto& r : reports) {
+            mean_m += r.error_m, max_m = std::max(max_m, r.error_m);
+            mean_r += r.error_rad, max_r = std::max(max_r, r.error_rad);
+            ms += r.correct_ms_mean;
+          }
+          const double k = static_cast<double>(reports.size());
+          std::cout << std::fixed << std::setprecision(2) << "| " << n << " | "
+                    << (source == robot::PoseSource::localized ? "MRPT localisation" : "odometry alone") << " | "
+                    << mean_m / k * 100 << " | " << max_m * 100 << " | " << mean_r / k * kDeg << " | " << max_r * kDeg << " | "
+                    << reports.back().odometry_error_m * 100 << " / " << reports.back().odometry_error_rad * kDeg << " | "
+                    << (source == robot::PoseSource::localized ? ms / k : 0.0) << " |\n";
+        }
+      }
+      const fs::path rawlog = args.get_or("rawlog", kDefaultGtRawlog.string());
+      const fs::path gt = args.get_or("ground-truth", rawlog.string() + ".GT.txt");
+      if (!fs::exists(rawlog) || !fs::exists(gt)) {
+        std::cout << "\nICP-SLAM part skipped: " << rawlog << " or " << gt << " not found\n";
+        return 0;
+      }
+      const auto steps = robot::read_rawlog(rawlog);
+      const fs::path dir = fs::temp_directory_path() / "projbot_bench_slam";
+      const auto r = robot::build_map(steps, std::nullopt, dir);
+      fs::remove_all(dir);
+      const auto truth = robot::read_trajectory(gt);
+      std::cout << "\nICP-SLAM on " << rawlog.filename() << " (" << steps.size() << " scans, " << r.keyframes << " keyframes, "
+                << r.seconds * 1000 / static_cast<double>(steps.size()) << " ms per scan):\n";
+      print_errors("ICP-SLAM vs ground truth", compare(r.trajectory, truth));
+      print_errors("odometry vs ground truth", compare(dead_reckoning(steps, r.trajectory.front().pose), truth));
+      return 0;
+    }};
+
+}  // namespace projbot::tools
