@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <numbers>
 
 #include "projbot/config/scene.hpp"
 
@@ -132,9 +133,40 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"translation_2",
                 kProj + "targets:\n  - {name: a, model: a.glb, pose: {translation: [0, 1]}}\n",
                 {"pose.translation", "3 numbers"}},
+        BadCase{"robot_unknown_key",
+                kProj + "targets: []\nrobot: {pan_tilt: {mount: {translation: [0, 0, 1]}, wheels: 4}}\n",
+                {"s.yaml:3:", "robot.pan_tilt.wheels", "unknown key"}},
+        BadCase{"robot_bad_limits",
+                kProj + "targets: []\nrobot:\n  pan_tilt: {pan_limits_deg: [90, -90]}\n",
+                {"s.yaml:4:", "robot.pan_tilt.pan_limits_deg", "min < max"}},
+        BadCase{"robot_camera_not_rigid",
+                kProj + "targets: []\nrobot:\n  pan_tilt:\n    camera: {matrix: [2,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}\n",
+                {"robot.pan_tilt.camera", "proper rotation"}},
         BadCase{"yaml_syntax", "projector: {width: 640\ntargets: [\n", {"s.yaml:", "YAML syntax error"}},
         BadCase{"empty", "", {"s.yaml", "empty"}}, BadCase{"root_not_map", "- 1\n- 2\n", {"s.yaml:1:", "mapping"}}),
     [](const ::testing::TestParamInfo<BadCase>& param_info) { return std::string(param_info.param.name); });
+
+TEST(SceneTest, RobotSectionOverridesTheRig) {
+  const auto plain = parse_scene(kGood, "/scenes/s.yaml");
+  const auto rig = projbot::config::default_pan_tilt();
+  EXPECT_TRUE(plain.pan_tilt.T_base_mount.isApprox(rig.T_base_mount));
+  const auto s = parse_scene(std::string(kGood) +
+                                 "robot:\n  pan_tilt:\n    mount: {translation: [0.1, 0, 0.8]}\n"
+                                 "    tilt_axis_offset: [0, 0, 0.05]\n    projector_from_camera: {translation: [0.01, 0.1, 0]}\n"
+                                 "    pan_limits_deg: [-90, 90]\n",
+                             "/scenes/s.yaml");
+  EXPECT_DOUBLE_EQ(s.pan_tilt.T_base_mount(2, 3), 0.8);
+  EXPECT_DOUBLE_EQ(s.pan_tilt.tilt_axis_offset_m.z(), 0.05);
+  EXPECT_DOUBLE_EQ(s.pan_tilt.T_projector_camera(1, 3), 0.1);
+  EXPECT_NEAR(s.pan_tilt.pan_max_rad, std::numbers::pi / 2, 1e-12);
+  EXPECT_DOUBLE_EQ(s.pan_tilt.tilt_max_rad, rig.tilt_max_rad);        // not given: the default
+  EXPECT_TRUE(s.pan_tilt.T_head_camera.isApprox(rig.T_head_camera));  // the optical-frame rotation kept
+  // The documented way to write the default camera in a file.
+  const auto c =
+      parse_scene(std::string(kGood) + "robot: {pan_tilt: {camera: {translation: [0.04, 0, 0], rpy_deg: [-90, 0, -90]}}}\n",
+                  "/scenes/s.yaml");
+  EXPECT_TRUE(c.pan_tilt.T_head_camera.isApprox(rig.T_head_camera, 1e-12));
+}
 
 TEST(SceneTest, MissingFileIsNamed) {
   try {

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -115,9 +116,10 @@ ProjectorConfig read_projector(MapReader& root) {
   return p;
 }
 
-Eigen::Matrix4d read_pose(MapReader& target, const std::string& path) {
-  YAML::Node node = target.child("pose", false);
-  if (!node) return Eigen::Matrix4d::Identity();
+Eigen::Matrix4d read_pose(MapReader& target, const std::string& path, const std::string& key = "pose",
+                          const Eigen::Matrix4d& fallback = Eigen::Matrix4d::Identity()) {
+  YAML::Node node = target.child(key, false);
+  if (!node) return fallback;
   MapReader r(node, path, target.file());
   Eigen::Matrix4d T;
   if (r.has("matrix")) {
@@ -139,6 +141,37 @@ Eigen::Matrix4d read_pose(MapReader& target, const std::string& path) {
     r.fail(node, "", e.what());
   }
   return T;
+}
+
+// The optional robot section: the pan-tilt rig's calibration, each key defaulting to the simulated rig.
+PanTiltConfig read_robot(MapReader& root) {
+  PanTiltConfig c = default_pan_tilt();
+  YAML::Node node = root.child("robot", false);
+  if (!node) return c;
+  MapReader r(node, "robot", root.file());
+  YAML::Node pt = r.child("pan_tilt", true);
+  MapReader p(pt, "robot.pan_tilt", root.file());
+  c.T_base_mount = read_pose(p, "robot.pan_tilt.mount", "mount", c.T_base_mount);
+  c.T_head_camera = read_pose(p, "robot.pan_tilt.camera", "camera", c.T_head_camera);
+  c.T_projector_camera = read_pose(p, "robot.pan_tilt.projector_from_camera", "projector_from_camera", c.T_projector_camera);
+  if (YAML::Node n = p.child("tilt_axis_offset", false)) {
+    const auto v = p.numbers(n, "robot.pan_tilt.tilt_axis_offset", 3);
+    c.tilt_axis_offset_m = {v[0], v[1], v[2]};
+  }
+  const auto limits = [&](const char* key, double& lo, double& hi) {
+    YAML::Node n = p.child(key, false);
+    if (!n) return;
+    const std::string path = std::string("robot.pan_tilt.") + key;
+    const auto v = p.numbers(n, path, 2);
+    if (!(v[0] < v[1]) || v[0] < -180.0 || v[1] > 180.0) p.fail(n, path, "need min < max within -180..180 degrees");
+    lo = v[0] * std::numbers::pi / 180.0;
+    hi = v[1] * std::numbers::pi / 180.0;
+  };
+  limits("pan_limits_deg", c.pan_min_rad, c.pan_max_rad);
+  limits("tilt_limits_deg", c.tilt_min_rad, c.tilt_max_rad);
+  p.reject_unknown();
+  r.reject_unknown();
+  return c;
 }
 
 }  // namespace
@@ -168,6 +201,7 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
   scene.source = source;
   MapReader r(root, "", file);
   scene.projector = read_projector(r);
+  scene.pan_tilt = read_robot(r);
 
   YAML::Node targets = r.child("targets", true);
   if (!targets.IsSequence()) r.fail(targets, "targets", "expected a list of targets");

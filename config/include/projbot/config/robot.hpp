@@ -15,7 +15,8 @@ struct PanTiltConfig {
   Eigen::Matrix4d T_base_mount = Eigen::Matrix4d::Identity();
   /// From the pan frame's origin to the tilt axis, in the pan frame, metres.
   Eigen::Vector3d tilt_axis_offset_m{0.0, 0.0, 0.06};
-  /// T_head_camera: the camera's optical frame in the head frame. Rigid.
+  /// T_head_camera: the camera's optical frame in the head frame. Rigid. In a scene file give the
+  /// whole rotation: rpy_deg [-90, 0, -90] is a camera looking along the head's x axis.
   Eigen::Matrix4d T_head_camera = Eigen::Matrix4d::Identity();
   /// T_projector_camera: camera-projector extrinsics (R_cp, T_cp of the paper's Eq. 2). Rigid.
   Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();

@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "projbot/config/robot.hpp"
+
 namespace projbot::config {
 
 /// A bad scene or value: the message names the file, line and key path ("scene.yaml:7: projector.fx: ...").
@@ -45,6 +47,8 @@ struct Scene {
   std::filesystem::path source;  ///< the file it came from (empty when parsed from a string)
   ProjectorConfig projector;
   std::vector<TargetConfig> targets;
+  /// The robot's pan-tilt rig (optional `robot.pan_tilt` section; defaults: default_pan_tilt()).
+  PanTiltConfig pan_tilt = default_pan_tilt();
 };
 
 /// Reads and validates a scene file. Throws ConfigError naming file:line and the key path.
