@@ -24,7 +24,7 @@ void print_help() {
                "Usage: projbot COMMAND [options]     (projbot COMMAND --help for its options)\n\nCommands:\n";
   for (const auto* c : commands()) {
     std::string name = "  " + c->name;
-    name.resize(16, ' ');
+    name.resize(18, ' ');
     std::cout << name << c->summary << '\n';
   }
   std::cout << "\nExamples:\n"

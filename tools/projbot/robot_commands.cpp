@@ -153,7 +153,7 @@ const Command kLocalize{
 
 const Command kBenchLocalize{
     "bench localize",
-    "benchmark: localisation error at the stops of simulated tours, and ICP-SLAM vs ground truth",
+    "benchmark localisation at the stops of simulated tours, and ICP-SLAM vs ground truth",
     "projbot bench localize [--stops 3,10,30] [--seed K] [--rawlog R --ground-truth GT]\n\n"
     "Drives the simulated youBot (wheel slip, wheel-radius and heading bias) through tours of the built-in\n"
     "8 x 6 m room, once closing the loop on MRPT localisation and once on odometry alone, and prints the\n"
