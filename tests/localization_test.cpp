@@ -10,7 +10,6 @@
 #include <iostream>
 #include <numbers>
 
-#include "projbot/robot/ptu_d46.hpp"
 #include "projbot/robot/sim_tour.hpp"
 
 namespace {

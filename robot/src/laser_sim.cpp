@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "mrpt_convert.hpp"
-#include "projbot/robot/ptu_d46.hpp"  // RobotError
 
 namespace projbot::robot {
 

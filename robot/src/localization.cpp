@@ -27,7 +27,6 @@
 #include <sstream>
 
 #include "mrpt_convert.hpp"
-#include "projbot/robot/ptu_d46.hpp"  // RobotError
 
 namespace projbot::robot {
 namespace {
@@ -77,10 +76,10 @@ mrpt::obs::CActionCollection::Ptr odometry_action(const Pose2D& increment, doubl
   return actions;
 }
 
-mrpt::poses::CPose2D mean2d(const mrpt::poses::CPose3DPDF& pdf) {
-  mrpt::poses::CPose3D p;
-  pdf.getMean(p);
-  return mrpt::poses::CPose2D(p);
+// MRPT's exception texts carry a call stack after the first line; users get the first line.
+std::string first_line(const std::exception& e) {
+  const std::string what = e.what();
+  return what.substr(0, what.find('\n'));
 }
 
 }  // namespace
@@ -126,9 +125,7 @@ std::vector<RawlogStep> read_rawlog(const std::filesystem::path& path) {
       steps.push_back(std::move(step));
     }
   } catch (const std::exception& e) {
-    std::string what = e.what();
-    if (const auto nl = what.find('\n'); nl != std::string::npos) what = what.substr(0, nl);
-    throw RobotError(path.string() + ": not a readable MRPT rawlog (" + what + ")");
+    throw RobotError(path.string() + ": not a readable MRPT rawlog (" + first_line(e) + ")");
   }
   if (steps.empty()) throw RobotError(path.string() + ": the rawlog holds no 2-D laser scans");
   return steps;
@@ -196,9 +193,7 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
   } catch (const RobotError&) {
     throw;
   } catch (const std::exception& e) {
-    std::string what = e.what();
-    if (const auto nl = what.find('\n'); nl != std::string::npos) what = what.substr(0, nl);
-    throw RobotError((ini ? ini->string() : std::string("default icp-slam config")) + ": " + what);
+    throw RobotError((ini ? ini->string() : std::string("default icp-slam config")) + ": " + first_line(e));
   }
   builder.initialize();
 
@@ -207,7 +202,7 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
     mrpt::obs::CSensoryFrame frame;
     frame.insert(detail::to_mrpt(step.scan));
     builder.processActionObservation(*odometry_action(step.odometry_increment.value_or(Pose2D{}), step.timestamp_s), frame);
-    result.trajectory.push_back({step.timestamp_s, detail::from_mrpt(mean2d(*builder.getCurrentPoseEstimation()))});
+    result.trajectory.push_back({step.timestamp_s, detail::from_mrpt(builder.getCurrentPoseEstimation()->getMeanVal())});
   }
   mrpt::maps::CSimpleMap keyframes;
   builder.getCurrentlyBuiltMap(keyframes);
@@ -259,10 +254,8 @@ Localizer::~Localizer() = default;
 
 Localizer::Localizer(const std::vector<std::pair<Pose2D, LaserScan>>& keyframes, const LocalizerConfig& config)
     : impl_(std::make_unique<Impl>(config)) {
-  for (const auto& [pose, scan] : keyframes) {
-    const Pose2D p = pose;
-    impl_->map.insertObservation(*detail::to_mrpt(scan), mrpt::poses::CPose3D(mrpt::poses::CPose2D(p.x_m, p.y_m, p.theta_rad)));
-  }
+  for (const auto& [pose, scan] : keyframes)
+    impl_->map.insertObservation(*detail::to_mrpt(scan), mrpt::poses::CPose3D(detail::to_mrpt(pose)));
   if (impl_->map.size() < 10) throw RobotError("localiser: the map has fewer than 10 points");
 }
 

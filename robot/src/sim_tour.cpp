@@ -58,8 +58,10 @@ std::vector<StopReport> run_sim_tour(const SimTourConfig& c) {
     for (long step = 0;; ++step) {
       const Pose2D before = odometry.pose();
       const Pose2D& after = odometry.update(base.read_encoders());
-      localizer.predict(between(before, after));
-      if (c.source == PoseSource::localized && step % c.localize_every == 0) scan_and_correct();
+      if (c.source == PoseSource::localized) {
+        localizer.predict(between(before, after));
+        if (step % c.localize_every == 0) scan_and_correct();
+      }
       const Pose2D estimate = c.source == PoseSource::localized ? localizer.pose() : odometry.pose();
       const BaseTwist cmd = controller.update(estimate, goal, c.control_dt_s);
       if (controller.arrived()) break;

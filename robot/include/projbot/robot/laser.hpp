@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "projbot/robot/error.hpp"
 #include "projbot/robot/pose2d.hpp"
 
 namespace projbot::robot {
@@ -64,10 +65,8 @@ class OccupancyMap {
   /// Simulates a scan from a base at T_world_base (ray tracing the grid, then seeded noise).
   LaserScan simulate_scan(const Pose2D& T_world_base, const LaserConfig& laser, std::mt19937_64& rng) const;
 
-  struct Impl;
-  const Impl& impl() const { return *impl_; }
-
  private:
+  struct Impl;
   explicit OccupancyMap(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

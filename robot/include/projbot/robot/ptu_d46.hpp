@@ -4,19 +4,13 @@
 
 #include <filesystem>
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "projbot/robot/error.hpp"
 #include "projbot/robot/pan_tilt.hpp"
 
 namespace projbot::robot {
-
-/// A robot device that could not be opened or configured; the message names it.
-class RobotError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// The real unit. Commands go through mrpt::hwdrivers::CPtuDPerception (9600 baud, verbose
 /// replies, echo on, immediate execution); limits and errors the unit reports become
