@@ -9,7 +9,7 @@ packages=(
   libglm-dev libeigen3-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
   libglfw3-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
   libpcl-dev libopenni2-dev libtiff-dev libboost-dev libmrpt-dev
-  libx11-dev libxrandr-dev xvfb x11-apps xauth bc
+  libx11-dev libxrandr-dev xvfb x11-apps xauth bc valgrind
 )
 
 missing=()

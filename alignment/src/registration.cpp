@@ -315,7 +315,9 @@ ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t sampl
     throw AlignmentError(path.string() + ": model cloud has " + std::to_string(cloud.points.size()) + " valid points");
   auto xyz = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   for (const auto& p : cloud.points) xyz->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-  for (const auto& p : *with_normals(xyz, 16)) {
+  // Keep the cloud alive for the loop: a range-for over `*with_normals(...)` would read a freed cloud.
+  const CloudN::Ptr with = with_normals(xyz, 16);
+  for (const auto& p : *with) {
     m.points.push_back(p.getVector3fMap());
     m.normals.push_back(p.getNormalVector3fMap());
   }
