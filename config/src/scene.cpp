@@ -144,12 +144,35 @@ Eigen::Matrix4d read_pose(MapReader& target, const std::string& path, const std:
 }
 
 // The optional robot section: the pan-tilt rig's calibration, each key defaulting to the simulated rig.
-PanTiltConfig read_robot(MapReader& root) {
+PanTiltConfig read_robot(MapReader& root, Scene& scene) {
   PanTiltConfig c = default_pan_tilt();
   YAML::Node node = root.child("robot", false);
   if (!node) return c;
   MapReader r(node, "robot", root.file());
-  YAML::Node pt = r.child("pan_tilt", true);
+  if (YAML::Node st = r.child("start", false)) {
+    const auto v = r.numbers(st, "robot.start", 3);
+    scene.robot_start = {v[0], v[1], v[2] * std::numbers::pi / 180.0};
+  }
+  if (YAML::Node dn = r.child("drift", false)) {
+    MapReader d(dn, "robot.drift", root.file());
+    DriftSpec& s = scene.drift;
+    const auto non_negative = [&](const char* key, double& value) {
+      value = d.get<double>(key, value);
+      if (value < 0.0) d.fail(dn[key], d.key_path(key), "must be >= 0");
+    };
+    non_negative("wheel_scale_sigma", s.wheel_scale_sigma);
+    non_negative("slip_scale", s.slip_scale);
+    s.heading_bias_rad_per_m = d.get<double>("heading_bias_rad_per_m", s.heading_bias_rad_per_m);
+    s.heading_bias_rad_per_rad = d.get<double>("heading_bias_rad_per_rad", s.heading_bias_rad_per_rad);
+    non_negative("random_translation_sigma", s.random_translation_sigma);
+    non_negative("random_rotation_sigma", s.random_rotation_sigma);
+    d.reject_unknown();
+  }
+  YAML::Node pt = r.child("pan_tilt", false);
+  if (!pt) {
+    r.reject_unknown();
+    return c;
+  }
   MapReader p(pt, "robot.pan_tilt", root.file());
   c.T_base_mount = read_pose(p, "robot.pan_tilt.mount", "mount", c.T_base_mount);
   c.T_head_camera = read_pose(p, "robot.pan_tilt.camera", "camera", c.T_head_camera);
@@ -201,7 +224,42 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
   scene.source = source;
   MapReader r(root, "", file);
   scene.projector = read_projector(r);
-  scene.pan_tilt = read_robot(r);
+  scene.pan_tilt = read_robot(r, scene);
+  if (YAML::Node cam = r.child("camera", false)) {
+    MapReader c(cam, "camera", file);
+    ProjectorConfig& k = scene.depth_camera;
+    k.width_px = c.get<int>("width", k.width_px);
+    k.height_px = c.get<int>("height", k.height_px);
+    k.fx_px = c.get<double>("fx", k.fx_px);
+    k.fy_px = c.get<double>("fy", k.fy_px);
+    k.cx_px = c.get<double>("cx", k.cx_px);
+    k.cy_px = c.get<double>("cy", k.cy_px);
+    k.near_m = c.get<double>("near", k.near_m);
+    k.far_m = c.get<double>("far", k.far_m);
+    c.reject_unknown();
+    try {
+      validate_projector(k, "camera");
+    } catch (const ConfigError& e) {
+      c.fail(cam, "", e.what());
+    }
+  }
+  if (YAML::Node room = r.child("room", false)) {
+    MapReader m(room, "room", file);
+    scene.room.width_m = m.get<double>("width", 0.0, true);
+    scene.room.depth_m = m.get<double>("depth", 0.0, true);
+    if (!(scene.room.width_m > 0.5) || !(scene.room.depth_m > 0.5) || scene.room.width_m > 200 || scene.room.depth_m > 200)
+      m.fail(room, "room", "width and depth must be 0.5..200 m");
+    if (YAML::Node obs = m.child("obstacles", false)) {
+      if (!obs.IsSequence()) m.fail(obs, "room.obstacles", "expected a list of [x0, y0, x1, y1]");
+      for (std::size_t i = 0; i < obs.size(); ++i) {
+        const auto v = m.numbers(obs[i], "room.obstacles[" + std::to_string(i) + "]", 4);
+        if (!(v[0] < v[2]) || !(v[1] < v[3]))
+          m.fail(obs[i], "room.obstacles[" + std::to_string(i) + "]", "need x0 < x1 and y0 < y1");
+        scene.room.obstacles.push_back({v[0], v[1], v[2], v[3]});
+      }
+    }
+    m.reject_unknown();
+  }
 
   YAML::Node targets = r.child("targets", true);
   if (!targets.IsSequence()) r.fail(targets, "targets", "expected a list of targets");
@@ -221,11 +279,69 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
     if (!(target.scale > 0.0)) t.fail(targets[i]["scale"], path + ".scale", "must be > 0");
     target.recenter = t.get<bool>("recenter", false);
     target.T_projector_target = read_pose(t, path + ".pose");
+    if (t.has("world_pose")) target.T_world_target = read_pose(t, path + ".world_pose", "world_pose");
+    if (t.has("map_pose")) {
+      if (!target.T_world_target) t.fail(targets[i]["map_pose"], path + ".map_pose", "needs world_pose too");
+      target.T_map_target = read_pose(t, path + ".map_pose", "map_pose");
+    }
+    if (YAML::Node st = t.child("stop", false)) {
+      const auto v = t.numbers(st, path + ".stop", 3);
+      target.stop = Eigen::Vector3d(v[0], v[1], v[2] * std::numbers::pi / 180.0);
+    }
+    if (YAML::Node mk = t.child("markers", false)) {
+      if (!mk.IsSequence() || mk.size() == 0) t.fail(mk, path + ".markers", "expected a non-empty list of [x, y, z]");
+      for (std::size_t k = 0; k < mk.size(); ++k) {
+        const auto v = t.numbers(mk[k], path + ".markers[" + std::to_string(k) + "]", 3);
+        target.markers_m.emplace_back(v[0], v[1], v[2]);
+      }
+    }
+    if (YAML::Node mo = t.child("motion", false)) {
+      MapReader m(mo, path + ".motion", file);
+      TargetMotion motion;
+      motion.visit = m.get<int>("visit", motion.visit);
+      if (motion.visit < 1) m.fail(mo["visit"], m.key_path("visit"), "must be >= 1");
+      motion.start_s = m.get<double>("start_s", motion.start_s);
+      motion.duration_s = m.get<double>("duration_s", motion.duration_s);
+      if (motion.start_s < 0.0 || !(motion.duration_s > 0.0))
+        m.fail(mo, path + ".motion", "need start_s >= 0 and duration_s > 0");
+      if (YAML::Node tr = m.child("translation", false)) {
+        const auto v = m.numbers(tr, m.key_path("translation"), 3);
+        motion.translation_m = {v[0], v[1], v[2]};
+      }
+      if (YAML::Node rpy = m.child("rpy_deg", false)) {
+        const auto v = m.numbers(rpy, m.key_path("rpy_deg"), 3);
+        motion.rpy_deg = {v[0], v[1], v[2]};
+      }
+      m.reject_unknown();
+      target.motion = motion;
+    }
     t.reject_unknown();
     scene.targets.push_back(std::move(target));
   }
+  if (YAML::Node tour = r.child("tour", false)) {
+    MapReader m(tour, "tour", file);
+    YAML::Node visits = m.child("visits", true);
+    if (!visits.IsSequence() || visits.size() == 0) m.fail(visits, "tour.visits", "expected a non-empty list of target names");
+    for (std::size_t i = 0; i < visits.size(); ++i) {
+      const std::string name = visits[i].IsScalar() ? visits[i].Scalar() : std::string();
+      const int index = scene.target_index(name);
+      if (index < 0) m.fail(visits[i], "tour.visits[" + std::to_string(i) + "]", "no target named '" + name + "'");
+      const TargetConfig& t = scene.targets[static_cast<std::size_t>(index)];
+      if (!t.T_world_target || !t.stop)
+        m.fail(visits[i], "tour.visits[" + std::to_string(i) + "]",
+               "target '" + name + "' needs world_pose and stop to be visited");
+      scene.visits.push_back(name);
+    }
+    m.reject_unknown();
+  }
   r.reject_unknown();
   return scene;
+}
+
+int Scene::target_index(std::string_view name) const {
+  for (std::size_t i = 0; i < targets.size(); ++i)
+    if (targets[i].name == name) return static_cast<int>(i);
+  return -1;
 }
 
 Scene load_scene(const std::filesystem::path& path) {

@@ -15,12 +15,11 @@ SimTourConfig default_sim_tour() {
   return c;
 }
 
-std::vector<StopReport> run_sim_tour(const SimTourConfig& c) {
-  const OccupancyMap map = OccupancyMap::from_room(c.room);
-  std::mt19937_64 rng(c.errors.seed * 7919 + 17);
+namespace {
 
-  // The environment map: a survey with scans at known poses (what a careful mapping run
-  // produces), so that localisation is judged against ground truth, not against its own map.
+// The environment map: a survey with scans at known poses (what a careful mapping run produces),
+// so that localisation is judged against ground truth, not against its own map.
+Localizer surveyed_localizer(const SimTourConfig& c, const OccupancyMap& map, std::mt19937_64& rng) {
   std::vector<std::pair<Pose2D, LaserScan>> survey;
   for (double y = c.survey_spacing_m / 2; y < c.room.depth_m; y += c.survey_spacing_m)
     for (double x = c.survey_spacing_m / 2; x < c.room.width_m; x += c.survey_spacing_m)
@@ -30,62 +29,76 @@ std::vector<StopReport> run_sim_tour(const SimTourConfig& c) {
       }
   Localizer localizer(survey, c.localizer);
   localizer.reset(c.start);
+  return localizer;
+}
 
-  SimulatedBase base(c.start, c.errors);
-  WheelOdometry odometry(base.geometry(), c.start);
-  odometry.update(base.read_encoders());
-  BaseController controller(c.controller, base.geometry());
-  double time_s = 0.0;
+}  // namespace
 
-  std::vector<StopReport> reports;
-  for (int i = 0; i < c.stop_count && !c.stops.empty(); ++i) {
-    const Pose2D goal = c.stops[static_cast<std::size_t>(i) % c.stops.size()];
-    StopReport r;
-    r.index = i;
-    r.goal = goal;
-    controller.reset();
-    double ms_total = 0.0;
-    const auto scan_and_correct = [&] {
-      LaserScan scan = map.simulate_scan(base.true_pose(), c.laser, rng);
-      scan.timestamp_s = time_s;
-      const auto t0 = std::chrono::steady_clock::now();
-      const LocalizationUpdate u = localizer.correct(scan);
-      ms_total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      ++r.corrections;
-      if (!u.accepted) ++r.rejected;
-    };
-    const double t_start = time_s;
-    for (long step = 0;; ++step) {
-      const Pose2D before = odometry.pose();
-      const Pose2D& after = odometry.update(base.read_encoders());
-      if (c.source == PoseSource::localized) {
-        localizer.predict(between(before, after));
-        if (step % c.localize_every == 0) scan_and_correct();
-      }
-      const Pose2D estimate = c.source == PoseSource::localized ? localizer.pose() : odometry.pose();
-      const BaseTwist cmd = controller.update(estimate, goal, c.control_dt_s);
-      if (controller.arrived()) break;
-      if (time_s - t_start > c.max_seconds_per_stop) break;
-      base.set_wheel_speeds(wheel_speeds_from_twist(cmd, base.geometry()));
-      base.advance(c.control_dt_s);
-      time_s += c.control_dt_s;
+SimRobot::SimRobot(const SimTourConfig& config)
+    : c_(config),
+      map_(OccupancyMap::from_room(config.room)),
+      rng_(config.errors.seed * 7919 + 17),
+      localizer_(surveyed_localizer(c_, map_, rng_)),
+      base_(config.start, config.errors),
+      odometry_(base_.geometry(), config.start),
+      controller_(config.controller, base_.geometry()) {
+  odometry_.update(base_.read_encoders());
+}
+
+Pose2D SimRobot::believed_pose() const { return c_.source == PoseSource::localized ? localizer_.pose() : odometry_.pose(); }
+
+StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
+  StopReport r;
+  r.index = index;
+  r.goal = goal;
+  controller_.reset();
+  double ms_total = 0.0;
+  const auto scan_and_correct = [&] {
+    LaserScan scan = map_.simulate_scan(base_.true_pose(), c_.laser, rng_);
+    scan.timestamp_s = time_s_;
+    const auto t0 = std::chrono::steady_clock::now();
+    const LocalizationUpdate u = localizer_.correct(scan);
+    ms_total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    ++r.corrections;
+    if (!u.accepted) ++r.rejected;
+  };
+  const double t_start = time_s_;
+  for (long step = 0;; ++step) {
+    const Pose2D before = odometry_.pose();
+    const Pose2D& after = odometry_.update(base_.read_encoders());
+    if (c_.source == PoseSource::localized) {
+      localizer_.predict(between(before, after));
+      if (step % c_.localize_every == 0) scan_and_correct();
     }
-    base.set_wheel_speeds({});
-    r.arrived = controller.arrived();
-    if (c.source == PoseSource::localized)
-      for (int k = 0; k < c.settle_scans; ++k) scan_and_correct();
-    r.drive_seconds = time_s - t_start;
-    r.truth = base.true_pose();
-    r.odometry = odometry.pose();
-    r.estimate = c.source == PoseSource::localized ? localizer.pose() : odometry.pose();
-    r.error_m = distance_m(r.estimate, r.truth);
-    r.error_rad = heading_error_rad(r.estimate, r.truth);
-    r.odometry_error_m = distance_m(r.odometry, r.truth);
-    r.odometry_error_rad = heading_error_rad(r.odometry, r.truth);
-    r.arrival_error_m = distance_m(r.truth, goal);
-    r.correct_ms_mean = r.corrections > 0 ? ms_total / r.corrections : 0.0;
-    reports.push_back(r);
+    const BaseTwist cmd = controller_.update(believed_pose(), goal, c_.control_dt_s);
+    if (controller_.arrived()) break;
+    if (time_s_ - t_start > c_.max_seconds_per_stop) break;
+    base_.set_wheel_speeds(wheel_speeds_from_twist(cmd, base_.geometry()));
+    base_.advance(c_.control_dt_s);
+    time_s_ += c_.control_dt_s;
   }
+  base_.set_wheel_speeds({});
+  r.arrived = controller_.arrived();
+  if (c_.source == PoseSource::localized)
+    for (int k = 0; k < c_.settle_scans; ++k) scan_and_correct();
+  r.drive_seconds = time_s_ - t_start;
+  r.truth = base_.true_pose();
+  r.odometry = odometry_.pose();
+  r.estimate = believed_pose();
+  r.error_m = distance_m(r.estimate, r.truth);
+  r.error_rad = heading_error_rad(r.estimate, r.truth);
+  r.odometry_error_m = distance_m(r.odometry, r.truth);
+  r.odometry_error_rad = heading_error_rad(r.odometry, r.truth);
+  r.arrival_error_m = distance_m(r.truth, goal);
+  r.correct_ms_mean = r.corrections > 0 ? ms_total / r.corrections : 0.0;
+  return r;
+}
+
+std::vector<StopReport> run_sim_tour(const SimTourConfig& c) {
+  SimRobot robot(c);
+  std::vector<StopReport> reports;
+  for (int i = 0; i < c.stop_count && !c.stops.empty(); ++i)
+    reports.push_back(robot.drive_to(c.stops[static_cast<std::size_t>(i) % c.stops.size()], i));
   return reports;
 }
 

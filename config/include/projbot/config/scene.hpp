@@ -2,7 +2,9 @@
 // Scene files: the projector and the targets it lights, validated once into plain structs.
 
 #include <Eigen/Core>
+#include <array>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -32,6 +34,17 @@ struct ProjectorConfig {
   double far_m = 20.0;    ///< far clipping distance along z, metres (> near_m)
 };
 
+/// A scripted move of a target while the robot projects onto it (the twin): during visit `visit`
+/// (1-based, counted per target), from `start_s` after projection starts, the target turns and slides
+/// smoothly by `delta` (applied in the world frame about the target's origin) over `duration_s`.
+struct TargetMotion {
+  int visit = 1;
+  double start_s = 0.5;
+  double duration_s = 2.0;
+  Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();  ///< world-frame shift, metres
+  Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();        ///< world-frame turn, degrees
+};
+
 /// One target object: its textured model and its pose in the projector frame.
 struct TargetConfig {
   std::string name;             ///< unique within the scene
@@ -40,6 +53,37 @@ struct TargetConfig {
   bool recenter = false;        ///< move the model frame's origin to the surface centroid
   /// T_projector_target: maps model-frame points (metres) into the projector frame. Rigid.
   Eigen::Matrix4d T_projector_target = Eigen::Matrix4d::Identity();
+
+  // The tour (optional; `projbot tour` needs world_pose and stop):
+  /// T_world_target: where the target truly stands in the map frame (the twin's ground truth).
+  std::optional<Eigen::Matrix4d> T_world_target;
+  /// The target's rough pose as surveyed into the map in preparation (Eq. 1's T_world_target);
+  /// defaults to world_pose.
+  std::optional<Eigen::Matrix4d> T_map_target;
+  /// The designated robot stop near it: x, y (metres, map frame) and heading (radians).
+  std::optional<Eigen::Vector3d> stop;
+  /// Marker points on the model (model frame after scale and recenter, metres): where the
+  /// projection error is measured.
+  std::vector<Eigen::Vector3d> markers_m;
+  std::optional<TargetMotion> motion;
+};
+
+/// The twin's room: an axis-aligned rectangle with box obstacles (metres, map frame).
+struct RoomSpec {
+  double width_m = 8.0;
+  double depth_m = 6.0;
+  std::vector<std::array<double, 4>> obstacles;  ///< x0, y0, x1, y1
+};
+
+/// Wheel-odometry error of the simulated base (see robot::BaseErrorModel for the meaning of each).
+/// Defaults are milder than the robot bench's: a base on a good floor.
+struct DriftSpec {
+  double wheel_scale_sigma = 0.005;
+  double slip_scale = 0.01;
+  double heading_bias_rad_per_m = 0.005;
+  double heading_bias_rad_per_rad = 0.005;
+  double random_translation_sigma = 0.002;
+  double random_rotation_sigma = 0.002;
 };
 
 /// A whole scene file.
@@ -49,6 +93,18 @@ struct Scene {
   std::vector<TargetConfig> targets;
   /// The robot's pan-tilt rig (optional `robot.pan_tilt` section; defaults: default_pan_tilt()).
   PanTiltConfig pan_tilt = default_pan_tilt();
+
+  // The tour (optional sections):
+  RoomSpec room;                                            ///< `room:`
+  Eigen::Vector3d robot_start{1.0, 1.0, 0.0};               ///< `robot.start: [x, y, heading_deg]`
+  DriftSpec drift;                                          ///< `robot.drift:`
+  ProjectorConfig depth_camera = kinect_v1_depth_camera();  ///< `camera:`, the RGB-D camera's depth intrinsics
+  std::vector<std::string> visits;                          ///< `tour.visits:` target names in order
+
+  /// Kinect v1 depth: 640x480, fx = fy = 525 px, 0.5-4.5 m.
+  static ProjectorConfig kinect_v1_depth_camera() { return {640, 480, 525.0, 525.0, 319.5, 239.5, 0.5, 4.5}; }
+  /// Index of the target named `name`, or -1.
+  int target_index(std::string_view name) const;
 };
 
 /// Reads and validates a scene file. Throws ConfigError naming file:line and the key path.

@@ -4,6 +4,7 @@
 // compared with the ground truth. Used by the tests, `projbot bench localize` and the twin.
 
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "projbot/robot/base.hpp"
@@ -43,6 +44,33 @@ struct StopReport {
   double drive_seconds = 0.0;  ///< simulated time to reach the stop
   int corrections = 0, rejected = 0;
   double correct_ms_mean = 0.0;  ///< wall time per localisation update
+};
+
+/// The simulated robot of a tour, one stop at a time: the room and its map, the drifting base, wheel
+/// odometry and the MRPT localiser. The twin drives it and asks where the robot believes it is.
+/// Deterministic for a given config. Not thread-safe: one owner thread.
+class SimRobot {
+ public:
+  explicit SimRobot(const SimTourConfig& config);
+  /// Drives to `goal` under the controller (closing the loop on config.source), then settles.
+  /// `index` is copied into the report.
+  StopReport drive_to(const Pose2D& goal, int index);
+  /// What the robot believes (localisation or odometry, by config.source) and the ground truth.
+  Pose2D believed_pose() const;
+  Pose2D true_pose() const { return base_.true_pose(); }
+  Pose2D odometry_pose() const { return odometry_.pose(); }
+  const OccupancyMap& map() const { return map_; }
+  double time_s() const { return time_s_; }
+
+ private:
+  SimTourConfig c_;
+  OccupancyMap map_;
+  std::mt19937_64 rng_;
+  Localizer localizer_;
+  SimulatedBase base_;
+  WheelOdometry odometry_;
+  BaseController controller_;
+  double time_s_ = 0.0;
 };
 
 /// Runs the tour. Deterministic for a given config (all noise is seeded).
