@@ -8,6 +8,7 @@
 #include <pcl/filters/statistical_outlier_removal.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/registration/correspondence_rejection_surface_normal.h>
 #include <pcl/registration/icp.h>
 #include <pcl/registration/sample_consensus_prerejective.h>
 
@@ -81,14 +82,16 @@ Features::Ptr fpfh(const CloudN::ConstPtr& cloud, double radius) {
   return features;
 }
 
-// Where a model sits: the centroid of its points and the largest distance of a point from it.
+// Where a model sits: the centroid of its points, the largest distance of a point from it, and its
+// bounding box in the model frame.
 struct Extent {
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
   double radius = 0.0;
+  Eigen::AlignedBox3f box;
 
   Extent() = default;
   explicit Extent(const std::vector<Eigen::Vector3f>& points) {
-    for (const auto& p : points) centroid += p;
+    for (const auto& p : points) centroid += p, box.extend(p);
     if (!points.empty()) centroid /= static_cast<float>(points.size());
     for (const auto& p : points) radius = std::max(radius, static_cast<double>((p - centroid).norm()));
   }
@@ -121,6 +124,28 @@ struct Aligner::Impl {
     for (const auto& p : scan.points)
       if (p.allFinite() && (crop_radius <= 0.0 || (p - centre).squaredNorm() <= r2))
         raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    return filter(raw, leaf);
+  }
+
+  // Finite scan points inside the model's bounding box, grown by `margin`, under T_scan_model: unlike
+  // a sphere, the box leaves out most of what the target stands on (a pedestal, the floor).
+  pcl::PointCloud<pcl::PointXYZ>::Ptr prepare_in_box(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model, double margin,
+                                                     double leaf) const {
+    const Eigen::Matrix4f T_model_scan = rigid_inverse(T_scan_model).cast<float>();
+    const Eigen::Matrix3f R = T_model_scan.topLeftCorner<3, 3>();
+    const Eigen::Vector3f t = T_model_scan.topRightCorner<3, 1>();
+    const Eigen::Vector3f lo = extent.box.min().array() - static_cast<float>(margin);
+    const Eigen::Vector3f hi = extent.box.max().array() + static_cast<float>(margin);
+    auto raw = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    for (const auto& p : scan.points) {
+      if (!p.allFinite()) continue;
+      const Eigen::Vector3f q = R * p + t;
+      if ((q.array() >= lo.array()).all() && (q.array() <= hi.array()).all()) raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    }
+    return filter(raw, leaf);
+  }
+
+  pcl::PointCloud<pcl::PointXYZ>::Ptr filter(const pcl::PointCloud<pcl::PointXYZ>::Ptr& raw, double leaf) const {
     if (raw->size() < cfg.min_points) return pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     auto down = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     pcl::VoxelGrid<pcl::PointXYZ> grid;
@@ -140,30 +165,47 @@ struct Aligner::Impl {
     return down;
   }
 
-  // The scan prepared around where the model sits under T_scan_model: what ICP and the gate work on.
-  pcl::PointCloud<pcl::PointXYZ>::Ptr near_scan(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const {
-    return prepare(scan, extent.centre_in(T_scan_model).cast<float>(), cfg.crop ? extent.radius + cfg.crop_margin_m : 0.0,
-                   cfg.voxel_m);
+  // The scan prepared around where the model sits under T_scan_model, its box grown by `margin`: what
+  // an ICP stage and the gate work on. Without cropping, all of it.
+  pcl::PointCloud<pcl::PointXYZ>::Ptr near_scan(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model,
+                                                double margin) const {
+    if (!cfg.crop) return prepare(scan, Eigen::Vector3f::Zero(), 0.0, cfg.voxel_m);
+    return prepare_in_box(scan, T_scan_model, margin, cfg.voxel_m);
   }
+  // What the quality gate judges: the box grown by a little more than the inlier distance.
+  double gate_margin() const { return 3.0 * cfg.inlier_distance_m; }
 
   // Point-to-plane ICP, coarse then fine correspondence distance. The scan is the source: every scan
   // point has a true match on the complete model, while the model's unseen side has none in the scan and
   // would pull the estimate. The planes are the model's exact surface normals, and the model's search
   // tree is built once, in the constructor.
-  Eigen::Matrix4d icp(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& scan, const Eigen::Matrix4d& T_scan_model_init,
-                      int& iterations, bool& converged) const {
-    auto source = pcl::make_shared<CloudN>();
-    source->reserve(scan->size());
-    for (const auto& p : *scan) {
-      PointN q;
-      q.x = p.x, q.y = p.y, q.z = p.z;
-      q.normal_x = q.normal_y = q.normal_z = 0.0F;
-      source->push_back(q);
-    }
+  // Each stage crops the scan afresh around the current estimate: the first with the whole crop margin
+  // (the initial guess may be that far off), later ones with their correspondence distance, so that
+  // what the target stands on drops out as the estimate tightens.
+  Eigen::Matrix4d icp(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model_init, int& iterations, bool& converged) const {
     Eigen::Matrix4f T_model_scan = rigid_inverse(T_scan_model_init).cast<float>();
     converged = true;
-    for (const double distance : cfg.icp_distances_m) {
+    for (std::size_t stage = 0; stage < cfg.icp_distances_m.size(); ++stage) {
+      const double distance = cfg.icp_distances_m[stage];
+      const auto near = near_scan(scan, rigid_inverse(T_model_scan.cast<double>()), stage == 0 ? cfg.crop_margin_m : distance);
+      if (near->size() < cfg.min_points) {
+        converged = false;
+        break;
+      }
+      // Scan normals (towards the sensor) let correspondences whose surfaces disagree be rejected: the
+      // side of a pedestal just below a target is near the target's underside, but faces another way,
+      // and would otherwise pull the estimate down onto it.
+      const CloudN::Ptr source = with_normals(near, cfg.normal_neighbours);
+      if (source->size() < cfg.min_points) {
+        converged = false;
+        break;
+      }
       CountingIcp icp;
+      if (cfg.max_normal_angle_deg < 180.0) {
+        auto normals = pcl::make_shared<pcl::registration::CorrespondenceRejectorSurfaceNormal>();
+        normals->setThreshold(std::cos(cfg.max_normal_angle_deg * M_PI / 180.0));
+        icp.addCorrespondenceRejector(normals);
+      }
       icp.setInputSource(source);
       icp.setInputTarget(model_icp);
       icp.setSearchMethodTarget(model_icp_tree, true);
@@ -353,7 +395,7 @@ const AcquisitionConfig& Aligner::config() const { return impl_->cfg; }
 AlignmentResult Aligner::score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const {
   AlignmentResult r;
   r.T_scan_model = T_scan_model;
-  impl_->evaluate(*impl_->near_scan(scan, T_scan_model), T_scan_model, r);
+  impl_->evaluate(*impl_->near_scan(scan, T_scan_model, impl_->gate_margin()), T_scan_model, r);
   r.converged = impl_->passes(r);
   return r;
 }
@@ -372,13 +414,11 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   best.inlier_ratio = 0.0;
   best.rmse_mm = std::numeric_limits<double>::infinity();
   const auto attempt = [&](const Eigen::Matrix4d& start, bool reinitialised) {
-    const auto near = m.near_scan(scan, start);
-    if (near->size() < m.cfg.min_points) return;
     AlignmentResult r;
     bool icp_converged = false;
-    r.T_scan_model = m.icp(near, start, best.iterations, icp_converged);
+    r.T_scan_model = m.icp(scan, start, best.iterations, icp_converged);
     r.reinitialised = reinitialised;
-    m.evaluate(*near, r.T_scan_model, r);
+    m.evaluate(*m.near_scan(scan, r.T_scan_model, m.gate_margin()), r.T_scan_model, r);
     r.converged = icp_converged && m.passes(r);
     r.iterations = best.iterations;
     const bool better =

@@ -137,4 +137,41 @@ Model make_uv_sphere(double radius_m, int rings, int segments) {
   return m;
 }
 
+Model make_box(const Eigen::Vector3d& min_m, const Eigen::Vector3d& max_m, const std::array<float, 4>& rgba) {
+  if (!min_m.allFinite() || !max_m.allFinite() || !(min_m.array() < max_m.array()).all())
+    throw AssetError("box: need finite min < max on every axis");
+  Model m;
+  m.source = "box";
+  Primitive p;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const int side : {-1, 1}) {
+      // The face on `side` of `axis`, its corners walked counter-clockwise seen from outside.
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      Eigen::Vector3d n = Eigen::Vector3d::Zero();
+      n[axis] = side;
+      const auto base = static_cast<std::uint32_t>(p.vertices.size());
+      for (const auto& [a, b] : {std::pair{0, 0}, std::pair{1, 0}, std::pair{1, 1}, std::pair{0, 1}}) {
+        Eigen::Vector3d c;
+        c[axis] = side > 0 ? max_m[axis] : min_m[axis];
+        c[u] = a ? max_m[u] : min_m[u];
+        c[v] = b ? max_m[v] : min_m[v];
+        Vertex vert;
+        vert.position = {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};
+        vert.normal = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
+        vert.uv = {static_cast<float>(a), static_cast<float>(b)};
+        p.vertices.push_back(vert);
+      }
+      // (u, v, n) is right-handed, so 0-1-2 is counter-clockwise seen from +n; flip for the -n face.
+      if (side > 0)
+        p.indices.insert(p.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+      else
+        p.indices.insert(p.indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+    }
+  m.primitives.push_back(std::move(p));
+  Material mat;
+  mat.base_color_factor = rgba;
+  m.materials.push_back(mat);
+  return m;
+}
+
 }  // namespace projbot::assets

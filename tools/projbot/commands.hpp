@@ -25,5 +25,6 @@ extern const Command kBenchTrack;
 extern const Command kSlam;
 extern const Command kLocalize;
 extern const Command kBenchLocalize;
+extern const Command kTour;
 
 }  // namespace projbot::tools

@@ -45,7 +45,10 @@ config::Scene scene_from_args(const cli::Args& args) {
   if (scene_path) {
     scene = config::load_scene(*scene_path);
   } else if (args.get("model")) {
-    scene.targets.push_back({"model", {}, 1.0, true, Eigen::Matrix4d::Identity()});
+    config::TargetConfig target;
+    target.name = "model";
+    target.recenter = true;
+    scene.targets.push_back(target);
     frame_model = !args.get("pose-matrix");
   } else {
     scene = config::load_scene(asset_dir() / "scenes" / "demo.yaml");

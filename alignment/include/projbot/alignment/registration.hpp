@@ -26,8 +26,10 @@ ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples = 50
 
 /// Defaults suit a Kinect-class camera 0.5-3 m from a 10-50 cm object.
 struct AcquisitionConfig {
-  bool crop = true;             ///< keep scan points near the expected target only
-  double crop_margin_m = 0.10;  ///< crop radius = model radius + this, around the initial guess
+  bool crop = true;  ///< keep scan points near the expected target only
+  /// ICP works on the scan inside the model's bounding box under the current estimate, grown by this for
+  /// the first stage (the initial guess may be off by as much) and by the correspondence distance after.
+  double crop_margin_m = 0.10;
   double voxel_m = 0.004;       ///< voxel grid leaf for scan and model
   int outlier_neighbours = 16;  ///< statistical outlier removal: neighbours considered
   double outlier_stddev = 2.5;  ///< ... and the distance threshold in standard deviations
@@ -36,7 +38,9 @@ struct AcquisitionConfig {
   /// sensor's noise: at 3 sigma or more (Kinect v1 at 2 m: sigma 5.7 mm plus 11 mm disparity steps) it
   /// keeps the error distribution whole; a 6 mm cut left a 0.69 degree bias at 2 m, 20 mm 0.27 degrees.
   std::vector<double> icp_distances_m{0.08, 0.03, 0.02};
-  int icp_iterations = 40;           ///< per stage
+  int icp_iterations = 40;  ///< per stage
+  /// ICP correspondences whose scan and model normals differ by more than this are rejected (180: none).
+  double max_normal_angle_deg = 60.0;
   double inlier_distance_m = 0.006;  ///< a scan point within this of the model counts as explained
   /// Quality gate: share of cropped scan points explained. Correct poses of an uncluttered target
   /// score 0.8-1.0 on Kinect-class data; a duck turned 30 degrees wrong still scored 0.53.

@@ -82,4 +82,7 @@ SurfaceSamples sample_surface(const Model& model, std::size_t count, std::uint32
 /// A textured UV sphere (rings x segments quads, two triangles each): a large mesh for benchmarks.
 Model make_uv_sphere(double radius_m, int rings, int segments);
 
+/// A box spanning [min, max] (metres, model frame), faces outward, one flat colour: floors, pedestals.
+Model make_box(const Eigen::Vector3d& min_m, const Eigen::Vector3d& max_m, const std::array<float, 4>& rgba);
+
 }  // namespace projbot::assets

@@ -1,0 +1,60 @@
+#pragma once
+// The simulated projector's half of the twin: where a projector pixel's light lands on the true
+// surfaces, and the paper's projection error at markers (sec. 4), measured automatically.
+
+#include <Eigen/Core>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "projbot/assets/model.hpp"
+#include "projbot/config/scene.hpp"
+
+namespace projbot::twin {
+
+/// One model's triangles in its model frame, for ray casting (brute force with a bounding-sphere
+/// test: the twin casts a few rays per marker, not an image).
+class MeshRaycaster {
+ public:
+  explicit MeshRaycaster(const assets::Model& model);
+  /// Distance along the ray (origin, unit direction; model frame) to the nearest front or back face
+  /// hit, or nothing.
+  std::optional<double> cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
+  /// The surface point nearest to `p` (model frame).
+  Eigen::Vector3d closest_point(const Eigen::Vector3d& p) const;
+
+ private:
+  std::vector<Eigen::Vector3d> a_, e1_, e2_;  // triangle corner and two edges
+  Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
+  double radius_ = 0.0;
+};
+
+/// A mesh placed in some frame: T_frame_model.
+struct PlacedMesh {
+  const MeshRaycaster* mesh = nullptr;
+  Eigen::Matrix4d T_frame_model = Eigen::Matrix4d::Identity();
+};
+
+/// The nearest hit of a ray (frame coordinates, unit direction) among the placed meshes.
+std::optional<Eigen::Vector3d> cast_ray(std::span<const PlacedMesh> scene, const Eigen::Vector3d& origin,
+                                        const Eigen::Vector3d& direction);
+
+/// Projection error at one marker.
+struct MarkerError {
+  Eigen::Vector3d marker_m = Eigen::Vector3d::Zero();  ///< model frame
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();     ///< the projector pixel that carries it (centre)
+  bool in_image = false;                               ///< the pixel lies inside the projector image
+  bool landed = false;                                 ///< its light hits a true surface
+  /// Distance between where the light lands and where the marker truly is, mm. When the light hits
+  /// nothing (or the pixel is outside the image), the distance from the marker to the pixel's ray.
+  double error_mm = 0.0;
+};
+
+/// Eq. 3 with the estimated pose gives the pixel that carries the marker (rounded to the pixel centre,
+/// as content is drawn in pixels); its ray from the projector centre is cast into `true_scene`
+/// (projector frame, true poses) and compared with the marker under the true pose.
+MarkerError measure_marker(const config::ProjectorConfig& projector, const Eigen::Matrix4d& T_projector_target_estimated,
+                           const Eigen::Matrix4d& T_projector_target_true, const Eigen::Vector3d& marker_m,
+                           std::span<const PlacedMesh> true_scene);
+
+}  // namespace projbot::twin

@@ -1,0 +1,85 @@
+#pragma once
+// The end-to-end tour in the twin: the paper's experiment (sec. 4, Table 1). At each stop the robot
+// localises, aims the pan-tilt at the target's surveyed position, captures depth, takes Eq. 1's
+// initial guess, refines it (ICP), moves it to the projector (Eq. 2) and projects (Eq. 3); the
+// projection error is measured at the target's markers.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "projbot/alignment/registration.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/twin/raycast.hpp"
+
+namespace projbot::twin {
+
+/// odometry: the paper's set-up (initial guess from wheel odometry, one plain ICP per stop).
+/// localized: MRPT localisation and our acquisition (ICP, restarts, FPFH re-initialisation, quality gate).
+/// tracking: localized, and the projective tracker follows the target while projecting.
+enum class TourMode { odometry, localized, tracking };
+const char* to_string(TourMode mode);
+
+struct TourOptions {
+  TourMode mode = TourMode::localized;
+  int visits = 0;                    ///< 0: the scene's tour.visits once; otherwise this many, cycling through them
+  std::uint64_t seed = 1;            ///< drift, laser and depth noise
+  std::filesystem::path frames_dir;  ///< when set, the projector frame of each visit as a PNG
+  double dwell_s = 3.0;              ///< simulated projection time per visit (camera at 30 Hz), when tracking or moving
+  bool depth_noise = true;
+};
+
+/// The projection error at one instant while projecting.
+struct TimelineSample {
+  double t_s = 0.0;      ///< since projection started
+  double mean_mm = 0.0;  ///< over the markers
+  double max_mm = 0.0;
+  bool moving = false;  ///< the target is being moved
+  bool shown = true;    ///< false while the target is blanked (lost)
+};
+
+struct VisitReport {
+  int visit = 0;         ///< 1-based, over the tour
+  int target_visit = 0;  ///< 1-based, this target's n-th visit
+  std::string target;
+  Eigen::Matrix4d T_projector_target_true = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d T_projector_target_estimated = Eigen::Matrix4d::Identity();
+  bool projected = false;  ///< the estimate passed the gate (the paper's set-up always projects)
+  std::vector<MarkerError> markers;
+  double mean_mm = 0.0, max_mm = 0.0;  ///< at acquisition (the paper's Table 1 figure)
+  alignment::AlignmentResult icp;
+  double base_error_cm = 0.0, base_error_deg = 0.0;         ///< believed vs true base pose at the stop
+  double odometry_error_cm = 0.0;                           ///< raw wheel odometry vs truth
+  double guess_error_cm = 0.0, guess_error_deg = 0.0;       ///< Eq. 1's initial guess vs the true T_camera_target
+  double drive_s = 0.0;                                     ///< simulated driving time to the stop
+  double capture_ms = 0.0, align_ms = 0.0, frame_ms = 0.0;  ///< wall time: depth render, acquisition, projector frame
+  std::vector<TimelineSample> timeline;                     ///< while projecting (empty when the visit projects one frame)
+  bool moved = false;                                       ///< the target moved during this visit
+  double max_mm_moving = 0.0;                               ///< worst mean error while it moved
+  /// Seconds from the end of the motion until the mean error is back under 3 mm and stays there;
+  /// 0 when it never left, -1 when it never came back within the dwell.
+  double reconverge_s = 0.0;
+  double track_ms_mean = 0.0;  ///< tracking mode: wall time per frame
+};
+
+struct TourReport {
+  TourMode mode = TourMode::localized;
+  std::uint64_t seed = 1;
+  config::ProjectorConfig projector;
+  std::vector<VisitReport> visits;
+  double wall_s = 0.0;
+};
+
+/// Runs the tour on a scene with tour sections. Throws TwinError / ConfigError / EngineError naming
+/// what is wrong.
+TourReport run_tour(const config::Scene& scene, const TourOptions& options);
+
+/// The paper's Table 1 beside ours: a row per visit of each target, a column per target, mm.
+void print_table(const TourReport& report, std::ostream& out);
+/// The whole report as JSON (see the README for the fields).
+void write_report_json(const TourReport& report, const std::filesystem::path& path);
+
+}  // namespace projbot::twin

@@ -1,0 +1,97 @@
+#pragma once
+// The twin's world: the room and the targets at their true poses, the simulated robot (drifting base,
+// MRPT localisation, pan-tilt with backlash), an RGB-D camera that renders the true scene's depth with
+// the Kinect v1 error model, and the true surfaces the projector's light falls on. Same interfaces as
+// the hardware; nothing here is visible to the estimator except through them.
+// Not thread-safe: one owner thread (the tour, or the sensor thread of `projbot run`).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/registration.hpp"
+#include "projbot/assets/model.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/engine/renderer.hpp"
+#include "projbot/robot/pan_tilt.hpp"
+#include "projbot/robot/sim_tour.hpp"
+#include "projbot/twin/raycast.hpp"
+
+namespace projbot::twin {
+
+/// Thrown for a scene the twin cannot simulate (missing tour sections, markers off the surface).
+class TwinError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct TwinOptions {
+  robot::PoseSource pose_source = robot::PoseSource::localized;
+  std::uint64_t seed = 1;
+  bool depth_noise = true;            ///< Kinect v1 noise on captured depth
+  double marker_tolerance_m = 0.005;  ///< markers farther than this from the model's surface are an error
+};
+
+/// One target as the twin and the estimator know it.
+struct TwinTarget {
+  config::TargetConfig config;
+  assets::Model model;  ///< scaled and recentred, model frame
+  std::unique_ptr<MeshRaycaster> raycaster;
+  alignment::ModelCloud cloud;          ///< 50k surface samples for ICP and tracking
+  Eigen::Matrix4d T_world_target_true;  ///< where it stands now (moves with its motion script)
+  Eigen::Matrix4d T_world_pedestal;     ///< the pedestal under it (a translation)
+  std::unique_ptr<MeshRaycaster> pedestal_raycaster;
+  std::size_t pedestal_id = 0;  ///< renderer model id
+};
+
+class Twin {
+ public:
+  /// Loads every target's model, checks the tour sections and markers, builds the room map and the
+  /// simulated robot, and uploads the scene's meshes to `renderer` (used for depth capture; it must
+  /// outlive the twin and belong to the calling thread). Throws TwinError, config::ConfigError or
+  /// assets::AssetError naming what is wrong.
+  Twin(const config::Scene& scene, const TwinOptions& options, engine::Renderer& renderer);
+
+  const config::Scene& scene() const { return scene_; }
+  std::vector<TwinTarget>& targets() { return targets_; }
+  const std::vector<TwinTarget>& targets() const { return targets_; }
+  robot::SimRobot& robot() { return *robot_; }
+  robot::SimulatedPanTilt& pan_tilt() { return pan_tilt_; }
+  const alignment::CameraIntrinsics& camera() const { return camera_; }
+
+  /// True and believed head frames for the robot's present state.
+  robot::HeadPoses true_head() const;
+  robot::HeadPoses believed_head();
+
+  /// The target's pose `t_s` into a projection during its `target_visit`-th visit (motion script).
+  Eigen::Matrix4d scripted_pose(std::size_t target, int target_visit, double t_s) const;
+
+  /// Renders the true scene's depth from T_world_camera (Kinect v1 noise when enabled, seeded).
+  alignment::DepthImage capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed);
+  /// The true surfaces placed in a frame (T_frame_world): for the projector's rays.
+  std::vector<PlacedMesh> true_scene(const Eigen::Matrix4d& T_frame_world) const;
+
+  /// Renderer model ids of the targets (same order as targets()).
+  const std::vector<std::size_t>& target_model_ids() const { return target_ids_; }
+
+ private:
+  config::Scene scene_;
+  TwinOptions options_;
+  engine::Renderer& renderer_;
+  std::vector<TwinTarget> targets_;
+  std::unique_ptr<MeshRaycaster> floor_ray_;
+  std::vector<std::size_t> target_ids_;
+  std::size_t floor_id_ = 0;
+  std::unique_ptr<robot::SimRobot> robot_;
+  robot::SimulatedPanTilt pan_tilt_;
+  alignment::CameraIntrinsics camera_;
+  std::unique_ptr<engine::RenderTarget> depth_target_;
+};
+
+/// The twin's robot set-up for a scene: its room (with a pedestal under each target), start pose and
+/// drift, closing the loop on `source`.
+robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed);
+
+}  // namespace projbot::twin

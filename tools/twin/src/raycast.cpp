@@ -1,0 +1,130 @@
+#include "projbot/twin/raycast.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace projbot::twin {
+
+MeshRaycaster::MeshRaycaster(const assets::Model& model) {
+  std::size_t n = 0;
+  for (const auto& p : model.primitives) {
+    for (std::size_t i = 0; i + 2 < p.indices.size(); i += 3) {
+      const auto v = [&](std::size_t k) {
+        const auto& q = p.vertices[p.indices[i + k]].position;
+        return Eigen::Vector3d(q[0], q[1], q[2]);
+      };
+      a_.push_back(v(0));
+      e1_.push_back(v(1) - v(0));
+      e2_.push_back(v(2) - v(0));
+      centre_ += v(0);
+      ++n;
+    }
+  }
+  if (n > 0) centre_ /= static_cast<double>(n);
+  for (std::size_t i = 0; i < a_.size(); ++i)
+    for (const Eigen::Vector3d& c : {a_[i], Eigen::Vector3d(a_[i] + e1_[i]), Eigen::Vector3d(a_[i] + e2_[i])})
+      radius_ = std::max(radius_, (c - centre_).norm());
+}
+
+std::optional<double> MeshRaycaster::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const {
+  // Skip the mesh when the ray passes outside its bounding sphere.
+  const Eigen::Vector3d oc = centre_ - o;
+  const double along = oc.dot(d);
+  if ((oc - along * d).squaredNorm() > radius_ * radius_ || along < -radius_) return std::nullopt;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < a_.size(); ++i) {
+    // Moeller-Trumbore.
+    const Eigen::Vector3d p = d.cross(e2_[i]);
+    const double det = e1_[i].dot(p);
+    if (std::abs(det) < 1e-15) continue;
+    const double inv = 1.0 / det;
+    const Eigen::Vector3d s = o - a_[i];
+    const double u = s.dot(p) * inv;
+    if (u < 0.0 || u > 1.0) continue;
+    const Eigen::Vector3d q = s.cross(e1_[i]);
+    const double v = d.dot(q) * inv;
+    if (v < 0.0 || u + v > 1.0) continue;
+    const double t = e2_[i].dot(q) * inv;
+    if (t > 1e-9 && t < best) best = t;
+  }
+  if (!std::isfinite(best)) return std::nullopt;
+  return best;
+}
+
+Eigen::Vector3d MeshRaycaster::closest_point(const Eigen::Vector3d& x) const {
+  double best = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d best_point = x;
+  const auto consider = [&](const Eigen::Vector3d& q) {
+    const double d = (x - q).norm();
+    if (d < best) best = d, best_point = q;
+  };
+  for (std::size_t i = 0; i < a_.size(); ++i) {
+    // Closest point on the triangle: inside the face, else on one of its edges.
+    const Eigen::Vector3d n = e1_[i].cross(e2_[i]);
+    const double area2 = n.squaredNorm();
+    if (area2 < 1e-24) continue;
+    const Eigen::Vector3d w = x - a_[i];
+    const Eigen::Vector3d on_plane = x - n * (w.dot(n) / area2);
+    const Eigen::Vector3d r = on_plane - a_[i];
+    // Barycentric coordinates of on_plane.
+    const double d00 = e1_[i].dot(e1_[i]), d01 = e1_[i].dot(e2_[i]), d11 = e2_[i].dot(e2_[i]);
+    const double d20 = r.dot(e1_[i]), d21 = r.dot(e2_[i]);
+    const double den = d00 * d11 - d01 * d01;
+    const double v = (d11 * d20 - d01 * d21) / den, w2 = (d00 * d21 - d01 * d20) / den;
+    if (v >= 0.0 && w2 >= 0.0 && v + w2 <= 1.0) {
+      consider(on_plane);
+      continue;
+    }
+    const auto segment = [&](const Eigen::Vector3d& p0, const Eigen::Vector3d& p1) {
+      const Eigen::Vector3d e = p1 - p0;
+      const double t = std::clamp((x - p0).dot(e) / e.squaredNorm(), 0.0, 1.0);
+      consider(p0 + t * e);
+    };
+    const Eigen::Vector3d b = a_[i] + e1_[i], c = a_[i] + e2_[i];
+    segment(a_[i], b), segment(b, c), segment(c, a_[i]);
+  }
+  return best_point;
+}
+
+std::optional<Eigen::Vector3d> cast_ray(std::span<const PlacedMesh> scene, const Eigen::Vector3d& origin,
+                                        const Eigen::Vector3d& direction) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& placed : scene) {
+    // Into the model frame; rigid, so distances along the ray are kept.
+    const Eigen::Matrix3d R = placed.T_frame_model.topLeftCorner<3, 3>();
+    const Eigen::Vector3d t = placed.T_frame_model.topRightCorner<3, 1>();
+    const auto hit = placed.mesh->cast(R.transpose() * (origin - t), R.transpose() * direction);
+    if (hit && *hit < best) best = *hit;
+  }
+  if (!std::isfinite(best)) return std::nullopt;
+  return Eigen::Vector3d(origin + best * direction);
+}
+
+MarkerError measure_marker(const config::ProjectorConfig& k, const Eigen::Matrix4d& T_est, const Eigen::Matrix4d& T_true,
+                           const Eigen::Vector3d& marker_m, std::span<const PlacedMesh> true_scene) {
+  MarkerError e;
+  e.marker_m = marker_m;
+  const Eigen::Vector3d truth = (T_true * marker_m.homogeneous()).head<3>();
+  const Eigen::Vector3d drawn = (T_est * marker_m.homogeneous()).head<3>();
+  // Eq. 3: x = A_p X, the content's pixel, then the centre of the pixel that shows it.
+  Eigen::Vector3d ray = drawn;
+  if (drawn.z() > 0.0) {
+    e.pixel = {std::round(k.fx_px * drawn.x() / drawn.z() + k.cx_px), std::round(k.fy_px * drawn.y() / drawn.z() + k.cy_px)};
+    e.in_image = e.pixel.x() >= 0 && e.pixel.y() >= 0 && e.pixel.x() < k.width_px && e.pixel.y() < k.height_px;
+    ray = {(e.pixel.x() - k.cx_px) / k.fx_px, (e.pixel.y() - k.cy_px) / k.fy_px, 1.0};
+  }
+  const Eigen::Vector3d d = ray.normalized();
+  if (e.in_image) {
+    if (const auto hit = cast_ray(true_scene, Eigen::Vector3d::Zero(), d)) {
+      e.landed = true;
+      e.error_mm = 1000.0 * (*hit - truth).norm();
+      return e;
+    }
+  }
+  e.error_mm = 1000.0 * (truth - truth.dot(d) * d).norm();
+  return e;
+}
+
+}  // namespace projbot::twin

@@ -1,0 +1,156 @@
+// The tour's report: the paper's Table 1 beside ours, and the JSON file.
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+
+#include "projbot/twin/tour.hpp"
+#include "projbot/twin/world.hpp"
+
+namespace projbot::twin {
+namespace {
+
+// Table 1 of the paper: projection error at markers, mm, per visit of each target (odometry only).
+constexpr double kPaperMm[2][3] = {{4.0, 6.0, 12.0}, {6.0, 6.0, 19.0}};
+
+nlohmann::json matrix_json(const Eigen::Matrix4d& T) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({T(r, 0), T(r, 1), T(r, 2), T(r, 3)});
+  return rows;
+}
+
+nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+std::string fixed(double v, int decimals) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(decimals) << v;
+  return s.str();
+}
+
+}  // namespace
+
+void print_table(const TourReport& report, std::ostream& out) {
+  // Targets in order of first visit: the paper's target 1 and target 2.
+  std::vector<std::string> names;
+  for (const auto& v : report.visits)
+    if (std::find(names.begin(), names.end(), v.target) == names.end()) names.push_back(v.target);
+  int rows = 0;
+  for (const auto& v : report.visits) rows = std::max(rows, v.target_visit);
+
+  out << "Projection error at the markers, mm (mean / max), mode " << to_string(report.mode) << ", seed " << report.seed
+      << ";\nthe paper's Table 1 (odometry only, one ICP per stop) beside it:\n\n";
+  out << "| visit |";
+  for (std::size_t c = 0; c < names.size(); ++c)
+    out << ' ' << names[c] << " |" << (c < 2 ? " paper target " + std::to_string(c + 1) + " |" : "");
+  out << "\n|---|";
+  for (std::size_t c = 0; c < names.size(); ++c) out << (c < 2 ? "---|---|" : "---|");
+  out << '\n';
+  for (int row = 1; row <= rows; ++row) {
+    out << "| " << row << " |";
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      const auto it = std::find_if(report.visits.begin(), report.visits.end(),
+                                   [&](const VisitReport& v) { return v.target == names[c] && v.target_visit == row; });
+      if (it == report.visits.end())
+        out << " - |";
+      else if (!it->projected)
+        out << " blanked (" << fixed(it->mean_mm, 1) << " / " << fixed(it->max_mm, 1) << " if shown) |";
+      else
+        out << ' ' << fixed(it->mean_mm, 1) << " / " << fixed(it->max_mm, 1) << " |";
+      if (c < 2) out << ' ' << (row <= 3 ? fixed(kPaperMm[c][row - 1], 0) : std::string("-")) << " |";
+    }
+    out << '\n';
+  }
+
+  out << "\n| # | target | base error cm / deg | odometry drift cm | Eq. 1 guess error cm / deg | ICP | inliers | rmse mm | "
+         "mean / max mm | align ms |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& v : report.visits) {
+    out << "| " << v.visit << " | " << v.target << " (" << v.target_visit << ") | " << fixed(v.base_error_cm, 2) << " / "
+        << fixed(v.base_error_deg, 2) << " | " << fixed(v.odometry_error_cm, 1) << " | " << fixed(v.guess_error_cm, 1) << " / "
+        << fixed(v.guess_error_deg, 1) << " | " << (v.icp.converged ? "ok" : "failed") << (v.icp.reinitialised ? " (FPFH)" : "")
+        << " | " << fixed(v.icp.inlier_ratio, 2) << " | " << fixed(v.icp.rmse_mm, 2) << " | " << fixed(v.mean_mm, 2) << " / "
+        << fixed(v.max_mm, 2) << " | " << fixed(v.align_ms, 0) << " |\n";
+  }
+  bool any_timeline = false;
+  for (const auto& v : report.visits) any_timeline = any_timeline || !v.timeline.empty();
+  if (any_timeline) {
+    out << "\nWhile projecting (" << to_string(report.mode)
+        << "):\n\n| # | target | moved | worst mean mm while moving | "
+           "mean mm at the end | re-converged after the move, s | track ms/frame |\n|---|---|---|---|---|---|---|\n";
+    for (const auto& v : report.visits) {
+      if (v.timeline.empty()) continue;
+      out << "| " << v.visit << " | " << v.target << " | " << (v.moved ? "yes" : "no") << " | "
+          << (v.moved ? fixed(v.max_mm_moving, 1) : std::string("-")) << " | " << fixed(v.timeline.back().mean_mm, 2) << " | "
+          << (v.reconverge_s < 0 ? std::string("never") : fixed(v.reconverge_s, 2)) << " | "
+          << (v.track_ms_mean > 0 ? fixed(v.track_ms_mean, 1) : std::string("-")) << " |\n";
+    }
+  }
+  out << "\nTour: " << report.visits.size() << " visits in " << fixed(report.wall_s, 1) << " s wall time.\n";
+}
+
+void write_report_json(const TourReport& report, const std::filesystem::path& path) {
+  nlohmann::json visits = nlohmann::json::array();
+  for (const auto& v : report.visits) {
+    nlohmann::json markers = nlohmann::json::array();
+    for (const auto& m : v.markers)
+      markers.push_back({{"model_m", {m.marker_m.x(), m.marker_m.y(), m.marker_m.z()}},
+                         {"pixel", {m.pixel.x(), m.pixel.y()}},
+                         {"in_image", m.in_image},
+                         {"landed", m.landed},
+                         {"error_mm", m.error_mm}});
+    nlohmann::json timeline = nlohmann::json::array();
+    for (const auto& s : v.timeline)
+      timeline.push_back(
+          {{"t_s", s.t_s}, {"mean_mm", s.mean_mm}, {"max_mm", s.max_mm}, {"moving", s.moving}, {"shown", s.shown}});
+    visits.push_back({{"visit", v.visit},
+                      {"target", v.target},
+                      {"target_visit", v.target_visit},
+                      {"projected", v.projected},
+                      {"T_projector_target_true", matrix_json(v.T_projector_target_true)},
+                      {"T_projector_target_estimated", matrix_json(v.T_projector_target_estimated)},
+                      {"markers", markers},
+                      {"mean_mm", v.mean_mm},
+                      {"max_mm", v.max_mm},
+                      {"icp",
+                       {{"converged", v.icp.converged},
+                        {"inlier_ratio", v.icp.inlier_ratio},
+                        {"rmse_mm", finite_or_null(v.icp.rmse_mm)},
+                        {"iterations", v.icp.iterations},
+                        {"reinitialised", v.icp.reinitialised}}},
+                      {"robot",
+                       {{"base_error_cm", v.base_error_cm},
+                        {"base_error_deg", v.base_error_deg},
+                        {"odometry_error_cm", v.odometry_error_cm},
+                        {"guess_error_cm", v.guess_error_cm},
+                        {"guess_error_deg", v.guess_error_deg},
+                        {"drive_s", v.drive_s}}},
+                      {"timings_ms",
+                       {{"capture", v.capture_ms},
+                        {"align", v.align_ms},
+                        {"projector_frame", v.frame_ms},
+                        {"track_per_frame", v.track_ms_mean}}},
+                      {"moved", v.moved},
+                      {"max_mean_mm_while_moving", v.max_mm_moving},
+                      {"reconverge_s", v.reconverge_s},
+                      {"timeline", timeline}});
+  }
+  const auto& k = report.projector;
+  const nlohmann::json out = {
+      {"mode", to_string(report.mode)},
+      {"seed", report.seed},
+      {"projector",
+       {{"width", k.width_px}, {"height", k.height_px}, {"fx", k.fx_px}, {"fy", k.fy_px}, {"cx", k.cx_px}, {"cy", k.cy_px}}},
+      {"paper_table1_mm", {{"target1", {4, 6, 12}}, {"target2", {6, 6, 19}}}},
+      {"wall_s", report.wall_s},
+      {"visits", visits}};
+  std::ofstream f(path);
+  if (!f) throw TwinError(path.string() + ": cannot write the report");
+  f << out.dump(2) << '\n';
+  if (!f) throw TwinError(path.string() + ": write failed");
+}
+
+}  // namespace projbot::twin

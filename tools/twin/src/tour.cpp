@@ -1,0 +1,227 @@
+#include "projbot/twin/tour.hpp"
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cmath>
+
+#include "projbot/alignment/equations.hpp"
+#include "projbot/alignment/tracker.hpp"
+#include "projbot/assets/image.hpp"
+#include "projbot/twin/world.hpp"
+
+namespace projbot::twin {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+constexpr double kCameraHz = 30.0;
+constexpr double kConvergedMm = 3.0;  // the goal for a visit's mean error
+
+struct Errors {
+  std::vector<MarkerError> markers;
+  double mean_mm = 0.0, max_mm = 0.0;
+};
+
+Errors marker_errors(const Twin& twin, std::size_t target, const config::ProjectorConfig& projector,
+                     const Eigen::Matrix4d& T_world_projector, const Eigen::Matrix4d& T_projector_target_estimated) {
+  const Eigen::Matrix4d T_projector_world = alignment::rigid_inverse(T_world_projector);
+  const auto scene = twin.true_scene(T_projector_world);
+  const TwinTarget& t = twin.targets()[target];
+  const Eigen::Matrix4d T_true = T_projector_world * t.T_world_target_true;
+  Errors e;
+  for (const auto& m : t.config.markers_m) {
+    e.markers.push_back(measure_marker(projector, T_projector_target_estimated, T_true, m, scene));
+    e.mean_mm += e.markers.back().error_mm / static_cast<double>(t.config.markers_m.size());
+    e.max_mm = std::max(e.max_mm, e.markers.back().error_mm);
+  }
+  return e;
+}
+
+}  // namespace
+
+const char* to_string(TourMode mode) {
+  switch (mode) {
+    case TourMode::odometry:
+      return "odometry";
+    case TourMode::localized:
+      return "localized";
+    case TourMode::tracking:
+      return "tracking";
+  }
+  return "?";
+}
+
+TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
+  const auto wall0 = Clock::now();
+  engine::Renderer renderer(engine::RendererOptions{});
+  TwinOptions twin_options;
+  twin_options.pose_source = options.mode == TourMode::odometry ? robot::PoseSource::odometry : robot::PoseSource::localized;
+  twin_options.seed = options.seed;
+  twin_options.depth_noise = options.depth_noise;
+  Twin twin(scene, twin_options, renderer);
+  auto& targets = twin.targets();
+  const config::PanTiltConfig& rig = scene.pan_tilt;
+
+  // The paper aligned once per stop with plain ICP from the initial guess; ours adds local restarts,
+  // FPFH re-initialisation and the quality gate.
+  alignment::AcquisitionConfig acquisition;
+  if (options.mode == TourMode::odometry) {
+    acquisition.restart_angle_deg = 0.0;
+    acquisition.reinitialise = false;
+  }
+  std::vector<alignment::Aligner> aligners;
+  std::vector<alignment::ProjectiveTracker> trackers;
+  for (const auto& t : targets) {
+    aligners.emplace_back(t.cloud, acquisition);
+    trackers.emplace_back(t.cloud, twin.camera());
+  }
+  std::unique_ptr<engine::RenderTarget> projector_frame;
+  if (!options.frames_dir.empty()) {
+    std::filesystem::create_directories(options.frames_dir);
+    projector_frame = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+  }
+
+  TourReport report;
+  report.mode = options.mode;
+  report.seed = options.seed;
+  report.projector = scene.projector;
+  const int visits = options.visits > 0 ? options.visits : static_cast<int>(scene.visits.size());
+  std::vector<int> visit_count(targets.size(), 0);
+  for (int v = 0; v < visits; ++v) {
+    const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
+    std::size_t i = 0;
+    while (targets[i].config.name != name) ++i;
+    TwinTarget& target = targets[i];
+    VisitReport r;
+    r.visit = v + 1;
+    r.target_visit = ++visit_count[i];
+    r.target = name;
+    for (std::size_t j = 0; j < targets.size(); ++j) targets[j].T_world_target_true = twin.scripted_pose(j, 0, 0.0);
+
+    // Drive to the stop, closing the loop on localisation (or odometry, the paper's set-up).
+    const Eigen::Vector3d& stop = *target.config.stop;
+    const robot::StopReport drive = twin.robot().drive_to({stop.x(), stop.y(), stop.z()}, v);
+    r.drive_s = drive.drive_seconds;
+    r.base_error_cm = 100.0 * drive.error_m;
+    r.base_error_deg = drive.error_rad * 180.0 / M_PI;
+    r.odometry_error_cm = 100.0 * drive.odometry_error_m;
+
+    // Aim at where the map says the target is, from where the robot believes it is.
+    const Eigen::Matrix4d T_map_target = target.config.T_map_target.value_or(*target.config.T_world_target);
+    const auto aim = robot::aim_at(twin.robot().believed_pose(), T_map_target.topRightCorner<3, 1>(), rig);
+    if (const auto s = twin.pan_tilt().move_to(aim.angles); !s.ok) throw TwinError("pan-tilt: " + s.error);
+    const robot::HeadPoses truth = twin.true_head();
+    const robot::HeadPoses believed = twin.believed_head();
+
+    // Capture, Eq. 1, acquisition, Eq. 2.
+    auto t0 = Clock::now();
+    const std::uint32_t noise_seed = static_cast<std::uint32_t>(options.seed * 100003 + static_cast<std::uint64_t>(v) * 1009);
+    const alignment::DepthImage depth = twin.capture(truth.T_world_camera.matrix(), noise_seed);
+    r.capture_ms = ms_since(t0);
+    const Eigen::Matrix4d T_init = alignment::camera_from_target_initial(believed.T_world_camera.matrix(), T_map_target);
+    const Eigen::Matrix4d T_camera_true = alignment::rigid_inverse(truth.T_world_camera.matrix()) * target.T_world_target_true;
+    const Eigen::Matrix4d guess_error = alignment::rigid_inverse(T_camera_true) * T_init;
+    r.guess_error_cm = 100.0 * alignment::translation_norm_m(guess_error);
+    r.guess_error_deg = alignment::rotation_angle_deg(guess_error);
+    t0 = Clock::now();
+    try {
+      r.icp = aligners[i].align(alignment::depth_to_cloud(depth, twin.camera()), T_init);
+    } catch (const alignment::AlignmentError&) {
+      r.icp.T_scan_model = T_init;  // too little of the target in view: nothing to align
+      r.icp.converged = false;
+    }
+    r.align_ms = ms_since(t0);
+    r.projected = options.mode == TourMode::odometry || r.icp.converged;
+    const Eigen::Matrix4d T_world_projector = truth.T_world_projector.matrix();
+    r.T_projector_target_estimated = alignment::projector_from_target(rig.T_projector_camera, r.icp.T_scan_model);
+    r.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;
+    Errors e = marker_errors(twin, i, scene.projector, T_world_projector, r.T_projector_target_estimated);
+    r.markers = e.markers;
+    r.mean_mm = e.mean_mm;
+    r.max_mm = e.max_mm;
+
+    if (projector_frame) {
+      t0 = Clock::now();
+      std::vector<engine::DrawItem> items;
+      if (r.projected) items.push_back({twin.target_model_ids()[i], r.T_projector_target_estimated});
+      renderer.draw_frame(*projector_frame, scene.projector, items);
+      const auto image = projector_frame->read_back();
+      r.frame_ms = ms_since(t0);
+      char file[64];
+      std::snprintf(file, sizeof file, "visit%02d_%s.png", r.visit, name.c_str());
+      assets::write_png(options.frames_dir / file, image);
+    }
+
+    // Projecting: the target may be moved; the tracker (tracking mode) follows it at camera rate.
+    r.moved = target.config.motion && target.config.motion->visit == r.target_visit;
+    if (options.mode == TourMode::tracking || r.moved) {
+      Eigen::Matrix4d T_camera_target = r.icp.T_scan_model;  // the newest estimate
+      bool shown = r.projected;
+      int failures = 0;
+      double track_ms = 0.0;
+      const int frames = static_cast<int>(std::lround(options.dwell_s * kCameraHz));
+      double motion_end_s = 0.0;
+      if (r.moved) motion_end_s = target.config.motion->start_s + target.config.motion->duration_s;
+      double back_under = -1.0;  // when the error went back under the goal for good, -1 while it is not
+      bool ever_over = false;
+      for (int k = 1; k <= frames; ++k) {
+        const double t_s = k / kCameraHz;
+        target.T_world_target_true = twin.scripted_pose(i, r.target_visit, t_s);
+        // What the projector shows now was computed from the previous frame (one camera period of latency).
+        TimelineSample s;
+        s.t_s = t_s;
+        s.shown = shown;
+        s.moving = r.moved && t_s > target.config.motion->start_s && t_s <= motion_end_s;
+        const Errors now = marker_errors(twin, i, scene.projector, T_world_projector,
+                                         alignment::projector_from_target(rig.T_projector_camera, T_camera_target));
+        s.mean_mm = now.mean_mm;
+        s.max_mm = now.max_mm;
+        r.timeline.push_back(s);
+        if (s.moving) r.max_mm_moving = std::max(r.max_mm_moving, s.mean_mm);
+        const bool good = shown && s.mean_mm <= kConvergedMm;
+        if (!good) ever_over = true;
+        if (!good)
+          back_under = -1.0;
+        else if (back_under < 0.0 && t_s >= motion_end_s)
+          back_under = t_s;
+        if (options.mode != TourMode::tracking) continue;
+        const alignment::DepthImage frame =
+            twin.capture(truth.T_world_camera.matrix(), noise_seed + static_cast<std::uint32_t>(k));
+        const auto tt = Clock::now();
+        const alignment::TrackResult tr = trackers[i].track(frame, T_camera_target);
+        if (tr.accepted) {
+          T_camera_target = tr.T_camera_target;
+          failures = 0;
+          shown = true;
+        } else if (++failures >= 5) {
+          // Lost: blank it and re-acquire from the last pose.
+          shown = false;
+          try {
+            const auto a = aligners[i].align(alignment::depth_to_cloud(frame, twin.camera()), T_camera_target);
+            if (a.converged) {
+              T_camera_target = a.T_scan_model;
+              failures = 0;
+              shown = true;
+            }
+          } catch (const alignment::AlignmentError&) {
+          }
+        }
+        track_ms += ms_since(tt);
+      }
+      r.track_ms_mean = options.mode == TourMode::tracking && frames > 0 ? track_ms / frames : 0.0;
+      if (!ever_over)
+        r.reconverge_s = 0.0;
+      else if (back_under >= 0.0)
+        r.reconverge_s = std::max(0.0, back_under - motion_end_s);
+      else
+        r.reconverge_s = -1.0;
+      target.T_world_target_true = twin.scripted_pose(i, 0, 0.0);  // put back for the next visit
+    }
+    report.visits.push_back(std::move(r));
+  }
+  report.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
+  return report;
+}
+
+}  // namespace projbot::twin

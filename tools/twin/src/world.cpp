@@ -1,0 +1,154 @@
+#include "projbot/twin/world.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "projbot/alignment/equations.hpp"
+#include "projbot/alignment/kinect_noise.hpp"
+
+namespace projbot::twin {
+namespace {
+
+constexpr double kPedestalHalfWidthM = 0.12;  // 24 cm square pedestals: narrower than the targets
+
+config::ProjectorConfig as_pinhole(const alignment::CameraIntrinsics& k, double near_m, double far_m) {
+  return {k.width_px, k.height_px, k.fx_px, k.fy_px, k.cx_px, k.cy_px, near_m, far_m};
+}
+
+// The pedestal's top is the target's lowest point, so the target stands on it: its height, metres.
+double pedestal_height(const assets::Model& model, const Eigen::Matrix4d& T_world_target) {
+  double z_min = std::numeric_limits<double>::infinity();
+  for (const auto& p : model.primitives)
+    for (const auto& v : p.vertices)
+      z_min = std::min(z_min, (T_world_target * Eigen::Vector4d(v.position[0], v.position[1], v.position[2], 1.0)).z());
+  return std::max(z_min, 0.01);
+}
+
+}  // namespace
+
+robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed) {
+  robot::SimTourConfig c;
+  c.room.width_m = scene.room.width_m;
+  c.room.depth_m = scene.room.depth_m;
+  for (const auto& o : scene.room.obstacles) c.room.obstacles.push_back({o[0], o[1], o[2], o[3]});
+  for (const auto& t : scene.targets)
+    if (t.T_world_target) {
+      const double x = (*t.T_world_target)(0, 3), y = (*t.T_world_target)(1, 3);
+      c.room.obstacles.push_back(
+          {x - kPedestalHalfWidthM, y - kPedestalHalfWidthM, x + kPedestalHalfWidthM, y + kPedestalHalfWidthM});
+    }
+  c.start = {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()};
+  c.errors.seed = seed;
+  c.errors.wheel_scale_sigma = scene.drift.wheel_scale_sigma;
+  c.errors.slip_scale = scene.drift.slip_scale;
+  c.errors.heading_bias_rad_per_m = scene.drift.heading_bias_rad_per_m;
+  c.errors.heading_bias_rad_per_rad = scene.drift.heading_bias_rad_per_rad;
+  c.errors.random_translation_sigma = scene.drift.random_translation_sigma;
+  c.errors.random_rotation_sigma = scene.drift.random_rotation_sigma;
+  c.source = source;
+  return c;
+}
+
+Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Renderer& renderer)
+    : scene_(scene), options_(options), renderer_(renderer), pan_tilt_(scene.pan_tilt), camera_{scene.depth_camera.width_px,
+                                                                                                scene.depth_camera.height_px,
+                                                                                                scene.depth_camera.fx_px,
+                                                                                                scene.depth_camera.fy_px,
+                                                                                                scene.depth_camera.cx_px,
+                                                                                                scene.depth_camera.cy_px} {
+  const std::string where = scene.source.empty() ? std::string("<scene>") : scene.source.string();
+  if (scene.visits.empty()) throw TwinError(where + ": the twin needs a 'tour: {visits: [...]}' section");
+  const auto floor = assets::make_box({-2.0, -2.0, -0.05}, {scene.room.width_m + 2.0, scene.room.depth_m + 2.0, 0.0},
+                                      {0.45F, 0.45F, 0.45F, 1.0F});
+  floor_ray_ = std::make_unique<MeshRaycaster>(floor);
+  floor_id_ = renderer_.add_model(floor);
+  for (const auto& t : scene.targets) {
+    if (!t.T_world_target) continue;
+    if (!t.stop) throw TwinError(where + ": target '" + t.name + "' has a world_pose but no stop");
+    if (t.markers_m.empty())
+      throw TwinError(where + ": target '" + t.name + "' has no markers to measure the projection error at");
+    TwinTarget tt;
+    tt.config = t;
+    tt.model = assets::load_gltf(t.model);
+    assets::scale_and_recenter(tt.model, t.scale, t.recenter);
+    tt.raycaster = std::make_unique<MeshRaycaster>(tt.model);
+    for (std::size_t k = 0; k < t.markers_m.size(); ++k) {
+      const Eigen::Vector3d q = tt.raycaster->closest_point(t.markers_m[k]);
+      const double d = (q - t.markers_m[k]).norm();
+      if (d > options.marker_tolerance_m) {
+        char msg[256];
+        std::snprintf(msg, sizeof msg,
+                      "lies %.1f mm off the model's surface (tolerance %.1f mm); the nearest surface point is [%.4f, %.4f, %.4f]",
+                      d * 1000, options.marker_tolerance_m * 1000, q.x(), q.y(), q.z());
+        throw TwinError(where + ": target '" + t.name + "' marker " + std::to_string(k) + " " + msg);
+      }
+    }
+    tt.cloud = alignment::model_cloud_from(tt.model, 50000);
+    tt.T_world_target_true = *t.T_world_target;
+    const auto pedestal = assets::make_box(
+        {-kPedestalHalfWidthM, -kPedestalHalfWidthM, 0.0},
+        {kPedestalHalfWidthM, kPedestalHalfWidthM, pedestal_height(tt.model, tt.T_world_target_true)}, {0.7F, 0.7F, 0.7F, 1.0F});
+    tt.T_world_pedestal = Eigen::Matrix4d::Identity();
+    tt.T_world_pedestal.topRightCorner<2, 1>() = tt.T_world_target_true.topRightCorner<2, 1>();
+    tt.pedestal_raycaster = std::make_unique<MeshRaycaster>(pedestal);
+    tt.pedestal_id = renderer_.add_model(pedestal);
+    target_ids_.push_back(renderer_.add_model(tt.model));
+    targets_.push_back(std::move(tt));
+  }
+  robot_ = std::make_unique<robot::SimRobot>(robot_config(scene, options.pose_source, options.seed));
+  depth_target_ = renderer_.make_depth_camera(camera_.width_px, camera_.height_px);
+}
+
+robot::HeadPoses Twin::true_head() const {
+  return robot::head_poses(robot_->true_pose(), pan_tilt_.true_angles(), scene_.pan_tilt);
+}
+
+robot::HeadPoses Twin::believed_head() {
+  robot::PanTiltAngles reported;
+  if (const auto s = pan_tilt_.position(reported); !s.ok) throw TwinError("pan-tilt: " + s.error);
+  return robot::head_poses(robot_->believed_pose(), reported, scene_.pan_tilt);
+}
+
+Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double t_s) const {
+  const TwinTarget& t = targets_.at(target);
+  const Eigen::Matrix4d& home = *t.config.T_world_target;
+  if (!t.config.motion || t.config.motion->visit != target_visit) return home;
+  const config::TargetMotion& m = *t.config.motion;
+  // Smoothstep from 0 to 1 over the motion: no jump in speed at its ends.
+  const double x = std::clamp((t_s - m.start_s) / m.duration_s, 0.0, 1.0);
+  const double s = x * x * (3.0 - 2.0 * x);
+  const Eigen::Matrix4d delta = config::pose_from_xyz_rpy(Eigen::Vector3d::Zero(), s * m.rpy_deg);
+  Eigen::Matrix4d T = home;
+  // Turn about the target's own origin, then shift, both in the world frame.
+  T.topLeftCorner<3, 3>() = delta.topLeftCorner<3, 3>() * home.topLeftCorner<3, 3>();
+  T.topRightCorner<3, 1>() += s * m.translation_m;
+  return T;
+}
+
+alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
+  const Eigen::Matrix4d T_camera_world = alignment::rigid_inverse(T_world_camera);
+  std::vector<engine::DrawItem> items{{floor_id_, T_camera_world}};
+  for (std::size_t i = 0; i < targets_.size(); ++i) {
+    items.push_back({target_ids_[i], T_camera_world * targets_[i].T_world_target_true});
+    items.push_back({targets_[i].pedestal_id, T_camera_world * targets_[i].T_world_pedestal});
+  }
+  renderer_.draw_frame(*depth_target_, as_pinhole(camera_, 0.3, 8.0), items);
+  const engine::DepthMap map = depth_target_->read_back_depth();
+  alignment::DepthImage clean{map.width, map.height, map.z_m, 0.0};
+  if (!options_.depth_noise) return clean;
+  return alignment::apply_kinect_v1_noise(clean, camera_, alignment::KinectNoiseConfig{}, noise_seed);
+}
+
+std::vector<PlacedMesh> Twin::true_scene(const Eigen::Matrix4d& T_frame_world) const {
+  std::vector<PlacedMesh> out{{floor_ray_.get(), T_frame_world}};
+  for (const auto& t : targets_) {
+    out.push_back({t.raycaster.get(), T_frame_world * t.T_world_target_true});
+    out.push_back({t.pedestal_raycaster.get(), T_frame_world * t.T_world_pedestal});
+  }
+  return out;
+}
+
+}  // namespace projbot::twin
