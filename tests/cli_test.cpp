@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 #include "projbot/assets/image.hpp"
 
@@ -126,6 +127,28 @@ TEST_F(CliTest, AlignPrintsJson) {
   EXPECT_NEAR(m00, 0.825, 0.02);  // cos(34.4 degrees)
 }
 
+TEST_F(CliTest, TourPrintsTheTableAndWritesReportAndFrames) {
+  const CliRun r =
+      run_projbot("tour --visits 1 --report " + (dir_ / "r.json").string() + " --frames " + (dir_ / "frames").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("| visit | duck | paper target 1 |"), std::string::npos) << r.output;
+  std::ifstream in(dir_ / "r.json");
+  std::ostringstream json;
+  json << in.rdbuf();
+  for (const char* key : {"\"T_projector_target_true\"", "\"T_projector_target_estimated\"", "\"error_mm\"", "\"model_m\"",
+                          "\"inlier_ratio\"", "\"fx\"", "\"timings_ms\""})
+    EXPECT_NE(json.str().find(key), std::string::npos) << key;
+  // The projector frame shows the Duck: a good share of lit pixels, the rest black.
+  const auto image = projbot::assets::read_image(dir_ / "frames" / "visit01_duck.png");
+  ASSERT_EQ(image.width, 1280);
+  std::size_t lit = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) lit += image.pixel(x, y)[0] + image.pixel(x, y)[1] > 40 ? 1 : 0;
+  const double share = static_cast<double>(lit) / (image.width * image.height);
+  EXPECT_GT(share, 0.01);
+  EXPECT_LT(share, 0.5);
+}
+
 struct BadRun {
   const char* name;
   std::string args;   // {dir} is replaced by the scratch folder
@@ -240,5 +263,9 @@ INSTANTIATE_TEST_SUITE_P(
                "",
                1,
                {"--initial"}},
-        BadRun{"bench_localize_bad_stops", "bench localize --stops 3,x", "", 2, {"--stops"}}),
+        BadRun{"bench_localize_bad_stops", "bench localize --stops 3,x", "", 2, {"--stops"}},
+        BadRun{"tour_bad_mode", "tour --mode paper", "", 2, {"--mode must be odometry, localized or tracking"}},
+        BadRun{"tour_missing_scene", "tour --scene {dir}/nope.yaml", "", 1, {"nope.yaml: cannot open scene file"}},
+        BadRun{"tour_without_tour_section", "tour --scene {dir}/bad.yaml", kProj + "targets: []\n", 1, {"needs a 'tour"}},
+        BadRun{"tour_bad_visits", "tour --visits 0", "", 2, {"--visits"}}),
     [](const ::testing::TestParamInfo<BadRun>& param_info) { return std::string(param_info.param.name); });

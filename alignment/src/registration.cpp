@@ -11,6 +11,7 @@
 #include <pcl/registration/correspondence_rejection_surface_normal.h>
 #include <pcl/registration/icp.h>
 #include <pcl/registration/sample_consensus_prerejective.h>
+#include <pcl/registration/transformation_estimation_point_to_plane_lls.h>
 
 #include <algorithm>
 #include <chrono>
@@ -28,9 +29,48 @@ using PointN = pcl::PointNormal;
 using CloudN = pcl::PointCloud<PointN>;
 using Features = pcl::PointCloud<pcl::FPFHSignature33>;
 
+// Point-to-plane least squares as PCL's TransformationEstimationPointToPlaneLLS, but damped: PCL inverts
+// the 6x6 normal matrix outright, and when the correspondences leave a direction unconstrained (one
+// visible plane, a handful of matches) that gives a NaN pose, and the next search asserts inside PCL.
+// Damping leaves such directions where they are instead.
+class DampedPointToPlane : public pcl::registration::TransformationEstimationPointToPlaneLLS<PointN, PointN> {
+ public:
+  using pcl::registration::TransformationEstimationPointToPlaneLLS<PointN, PointN>::estimateRigidTransformation;
+  void estimateRigidTransformation(const pcl::PointCloud<PointN>& source, const pcl::PointCloud<PointN>& target,
+                                   const pcl::Correspondences& correspondences, Eigen::Matrix4f& T) const override {
+    Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> atb = Eigen::Matrix<double, 6, 1>::Zero();
+    for (const auto& c : correspondences) {
+      const Eigen::Vector3d p = source[static_cast<std::size_t>(c.index_query)].getVector3fMap().cast<double>();
+      const PointN& q = target[static_cast<std::size_t>(c.index_match)];
+      const Eigen::Vector3d n = q.getNormalVector3fMap().cast<double>();
+      if (!p.allFinite() || !n.allFinite()) continue;
+      Eigen::Matrix<double, 6, 1> a;
+      a << p.cross(n), n;
+      ata += a * a.transpose();
+      atb += a * n.dot(q.getVector3fMap().cast<double>() - p);
+    }
+    const double damping = 1e-9 + 1e-6 * ata.trace() / 6.0;
+    const Eigen::Matrix<double, 6, 1> x = (ata + damping * Eigen::Matrix<double, 6, 6>::Identity()).ldlt().solve(atb);
+    Eigen::Matrix4d out = Eigen::Matrix4d::Identity();
+    if (x.allFinite()) {
+      out.topLeftCorner<3, 3>() =
+          (Eigen::AngleAxisd(x[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(x[1], Eigen::Vector3d::UnitY()) *
+           Eigen::AngleAxisd(x[0], Eigen::Vector3d::UnitX()))
+              .toRotationMatrix();
+      out.topRightCorner<3, 1>() = x.tail<3>();
+    }
+    T = out.cast<float>();
+  }
+};
+
 // PCL keeps the iteration count protected; the result struct reports it.
 class CountingIcp : public pcl::IterativeClosestPointWithNormals<PointN, PointN> {
  public:
+  CountingIcp() {
+    min_number_correspondences_ = 10;
+    setTransformationEstimation(pcl::make_shared<DampedPointToPlane>());
+  }
   int iterations() const { return nr_iterations_; }
 };
 
@@ -167,10 +207,11 @@ struct Aligner::Impl {
 
   // The scan prepared around where the model sits under T_scan_model, its box grown by `margin`: what
   // an ICP stage and the gate work on. Without cropping, all of it.
-  pcl::PointCloud<pcl::PointXYZ>::Ptr near_scan(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model,
-                                                double margin) const {
-    if (!cfg.crop) return prepare(scan, Eigen::Vector3f::Zero(), 0.0, cfg.voxel_m);
-    return prepare_in_box(scan, T_scan_model, margin, cfg.voxel_m);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr near_scan(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model, double margin,
+                                                double leaf = 0.0) const {
+    if (leaf <= 0.0) leaf = cfg.voxel_m;
+    if (!cfg.crop) return prepare(scan, Eigen::Vector3f::Zero(), 0.0, leaf);
+    return prepare_in_box(scan, T_scan_model, margin, leaf);
   }
   // What the quality gate judges: the box grown by a little more than the inlier distance.
   double gate_margin() const { return 3.0 * cfg.inlier_distance_m; }
@@ -187,7 +228,9 @@ struct Aligner::Impl {
     converged = true;
     for (std::size_t stage = 0; stage < cfg.icp_distances_m.size(); ++stage) {
       const double distance = cfg.icp_distances_m[stage];
-      const auto near = near_scan(scan, rigid_inverse(T_model_scan.cast<double>()), stage == 0 ? cfg.crop_margin_m : distance);
+      // Coarse stages need fewer points: a leaf of a tenth of the correspondence distance, at least voxel_m.
+      const auto near = near_scan(scan, rigid_inverse(T_model_scan.cast<double>()), stage == 0 ? cfg.crop_margin_m : distance,
+                                  std::max(cfg.voxel_m, distance / 10.0));
       if (near->size() < cfg.min_points) {
         converged = false;
         break;
@@ -217,6 +260,11 @@ struct Aligner::Impl {
       icp.align(aligned, T_model_scan);
       iterations += icp.iterations();
       converged = converged && icp.hasConverged();
+      // Too few correspondences leave PCL's point-to-plane solve singular: a NaN pose, not an estimate.
+      if (!icp.getFinalTransformation().allFinite()) {
+        converged = false;
+        break;
+      }
       T_model_scan = icp.getFinalTransformation();
     }
     return rigid_inverse(T_model_scan.cast<double>());
@@ -239,6 +287,7 @@ struct Aligner::Impl {
     for (const auto& p : near) {
       PointN q;
       q.getVector3fMap() = (inv * Eigen::Vector4f(p.x, p.y, p.z, 1.0F)).head<3>();
+      if (!q.getVector3fMap().allFinite()) continue;
       if (model_tree.nearestKSearch(q, 1, index, dist2) < 1) continue;
       if (dist2[0] > 4.0F * static_cast<float>(cfg.inlier_distance_m * cfg.inlier_distance_m)) continue;
       const PointN& m = (*model)[static_cast<std::size_t>(index[0])];

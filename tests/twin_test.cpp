@@ -1,0 +1,199 @@
+// The digital twin: the projection-error measurement on hand-computed cases, scene checks, and a short
+// deterministic tour on the shipped demo scene.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "projbot/alignment/equations.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/twin/raycast.hpp"
+#include "projbot/twin/tour.hpp"
+#include "projbot/twin/world.hpp"
+
+namespace {
+
+using projbot::twin::MeshRaycaster;
+using projbot::twin::PlacedMesh;
+
+Eigen::Matrix4d translation(double x, double y, double z) {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topRightCorner<3, 1>() = Eigen::Vector3d(x, y, z);
+  return T;
+}
+
+// A 1000x1000 projector with f = 1000 px and the principal point on a pixel centre, and a 1 m square
+// slab whose near face (model z = 0) stands 1 m in front of it.
+class MarkerErrorTest : public ::testing::Test {
+ protected:
+  projbot::config::ProjectorConfig k_{1000, 1000, 1000.0, 1000.0, 500.0, 500.0, 0.1, 10.0};
+  MeshRaycaster slab_{projbot::assets::make_box({-0.5, -0.5, 0.0}, {0.5, 0.5, 0.02}, {1, 1, 1, 1})};
+  Eigen::Matrix4d T_true_ = translation(0, 0, 1.0);
+  Eigen::Vector3d marker_{0.1, 0.0, 0.0};
+  std::vector<PlacedMesh> scene_{{&slab_, T_true_}};
+
+  projbot::twin::MarkerError measure(const Eigen::Matrix4d& T_est) const {
+    return projbot::twin::measure_marker(k_, T_est, T_true_, marker_, scene_);
+  }
+};
+
+TEST_F(MarkerErrorTest, ExactPoseLandsOnTheMarker) {
+  const auto e = measure(T_true_);
+  EXPECT_TRUE(e.in_image);
+  EXPECT_TRUE(e.landed);
+  EXPECT_DOUBLE_EQ(e.pixel.x(), 600.0);  // u = 1000 * 0.1 / 1 + 500
+  EXPECT_DOUBLE_EQ(e.pixel.y(), 500.0);
+  EXPECT_NEAR(e.error_mm, 0.0, 1e-9);
+}
+
+TEST_F(MarkerErrorTest, Sideways5mmIs5mm) {
+  const auto e = measure(translation(0.005, 0, 1.0));
+  EXPECT_DOUBLE_EQ(e.pixel.x(), 605.0);
+  EXPECT_NEAR(e.error_mm, 5.0, 1e-6);
+}
+
+TEST_F(MarkerErrorTest, DepthErrorShowsAsTheRaysShift) {
+  // Estimated 10 cm too far: the content is drawn at u = 1000 * 0.1 / 1.1 + 500 = 590.9, shown by pixel
+  // 591, whose ray meets the true surface at x = 0.091 m: 9 mm from the marker.
+  const auto e = measure(translation(0, 0, 1.1));
+  EXPECT_DOUBLE_EQ(e.pixel.x(), 591.0);
+  EXPECT_TRUE(e.landed);
+  EXPECT_NEAR(e.error_mm, 9.0, 1e-6);
+}
+
+TEST_F(MarkerErrorTest, PixelOutsideTheImageMeasuresTheMissToTheRay) {
+  // Drawn at (1.1, 0, 1): u = 1600, off the image. Distance from (0.1, 0, 1) to the ray through (1.1, 0, 1).
+  const auto e = measure(translation(1.0, 0, 1.0));
+  EXPECT_FALSE(e.in_image);
+  EXPECT_FALSE(e.landed);
+  const Eigen::Vector3d d = Eigen::Vector3d(1.1, 0, 1).normalized(), t(0.1, 0, 1);
+  EXPECT_NEAR(e.error_mm, 1000.0 * (t - t.dot(d) * d).norm(), 1e-6);
+  EXPECT_NEAR(e.error_mm, 672.7, 0.1);
+}
+
+TEST_F(MarkerErrorTest, AnOccluderCatchesTheLight) {
+  // A small box halfway along the marker's ray: the light lands on it, 0.5 m short of the marker.
+  const MeshRaycaster blocker(projbot::assets::make_box({-0.02, -0.02, 0.0}, {0.02, 0.02, 0.02}, {1, 1, 1, 1}));
+  scene_.push_back({&blocker, translation(0.05, 0.0, 0.5)});
+  const auto e = measure(T_true_);
+  EXPECT_TRUE(e.landed);
+  EXPECT_NEAR(e.error_mm, 1000.0 * std::sqrt(0.05 * 0.05 + 0.5 * 0.5), 1e-6);
+}
+
+TEST(MeshRaycasterTest, NearestSurfacePointAndRays) {
+  const MeshRaycaster box(projbot::assets::make_box({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}, {1, 1, 1, 1}));
+  // Vertices are floats: 1e-7 m tolerances.
+  EXPECT_LT((box.closest_point({0.0, 0.0, -0.3}) - Eigen::Vector3d(0, 0, -0.1)).norm(), 1e-7);
+  EXPECT_LT((box.closest_point({0.3, 0.3, 0.0}) - Eigen::Vector3d(0.1, 0.1, 0.0)).norm(), 1e-7);
+  const auto hit = box.cast({0, 0, -1}, {0, 0, 1});
+  ASSERT_TRUE(hit.has_value());
+  EXPECT_NEAR(*hit, 0.9, 1e-7);
+  EXPECT_FALSE(box.cast({0, 0, -1}, {0, 1, 0}).has_value());
+  EXPECT_FALSE(box.cast({0, 0, -1}, {0, 0, -1}).has_value());  // behind the origin
+}
+
+const std::string kAssets = PROJBOT_ASSET_DIR;
+
+std::string demo_tour_text() {
+  std::ifstream in(kAssets + "/scenes/tour.yaml");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+projbot::config::Scene demo_with(const std::string& from, const std::string& to) {
+  std::string text = demo_tour_text();
+  const auto at = text.find(from);
+  if (at == std::string::npos) throw std::runtime_error("test: '" + from + "' not in the demo tour");
+  text.replace(at, from.size(), to);
+  return projbot::config::parse_scene(text, kAssets + "/scenes/tour.yaml");
+}
+
+std::string twin_error(const projbot::config::Scene& scene) {
+  projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
+  try {
+    projbot::twin::Twin twin(scene, {}, renderer);
+  } catch (const projbot::twin::TwinError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(TwinSceneTest, BadToursAreNamed) {
+  using projbot::config::ConfigError;
+  const auto config_error = [](const std::string& from, const std::string& to) {
+    try {
+      demo_with(from, to);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(config_error("visits: [duck, box", "visits: [duck, cat").find("tour.visits[1]: no target named 'cat'"),
+            std::string::npos);
+  EXPECT_NE(config_error("stop: [3.0, 1.8, 90]", "stop: [3.0, 1.8]").find("targets[0].stop: expected a list of 3 numbers"),
+            std::string::npos);
+  EXPECT_NE(config_error("motion: {visit: 2,", "motion: {visit: 0,").find("targets[1].motion.visit: must be >= 1"),
+            std::string::npos);
+  EXPECT_NE(config_error("slip_scale: 0.01", "slip_scale: -0.01").find("robot.drift.slip_scale: must be >= 0"),
+            std::string::npos);
+  EXPECT_NE(config_error("  width: 8\n", "  width: 0\n").find("room: width and depth must be 0.5..200 m"), std::string::npos);
+  // A marker 5 cm off the Duck's surface: the twin names it and where the surface is.
+  const std::string off = twin_error(demo_with("[-0.0024, -0.0389, 0.1421]", "[-0.0024, -0.0389, 0.1921]"));
+  EXPECT_NE(off.find("target 'duck' marker 0 lies"), std::string::npos) << off;
+  EXPECT_NE(off.find("the nearest surface point is"), std::string::npos) << off;
+  const std::string no_tour = twin_error(demo_with("tour:\n  visits: [duck, box, duck, box, duck, box]", ""));
+  EXPECT_NE(no_tour.find("needs a 'tour: {visits: [...]}' section"), std::string::npos) << no_tour;
+}
+
+// Two targets, two visits each, fixed seed: localisation keeps every visit within the 3 mm.
+TEST(TourTest, ShortLocalizedTourStaysWithin3mm) {
+  const auto scene = projbot::config::load_scene(kAssets + "/scenes/tour.yaml");
+  projbot::twin::TourOptions o;
+  o.mode = projbot::twin::TourMode::localized;
+  o.visits = 4;
+  o.seed = 3;
+  const auto report = projbot::twin::run_tour(scene, o);
+  ASSERT_EQ(report.visits.size(), 4U);
+  for (const auto& v : report.visits) {
+    SCOPED_TRACE(v.target + " visit " + std::to_string(v.target_visit));
+    EXPECT_TRUE(v.projected);
+    EXPECT_EQ(v.markers.size(), v.target == "duck" ? 5U : 6U);
+    for (const auto& m : v.markers) EXPECT_TRUE(m.landed);
+    EXPECT_LT(v.mean_mm, 3.0);
+    EXPECT_LT(v.max_mm, 5.0);
+    EXPECT_LT(v.base_error_cm, 2.0);  // the robot issue's bound on localisation
+    // The report's true pose is the twin's: markers under it land within a pixel's rounding.
+    EXPECT_LT(projbot::alignment::translation_norm_m(projbot::alignment::rigid_inverse(v.T_projector_target_true) *
+                                                     v.T_projector_target_estimated),
+              0.005);
+  }
+  EXPECT_EQ(report.visits[3].target, "box");
+  EXPECT_TRUE(report.visits[3].moved);
+  // Aligned once, the moved box is not followed: its content stays where the box was.
+  EXPECT_LT(report.visits[3].reconverge_s, 0.0);
+  EXPECT_GT(report.visits[3].max_mm_moving, 50.0);
+}
+
+// The tracker follows the box while it is moved 10 cm and 15 degrees, back within 3 mm within 0.5 s.
+TEST(TourTest, TrackingFollowsTheMovedTarget) {
+  const auto scene = projbot::config::load_scene(kAssets + "/scenes/tour.yaml");
+  projbot::twin::TourOptions o;
+  o.mode = projbot::twin::TourMode::tracking;
+  o.visits = 4;
+  o.seed = 3;
+  o.dwell_s = 3.0;
+  const auto report = projbot::twin::run_tour(scene, o);
+  const auto& moved = report.visits[3];
+  ASSERT_TRUE(moved.moved);
+  EXPECT_EQ(moved.timeline.size(), 90U);  // 3 s at 30 Hz
+  EXPECT_GE(moved.reconverge_s, 0.0);
+  EXPECT_LE(moved.reconverge_s, 0.5);
+  EXPECT_LT(moved.max_mm_moving, 15.0);
+  EXPECT_LT(moved.timeline.back().mean_mm, 3.0);
+  for (const auto& s : moved.timeline) EXPECT_TRUE(s.shown);
+}
+
+}  // namespace
