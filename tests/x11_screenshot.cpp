@@ -38,6 +38,14 @@ assets::Image X11Display::screenshot(std::uint64_t window, int width, int height
   return out;
 }
 
+std::uint64_t X11Display::root_window() const { return DefaultRootWindow(static_cast<Display*>(display_)); }
+int X11Display::screen_width() const {
+  return DisplayWidth(static_cast<Display*>(display_), DefaultScreen(static_cast<Display*>(display_)));
+}
+int X11Display::screen_height() const {
+  return DisplayHeight(static_cast<Display*>(display_), DefaultScreen(static_cast<Display*>(display_)));
+}
+
 void X11Display::resize(std::uint64_t window, int width, int height) {
   auto* display = static_cast<Display*>(display_);
   XResizeWindow(display, static_cast<Window>(window), static_cast<unsigned>(width), static_cast<unsigned>(height));

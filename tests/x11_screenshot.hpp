@@ -16,6 +16,10 @@ class X11Display {
   bool ok() const { return display_ != nullptr; }
   /// The window's contents as the X server holds them, RGBA (alpha 255). Empty image on failure.
   assets::Image screenshot(std::uint64_t window, int width, int height);
+  /// The root window (the whole screen) and its size.
+  std::uint64_t root_window() const;
+  int screen_width() const;
+  int screen_height() const;
   /// Resizes a window from outside, as a window manager would.
   void resize(std::uint64_t window, int width, int height);
 

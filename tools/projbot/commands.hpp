@@ -26,5 +26,6 @@ extern const Command kSlam;
 extern const Command kLocalize;
 extern const Command kBenchLocalize;
 extern const Command kTour;
+extern const Command kRun;
 
 }  // namespace projbot::tools

@@ -12,9 +12,9 @@ using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
   static const std::vector<const Command*> all{
-      &projbot::tools::kRender,   &projbot::tools::kShow,          &projbot::tools::kBenchRender,
-      &projbot::tools::kAlign,    &projbot::tools::kBenchTrack,    &projbot::tools::kSlam,
-      &projbot::tools::kLocalize, &projbot::tools::kBenchLocalize, &projbot::tools::kTour};
+      &projbot::tools::kRender,     &projbot::tools::kShow, &projbot::tools::kBenchRender, &projbot::tools::kAlign,
+      &projbot::tools::kBenchTrack, &projbot::tools::kSlam, &projbot::tools::kLocalize,    &projbot::tools::kBenchLocalize,
+      &projbot::tools::kTour,       &projbot::tools::kRun};
   return all;
 }
 

@@ -22,13 +22,6 @@ engine::RendererOptions renderer_options(const cli::Args& args, bool windowing) 
   return o;
 }
 
-engine::PresentMode present_mode(const std::string& name) {
-  if (name == "fifo") return engine::PresentMode::kFifo;
-  if (name == "mailbox") return engine::PresentMode::kMailbox;
-  if (name == "immediate") return engine::PresentMode::kImmediate;
-  throw cli::UsageError("--present-mode must be fifo, mailbox or immediate, got '" + name + "'");
-}
-
 // Prints validation results and returns false when the layer reported anything.
 bool report_validation(const cli::Args& args, const engine::Renderer& renderer) {
   if (!args.flag("validation")) return true;

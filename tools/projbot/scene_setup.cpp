@@ -107,4 +107,11 @@ std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const con
   return items;
 }
 
+engine::PresentMode present_mode(const std::string& name) {
+  if (name == "fifo") return engine::PresentMode::kFifo;
+  if (name == "mailbox") return engine::PresentMode::kMailbox;
+  if (name == "immediate") return engine::PresentMode::kImmediate;
+  throw cli::UsageError("--present-mode must be fifo, mailbox or immediate, got '" + name + "'");
+}
+
 }  // namespace projbot::tools

@@ -27,5 +27,7 @@ Eigen::Matrix4d framing_pose(const config::ProjectorConfig& projector, double ra
 
 /// Loads, scales and recentres each target's model and uploads it; returns one DrawItem per target.
 std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene);
+/// --present-mode: fifo, mailbox or immediate. Throws cli::UsageError.
+engine::PresentMode present_mode(const std::string& name);
 
 }  // namespace projbot::tools

@@ -1,0 +1,247 @@
+// projbot run: the live engine. The render thread (this one) draws every frame from the newest accepted
+// pose of each target's tracker worker; the robot thread drives the tour, aims, hands each stop's
+// initial guess (Eq. 1) to the worker and, in the twin, plays the depth camera at 30 Hz.
+
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <thread>
+
+#include "commands.hpp"
+#include "projbot/alignment/equations.hpp"
+#include "projbot/alignment/latest_value.hpp"
+#include "projbot/alignment/registration.hpp"
+#include "projbot/alignment/tracker_worker.hpp"
+#include "projbot/engine/frame_profiler.hpp"
+#include "projbot/engine/renderer.hpp"
+#include "projbot/twin/world.hpp"
+#include "scene_setup.hpp"
+
+namespace projbot::tools {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double now_s() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
+
+// What the robot thread tells the render thread: which target the robot is projecting onto (-1 while
+// it drives) and since when; poses captured before that belong to an earlier stop.
+struct RobotState {
+  int target = -1;
+  double since_s = 0.0;
+  int visit = 0;
+  bool done = false;
+};
+
+struct RunOptions {
+  int visits = 0;
+  double dwell_s = 4.0;
+  std::uint64_t seed = 1;
+};
+
+// The robot thread against the twin: drive, aim, Eq. 1, then capture depth at 30 Hz while dwelling.
+void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std::unique_ptr<alignment::TrackerWorker>>& workers,
+                alignment::LatestValue<RobotState>& state, std::vector<double>& capture_ms, const std::stop_token& stop) {
+  engine::Renderer depth_renderer(engine::RendererOptions{});
+  twin::TwinOptions to;
+  to.seed = o.seed;
+  twin::Twin twin(scene, to, depth_renderer);
+  auto& targets = twin.targets();
+  const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
+  std::vector<int> count(targets.size(), 0);
+  for (int v = 0; v < visits && !stop.stop_requested(); ++v) {
+    const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
+    std::size_t i = 0;
+    while (targets[i].config.name != name) ++i;
+    const auto scene_index = static_cast<std::size_t>(scene.target_index(name));
+    state.publish({-1, now_s(), v + 1, false});
+    const Eigen::Vector3d& stop_pose = *targets[i].config.stop;
+    twin.robot().drive_to({stop_pose.x(), stop_pose.y(), stop_pose.z()}, v);
+    const Eigen::Matrix4d T_map_target = targets[i].config.T_map_target.value_or(*targets[i].config.T_world_target);
+    const auto aim = robot::aim_at(twin.robot().believed_pose(), T_map_target.topRightCorner<3, 1>(), scene.pan_tilt);
+    if (const auto s = twin.pan_tilt().move_to(aim.angles); !s.ok) throw twin::TwinError("pan-tilt: " + s.error);
+    const Eigen::Matrix4d T_world_camera = twin.true_head().T_world_camera.matrix();
+    workers[scene_index]->set_initial_guess(
+        alignment::camera_from_target_initial(twin.believed_head().T_world_camera.matrix(), T_map_target));  // Eq. 1
+    const int target_visit = ++count[i];
+    const double since = now_s();
+    state.publish({static_cast<int>(scene_index), since, v + 1, false});
+    auto tick = Clock::now();
+    for (std::uint32_t k = 0; !stop.stop_requested(); ++k) {
+      const double t = now_s() - since;
+      if (t >= o.dwell_s) break;
+      targets[i].T_world_target_true = twin.scripted_pose(i, target_visit, t);
+      const double captured = now_s();
+      auto frame =
+          std::make_shared<alignment::DepthImage>(twin.capture(T_world_camera, static_cast<std::uint32_t>(o.seed * 7919 + k)));
+      // Stamped with the instant the scene was sampled (the exposure), so the simulated sensor's own
+      // rendering counts in the pose's age, as a real camera's readout and transfer would.
+      frame->capture_time_s = captured;
+      capture_ms.push_back(1000.0 * (now_s() - captured));
+      workers[scene_index]->submit(std::move(frame));
+      tick += std::chrono::microseconds(33333);  // 30 Hz, like the Kinect
+      std::this_thread::sleep_until(tick);
+      if (Clock::now() > tick + std::chrono::milliseconds(100)) tick = Clock::now();  // fell behind: do not burst
+    }
+    targets[i].T_world_target_true = twin.scripted_pose(i, 0, 0.0);
+  }
+  state.publish({-1, now_s(), visits, true});
+}
+
+}  // namespace
+
+const Command kRun{
+    "run",
+    "the live engine: project onto the tracked targets while the robot tours (the twin with --sim)",
+    "projbot run [--config C.yaml] [--sim] [--fullscreen] [--monitor N] [--profile p.csv] [--seconds S]\n"
+    "            [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n\n"
+    "Opens the projector output and draws, every frame, each target the robot is projecting onto at the\n"
+    "newest pose its tracker worker accepted (Eq. 2, Eq. 3); targets not yet found or lost are blanked.\n"
+    "The robot thread drives the tour of the config's `tour.visits`, aims the pan-tilt, gives the worker\n"
+    "the initial guess (Eq. 1) and dwells while the camera streams depth. Per frame it records the pose's\n"
+    "age at present (depth capture to present) and the frame time, and prints percentiles at the end.\n"
+    "No robot or camera drivers are configured in a scene file yet, so it runs against the digital twin\n"
+    "(--sim, the default). Without --config the shipped demo tour runs.\n",
+    {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)"},
+     {"sim", "", "run against the digital twin (the default while no hardware is configured)"},
+     {"fullscreen", "", "fullscreen on --monitor (the projector)"},
+     {"monitor", "N", "monitor index for --fullscreen (default 0)"},
+     {"headless", "", "draw offscreen at 60 Hz instead of a window (profiling without a display)"},
+     {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
+     {"profile", "FILE", "write one CSV row per frame: frame time and pose age"},
+     {"seconds", "S", "stop after S seconds (default: when the tour ends or the window is closed)"},
+     {"visits", "N", "visits, cycling through the tour (default: the list once)"},
+     {"dwell", "S", "seconds the robot projects at each stop (default 4)"},
+     {"seed", "K", "seed of the twin's noise (default 1)"}},
+    [](const cli::Args& args) {
+      const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
+      if (scene.visits.empty())
+        throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
+      if (!args.flag("sim")) std::cout << "no robot or camera hardware configured: running against the digital twin (--sim)\n";
+      RunOptions o;
+      o.visits = args.get_int("visits", 0, 1, 1000);
+      o.dwell_s = args.get_double("dwell", 4.0);
+      if (!(o.dwell_s > 0.0 && o.dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
+      o.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
+      const double seconds = args.get_double("seconds", 0.0);
+      if (!(seconds >= 0.0)) throw cli::UsageError("--seconds must be >= 0");
+      const bool headless = args.flag("headless");
+
+      engine::RendererOptions ro;
+      ro.windowing = !headless;
+      engine::Renderer renderer(ro);
+      std::cout << "device: " << renderer.device_info().name << '\n';
+      const auto items = upload_scene(renderer, scene);
+      std::unique_ptr<engine::RenderTarget> target;
+      if (headless) {
+        target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+      } else {
+        engine::WindowOptions w;
+        w.title = "projbot run: " + scene.source.filename().string();
+        w.width_px = scene.projector.width_px;
+        w.height_px = scene.projector.height_px;
+        w.fullscreen = args.flag("fullscreen");
+        w.monitor = args.get_int("monitor", 0, 0, 64);
+        w.present_mode = present_mode(args.get_or("present-mode", "fifo"));
+        target = renderer.make_window(w);
+        if (w.fullscreen && (target->width() != scene.projector.width_px || target->height() != scene.projector.height_px))
+          std::cerr << "projbot: warning: monitor is " << target->width() << "x" << target->height()
+                    << " but the projector model is " << scene.projector.width_px << "x" << scene.projector.height_px
+                    << "; the image is stretched\n";
+      }
+
+      // One tracker worker per target the tour visits.
+      const alignment::CameraIntrinsics k{scene.depth_camera.width_px, scene.depth_camera.height_px, scene.depth_camera.fx_px,
+                                          scene.depth_camera.fy_px,    scene.depth_camera.cx_px,     scene.depth_camera.cy_px};
+      std::vector<std::unique_ptr<alignment::TrackerWorker>> workers(scene.targets.size());
+      for (std::size_t i = 0; i < scene.targets.size(); ++i) {
+        if (!scene.targets[i].T_world_target) continue;
+        auto model = assets::load_gltf(scene.targets[i].model);
+        assets::scale_and_recenter(model, scene.targets[i].scale, scene.targets[i].recenter);
+        workers[i] = std::make_unique<alignment::TrackerWorker>(alignment::model_cloud_from(model, 50000), k);
+      }
+
+      alignment::LatestValue<RobotState> state;
+      std::exception_ptr robot_error;
+      std::atomic<bool> robot_done{false};
+      std::vector<double> capture_ms;  // the robot thread's until it is joined
+      std::jthread robot_thread([&](std::stop_token stop) {
+        try {
+          drive_twin(scene, o, workers, state, capture_ms, stop);
+        } catch (...) {
+          robot_error = std::current_exception();
+        }
+        robot_done = true;
+      });
+
+      engine::FrameProfiler profiler;
+      std::vector<double> ages_ms;
+      struct Row {
+        double start_ms, age_ms;
+        int target;
+      };
+      std::vector<Row> rows;
+      RobotState robot;
+      const double t0 = now_s();
+      std::size_t blank = 0;
+      auto next_frame = Clock::now();
+      while (!target->poll_close() && !robot_done && (seconds == 0.0 || now_s() - t0 < seconds)) {
+        double used_capture = -1.0;
+        state.read(robot);
+        const auto read_poses = [&](std::vector<engine::DrawItem>& out) {
+          out.clear();
+          if (robot.target < 0) return;
+          alignment::PoseSample pose;
+          auto& worker = *workers[static_cast<std::size_t>(robot.target)];
+          if (!worker.latest(pose) || pose.lost || pose.capture_time_s < robot.since_s) return;
+          out.push_back({items[static_cast<std::size_t>(robot.target)].model,
+                         alignment::projector_from_target(scene.pan_tilt.T_projector_camera, pose.T_camera_target)});  // Eq. 2
+          used_capture = pose.capture_time_s;
+        };
+        if (headless) {  // an offscreen target has no vsync: pace it like a 60 Hz projector
+          next_frame += std::chrono::microseconds(16667);
+          std::this_thread::sleep_until(next_frame);
+          if (Clock::now() > next_frame + std::chrono::milliseconds(50)) next_frame = Clock::now();
+        }
+        const double start_ms = profiler.now_ms();
+        if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
+        const double age_ms = used_capture >= 0.0 ? 1000.0 * (now_s() - used_capture) : -1.0;
+        if (age_ms >= 0.0)
+          ages_ms.push_back(age_ms);
+        else
+          ++blank;
+        rows.push_back({start_ms, age_ms, age_ms >= 0.0 ? robot.target : -1});
+      }
+      renderer.finish(*target);
+      robot_thread.request_stop();
+      robot_thread.join();
+      if (robot_error) std::rethrow_exception(robot_error);
+      for (const auto& w : workers)
+        if (w && w->error()) std::rethrow_exception(w->error());
+
+      std::cout << engine::format_summary(profiler.summary()) << '\n';
+      std::cout << std::fixed << std::setprecision(1) << "pose age at present (depth capture to present), " << ages_ms.size()
+                << " frames with a target: p50 " << engine::percentile(ages_ms, 0.5) << " ms, p95 "
+                << engine::percentile(ages_ms, 0.95) << " ms, p99 " << engine::percentile(ages_ms, 0.99) << " ms, max "
+                << engine::percentile(ages_ms, 1.0) << " ms; " << blank << " frames blank (driving, acquiring or lost)\n";
+      std::size_t tracked = 0;
+      for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
+      std::cout << "robot: " << robot.visit << " visit(s); the twin's depth camera delivered " << capture_ms.size()
+                << " frames (render + Kinect noise p50 " << engine::percentile(capture_ms, 0.5) << " ms, p95 "
+                << engine::percentile(capture_ms, 0.95) << " ms of each pose's age); the tracker workers processed " << tracked
+                << "\n";
+      if (const auto csv = args.get("profile")) {
+        std::ofstream f(*csv);
+        f << "frame,start_ms,pose_age_ms,target\n";
+        for (std::size_t i = 0; i < rows.size(); ++i)
+          f << i << ',' << rows[i].start_ms << ',' << (rows[i].age_ms >= 0 ? std::to_string(rows[i].age_ms) : std::string())
+            << ',' << (rows[i].target >= 0 ? scene.targets[static_cast<std::size_t>(rows[i].target)].name : std::string())
+            << '\n';
+        if (!f) throw std::runtime_error(*csv + ": cannot write the profile");
+        std::cout << "per-frame profile written to " << *csv << '\n';
+      }
+      return 0;
+    }};
+
+}  // namespace projbot::tools
