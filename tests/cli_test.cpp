@@ -267,5 +267,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"tour_bad_mode", "tour --mode paper", "", 2, {"--mode must be odometry, localized or tracking"}},
         BadRun{"tour_missing_scene", "tour --scene {dir}/nope.yaml", "", 1, {"nope.yaml: cannot open scene file"}},
         BadRun{"tour_without_tour_section", "tour --scene {dir}/bad.yaml", kProj + "targets: []\n", 1, {"needs a 'tour"}},
-        BadRun{"tour_bad_visits", "tour --visits 0", "", 2, {"--visits"}}),
+        BadRun{"tour_bad_visits", "tour --visits 0", "", 2, {"--visits"}},
+        BadRun{"run_without_tour_section",
+               "run --headless --config {dir}/bad.yaml",
+               kProj + "targets: []\n",
+               1,
+               {"needs a 'tour: {visits: [...]}' section"}},
+        BadRun{"run_bad_dwell", "run --headless --dwell 0", "", 2, {"--dwell"}}),
     [](const ::testing::TestParamInfo<BadRun>& param_info) { return std::string(param_info.param.name); });
