@@ -3,6 +3,7 @@
 
 #include "projbot/alignment/registration.hpp"
 
+#include <pcl/console/print.h>
 #include <pcl/features/fpfh_omp.h>
 #include <pcl/features/normal_3d.h>
 #include <pcl/filters/statistical_outlier_removal.h>
@@ -416,6 +417,9 @@ ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t sampl
 }
 
 Aligner::Aligner(ModelCloud model, AcquisitionConfig config) : impl_(std::make_unique<Impl>()) {
+  // PCL prints its own complaints ("Not enough correspondences found") to stderr; the result struct
+  // carries every outcome, so keep the console for our messages.
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   impl_->cfg = config;
   impl_->extent = Extent(model.points);
   if (model.points.size() < 10 || model.normals.size() != model.points.size())
