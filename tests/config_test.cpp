@@ -168,6 +168,28 @@ TEST(SceneTest, RobotSectionOverridesTheRig) {
   EXPECT_TRUE(c.pan_tilt.T_head_camera.isApprox(rig.T_head_camera, 1e-12));
 }
 
+TEST(SceneTest, TourSectionsAndTheirDefaults) {
+  const auto plain = parse_scene(kGood, "/scenes/s.yaml");
+  EXPECT_TRUE(plain.visits.empty());
+  EXPECT_EQ(plain.depth_camera.width_px, 640);  // Kinect v1 unless `camera:` says otherwise
+  EXPECT_DOUBLE_EQ(plain.depth_camera.fx_px, 525.0);
+  const auto s = parse_scene(std::string(kGood) +
+                                 "camera: {fx: 580, fy: 580}\n"
+                                 "room: {width: 5, depth: 4, obstacles: [[0, 0, 1, 1]]}\n"
+                                 "robot: {start: [1, 2, 90], drift: {slip_scale: 0.02}}\n",
+                             "/scenes/s.yaml");
+  EXPECT_DOUBLE_EQ(s.depth_camera.fx_px, 580.0);
+  EXPECT_EQ(s.depth_camera.height_px, 480);
+  EXPECT_DOUBLE_EQ(s.room.width_m, 5.0);
+  ASSERT_EQ(s.room.obstacles.size(), 1U);
+  EXPECT_DOUBLE_EQ(s.room.obstacles[0][2], 1.0);
+  EXPECT_NEAR(s.robot_start.z(), M_PI / 2, 1e-12);
+  EXPECT_DOUBLE_EQ(s.drift.slip_scale, 0.02);
+  EXPECT_DOUBLE_EQ(s.drift.wheel_scale_sigma, projbot::config::DriftSpec{}.wheel_scale_sigma);
+  // A camera with a bad intrinsic is named like the projector.
+  EXPECT_THROW(parse_scene(std::string(kGood) + "camera: {fx: -1}\n", "/scenes/s.yaml"), projbot::config::ConfigError);
+}
+
 TEST(SceneTest, MissingFileIsNamed) {
   try {
     projbot::config::load_scene("/nonexistent/scene.yaml");

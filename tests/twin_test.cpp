@@ -148,14 +148,19 @@ TEST(TwinSceneTest, BadToursAreNamed) {
   EXPECT_NE(no_tour.find("needs a 'tour: {visits: [...]}' section"), std::string::npos) << no_tour;
 }
 
-// Two targets, two visits each, fixed seed: localisation keeps every visit within the 3 mm.
-TEST(TourTest, ShortLocalizedTourStaysWithin3mm) {
-  const auto scene = projbot::config::load_scene(kAssets + "/scenes/tour.yaml");
+// The demo tour, two visits of each target (the box moves on its second), seed 3.
+projbot::twin::TourReport short_demo_tour(projbot::twin::TourMode mode) {
   projbot::twin::TourOptions o;
-  o.mode = projbot::twin::TourMode::localized;
+  o.mode = mode;
   o.visits = 4;
   o.seed = 3;
-  const auto report = projbot::twin::run_tour(scene, o);
+  o.dwell_s = 3.0;
+  return projbot::twin::run_tour(projbot::config::load_scene(kAssets + "/scenes/tour.yaml"), o);
+}
+
+// Localisation keeps every visit within the 3 mm.
+TEST(TourTest, ShortLocalizedTourStaysWithin3mm) {
+  const auto report = short_demo_tour(projbot::twin::TourMode::localized);
   ASSERT_EQ(report.visits.size(), 4U);
   for (const auto& v : report.visits) {
     SCOPED_TRACE(v.target + " visit " + std::to_string(v.target_visit));
@@ -179,13 +184,7 @@ TEST(TourTest, ShortLocalizedTourStaysWithin3mm) {
 
 // The tracker follows the box while it is moved 10 cm and 15 degrees, back within 3 mm within 0.5 s.
 TEST(TourTest, TrackingFollowsTheMovedTarget) {
-  const auto scene = projbot::config::load_scene(kAssets + "/scenes/tour.yaml");
-  projbot::twin::TourOptions o;
-  o.mode = projbot::twin::TourMode::tracking;
-  o.visits = 4;
-  o.seed = 3;
-  o.dwell_s = 3.0;
-  const auto report = projbot::twin::run_tour(scene, o);
+  const auto report = short_demo_tour(projbot::twin::TourMode::tracking);
   const auto& moved = report.visits[3];
   ASSERT_TRUE(moved.moved);
   EXPECT_EQ(moved.timeline.size(), 90U);  // 3 s at 30 Hz

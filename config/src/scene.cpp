@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -95,21 +96,24 @@ class MapReader {
   std::set<std::string> used_;
 };
 
-ProjectorConfig read_projector(MapReader& root) {
-  YAML::Node node = root.child("projector", true);
-  MapReader r(node, "projector", root.file());
-  ProjectorConfig p;
-  p.width_px = r.get<int>("width", 0, true);
-  p.height_px = r.get<int>("height", 0, true);
-  p.fx_px = r.get<double>("fx", 0.0, true);
-  p.fy_px = r.get<double>("fy", 0.0, true);
-  p.cx_px = r.get<double>("cx", 0.0, true);
-  p.cy_px = r.get<double>("cy", 0.0, true);
-  p.near_m = r.get<double>("near", p.near_m);
-  p.far_m = r.get<double>("far", p.far_m);
+// A pinhole section (`projector:`, `camera:`): every intrinsic required unless defaults are given.
+ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std::optional<ProjectorConfig>& defaults) {
+  YAML::Node node = root.child(key, !defaults);
+  ProjectorConfig p = defaults.value_or(ProjectorConfig{0, 0, 0.0, 0.0, 0.0, 0.0});
+  if (!node) return p;
+  MapReader r(node, key, root.file());
+  const bool required = !defaults;
+  p.width_px = r.get<int>("width", p.width_px, required);
+  p.height_px = r.get<int>("height", p.height_px, required);
+  p.fx_px = r.get<double>("fx", p.fx_px, required);
+  p.fy_px = r.get<double>("fy", p.fy_px, required);
+  p.cx_px = r.get<double>("cx", p.cx_px, required);
+  p.cy_px = r.get<double>("cy", p.cy_px, required);
+  p.near_m = r.get<double>("near", defaults ? p.near_m : ProjectorConfig{}.near_m);
+  p.far_m = r.get<double>("far", defaults ? p.far_m : ProjectorConfig{}.far_m);
   r.reject_unknown();
   try {
-    validate_projector(p, "projector");
+    validate_projector(p, key);
   } catch (const ConfigError& e) {
     r.fail(node, "", e.what());
   }
@@ -223,26 +227,9 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
   Scene scene;
   scene.source = source;
   MapReader r(root, "", file);
-  scene.projector = read_projector(r);
+  scene.projector = read_pinhole(r, "projector", std::nullopt);
   scene.pan_tilt = read_robot(r, scene);
-  if (YAML::Node cam = r.child("camera", false)) {
-    MapReader c(cam, "camera", file);
-    ProjectorConfig& k = scene.depth_camera;
-    k.width_px = c.get<int>("width", k.width_px);
-    k.height_px = c.get<int>("height", k.height_px);
-    k.fx_px = c.get<double>("fx", k.fx_px);
-    k.fy_px = c.get<double>("fy", k.fy_px);
-    k.cx_px = c.get<double>("cx", k.cx_px);
-    k.cy_px = c.get<double>("cy", k.cy_px);
-    k.near_m = c.get<double>("near", k.near_m);
-    k.far_m = c.get<double>("far", k.far_m);
-    c.reject_unknown();
-    try {
-      validate_projector(k, "camera");
-    } catch (const ConfigError& e) {
-      c.fail(cam, "", e.what());
-    }
-  }
+  scene.depth_camera = read_pinhole(r, "camera", Scene::kinect_v1_depth_camera());
   if (YAML::Node room = r.child("room", false)) {
     MapReader m(room, "room", file);
     scene.room.width_m = m.get<double>("width", 0.0, true);
