@@ -299,6 +299,7 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
         const auto v = m.numbers(rpy, m.key_path("rpy_deg"), 3);
         motion.rpy_deg = {v[0], v[1], v[2]};
       }
+      motion.stays = m.get<bool>("stays", false);
       m.reject_unknown();
       target.motion = motion;
     }

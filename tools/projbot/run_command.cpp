@@ -84,7 +84,7 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
       std::this_thread::sleep_until(tick);
       if (Clock::now() > tick + std::chrono::milliseconds(100)) tick = Clock::now();  // fell behind: do not burst
     }
-    targets[i].T_world_target_true = twin.scripted_pose(i, 0, 0.0);
+    twin.end_visit(i, target_visit);
   }
   state.publish({-1, now_s(), visits, true});
 }

@@ -216,8 +216,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
         r.reconverge_s = std::max(0.0, back_under - motion_end_s);
       else
         r.reconverge_s = -1.0;
-      target.T_world_target_true = twin.scripted_pose(i, 0, 0.0);  // put back for the next visit
     }
+    twin.end_visit(i, r.target_visit);  // back home, or left where it was moved
     report.visits.push_back(std::move(r));
   }
   report.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();

@@ -96,6 +96,7 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     tt.pedestal_raycaster = std::make_unique<MeshRaycaster>(pedestal);
     tt.pedestal_id = renderer_.add_model(pedestal);
     target_ids_.push_back(renderer_.add_model(tt.model));
+    home_.push_back(tt.T_world_target_true);
     targets_.push_back(std::move(tt));
   }
   robot_ = std::make_unique<robot::SimRobot>(robot_config(scene, options.pose_source, options.seed));
@@ -114,7 +115,7 @@ robot::HeadPoses Twin::believed_head() {
 
 Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double t_s) const {
   const TwinTarget& t = targets_.at(target);
-  const Eigen::Matrix4d& home = *t.config.T_world_target;
+  const Eigen::Matrix4d& home = home_.at(target);
   if (!t.config.motion || t.config.motion->visit != target_visit) return home;
   const config::TargetMotion& m = *t.config.motion;
   // Smoothstep from 0 to 1 over the motion: no jump in speed at its ends.
@@ -126,6 +127,13 @@ Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double
   T.topLeftCorner<3, 3>() = delta.topLeftCorner<3, 3>() * home.topLeftCorner<3, 3>();
   T.topRightCorner<3, 1>() += s * m.translation_m;
   return T;
+}
+
+void Twin::end_visit(std::size_t target, int target_visit) {
+  const auto& motion = targets_.at(target).config.motion;
+  if (motion && motion->stays && motion->visit == target_visit)
+    home_[target] = scripted_pose(target, target_visit, motion->start_s + motion->duration_s);
+  targets_[target].T_world_target_true = home_[target];
 }
 
 alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {

@@ -43,6 +43,7 @@ struct TargetMotion {
   double duration_s = 2.0;
   Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();  ///< world-frame shift, metres
   Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();        ///< world-frame turn, degrees
+  bool stays = false;  ///< the target is left where it was moved: later visits find it away from its map pose
 };
 
 /// One target object: its textured model and its pose in the projector frame.

@@ -65,8 +65,11 @@ class Twin {
   robot::HeadPoses true_head() const;
   robot::HeadPoses believed_head();
 
-  /// The target's pose `t_s` into a projection during its `target_visit`-th visit (motion script).
+  /// The target's pose `t_s` into a projection during its `target_visit`-th visit (motion script);
+  /// visit 0 is where it stands between visits.
   Eigen::Matrix4d scripted_pose(std::size_t target, int target_visit, double t_s) const;
+  /// After a visit: a target whose motion `stays` is left where the motion took it.
+  void end_visit(std::size_t target, int target_visit);
 
   /// Renders the true scene's depth from T_world_camera (Kinect v1 noise when enabled, seeded).
   alignment::DepthImage capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed);
@@ -81,6 +84,7 @@ class Twin {
   TwinOptions options_;
   engine::Renderer& renderer_;
   std::vector<TwinTarget> targets_;
+  std::vector<Eigen::Matrix4d> home_;  // where each target stands between visits
   std::unique_ptr<MeshRaycaster> floor_ray_;
   std::vector<std::size_t> target_ids_;
   std::size_t floor_id_ = 0;
