@@ -35,6 +35,9 @@ void print_help() {
                "  projbot align --model bun0.pcd --scan bun4.pcd --init \"0 0 0 0 -30 0\" --json\n"
                "  projbot slam --rawlog run.rawlog --out-map map --out-trajectory slam.txt\n"
                "  projbot localize --map map --rawlog run2.rawlog --out-trajectory loc.txt\n"
+               "  projbot tour                                      the demo tour in the digital twin (Table 1)\n"
+               "  projbot tour --mode odometry --report r.json      the paper's set-up, with a JSON report\n"
+               "  projbot run --sim --fullscreen                    the live engine against the twin\n"
                "  projbot bench render\n";
 }
 

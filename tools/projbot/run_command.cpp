@@ -94,8 +94,8 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
 const Command kRun{
     "run",
     "the live engine: project onto the tracked targets while the robot tours (the twin with --sim)",
-    "projbot run [--config C.yaml] [--sim] [--fullscreen] [--monitor N] [--profile p.csv] [--seconds S]\n"
-    "            [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n\n"
+    "projbot run [--config C.yaml] [--sim] [--fullscreen] [--monitor N] [--headless] [--profile p.csv]\n"
+    "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n\n"
     "Opens the projector output and draws, every frame, each target the robot is projecting onto at the\n"
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3); targets not yet found or lost are blanked.\n"
     "The robot thread drives the tour of the config's `tour.visits`, aims the pan-tilt, gives the worker\n"
