@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "projbot/alignment/equations.hpp"
-#include "projbot/alignment/tracker.hpp"
+#include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/image.hpp"
 #include "projbot/twin/world.hpp"
 
@@ -70,12 +70,12 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     acquisition.restart_angle_deg = 0.0;
     acquisition.reinitialise = false;
   }
-  std::vector<alignment::Aligner> aligners;
-  std::vector<alignment::ProjectiveTracker> trackers;
-  for (const auto& t : targets) {
-    aligners.emplace_back(t.cloud, acquisition);
-    trackers.emplace_back(t.cloud, twin.camera());
-  }
+  // One follower per target: its aligner acquires at each stop, its policy tracks while projecting
+  // (the same one the live engine's TrackerWorker runs).
+  alignment::WorkerConfig follow;
+  follow.acquisition = acquisition;
+  std::vector<alignment::TargetFollower> followers;
+  for (const auto& t : targets) followers.emplace_back(t.cloud, twin.camera(), follow);
   std::unique_ptr<engine::RenderTarget> projector_frame;
   if (!options.frames_dir.empty()) {
     std::filesystem::create_directories(options.frames_dir);
@@ -90,43 +90,35 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   std::vector<int> visit_count(targets.size(), 0);
   for (int v = 0; v < visits; ++v) {
     const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
-    std::size_t i = 0;
-    while (targets[i].config.name != name) ++i;
+    const std::size_t i = twin.target_index(name);
     TwinTarget& target = targets[i];
     VisitReport r;
     r.visit = v + 1;
     r.target_visit = ++visit_count[i];
     r.target = name;
-    for (std::size_t j = 0; j < targets.size(); ++j) targets[j].T_world_target_true = twin.scripted_pose(j, 0, 0.0);
 
-    // Drive to the stop, closing the loop on localisation (or odometry, the paper's set-up).
-    const Eigen::Vector3d& stop = *target.config.stop;
-    const robot::StopReport drive = twin.robot().drive_to({stop.x(), stop.y(), stop.z()}, v);
-    r.drive_s = drive.drive_seconds;
-    r.base_error_cm = 100.0 * drive.error_m;
-    r.base_error_deg = drive.error_rad * 180.0 / M_PI;
-    r.odometry_error_cm = 100.0 * drive.odometry_error_m;
-
-    // Aim at where the map says the target is, from where the robot believes it is.
-    const Eigen::Matrix4d T_map_target = target.config.T_map_target.value_or(*target.config.T_world_target);
-    const auto aim = robot::aim_at(twin.robot().believed_pose(), T_map_target.topRightCorner<3, 1>(), rig);
-    if (const auto s = twin.pan_tilt().move_to(aim.angles); !s.ok) throw TwinError("pan-tilt: " + s.error);
-    const robot::HeadPoses truth = twin.true_head();
-    const robot::HeadPoses believed = twin.believed_head();
+    // Drive to the stop, closing the loop on localisation (or odometry, the paper's set-up), and aim at
+    // where the map says the target is, from where the robot believes it is.
+    const Arrival arrival = twin.arrive(i, v);
+    r.drive_s = arrival.drive.drive_seconds;
+    r.base_error_cm = 100.0 * arrival.drive.error_m;
+    r.base_error_deg = arrival.drive.error_rad * 180.0 / M_PI;
+    r.odometry_error_cm = 100.0 * arrival.drive.odometry_error_m;
+    const robot::HeadPoses& truth = arrival.truth;
 
     // Capture, Eq. 1, acquisition, Eq. 2.
     auto t0 = Clock::now();
     const std::uint32_t noise_seed = static_cast<std::uint32_t>(options.seed * 100003 + static_cast<std::uint64_t>(v) * 1009);
     const alignment::DepthImage depth = twin.capture(truth.T_world_camera.matrix(), noise_seed);
     r.capture_ms = ms_since(t0);
-    const Eigen::Matrix4d T_init = alignment::camera_from_target_initial(believed.T_world_camera.matrix(), T_map_target);
+    const Eigen::Matrix4d& T_init = arrival.T_camera_target_guess;
     const Eigen::Matrix4d T_camera_true = alignment::rigid_inverse(truth.T_world_camera.matrix()) * target.T_world_target_true;
     const Eigen::Matrix4d guess_error = alignment::rigid_inverse(T_camera_true) * T_init;
     r.guess_error_cm = 100.0 * alignment::translation_norm_m(guess_error);
     r.guess_error_deg = alignment::rotation_angle_deg(guess_error);
     t0 = Clock::now();
     try {
-      r.icp = aligners[i].align(alignment::depth_to_cloud(depth, twin.camera()), T_init);
+      r.icp = followers[i].aligner().align(alignment::depth_to_cloud(depth, twin.camera()), T_init);
     } catch (const alignment::AlignmentError&) {
       r.icp.T_scan_model = T_init;  // too little of the target in view: nothing to align
       r.icp.converged = false;
@@ -158,7 +150,10 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     if (options.mode == TourMode::tracking || r.moved) {
       Eigen::Matrix4d T_camera_target = r.icp.T_scan_model;  // the newest estimate
       bool shown = r.projected;
-      int failures = 0;
+      if (r.icp.converged)
+        followers[i].set_pose(T_camera_target);
+      else
+        followers[i].set_initial_guess(T_init);
       double track_ms = 0.0;
       const int frames = static_cast<int>(std::lround(options.dwell_s * kCameraHz));
       double motion_end_s = 0.0;
@@ -180,32 +175,19 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
         r.timeline.push_back(s);
         if (s.moving) r.max_mm_moving = std::max(r.max_mm_moving, s.mean_mm);
         const bool good = shown && s.mean_mm <= kConvergedMm;
-        if (!good) ever_over = true;
-        if (!good)
+        if (!good) {
+          ever_over = true;
           back_under = -1.0;
-        else if (back_under < 0.0 && t_s >= motion_end_s)
+        } else if (back_under < 0.0 && t_s >= motion_end_s) {
           back_under = t_s;
+        }
         if (options.mode != TourMode::tracking) continue;
         const alignment::DepthImage frame =
             twin.capture(truth.T_world_camera.matrix(), noise_seed + static_cast<std::uint32_t>(k));
         const auto tt = Clock::now();
-        const alignment::TrackResult tr = trackers[i].track(frame, T_camera_target);
-        if (tr.accepted) {
-          T_camera_target = tr.T_camera_target;
-          failures = 0;
-          shown = true;
-        } else if (++failures >= 5) {
-          // Lost: blank it and re-acquire from the last pose.
-          shown = false;
-          try {
-            const auto a = aligners[i].align(alignment::depth_to_cloud(frame, twin.camera()), T_camera_target);
-            if (a.converged) {
-              T_camera_target = a.T_scan_model;
-              failures = 0;
-              shown = true;
-            }
-          } catch (const alignment::AlignmentError&) {
-          }
+        if (const auto sample = followers[i].step(frame)) {
+          shown = !sample->lost;
+          if (shown) T_camera_target = sample->T_camera_target;
         }
         track_ms += ms_since(tt);
       }

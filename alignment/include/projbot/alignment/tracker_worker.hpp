@@ -35,6 +35,35 @@ struct PoseSample {
   double rmse_mm = 0.0;
 };
 
+/// The worker's policy for one frame, without the thread: track from the last pose; when tracking
+/// fails, acquire on the same frame from where the target was last seen; after `lost_after` frames in
+/// which neither found it, report it lost. The twin's tour runs it in simulated time. Not thread-safe.
+class TargetFollower {
+ public:
+  /// Throws AlignmentError for a bad model or intrinsics.
+  TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config = {});
+  /// A new stop: the next frame acquires from this guess (Eq. 1).
+  void set_initial_guess(const Eigen::Matrix4d& T_camera_target);
+  /// The target was already acquired at T_camera_target: the next frame tracks from there.
+  void set_pose(const Eigen::Matrix4d& T_camera_target);
+  /// One frame: the sample to publish (sequence left 0), or nothing when there is no guess yet or the
+  /// frame was rejected without the target being lost yet.
+  std::optional<PoseSample> step(const DepthImage& frame);
+  /// The tracked pose, or the guess while acquiring.
+  Eigen::Matrix4d last_pose() const { return pose_.value_or(guess_); }
+  const Aligner& aligner() const { return aligner_; }
+
+ private:
+  Aligner aligner_;
+  ProjectiveTracker tracker_;
+  CameraIntrinsics k_;
+  WorkerConfig cfg_;
+  std::optional<Eigen::Matrix4d> pose_;  // tracked pose; empty while acquiring
+  Eigen::Matrix4d guess_ = Eigen::Matrix4d::Identity();
+  bool have_guess_ = false;
+  int rejected_ = 0;
+};
+
 class TrackerWorker {
  public:
   /// Starts the worker thread. Throws AlignmentError for a bad model or intrinsics.
@@ -58,10 +87,7 @@ class TrackerWorker {
  private:
   void run(std::stop_token stop);
 
-  Aligner aligner_;
-  ProjectiveTracker tracker_;
-  CameraIntrinsics k_;
-  WorkerConfig cfg_;
+  TargetFollower follower_;  // used by the worker thread only
   LatestValue<PoseSample> poses_;
   std::atomic<std::uint64_t> processed_{0};
 
