@@ -261,11 +261,6 @@ struct Aligner::Impl {
       icp.align(aligned, T_model_scan);
       iterations += icp.iterations();
       converged = converged && icp.hasConverged();
-      // Too few correspondences leave PCL's point-to-plane solve singular: a NaN pose, not an estimate.
-      if (!icp.getFinalTransformation().allFinite()) {
-        converged = false;
-        break;
-      }
       T_model_scan = icp.getFinalTransformation();
     }
     return rigid_inverse(T_model_scan.cast<double>());

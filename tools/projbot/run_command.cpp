@@ -52,18 +52,12 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
   std::vector<int> count(targets.size(), 0);
   for (int v = 0; v < visits && !stop.stop_requested(); ++v) {
     const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
-    std::size_t i = 0;
-    while (targets[i].config.name != name) ++i;
-    const auto scene_index = static_cast<std::size_t>(scene.target_index(name));
+    const std::size_t i = twin.target_index(name);
+    const auto scene_index = static_cast<std::size_t>(scene.target_index(name));  // workers and draw items
     state.publish({-1, now_s(), v + 1, false});
-    const Eigen::Vector3d& stop_pose = *targets[i].config.stop;
-    twin.robot().drive_to({stop_pose.x(), stop_pose.y(), stop_pose.z()}, v);
-    const Eigen::Matrix4d T_map_target = targets[i].config.T_map_target.value_or(*targets[i].config.T_world_target);
-    const auto aim = robot::aim_at(twin.robot().believed_pose(), T_map_target.topRightCorner<3, 1>(), scene.pan_tilt);
-    if (const auto s = twin.pan_tilt().move_to(aim.angles); !s.ok) throw twin::TwinError("pan-tilt: " + s.error);
-    const Eigen::Matrix4d T_world_camera = twin.true_head().T_world_camera.matrix();
-    workers[scene_index]->set_initial_guess(
-        alignment::camera_from_target_initial(twin.believed_head().T_world_camera.matrix(), T_map_target));  // Eq. 1
+    const twin::Arrival arrival = twin.arrive(i, v);
+    const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
+    workers[scene_index]->set_initial_guess(arrival.T_camera_target_guess);  // Eq. 1
     const int target_visit = ++count[i];
     const double since = now_s();
     state.publish({static_cast<int>(scene_index), since, v + 1, false});
@@ -152,8 +146,7 @@ const Command kRun{
       }
 
       // One tracker worker per target the tour visits.
-      const alignment::CameraIntrinsics k{scene.depth_camera.width_px, scene.depth_camera.height_px, scene.depth_camera.fx_px,
-                                          scene.depth_camera.fy_px,    scene.depth_camera.cx_px,     scene.depth_camera.cy_px};
+      const alignment::CameraIntrinsics k = twin::depth_intrinsics(scene);
       std::vector<std::unique_ptr<alignment::TrackerWorker>> workers(scene.targets.size());
       for (std::size_t i = 0; i < scene.targets.size(); ++i) {
         if (!scene.targets[i].T_world_target) continue;

@@ -14,10 +14,6 @@ namespace {
 
 constexpr double kPedestalHalfWidthM = 0.12;  // 24 cm square pedestals: narrower than the targets
 
-config::ProjectorConfig as_pinhole(const alignment::CameraIntrinsics& k, double near_m, double far_m) {
-  return {k.width_px, k.height_px, k.fx_px, k.fy_px, k.cx_px, k.cy_px, near_m, far_m};
-}
-
 // The pedestal's top is the target's lowest point, so the target stands on it: its height, metres.
 double pedestal_height(const assets::Model& model, const Eigen::Matrix4d& T_world_target) {
   double z_min = std::numeric_limits<double>::infinity();
@@ -28,6 +24,11 @@ double pedestal_height(const assets::Model& model, const Eigen::Matrix4d& T_worl
 }
 
 }  // namespace
+
+alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene) {
+  const config::ProjectorConfig& k = scene.depth_camera;
+  return {k.width_px, k.height_px, k.fx_px, k.fy_px, k.cx_px, k.cy_px};
+}
 
 robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed) {
   robot::SimTourConfig c;
@@ -53,12 +54,7 @@ robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource 
 }
 
 Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Renderer& renderer)
-    : scene_(scene), options_(options), renderer_(renderer), pan_tilt_(scene.pan_tilt), camera_{scene.depth_camera.width_px,
-                                                                                                scene.depth_camera.height_px,
-                                                                                                scene.depth_camera.fx_px,
-                                                                                                scene.depth_camera.fy_px,
-                                                                                                scene.depth_camera.cx_px,
-                                                                                                scene.depth_camera.cy_px} {
+    : scene_(scene), options_(options), renderer_(renderer), pan_tilt_(scene.pan_tilt), camera_(depth_intrinsics(scene)) {
   const std::string where = scene.source.empty() ? std::string("<scene>") : scene.source.string();
   if (scene.visits.empty()) throw TwinError(where + ": the twin needs a 'tour: {visits: [...]}' section");
   const auto floor = assets::make_box({-2.0, -2.0, -0.05}, {scene.room.width_m + 2.0, scene.room.depth_m + 2.0, 0.0},
@@ -103,14 +99,26 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
   depth_target_ = renderer_.make_depth_camera(camera_.width_px, camera_.height_px);
 }
 
-robot::HeadPoses Twin::true_head() const {
-  return robot::head_poses(robot_->true_pose(), pan_tilt_.true_angles(), scene_.pan_tilt);
+std::size_t Twin::target_index(const std::string& name) const {
+  for (std::size_t i = 0; i < targets_.size(); ++i)
+    if (targets_[i].config.name == name) return i;
+  throw TwinError("the twin has no target named '" + name + "'");
 }
 
-robot::HeadPoses Twin::believed_head() {
+Arrival Twin::arrive(std::size_t target, int index) {
+  const TwinTarget& t = targets_.at(target);
+  Arrival a;
+  const Eigen::Vector3d& stop = *t.config.stop;
+  a.drive = robot_->drive_to({stop.x(), stop.y(), stop.z()}, index);
+  a.T_map_target = t.config.T_map_target.value_or(*t.config.T_world_target);
+  const auto aim = robot::aim_at(robot_->believed_pose(), a.T_map_target.topRightCorner<3, 1>(), scene_.pan_tilt);
+  if (const auto s = pan_tilt_.move_to(aim.angles); !s.ok) throw TwinError("pan-tilt: " + s.error);
   robot::PanTiltAngles reported;
   if (const auto s = pan_tilt_.position(reported); !s.ok) throw TwinError("pan-tilt: " + s.error);
-  return robot::head_poses(robot_->believed_pose(), reported, scene_.pan_tilt);
+  a.truth = robot::head_poses(robot_->true_pose(), pan_tilt_.true_angles(), scene_.pan_tilt);
+  a.believed = robot::head_poses(robot_->believed_pose(), reported, scene_.pan_tilt);
+  a.T_camera_target_guess = alignment::camera_from_target_initial(a.believed.T_world_camera.matrix(), a.T_map_target);
+  return a;
 }
 
 Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double t_s) const {
@@ -143,7 +151,11 @@ alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::
     items.push_back({target_ids_[i], T_camera_world * targets_[i].T_world_target_true});
     items.push_back({targets_[i].pedestal_id, T_camera_world * targets_[i].T_world_pedestal});
   }
-  renderer_.draw_frame(*depth_target_, as_pinhole(camera_, 0.3, 8.0), items);
+  // Rendered from 0.3 to 8 m: the noise model, not the clip planes, drops what the Kinect cannot see.
+  config::ProjectorConfig pinhole = scene_.depth_camera;
+  pinhole.near_m = 0.3;
+  pinhole.far_m = 8.0;
+  renderer_.draw_frame(*depth_target_, pinhole, items);
   const engine::DepthMap map = depth_target_->read_back_depth();
   alignment::DepthImage clean{map.width, map.height, map.z_m, 0.0};
   if (!options_.depth_noise) return clean;

@@ -46,6 +46,16 @@ struct TwinTarget {
   std::size_t pedestal_id = 0;  ///< renderer model id
 };
 
+/// Where the robot stands after driving to a target's stop and aiming at it.
+struct Arrival {
+  robot::StopReport drive;
+  robot::HeadPoses truth;                                      ///< the head's true frames
+  robot::HeadPoses believed;                                   ///< where the robot believes its head is
+  Eigen::Matrix4d T_map_target = Eigen::Matrix4d::Identity();  ///< the target as surveyed
+  /// Eq. 1: the target's initial pose in the camera frame, from the map and the believed head.
+  Eigen::Matrix4d T_camera_target_guess = Eigen::Matrix4d::Identity();
+};
+
 class Twin {
  public:
   /// Loads every target's model, checks the tour sections and markers, builds the room map and the
@@ -61,9 +71,11 @@ class Twin {
   robot::SimulatedPanTilt& pan_tilt() { return pan_tilt_; }
   const alignment::CameraIntrinsics& camera() const { return camera_; }
 
-  /// True and believed head frames for the robot's present state.
-  robot::HeadPoses true_head() const;
-  robot::HeadPoses believed_head();
+  /// Index into targets() of the target named `name`. Throws TwinError if the twin has none.
+  std::size_t target_index(const std::string& name) const;
+  /// Drives to the target's stop (`index` goes into the report), aims the pan-tilt at the target's
+  /// surveyed position from where the robot believes it is, and takes Eq. 1's initial guess.
+  Arrival arrive(std::size_t target, int index);
 
   /// The target's pose `t_s` into a projection during its `target_visit`-th visit (motion script);
   /// visit 0 is where it stands between visits.
@@ -93,6 +105,9 @@ class Twin {
   alignment::CameraIntrinsics camera_;
   std::unique_ptr<engine::RenderTarget> depth_target_;
 };
+
+/// The scene's depth camera as the estimator's intrinsics.
+alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene);
 
 /// The twin's robot set-up for a scene: its room (with a pedestal under each target), start pose and
 /// drift, closing the loop on `source`.
