@@ -65,41 +65,32 @@ const Command kRender{"render", "render the projector image headless (offscreen)
                         return report_validation(args, renderer) ? 0 : 1;
                       }};
 
-const Command kShow{
-    "show", "open the projector output in a window (fullscreen on a projector, or a preview)",
-    "projbot show [--scene S.yaml] [--fullscreen] [--monitor N] [--present-mode fifo|mailbox|immediate]\n\n"
-    "Opens a window showing the projector image and redraws it every frame until the window is closed\n"
-    "(or --frames have been drawn). Without --fullscreen the window has the projector's size.\n",
-    with_scene_options({{"fullscreen", "", "fullscreen on --monitor (the projector)"},
-                        {"monitor", "N", "monitor index for --fullscreen (default 0)"},
-                        {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
-                        {"frames", "N", "close after N frames (default: run until closed)"},
-                        {"profile", "FILE", "write one CSV row of timings per frame"}}),
-    [](const cli::Args& args) {
-      const config::Scene scene = scene_from_args(args);
-      const int frames = args.get_int("frames", 0, 0, 100000000);
-      engine::WindowOptions w;
-      w.title = "projbot: " + (scene.source.empty() ? std::string("model") : scene.source.filename().string());
-      w.width_px = scene.projector.width_px;
-      w.height_px = scene.projector.height_px;
-      w.fullscreen = args.flag("fullscreen");
-      w.monitor = args.get_int("monitor", 0, 0, 64);
-      w.present_mode = present_mode(args.get_or("present-mode", "fifo"));
-      engine::Renderer renderer(renderer_options(args, true));
-      std::cout << "device: " << renderer.device_info().name << '\n';
-      const auto items = upload_scene(renderer, scene);
-      auto window = renderer.make_window(w);
-      if (w.fullscreen && (window->width() != scene.projector.width_px || window->height() != scene.projector.height_px))
-        std::cerr << "projbot: warning: monitor is " << window->width() << "x" << window->height()
-                  << " but the projector model is " << scene.projector.width_px << "x" << scene.projector.height_px
-                  << "; the image is stretched\n";
-      engine::FrameProfiler profiler;
-      int drawn = 0;
-      while (!window->poll_close() && (frames == 0 || drawn < frames))
-        if (renderer.draw_frame(*window, scene.projector, items, &profiler)) ++drawn;
-      renderer.finish(*window);
-      finish_profile(args, profiler);
-      return report_validation(args, renderer) ? 0 : 1;
-    }};
+const Command kShow{"show", "open the projector output in a window (fullscreen on a projector, or a preview)",
+                    "projbot show [--scene S.yaml] [--fullscreen] [--monitor N] [--present-mode fifo|mailbox|immediate]\n\n"
+                    "Opens a window showing the projector image and redraws it every frame until the window is closed\n"
+                    "(or --frames have been drawn). Without --fullscreen the window has the projector's size.\n",
+                    with_scene_options({{"fullscreen", "", "fullscreen on --monitor (the projector)"},
+                                        {"monitor", "N", "monitor index for --fullscreen (default 0)"},
+                                        {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
+                                        {"frames", "N", "close after N frames (default: run until closed)"},
+                                        {"profile", "FILE", "write one CSV row of timings per frame"}}),
+                    [](const cli::Args& args) {
+                      const config::Scene scene = scene_from_args(args);
+                      const int frames = args.get_int("frames", 0, 0, 100000000);
+                      const engine::WindowOptions w = window_options(
+                          args, scene.projector,
+                          "projbot: " + (scene.source.empty() ? std::string("model") : scene.source.filename().string()));
+                      engine::Renderer renderer(renderer_options(args, true));
+                      std::cout << "device: " << renderer.device_info().name << '\n';
+                      const auto items = upload_scene(renderer, scene);
+                      auto window = open_window(renderer, w, scene.projector);
+                      engine::FrameProfiler profiler;
+                      int drawn = 0;
+                      while (!window->poll_close() && (frames == 0 || drawn < frames))
+                        if (renderer.draw_frame(*window, scene.projector, items, &profiler)) ++drawn;
+                      renderer.finish(*window);
+                      finish_profile(args, profiler);
+                      return report_validation(args, renderer) ? 0 : 1;
+                    }};
 
 }  // namespace projbot::tools

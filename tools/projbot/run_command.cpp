@@ -131,18 +131,8 @@ const Command kRun{
       if (headless) {
         target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
       } else {
-        engine::WindowOptions w;
-        w.title = "projbot run: " + scene.source.filename().string();
-        w.width_px = scene.projector.width_px;
-        w.height_px = scene.projector.height_px;
-        w.fullscreen = args.flag("fullscreen");
-        w.monitor = args.get_int("monitor", 0, 0, 64);
-        w.present_mode = present_mode(args.get_or("present-mode", "fifo"));
-        target = renderer.make_window(w);
-        if (w.fullscreen && (target->width() != scene.projector.width_px || target->height() != scene.projector.height_px))
-          std::cerr << "projbot: warning: monitor is " << target->width() << "x" << target->height()
-                    << " but the projector model is " << scene.projector.width_px << "x" << scene.projector.height_px
-                    << "; the image is stretched\n";
+        target = open_window(renderer, window_options(args, scene.projector, "projbot run: " + scene.source.filename().string()),
+                             scene.projector);
       }
 
       // One tracker worker per target the tour visits.

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <iostream>
 
 #include "projbot/assets/model.hpp"
 
@@ -107,11 +108,35 @@ std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const con
   return items;
 }
 
+namespace {
+
 engine::PresentMode present_mode(const std::string& name) {
   if (name == "fifo") return engine::PresentMode::kFifo;
   if (name == "mailbox") return engine::PresentMode::kMailbox;
   if (name == "immediate") return engine::PresentMode::kImmediate;
   throw cli::UsageError("--present-mode must be fifo, mailbox or immediate, got '" + name + "'");
+}
+
+}  // namespace
+
+engine::WindowOptions window_options(const cli::Args& args, const config::ProjectorConfig& projector, std::string title) {
+  engine::WindowOptions w;
+  w.title = std::move(title);
+  w.width_px = projector.width_px;
+  w.height_px = projector.height_px;
+  w.fullscreen = args.flag("fullscreen");
+  w.monitor = args.get_int("monitor", 0, 0, 64);
+  w.present_mode = present_mode(args.get_or("present-mode", "fifo"));
+  return w;
+}
+
+std::unique_ptr<engine::RenderTarget> open_window(engine::Renderer& renderer, const engine::WindowOptions& options,
+                                                  const config::ProjectorConfig& projector) {
+  auto window = renderer.make_window(options);
+  if (options.fullscreen && (window->width() != projector.width_px || window->height() != projector.height_px))
+    std::cerr << "projbot: warning: monitor is " << window->width() << "x" << window->height() << " but the projector model is "
+              << projector.width_px << "x" << projector.height_px << "; the image is stretched\n";
+  return window;
 }
 
 }  // namespace projbot::tools

@@ -3,6 +3,8 @@
 // render-type subcommands share, and the upload of every target's model.
 
 #include <filesystem>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "cli.hpp"
@@ -27,7 +29,11 @@ Eigen::Matrix4d framing_pose(const config::ProjectorConfig& projector, double ra
 
 /// Loads, scales and recentres each target's model and uploads it; returns one DrawItem per target.
 std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene);
-/// --present-mode: fifo, mailbox or immediate. Throws cli::UsageError.
-engine::PresentMode present_mode(const std::string& name);
+/// The projector window from --fullscreen, --monitor and --present-mode (fifo, mailbox or immediate), the
+/// projector's size when windowed. Throws cli::UsageError.
+engine::WindowOptions window_options(const cli::Args& args, const config::ProjectorConfig& projector, std::string title);
+/// Opens it, warning on stderr when a fullscreen monitor's mode differs from the projector model's size.
+std::unique_ptr<engine::RenderTarget> open_window(engine::Renderer& renderer, const engine::WindowOptions& options,
+                                                  const config::ProjectorConfig& projector);
 
 }  // namespace projbot::tools
