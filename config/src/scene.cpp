@@ -67,6 +67,11 @@ class MapReader {
     return out;
   }
 
+  Eigen::Vector3d vector3(const YAML::Node& n, const std::string& key_path) const {
+    const auto v = numbers(n, key_path, 3);
+    return {v[0], v[1], v[2]};
+  }
+
   // Call once every known key was read: any other key is a typo the user must hear about.
   void reject_unknown() const {
     for (const auto& kv : node_) {
@@ -109,8 +114,8 @@ ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std:
   p.fy_px = r.get<double>("fy", p.fy_px, required);
   p.cx_px = r.get<double>("cx", p.cx_px, required);
   p.cy_px = r.get<double>("cy", p.cy_px, required);
-  p.near_m = r.get<double>("near", defaults ? p.near_m : ProjectorConfig{}.near_m);
-  p.far_m = r.get<double>("far", defaults ? p.far_m : ProjectorConfig{}.far_m);
+  p.near_m = r.get<double>("near", p.near_m);  // the aggregate above keeps near and far's defaults
+  p.far_m = r.get<double>("far", p.far_m);
   r.reject_unknown();
   try {
     validate_projector(p, key);
@@ -132,11 +137,10 @@ Eigen::Matrix4d read_pose(MapReader& target, const std::string& path, const std:
     const auto m = r.numbers(r.child("matrix", true), r.key_path("matrix"), 16);
     for (int i = 0; i < 16; ++i) T(i / 4, i % 4) = m[static_cast<std::size_t>(i)];
   } else {
-    const auto t = r.numbers(r.child("translation", true), r.key_path("translation"), 3);
+    const Eigen::Vector3d t = r.vector3(r.child("translation", true), r.key_path("translation"));
     YAML::Node rpy_node = r.child("rpy_deg", false);
-    std::vector<double> rpy{0.0, 0.0, 0.0};
-    if (rpy_node) rpy = r.numbers(rpy_node, r.key_path("rpy_deg"), 3);
-    T = pose_from_xyz_rpy({t[0], t[1], t[2]}, {rpy[0], rpy[1], rpy[2]});
+    const Eigen::Vector3d rpy = rpy_node ? r.vector3(rpy_node, r.key_path("rpy_deg")) : Eigen::Vector3d::Zero();
+    T = pose_from_xyz_rpy(t, rpy);
   }
   r.reject_unknown();
   try {
@@ -154,8 +158,8 @@ PanTiltConfig read_robot(MapReader& root, Scene& scene) {
   if (!node) return c;
   MapReader r(node, "robot", root.file());
   if (YAML::Node st = r.child("start", false)) {
-    const auto v = r.numbers(st, "robot.start", 3);
-    scene.robot_start = {v[0], v[1], v[2] * std::numbers::pi / 180.0};
+    scene.robot_start = r.vector3(st, "robot.start");
+    scene.robot_start.z() *= std::numbers::pi / 180.0;
   }
   if (YAML::Node dn = r.child("drift", false)) {
     MapReader d(dn, "robot.drift", root.file());
@@ -181,10 +185,7 @@ PanTiltConfig read_robot(MapReader& root, Scene& scene) {
   c.T_base_mount = read_pose(p, "robot.pan_tilt.mount", "mount", c.T_base_mount);
   c.T_head_camera = read_pose(p, "robot.pan_tilt.camera", "camera", c.T_head_camera);
   c.T_projector_camera = read_pose(p, "robot.pan_tilt.projector_from_camera", "projector_from_camera", c.T_projector_camera);
-  if (YAML::Node n = p.child("tilt_axis_offset", false)) {
-    const auto v = p.numbers(n, "robot.pan_tilt.tilt_axis_offset", 3);
-    c.tilt_axis_offset_m = {v[0], v[1], v[2]};
-  }
+  if (YAML::Node n = p.child("tilt_axis_offset", false)) c.tilt_axis_offset_m = p.vector3(n, "robot.pan_tilt.tilt_axis_offset");
   const auto limits = [&](const char* key, double& lo, double& hi) {
     YAML::Node n = p.child(key, false);
     if (!n) return;
@@ -272,14 +273,13 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
       target.T_map_target = read_pose(t, path + ".map_pose", "map_pose");
     }
     if (YAML::Node st = t.child("stop", false)) {
-      const auto v = t.numbers(st, path + ".stop", 3);
-      target.stop = Eigen::Vector3d(v[0], v[1], v[2] * std::numbers::pi / 180.0);
+      target.stop = t.vector3(st, path + ".stop");
+      target.stop->z() *= std::numbers::pi / 180.0;
     }
     if (YAML::Node mk = t.child("markers", false)) {
       if (!mk.IsSequence() || mk.size() == 0) t.fail(mk, path + ".markers", "expected a non-empty list of [x, y, z]");
       for (std::size_t k = 0; k < mk.size(); ++k) {
-        const auto v = t.numbers(mk[k], path + ".markers[" + std::to_string(k) + "]", 3);
-        target.markers_m.emplace_back(v[0], v[1], v[2]);
+        target.markers_m.push_back(t.vector3(mk[k], path + ".markers[" + std::to_string(k) + "]"));
       }
     }
     if (YAML::Node mo = t.child("motion", false)) {
@@ -291,14 +291,8 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
       motion.duration_s = m.get<double>("duration_s", motion.duration_s);
       if (motion.start_s < 0.0 || !(motion.duration_s > 0.0))
         m.fail(mo, path + ".motion", "need start_s >= 0 and duration_s > 0");
-      if (YAML::Node tr = m.child("translation", false)) {
-        const auto v = m.numbers(tr, m.key_path("translation"), 3);
-        motion.translation_m = {v[0], v[1], v[2]};
-      }
-      if (YAML::Node rpy = m.child("rpy_deg", false)) {
-        const auto v = m.numbers(rpy, m.key_path("rpy_deg"), 3);
-        motion.rpy_deg = {v[0], v[1], v[2]};
-      }
+      if (YAML::Node tr = m.child("translation", false)) motion.translation_m = m.vector3(tr, m.key_path("translation"));
+      if (YAML::Node rpy = m.child("rpy_deg", false)) motion.rpy_deg = m.vector3(rpy, m.key_path("rpy_deg"));
       motion.stays = m.get<bool>("stays", false);
       m.reject_unknown();
       target.motion = motion;
