@@ -144,7 +144,7 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
       {"seed", report.seed},
       {"projector",
        {{"width", k.width_px}, {"height", k.height_px}, {"fx", k.fx_px}, {"fy", k.fy_px}, {"cx", k.cx_px}, {"cy", k.cy_px}}},
-      {"paper_table1_mm", {{"target1", {4, 6, 12}}, {"target2", {6, 6, 19}}}},
+      {"paper_table1_mm", {{"target1", kPaperMm[0]}, {"target2", kPaperMm[1]}}},
       {"wall_s", report.wall_s},
       {"visits", visits}};
   std::ofstream f(path);
