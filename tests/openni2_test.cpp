@@ -1,7 +1,16 @@
 // OpenNI2 through the packaged drivers: the Dummy device (320x240 depth) live, recording it to .oni,
-// and what the packaged OniFile driver does when that recording is played back.
+// and playing recordings back frame by frame through the packaged OniFile driver.
+//
+// Each test opens the Dummy device at most once: the packaged DummyDevice driver keeps a closed device's
+// frame generator running, so a Dummy device reopened in the same process streams the frames of every
+// earlier opening too (interleaved timestamp sequences: 33 363 66 396 ... ms), and a third opening
+// can crash. ctest runs every test in its own process (gtest_discover_tests).
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <iterator>
 
 #include "projbot/alignment/openni2_source.hpp"
 
@@ -29,26 +38,112 @@ TEST(OpenNi2Test, DummyDeviceStreamsDepth) {
   }
 }
 
-TEST(OpenNi2Test, RecordingAndWhatPlaybackDoes) {
-  const fs::path oni = fs::temp_directory_path() / ("projbot_dummy_" + std::to_string(::getpid()) + ".oni");
-  {
-    OpenNi2Source live({"Dummy", oni, 3000});
-    for (int i = 0; i < 10; ++i) live.next();
-  }  // the recorder is finalised here
-  ASSERT_TRUE(fs::exists(oni));
-  EXPECT_GT(fs::file_size(oni), 10000U);
-  OpenNi2Source playback({oni.string(), {}, 1500});
-  // The file holds the frames (the recorder, attached after the stream started, may miss the first)...
-  EXPECT_GE(playback.recorded_frames(), 9);
-  // ...but the packaged OniFile driver (2.2.0.33) delivers none of them: waitForAnyStream times out. This
-  // pins that behaviour; when it changes, replace this with a frame-by-frame playback test.
+namespace {
+
+fs::path temp_oni(const std::string& tag) {
+  return fs::temp_directory_path() / ("projbot_" + tag + "_" + std::to_string(::getpid()) + ".oni");
+}
+
+// Records `frames` live Dummy frames to `oni` and returns them.
+std::vector<DepthImage> record_dummy(const fs::path& oni, int frames) {
+  std::vector<DepthImage> live;
+  OpenNi2Source source({"Dummy", oni, 3000});
+  for (int i = 0; i < frames; ++i) live.push_back(source.next());
+  return live;
+}  // the recorder is finalised (and the cropping property added) when the source goes
+
+std::size_t playback_count_and_check(const fs::path& oni, const std::vector<DepthImage>& live) {
+  OpenNi2Source playback({oni.string(), {}, 3000});
+  const int n = playback.recorded_frames();
+  // The recorder, attached after the stream started, may miss the first live frame.
+  EXPECT_GE(n, static_cast<int>(live.size()) - 1);
+  EXPECT_LE(n, static_cast<int>(live.size()));
+  const std::size_t offset = live.size() - static_cast<std::size_t>(n);
+  double first_time = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const DepthImage frame = playback.next();  // stepped: called as fast as it likes, it gets every frame
+    EXPECT_EQ(playback.frames_read(), k + 1);
+    const DepthImage& original = live[offset + static_cast<std::size_t>(k)];
+    EXPECT_EQ(frame.width, original.width);
+    EXPECT_EQ(frame.height, original.height);
+    EXPECT_EQ(frame.depth_m, original.depth_m) << "frame " << k << " decodes differently from what was recorded";
+    if (k == 0) first_time = frame.capture_time_s;
+    // Recorded times restart at 0 and keep the live spacing (the Dummy device: 33 ms).
+    EXPECT_NEAR(frame.capture_time_s - first_time, original.capture_time_s - live[offset].capture_time_s, 1e-6);
+  }
   try {
     playback.next();
-    ADD_FAILURE() << "playback delivered a frame: the packaged OpenNI2 now plays this recording";
+    ADD_FAILURE() << "a frame after the end of the recording";
   } catch (const AlignmentError& e) {
-    EXPECT_NE(std::string(e.what()).find("playback of this recording delivers no frames"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("end of the recording"), std::string::npos) << e.what();
   }
+  return static_cast<std::size_t>(n);
+}
+
+}  // namespace
+
+TEST(OpenNi2Test, RecordingPlaysBackFrameByFrame) {
+  const fs::path oni = temp_oni("dummy");
+  const std::vector<DepthImage> live = record_dummy(oni, 10);
+  ASSERT_TRUE(fs::exists(oni));
+  EXPECT_GT(fs::file_size(oni), 10000U);
+  // The Dummy device's stream has no cropping, so OpenNI2's recorder left the property out and the
+  // packaged player would drop every frame; the source added it when the recording was finalised.
+  EXPECT_TRUE(oni_declares_cropping(oni));
+  EXPECT_FALSE(add_oni_cropping_property(oni));  // nothing missing any more
+  EXPECT_GE(playback_count_and_check(oni, live), 9U);
   fs::remove(oni);
+}
+
+TEST(OpenNi2Test, RecordingWithoutCroppingPlaysFromARepairedCopy) {
+  const fs::path oni = temp_oni("uncropped");
+  const std::vector<DepthImage> live = record_dummy(oni, 6);
+  // Make it what OpenNI2's recorder writes for the Dummy device: no xnCropping property (renamed to a
+  // name the player ignores, keeping every file position).
+  std::string bytes;
+  {
+    std::ifstream in(oni, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::size_t at = bytes.find("xnCropping");
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + 9] = 'X';
+  std::ofstream(oni, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_FALSE(oni_declares_cropping(oni));
+  EXPECT_GE(playback_count_and_check(oni, live), 5U);
+  EXPECT_FALSE(oni_declares_cropping(oni));  // the user's file is left as it was
+  for (const auto& entry : fs::directory_iterator(fs::temp_directory_path()))
+    EXPECT_EQ(entry.path().filename().string().rfind("projbot_playback_" + std::to_string(::getpid()) + "_", 0),
+              std::string::npos)
+        << "temporary copy left behind: " << entry.path();
+  fs::remove(oni);
+}
+
+TEST(OpenNi2Test, MalformedRecordingsAreNamed) {
+  const fs::path not_oni = temp_oni("not");
+  std::ofstream(not_oni) << "this is not a recording";
+  for (const auto& call :
+       {+[](const fs::path& p) { oni_declares_cropping(p); }, +[](const fs::path& p) { add_oni_cropping_property(p); }}) {
+    try {
+      call(not_oni);
+      ADD_FAILURE() << "no error";
+    } catch (const AlignmentError& e) {
+      EXPECT_NE(std::string(e.what()).find(not_oni.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("NI10"), std::string::npos) << e.what();
+    }
+  }
+  // A recording cut short: named, with where it ends.
+  const fs::path cut = temp_oni("cut");
+  record_dummy(cut, 3);
+  fs::resize_file(cut, fs::file_size(cut) / 2);
+  try {
+    OpenNi2Source({cut.string(), {}, 500});
+    ADD_FAILURE() << "no error";
+  } catch (const AlignmentError& e) {
+    EXPECT_NE(std::string(e.what()).find(cut.string()), std::string::npos) << e.what();
+  }
+  fs::remove(not_oni);
+  fs::remove(cut);
 }
 
 TEST(OpenNi2Test, BadUrisAreNamed) {

@@ -3,8 +3,11 @@
 #include "projbot/alignment/openni2_source.hpp"
 
 #include <OpenNI.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <cmath>
+#include <cstdio>
 
 namespace projbot::alignment {
 namespace {
@@ -17,14 +20,30 @@ std::string describe(const std::string& uri) {
   throw AlignmentError(describe(uri) + ": " + what + ": " + openni::OpenNI::getExtendedError());
 }
 
+// A file removed when this goes, also when the constructor throws half way.
+struct TemporaryFile {
+  std::filesystem::path path;
+  TemporaryFile() = default;
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  ~TemporaryFile() {
+    std::error_code ignored;
+    if (!path.empty()) std::filesystem::remove(path, ignored);
+  }
+};
+
 }  // namespace
 
 struct OpenNi2Source::Impl {
+  TemporaryFile repaired_copy;  // a copy of a recording that lacked the cropping property; outlives the device
   OpenNi2Options options;
   openni::Device device;
   openni::VideoStream depth;
   openni::Recorder recorder;
   double metres_per_unit = 0.001;
+  bool playback = false;
+  int frames_read = 0;
+  bool stream_crops = true;  // whether the recorded stream declares cropping itself
 };
 
 OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_unique<Impl>()) {
@@ -35,8 +54,24 @@ OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_un
   if (openni::OpenNI::initialize() != openni::STATUS_OK) fail(options.uri, "cannot initialise OpenNI2");
   const bool is_file = options.uri.size() > 4 && options.uri.substr(options.uri.size() - 4) == ".oni";
   if (is_file && !std::filesystem::is_regular_file(options.uri)) throw AlignmentError(options.uri + ": no such .oni recording");
-  if (m.device.open(options.uri.empty() ? openni::ANY_DEVICE : options.uri.c_str()) != openni::STATUS_OK)
+  std::string open_uri = options.uri;
+  if (is_file && !oni_declares_cropping(options.uri)) {
+    // The packaged player would deliver no frame of it (see the header): play a repaired copy.
+    static std::atomic<int> copies{0};
+    m.repaired_copy.path = std::filesystem::temp_directory_path() /
+                           ("projbot_playback_" + std::to_string(::getpid()) + "_" + std::to_string(copies++) + ".oni");
+    std::filesystem::copy_file(options.uri, m.repaired_copy.path, std::filesystem::copy_options::overwrite_existing);
+    add_oni_cropping_property(m.repaired_copy.path);
+    open_uri = m.repaired_copy.path.string();
+  }
+  if (m.device.open(open_uri.empty() ? openni::ANY_DEVICE : open_uri.c_str()) != openni::STATUS_OK)
     fail(options.uri, "cannot open");
+  if (auto* control = m.device.getPlaybackControl(); control != nullptr && control->isValid()) {
+    // Step: the player waits for each read to release the next frame, and stops at the end.
+    m.playback = true;
+    if (control->setSpeed(-1.0F) != openni::STATUS_OK || control->setRepeatEnabled(false) != openni::STATUS_OK)
+      fail(options.uri, "cannot set frame-by-frame playback");
+  }
   if (!m.device.hasSensor(openni::SENSOR_DEPTH)) throw AlignmentError(describe(options.uri) + ": has no depth sensor");
   if (m.depth.create(m.device, openni::SENSOR_DEPTH) != openni::STATUS_OK) fail(options.uri, "cannot create the depth stream");
   const openni::PixelFormat format = m.depth.getVideoMode().getPixelFormat();
@@ -48,6 +83,7 @@ OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_un
     throw AlignmentError(describe(options.uri) + ": depth pixel format " + std::to_string(static_cast<int>(format)) +
                          " is not in mm or 100 um");
   if (m.depth.start() != openni::STATUS_OK) fail(options.uri, "cannot start the depth stream");
+  m.stream_crops = m.depth.isCroppingSupported();
   if (!options.record_to.empty()) {
     if (m.recorder.create(options.record_to.c_str()) != openni::STATUS_OK || m.recorder.attach(m.depth) != openni::STATUS_OK ||
         m.recorder.start() != openni::STATUS_OK)
@@ -59,7 +95,14 @@ OpenNi2Source::~OpenNi2Source() {
   Impl& m = *impl_;
   if (m.recorder.isValid()) {
     m.recorder.stop();
-    m.recorder.destroy();
+    m.recorder.destroy();  // writes the seek table and closes the file
+    if (!m.stream_crops) {
+      try {
+        add_oni_cropping_property(m.options.record_to);
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "projbot: %s: the recording will not play back with the packaged OpenNI2\n", e.what());
+      }
+    }
   }
   m.depth.stop();
   m.depth.destroy();
@@ -68,14 +111,15 @@ OpenNi2Source::~OpenNi2Source() {
 
 DepthImage OpenNi2Source::next() {
   Impl& m = *impl_;
+  if (m.playback && m.frames_read >= recorded_frames())
+    throw AlignmentError(describe(m.options.uri) + ": end of the recording (" + std::to_string(m.frames_read) + " frames)");
   openni::VideoStream* streams[] = {&m.depth};
   int ready = -1;
   if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, m.options.timeout_ms) != openni::STATUS_OK)
-    throw AlignmentError(
-        describe(m.options.uri) + ": no depth frame within " + std::to_string(m.options.timeout_ms) + " ms" +
-        (recorded_frames() >= 0 ? " (playback of this recording delivers no frames with the installed OpenNI2)" : ""));
+    throw AlignmentError(describe(m.options.uri) + ": no depth frame within " + std::to_string(m.options.timeout_ms) + " ms");
   openni::VideoFrameRef frame;
   if (m.depth.readFrame(&frame) != openni::STATUS_OK || !frame.isValid()) fail(m.options.uri, "cannot read a depth frame");
+  ++m.frames_read;
   DepthImage out;
   out.width = frame.getWidth();
   out.height = frame.getHeight();
@@ -104,6 +148,8 @@ std::optional<CameraIntrinsics> OpenNi2Source::intrinsics() const {
   k.cy_px = (k.height_px - 1) / 2.0;
   return k;
 }
+
+int OpenNi2Source::frames_read() const { return impl_->frames_read; }
 
 int OpenNi2Source::recorded_frames() const {
   auto* playback = impl_->device.getPlaybackControl();

@@ -2,6 +2,15 @@
 // Depth frames from OpenNI2: a live device by URI (PrimeSense / Asus Xtion class through the PS1080
 // driver; "Dummy" for the packaged test device) or an .oni recording, optionally recorded to an .oni.
 // One thread per source. OpenNI2 types stay in src/.
+//
+// Recordings and Debian's OpenNI2 2.2.0.33: the OniFile player hands a frame to a stream only when the
+// recording declares the stream's cropping ("xnCropping"; PlayerStream::OnNewDataCallback returns early
+// when the property is missing), and the recorder writes that property only for streams that support
+// cropping. The PS1080 driver's streams do; the Dummy device's do not, so its recordings open, report
+// their frames and then deliver none. Recording here therefore adds the property (cropping off) when the
+// stream lacked it, and playing a recording without it plays a repaired temporary copy.
+// PlaybackControl::seek crashes the player thread of that build (recordings with or without the
+// property), so playback steps frame by frame from the start and never seeks.
 
 #include <filesystem>
 #include <memory>
@@ -27,17 +36,28 @@ class OpenNi2Source {
   OpenNi2Source& operator=(const OpenNi2Source&) = delete;
 
   /// The next depth frame in metres (0 = no depth), capture time from the device's timestamp, seconds.
-  /// Throws AlignmentError when no frame arrives within timeout_ms.
+  /// A recording is stepped: each call returns the following recorded frame, however fast it is called,
+  /// and the end of the recording is an AlignmentError saying so. Throws AlignmentError when no frame
+  /// arrives within timeout_ms.
   DepthImage next();
   /// Pinhole intrinsics from the stream's resolution and fields of view (principal point at the centre);
   /// empty when the device reports no field of view (the Dummy device): then calibrate and pass them.
   std::optional<CameraIntrinsics> intrinsics() const;
   /// Frames in the recording when playing an .oni, -1 for a live device.
   int recorded_frames() const;
+  /// Frames returned by next() so far.
+  int frames_read() const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Whether an .oni recording declares a stream's cropping (see above). Throws AlignmentError naming the
+/// file when it is missing or not an .oni recording.
+bool oni_declares_cropping(const std::filesystem::path& recording);
+/// Adds the cropping property (cropping off) for every node that lacks it, in place, moving the file
+/// positions stored after it (seek table, undo positions). Returns false when nothing was missing.
+bool add_oni_cropping_property(const std::filesystem::path& recording);
 
 }  // namespace projbot::alignment
