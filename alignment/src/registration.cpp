@@ -68,9 +68,12 @@ class DampedPointToPlane : public pcl::registration::TransformationEstimationPoi
 // PCL keeps the iteration count protected; the result struct reports it.
 class CountingIcp : public pcl::IterativeClosestPointWithNormals<PointN, PointN> {
  public:
-  CountingIcp() {
+  explicit CountingIcp(bool point_to_plane) {
     min_number_correspondences_ = 10;
-    setTransformationEstimation(pcl::make_shared<DampedPointToPlane>());
+    if (point_to_plane)
+      setTransformationEstimation(pcl::make_shared<DampedPointToPlane>());
+    else
+      setTransformationEstimation(pcl::make_shared<pcl::registration::TransformationEstimationSVD<PointN, PointN>>());
   }
   int iterations() const { return nr_iterations_; }
 };
@@ -244,7 +247,7 @@ struct Aligner::Impl {
         converged = false;
         break;
       }
-      CountingIcp icp;
+      CountingIcp icp(cfg.point_to_plane);
       if (cfg.max_normal_angle_deg < 180.0) {
         auto normals = pcl::make_shared<pcl::registration::CorrespondenceRejectorSurfaceNormal>();
         normals->setThreshold(std::cos(cfg.max_normal_angle_deg * M_PI / 180.0));

@@ -19,8 +19,9 @@ const Command kTour{
     "ICP, moves it to the projector (Eq. 2) and projects (Eq. 3). The projection error is measured at the\n"
     "target's markers: the projector pixel carrying each marker is cast into the true scene and the distance\n"
     "to the true marker is reported, in mm, with the paper's Table 1 beside it. Without --scene the shipped\n"
-    "demo tour runs (two targets, three visits each).\n\n"
-    "Modes: odometry = the paper's set-up (odometry only, one plain ICP per stop); localized = MRPT\n"
+    "demo tour runs (two targets, three visits each; the box is moved on its second visit).\n\n"
+    "Modes: odometry = the paper's set-up (odometry only, one plain point-to-point ICP per stop, always\n"
+    "projected; assets/scenes/paper.yaml is the paper's experiment, nothing moved); localized = MRPT\n"
     "localisation and robust acquisition with a quality gate (rejected estimates are blanked); tracking =\n"
     "localized, and the projective tracker follows the target at 30 Hz while projecting.\n",
     {{"scene", "FILE", "tour scene (default: the shipped demo tour, assets/scenes/tour.yaml)"},

@@ -63,12 +63,19 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   auto& targets = twin.targets();
   const config::PanTiltConfig& rig = scene.pan_tilt;
 
-  // The paper aligned once per stop with plain ICP from the initial guess; ours adds local restarts,
-  // FPFH re-initialisation and the quality gate.
+  // The paper aligned once per stop with plain ICP from the initial guess; ours is point-to-plane, coarse
+  // to fine, rejects correspondences whose normals disagree, and adds local restarts, FPFH
+  // re-initialisation and the quality gate.
   alignment::AcquisitionConfig acquisition;
   if (options.mode == TourMode::odometry) {
     acquisition.restart_angle_deg = 0.0;
     acquisition.reinitialise = false;
+    // Plain ICP as the paper ran it: point-to-point (PCL's SVD estimation), one pass with a fixed
+    // correspondence distance and iteration budget, on the scan near the expected target.
+    acquisition.point_to_plane = false;
+    acquisition.icp_distances_m = {0.05};
+    acquisition.icp_iterations = 30;
+    acquisition.max_normal_angle_deg = 180.0;
   }
   // One follower per target: its aligner acquires at each stop, its policy tracks while projecting
   // (the same one the live engine's TrackerWorker runs).

@@ -39,6 +39,8 @@ struct AcquisitionConfig {
   /// keeps the error distribution whole; a 6 mm cut left a 0.69 degree bias at 2 m, 20 mm 0.27 degrees.
   std::vector<double> icp_distances_m{0.08, 0.03, 0.02};
   int icp_iterations = 40;  ///< per stage
+  /// Point-to-plane against the model's normals (ours); false: point-to-point (SVD), as plain ICP does.
+  bool point_to_plane = true;
   /// ICP correspondences whose scan and model normals differ by more than this are rejected (180: none).
   double max_normal_angle_deg = 60.0;
   double inlier_distance_m = 0.006;  ///< a scan point within this of the model counts as explained
