@@ -50,10 +50,16 @@ DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics
     return Eigen::Vector3f((static_cast<float>(x) - cx) * z * ifx, (static_cast<float>(y) - cy) * z * ify, z);
   };
   const double cos_max = std::cos(cfg.max_incidence_deg * M_PI / 180.0);
+  const float cos2_max = static_cast<float>(cos_max * cos_max);
   const std::vector<float>& gauss = gaussian_table();
   XorShift rng(seed);
-  const double bf = cfg.baseline_m * cfg.disparity_focal_px;
+  const float bf = static_cast<float>(cfg.baseline_m * cfg.disparity_focal_px);
+  const bool quantise = cfg.disparity_step_px > 0.0;
+  const float step = static_cast<float>(cfg.disparity_step_px), inv_step = quantise ? 1.0F / step : 0.0F;
+  const float sigma_coeff = static_cast<float>(cfg.sigma_z_coeff);
   const bool border_drops = cfg.edge_jump_m < 1e8;
+  const float edge_jump = static_cast<float>(cfg.edge_jump_m);
+  const float min_range = static_cast<float>(cfg.min_range_m), max_range = static_cast<float>(cfg.max_range_m);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
@@ -63,8 +69,7 @@ DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics
         z_out = 0.0F;
         continue;
       }
-      const double z = zf;
-      bool drop = z < cfg.min_range_m || z > cfg.max_range_m;
+      bool drop = zf < min_range || zf > max_range;
       // Discontinuities and the image border: the Kinect's pattern is shadowed or ambiguous there.
       const bool inside = x > 0 && y > 0 && x + 1 < w && y + 1 < h;
       const float zr = x + 1 < w ? zin[i + 1] : 0.0F, zl = x > 0 ? zin[i - 1] : 0.0F;
@@ -75,27 +80,27 @@ DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics
         if (!all_valid) {
           drop = border_drops;
         } else {
-          const double jump = cfg.edge_jump_m + 0.02 * z;
-          drop = std::abs(zr - z) > jump || std::abs(zl - z) > jump || std::abs(zd - z) > jump || std::abs(zu - z) > jump;
+          const float jump = edge_jump + 0.02F * zf;
+          drop = std::abs(zr - zf) > jump || std::abs(zl - zf) > jump || std::abs(zd - zf) > jump || std::abs(zu - zf) > jump;
         }
       }
-      // Grazing angles: the surface normal from the neighbours against the viewing ray.
+      // Grazing angles: the surface normal from the neighbours against the viewing ray (squared, no roots).
       if (!drop && cos_max > 0.0 && all_valid) {
         const Eigen::Vector3f n = (point(x + 1, y, zr) - point(x - 1, y, zl)).cross(point(x, y + 1, zd) - point(x, y - 1, zu));
         const Eigen::Vector3f ray = point(x, y, zf);
-        const float nn = n.norm();
-        if (nn > 0.0F) drop = std::abs(n.dot(ray)) / (nn * ray.norm()) < static_cast<float>(cos_max);
+        const float along = n.dot(ray);
+        drop = along * along < cos2_max * n.squaredNorm() * ray.squaredNorm();
       }
       if (drop) {
         z_out = 0.0F;
         continue;
       }
-      double noisy = z + cfg.sigma_z_coeff * z * z * gauss[rng.next() & 0xFFFFU];
-      if (cfg.disparity_step_px > 0.0 && noisy > 0.0) {
-        const double d = std::round(bf / noisy / cfg.disparity_step_px) * cfg.disparity_step_px;
-        noisy = d > 0.0 ? bf / d : 0.0;
+      float noisy = zf + sigma_coeff * zf * zf * gauss[rng.next() & 0xFFFFU];
+      if (quantise && noisy > 0.0F) {  // to the disparity steps: d = bf / z, rounded to 1/8 px
+        const float d = std::nearbyint(bf / noisy * inv_step) * step;
+        noisy = d > 0.0F ? bf / d : 0.0F;
       }
-      z_out = static_cast<float>(noisy);
+      z_out = noisy;
     }
   return out;
 }
