@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <string>
 #include <vector>
@@ -57,29 +58,39 @@ std::vector<std::uint8_t> read_all(const std::filesystem::path& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-std::vector<Record> walk(const std::vector<std::uint8_t>& bytes, const std::filesystem::path& path) {
+// Reads `n` bytes at offset `at` of a recording of `size` bytes into `out`; the walker checks bounds.
+using ReadAt = std::function<void(std::size_t at, void* out, std::size_t n)>;
+
+// Every record's header and name, without the frames: a recording is walked from its file by seeking,
+// or from bytes already in memory.
+std::vector<Record> walk(const ReadAt& read, std::size_t size, const std::filesystem::path& path) {
   const auto bad = [&](std::size_t at, const std::string& what) {
     return AlignmentError(path.string() + ": not a readable .oni recording at byte " + std::to_string(at) + ": " + what);
   };
-  if (bytes.size() < kFileHeaderBytes || std::memcmp(bytes.data(), "NI10", 4) != 0) throw bad(0, "no NI10 header");
+  char identity[4] = {};
+  if (size >= kFileHeaderBytes) read(0, identity, sizeof identity);
+  if (size < kFileHeaderBytes || std::memcmp(identity, "NI10", 4) != 0) throw bad(0, "no NI10 header");
   std::vector<Record> records;
   std::size_t at = kFileHeaderBytes;
   for (;;) {
-    if (at + kRecordHeaderBytes > bytes.size()) throw bad(at, "the file ends inside a record (no end record)");
+    if (at + kRecordHeaderBytes > size) throw bad(at, "the file ends inside a record (no end record)");
+    std::uint32_t header[5];  // magic, type, node id, fields size, payload size (the undo position follows)
+    read(at, header, sizeof header);
     Record r;
     r.at = at;
-    if (get<std::uint32_t>(bytes, at) != kMagic) throw bad(at, "record magic is not NIR");
-    r.type = get<std::uint32_t>(bytes, at + 4);
-    r.node = get<std::uint32_t>(bytes, at + 8);
-    r.fields = get<std::uint32_t>(bytes, at + 12);
-    r.payload = get<std::uint32_t>(bytes, at + 16);
-    if (r.fields < kRecordHeaderBytes || at + r.fields + r.payload > bytes.size())
-      throw bad(at, "record sizes run past the file");
+    if (header[0] != kMagic) throw bad(at, "record magic is not NIR");
+    r.type = header[1];
+    r.node = header[2];
+    r.fields = header[3];
+    r.payload = header[4];
+    if (r.fields < kRecordHeaderBytes || at + r.fields + r.payload > size) throw bad(at, "record sizes run past the file");
     const bool named = r.type == kNodeAdded || (r.type >= kIntProperty && r.type <= kGeneralProperty);
     if (named && r.fields >= kRecordHeaderBytes + 4) {
-      const auto length = get<std::uint32_t>(bytes, at + kRecordHeaderBytes);
+      std::uint32_t length = 0;
+      read(at + kRecordHeaderBytes, &length, sizeof length);
       if (length == 0 || kRecordHeaderBytes + 4 + length > r.fields) throw bad(at, "name runs past its record");
-      r.name.assign(reinterpret_cast<const char*>(bytes.data() + at + kRecordHeaderBytes + 4), length - 1);
+      r.name.resize(length - 1);
+      read(at + kRecordHeaderBytes + 4, r.name.data(), length - 1);
     }
     records.push_back(r);
     if (r.type == kEnd) return records;
@@ -87,11 +98,22 @@ std::vector<Record> walk(const std::vector<std::uint8_t>& bytes, const std::file
   }
 }
 
+std::vector<Record> walk(const std::vector<std::uint8_t>& bytes, const std::filesystem::path& path) {
+  return walk([&](std::size_t at, void* out, std::size_t n) { std::memcpy(out, bytes.data() + at, n); }, bytes.size(), path);
+}
+
 }  // namespace
 
 bool oni_declares_cropping(const std::filesystem::path& recording) {
-  const std::vector<std::uint8_t> bytes = read_all(recording);
-  for (const Record& r : walk(bytes, recording))
+  // Recordings can be large: seek from record to record instead of reading the frames.
+  std::ifstream in(recording, std::ios::binary);
+  if (!in) throw AlignmentError(recording.string() + ": cannot open the .oni recording");
+  const ReadAt read = [&](std::size_t at, void* out, std::size_t n) {
+    in.seekg(static_cast<std::streamoff>(at));
+    in.read(static_cast<char*>(out), static_cast<std::streamsize>(n));
+    if (!in) throw AlignmentError(recording.string() + ": cannot read byte " + std::to_string(at) + " of the .oni recording");
+  };
+  for (const Record& r : walk(read, std::filesystem::file_size(recording), recording))
     if (r.type == kGeneralProperty && r.name == kCroppingName) return true;
   return false;
 }

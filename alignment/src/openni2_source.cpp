@@ -43,7 +43,6 @@ struct OpenNi2Source::Impl {
   double metres_per_unit = 0.001;
   bool playback = false;
   int frames_read = 0;
-  bool stream_crops = true;  // whether the recorded stream declares cropping itself
 };
 
 OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_unique<Impl>()) {
@@ -83,7 +82,6 @@ OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_un
     throw AlignmentError(describe(options.uri) + ": depth pixel format " + std::to_string(static_cast<int>(format)) +
                          " is not in mm or 100 um");
   if (m.depth.start() != openni::STATUS_OK) fail(options.uri, "cannot start the depth stream");
-  m.stream_crops = m.depth.isCroppingSupported();
   if (!options.record_to.empty()) {
     if (m.recorder.create(options.record_to.c_str()) != openni::STATUS_OK || m.recorder.attach(m.depth) != openni::STATUS_OK ||
         m.recorder.start() != openni::STATUS_OK)
@@ -95,8 +93,8 @@ OpenNi2Source::~OpenNi2Source() {
   Impl& m = *impl_;
   if (m.recorder.isValid()) {
     m.recorder.stop();
-    m.recorder.destroy();  // writes the seek table and closes the file
-    if (!m.stream_crops) {
+    m.recorder.destroy();                  // writes the seek table and closes the file
+    if (!m.depth.isCroppingSupported()) {  // then the recorder left the property out (see the header)
       try {
         add_oni_cropping_property(m.options.record_to);
       } catch (const std::exception& e) {
