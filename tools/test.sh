@@ -1,10 +1,21 @@
 #!/usr/bin/env bash
 # Quick start, command 2 (and CI): install what is missing, build everything with warnings as errors,
-# check formatting, and run the whole test suite (GPU tests on lavapipe, window tests under Xvfb).
+# check formatting, check the align path for memory errors under AddressSanitizer + UBSan (on every
+# machine; valgrind's memcheck in the main suite is skipped where valgrind cannot run the executable,
+# see the README), then run the whole test suite (GPU tests on lavapipe, window tests under Xvfb).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# ccache keys without this checkout's absolute path, so a fresh clone (CI's) reuses earlier compiles.
+export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
 bash tools/setup-debian.sh
 bash tools/check-format.sh
 cmake --preset ci >/dev/null
 cmake --build --preset ci
-ctest --preset ci
+cmake --preset asan >/dev/null
+cmake --build --preset asan --target projbot
+ctest --preset asan-memory
+status=0
+ctest --preset ci || status=$?
+# ctest does not show a skipped test's output: say why each one was skipped.
+grep -h '^[a-z]*: SKIPPED:' build/ci/Testing/Temporary/LastTest.log 2>/dev/null || true
+exit "$status"

@@ -22,7 +22,8 @@ void print_help() {
   std::cout << "projbot: projection mapping for a projector robot.\n\n"
                "Renders textured 3-D models of target objects through a calibrated projector so the\n"
                "content lands on the real objects.\n\n"
-               "Usage: projbot COMMAND [options]     (projbot COMMAND --help for its options)\n\nCommands:\n";
+               "Usage: projbot COMMAND [options]     (projbot COMMAND --help for its options)\n"
+               "       projbot --version\n\nCommands:\n";
   for (const auto* c : commands()) {
     std::string name = "  " + c->name;
     name.resize(18, ' ');
@@ -53,6 +54,10 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h" || std::string(argv[1]) == "help") {
     print_help();
     return argc < 2 ? 2 : 0;
+  }
+  if (std::string(argv[1]) == "--version") {
+    std::cout << "projbot " << PROJBOT_VERSION << '\n';
+    return 0;
   }
   std::string name = argv[1];
   int first = 2;
