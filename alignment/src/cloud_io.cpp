@@ -8,6 +8,7 @@
 #include <cctype>
 
 #include "file_kind.hpp"
+#include "pcd_header.hpp"
 #include "projbot/alignment/depth.hpp"
 
 namespace projbot::alignment {
@@ -21,14 +22,21 @@ PointCloud read_cloud(const std::filesystem::path& path) {
   // PCL prints its own complaints to stderr; ours, below, names the file and what to do.
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   try {
-    if (ext == ".pcd")
+    if (ext == ".pcd") {
+      const detail::PcdHeader header = detail::check_pcd(path);  // PCL's reader crashes on what this refuses
       rc = pcl::io::loadPCDFile(path.string(), cloud);
-    else if (ext == ".ply")
+      if (rc >= 0 && cloud.size() != header.points)
+        throw AlignmentError(path.string() + ": read " + std::to_string(cloud.size()) + " points, the header claims " +
+                             std::to_string(header.points) + " (malformed data section?)");
+    } else if (ext == ".ply") {
       rc = pcl::io::loadPLYFile(path.string(), cloud);
-    else
+    } else {
       throw AlignmentError(path.string() + ": unknown point cloud format (use .pcd or .ply)");
+    }
   } catch (const pcl::PCLException& e) {
     throw AlignmentError(path.string() + ": cannot read point cloud: " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw AlignmentError(path.string() + ": out of memory reading the point cloud");
   }
   if (rc < 0) throw AlignmentError(path.string() + ": cannot read point cloud (malformed " + ext.substr(1) + " file?)");
   if (cloud.empty()) throw AlignmentError(path.string() + ": the point cloud holds no points (malformed or empty file?)");
