@@ -1,12 +1,20 @@
 // The projbot executable as a user meets it: exit codes and the one line it prints on bad input.
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 #include "projbot/assets/image.hpp"
 
@@ -28,6 +36,74 @@ CliRun run_projbot(const std::string& args) {
   const int status = pipe != nullptr ? pclose(pipe) : -1;
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
+
+// projbot started in the background with its output in a file, for tests that signal it.
+struct Background {
+  pid_t pid = -1;
+  std::filesystem::path log;
+
+  Background(const std::vector<std::string>& args, std::filesystem::path log_file) : log(std::move(log_file)) {
+    std::vector<std::string> all{PROJBOT_EXE};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    // As from a terminal: no signal blocked, SIGINT and SIGTERM at their defaults (a test runner started
+    // in the background may pass them on ignored or blocked).
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    sigset_t none, defaults;
+    sigemptyset(&none);
+    sigemptyset(&defaults);
+    sigaddset(&defaults, SIGINT);
+    sigaddset(&defaults, SIGTERM);
+    posix_spawnattr_setsigmask(&attr, &none);
+    posix_spawnattr_setsigdefault(&attr, &defaults);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+    if (posix_spawn(&pid, PROJBOT_EXE, &actions, &attr, argv.data(), environ) != 0) pid = -1;
+    posix_spawnattr_destroy(&attr);
+    posix_spawn_file_actions_destroy(&actions);
+  }
+  ~Background() {
+    if (pid > 0 && waitpid(pid, nullptr, WNOHANG) == 0) {
+      kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+    }
+  }
+  std::string output() const {
+    std::ifstream in(log);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  // Waits (up to `limit`) until the output contains `text`.
+  bool wait_for_output(const std::string& text, std::chrono::seconds limit) const {
+    const auto end = std::chrono::steady_clock::now() + limit;
+    while (std::chrono::steady_clock::now() < end) {
+      if (output().find(text) != std::string::npos) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return false;
+  }
+  // Sends `sig`, waits for the exit; returns the exit code (-1 for a signal death or a timeout) and
+  // the seconds from the signal to the exit.
+  std::pair<int, double> signal_and_wait(int sig, std::chrono::seconds limit) {
+    const auto t0 = std::chrono::steady_clock::now();
+    kill(pid, sig);
+    int status = 0;
+    while (waitpid(pid, &status, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() - t0 > limit) return {-1, 1e9};
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    pid = -1;
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s};
+  }
+};
 
 class CliTest : public ::testing::Test {
  protected:
@@ -83,10 +159,11 @@ TEST_F(CliTest, OverridesAndProfile) {
   int lines = 0;
   for (std::string l; std::getline(in, l);) ++lines;
   EXPECT_EQ(lines, 5);  // header + 4 frames
-  // --pose-matrix puts the single target exactly where asked: behind the projector, nothing shows.
+  // --pose-matrix puts the single target exactly where asked: behind the projector, nothing shows; the
+  // black frame is written all the same, and the exit status (3) says it is empty.
   const CliRun behind = run_projbot("render --model " + kDuck + " --size 64x48 --out " + out.string() +
                                     " --pose-matrix 1,0,0,0,0,1,0,0,0,0,1,-3,0,0,0,1");
-  ASSERT_EQ(behind.code, 0) << behind.output;
+  ASSERT_EQ(behind.code, 3) << behind.output;
   const auto img = projbot::assets::read_image(out);
   for (std::size_t i = 0; i < img.rgba.size(); i += 4) ASSERT_EQ(img.rgba[i], 0);
 }
@@ -125,6 +202,125 @@ TEST_F(CliTest, AlignPrintsJson) {
     EXPECT_NE(r.output.find(key), std::string::npos) << key;
   const double m00 = std::stod(r.output.substr(8));
   EXPECT_NEAR(m00, 0.825, 0.02);  // cos(34.4 degrees)
+}
+
+// A 16-bit depth PNG read by the executable itself: libraries projbot links (MRPT's nanogui, draco)
+// export older stb functions that once took the place of ours and refused every 16-bit PNG.
+TEST_F(CliTest, AlignReadsA16BitDepthPng) {
+  const std::string png = std::string(PROJBOT_SHARED_DATA) + "/rgbd/open3d_rgbd_sequence/depth/00000.png";
+  const auto depth = projbot::assets::read_png_gray16(png);
+  ASSERT_EQ(depth.width, 640);
+  ASSERT_EQ(depth.height, 480);
+  std::size_t expected = 0;  // what depth_to_cloud keeps: 0.3 m to 8 m at 1000 units per metre
+  for (const auto v : depth.values) {
+    const float z = static_cast<float>(v / 1000.0);
+    expected += (z > 0.0F && z >= 0.3 && z <= 8.0) ? 1 : 0;
+  }
+  ASSERT_GT(expected, 100000U);
+  // The duck is not in this room scan: the read must succeed, the gate must refuse (exit 3).
+  const CliRun r = run_projbot("align --model " + kDuck + " --scan " + png +
+                               " --intrinsics 525,525,319.5,239.5 --depth-scale 1000 --voxel 0.02 --json 2>/dev/null");
+  ASSERT_EQ(r.code, 3) << r.output;
+  const auto at = r.output.find("\"scan_valid_points\":");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  EXPECT_EQ(std::stoul(r.output.substr(at + 20)), expected) << r.output;
+}
+
+// Ctrl-C in the live engine: it stops at the next frame, prints its summary, writes the whole profile
+// and exits 130 within a second.
+TEST_F(CliTest, RunInterruptedKeepsTheProfile) {
+  const fs::path csv = dir_ / "p.csv";
+  Background run({"run", "--headless", "--profile", csv.string()}, dir_ / "run.log");
+  ASSERT_GT(run.pid, 0);
+  ASSERT_TRUE(run.wait_for_output("device:", std::chrono::seconds(60))) << run.output();
+  std::this_thread::sleep_for(std::chrono::seconds(5));
+  const auto [code, seconds] = run.signal_and_wait(SIGINT, std::chrono::seconds(30));
+  EXPECT_EQ(code, 130) << run.output();
+  EXPECT_LT(seconds, 1.0);
+  const std::string out = run.output();
+  EXPECT_NE(out.find("frame time p50"), std::string::npos) << out;
+  EXPECT_NE(out.find("per-frame profile written to"), std::string::npos) << out;
+  std::ifstream in(csv);
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "frame,start_ms,pose_age_ms,target");
+  int rows = 0;
+  for (; std::getline(in, line); ++rows) EXPECT_EQ(std::count(line.begin(), line.end(), ','), 3) << line;
+  EXPECT_GT(rows, 100) << "about 5 s at 60 Hz";
+}
+
+// Ctrl-C in a tour: the visits finished so far are in the report, marked interrupted; exit 130.
+TEST_F(CliTest, TourInterruptedKeepsTheFinishedVisits) {
+  const fs::path report = dir_ / "r.json";
+  Background tour({"tour", "--visits", "6", "--report", report.string()}, dir_ / "tour.log");
+  ASSERT_GT(tour.pid, 0);
+  ASSERT_TRUE(tour.wait_for_output("visit 1 (", std::chrono::seconds(120))) << tour.output();
+  const auto [code, seconds] = tour.signal_and_wait(SIGINT, std::chrono::seconds(120));
+  EXPECT_EQ(code, 130) << tour.output();
+  std::ifstream in(report);
+  ASSERT_TRUE(in) << tour.output();
+  const auto json = nlohmann::json::parse(in);
+  EXPECT_TRUE(json.at("interrupted").get<bool>());
+  EXPECT_GE(json.at("visits").size(), 1U);
+  EXPECT_LT(json.at("visits").size(), 6U);
+  EXPECT_NE(tour.output().find("interrupted"), std::string::npos);
+}
+
+// Hostile point clouds through the executable: one line naming the file, exit 1, never a signal; the
+// one claiming 2e9 points is refused within a second and in little memory.
+TEST_F(CliTest, HostilePcdFilesAreRefused) {
+  const std::string header = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2000000000\nHEIGHT 1\nPOINTS 2000000000\nDATA binary\n";
+  const std::vector<std::pair<std::string, std::string>> files{
+      {"empty.pcd", ""},
+      {"header_only.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 5\nHEIGHT 1\n"},
+      {"random.pcd", std::string("\x89\x01\xfe\x00garbage\x7f\x10", 14) + std::string(3000, '\x9c')},
+      {"huge.pcd", header + std::string(4800, '\x01')}};
+  for (const auto& [name, bytes] : files) {
+    std::ofstream(dir_ / name, std::ios::binary) << bytes;
+    for (const std::string role : {"--model", "--scan"}) {
+      const std::string other = role == "--model" ? " --scan " + (dir_ / "empty.pcd").string() : " --model " + kDuck;
+      const auto t0 = std::chrono::steady_clock::now();
+      const CliRun r = run_projbot("align " + role + " " + (dir_ / name).string() + other);
+      EXPECT_EQ(r.code, 1) << name << ' ' << role << ": " << r.output;
+      EXPECT_NE(r.output.find(name), std::string::npos) << r.output;
+      EXPECT_NE(r.output.find("malformed PCD file"), std::string::npos) << r.output;
+      if (name == "huge.pcd" && role == "--model") {
+        EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+      }
+    }
+  }
+  rusage children{};
+  getrusage(RUSAGE_CHILDREN, &children);
+  EXPECT_LT(children.ru_maxrss, 200 * 1024) << "peak resident KiB of any projbot run above";
+}
+
+// render --model frames any model whole: a 10 m box (once cut by the 10 m far plane: an all-black PNG
+// and exit 0) and a 1 cm one both fill a good part of the frame; an empty frame is exit 3.
+TEST_F(CliTest, RenderModelFramesAnySize) {
+  const fs::path box = fs::path(PROJBOT_SHARED_DATA) / "gltf" / "BoxTextured" / "glTF";
+  fs::copy(box, dir_ / "box");
+  std::ifstream in(dir_ / "box" / "BoxTextured.gltf");
+  auto gltf = nlohmann::json::parse(in);
+  in.close();
+  gltf["nodes"].push_back({{"children", {0}}, {"scale", {1.0, 1.0, 1.0}}});
+  gltf["scenes"][0]["nodes"] = {gltf["nodes"].size() - 1};
+  for (const double scale : {10.0, 0.01}) {
+    gltf["nodes"].back()["scale"] = {scale, scale, scale};
+    std::ofstream(dir_ / "box" / "scaled.gltf") << gltf.dump();
+    const fs::path png = dir_ / "scaled.png";
+    const CliRun r =
+        run_projbot("render --model " + (dir_ / "box" / "scaled.gltf").string() + " --size 160x100 --out " + png.string());
+    ASSERT_EQ(r.code, 0) << "scale " << scale << ": " << r.output;
+    const auto img = projbot::assets::read_image(png);
+    std::size_t lit = 0;
+    for (std::size_t i = 0; i < img.rgba.size(); i += 4) lit += (img.rgba[i] | img.rgba[i + 1] | img.rgba[i + 2]) != 0 ? 1 : 0;
+    EXPECT_GT(lit, 160U * 100U / 20U) << "scale " << scale << ": the box should fill more than 5 % of the frame";
+  }
+  const CliRun empty =
+      run_projbot("render --model " + kDuck + " --pose-matrix 1,0,0,0,0,1,0,0,0,0,1,-5,0,0,0,1 --size 64x48 --out " +
+                  (dir_ / "empty.png").string());
+  EXPECT_EQ(empty.code, 3) << empty.output;
+  EXPECT_NE(empty.output.find("the frame is empty"), std::string::npos) << empty.output;
 }
 
 TEST_F(CliTest, TourPrintsTheTableAndWritesReportAndFrames) {
@@ -214,8 +410,38 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"unwritable_png",
                "render --out /nonexistent-dir/a.png --size 64x48",
                "",
-               1,
-               {"/nonexistent-dir/a.png", "cannot write"}},
+               2,
+               {"--out /nonexistent-dir/a.png", "does not exist"}},
+        BadRun{"render_out_is_a_folder", "render --out {dir} --size 64x48", "", 2, {"--out", "is a folder"}},
+        BadRun{"render_profile_missing_folder",
+               "render --out {dir}/a.png --profile {dir}/no/p.csv",
+               "",
+               2,
+               {"--profile", "no/p.csv", "does not exist"}},
+        BadRun{"tour_report_missing_folder", "tour --report {dir}/no/r.json", "", 2, {"--report", "does not exist"}},
+        BadRun{"tour_frames_parent_missing", "tour --frames {dir}/no/frames", "", 2, {"--frames", "parent folder"}},
+        BadRun{"run_profile_missing_folder", "run --headless --profile {dir}/no/p.csv", "", 2, {"--profile", "does not exist"}},
+        BadRun{"run_bad_present_mode_headless",
+               "run --headless --present-mode bogus",
+               "",
+               2,
+               {"--present-mode must be fifo, mailbox or immediate", "bogus"}},
+        BadRun{"run_bad_seconds", "run --headless --seconds -1", "", 2, {"--seconds"}},
+        BadRun{"slam_out_map_parent_missing",
+               "slam --rawlog " + kRawlog + " --out-map {dir}/a/b/m --out-trajectory {dir}/t.txt",
+               "",
+               2,
+               {"--out-map", "parent folder", "does not exist"}},
+        BadRun{"slam_trajectory_missing_folder",
+               "slam --rawlog " + kRawlog + " --out-map {dir}/m --out-trajectory {dir}/no/t.txt",
+               "",
+               2,
+               {"--out-trajectory", "does not exist"}},
+        BadRun{"localize_trajectory_is_a_folder",
+               "localize --map {dir} --rawlog " + kRawlog + " --out-trajectory {dir}",
+               "",
+               2,
+               {"--out-trajectory", "is a folder"}},
         BadRun{"bench_without_target", "bench", "", 2, {"bench render"}},
         BadRun{"align_no_model", "align --scan x.pcd", "", 2, {"--model FILE is required"}},
         BadRun{"align_missing_scan",

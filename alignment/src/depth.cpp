@@ -1,15 +1,16 @@
-// Depth images and their back-projection. PNG through stb, TIFF through libtiff, the grabber XML
+// Depth images and their back-projection. PNG through assets (stb), TIFF through libtiff, the grabber XML
 // through Boost.PropertyTree; no PCL here.
 
 #include "projbot/alignment/depth.hpp"
 
-#include <stb_image.h>
 #include <tiffio.h>
 
 #include <boost/property_tree/ptree.hpp>
 #include <boost/property_tree/xml_parser.hpp>
 #include <cmath>
 #include <memory>
+
+#include "projbot/assets/image.hpp"
 
 namespace projbot::alignment {
 
@@ -22,19 +23,17 @@ std::size_t PointCloud::finite_count() const {
 DepthImage read_depth_png(const std::filesystem::path& path, double units_per_metre) {
   if (!(units_per_metre > 0.0) || !std::isfinite(units_per_metre))
     throw AlignmentError(path.string() + ": depth scale must be a finite number > 0 units per metre");
-  int w = 0, h = 0, comps = 0;
-  if (!stbi_info(path.c_str(), &w, &h, &comps))
-    throw AlignmentError(path.string() + ": cannot read PNG: " + stbi_failure_reason());
-  if (!stbi_is_16_bit(path.c_str()) || comps != 1)
-    throw AlignmentError(path.string() + ": a depth PNG must be 16-bit single-channel (this one has " + std::to_string(comps) +
-                         " channel(s), " + (stbi_is_16_bit(path.c_str()) ? "16" : "8") + " bits)");
-  std::unique_ptr<stbi_us, void (*)(void*)> data(stbi_load_16(path.c_str(), &w, &h, &comps, 1), stbi_image_free);
-  if (!data) throw AlignmentError(path.string() + ": cannot decode PNG: " + stbi_failure_reason());
+  assets::Gray16Image png;
+  try {
+    png = assets::read_png_gray16(path);
+  } catch (const assets::AssetError& e) {
+    throw AlignmentError(e.what());
+  }
   DepthImage d;
-  d.width = w;
-  d.height = h;
-  d.depth_m.resize(static_cast<std::size_t>(w) * h);
-  for (std::size_t i = 0; i < d.depth_m.size(); ++i) d.depth_m[i] = static_cast<float>(data.get()[i] / units_per_metre);
+  d.width = png.width;
+  d.height = png.height;
+  d.depth_m.resize(png.values.size());
+  for (std::size_t i = 0; i < d.depth_m.size(); ++i) d.depth_m[i] = static_cast<float>(png.values[i] / units_per_metre);
   return d;
 }
 

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "projbot/config/output_file.hpp"
+
 namespace projbot::engine {
 
 FrameProfiler::FrameProfiler() : t0_(std::chrono::steady_clock::now()) {}
@@ -55,18 +57,16 @@ FrameSummary FrameProfiler::summary() const {
 }
 
 void FrameProfiler::write_csv(const std::filesystem::path& path) const {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path.string() + ": cannot write profile");
-  out << "frame,start_ms,pose_read_ms,recorded_ms,submitted_ms,presented_ms,completed_ms,frame_ms,gpu_ms\n";
+  std::string out = "frame,start_ms,pose_read_ms,recorded_ms,submitted_ms,presented_ms,completed_ms,frame_ms,gpu_ms\n";
   for (std::size_t i = 0; i < records_.size(); ++i) {
     const auto& r = records_[i];
     const double frame = (i + 1 < records_.size() ? records_[i + 1].start_ms : r.completed_ms) - r.start_ms;
     char line[256];
     std::snprintf(line, sizeof line, "%llu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", static_cast<unsigned long long>(r.index),
                   r.start_ms, r.pose_read_ms, r.recorded_ms, r.submitted_ms, r.presented_ms, r.completed_ms, frame, r.gpu_ms);
-    out << line;
+    out += line;
   }
-  if (!out) throw std::runtime_error(path.string() + ": write failed");
+  config::write_file_atomically(path, out);
 }
 
 std::string format_summary(const FrameSummary& s) {

@@ -20,6 +20,7 @@
 #include <mrpt/serialization/CSerializable.h>
 #include <mrpt/slam/CICP.h>
 #include <mrpt/slam/CMetricMapBuilderICP.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <fstream>
@@ -27,6 +28,7 @@
 #include <sstream>
 
 #include "mrpt_convert.hpp"
+#include "projbot/config/output_file.hpp"
 
 namespace projbot::robot {
 namespace {
@@ -80,6 +82,35 @@ mrpt::obs::CActionCollection::Ptr odometry_action(const Pose2D& increment, doubl
 std::string first_line(const std::exception& e) {
   const std::string what = e.what();
   return what.substr(0, what.find('\n'));
+}
+
+void write_map_files(const std::filesystem::path& out_dir, const mrpt::maps::CSimpleMap& keyframes) {
+  if (!keyframes.saveToFile((out_dir / "map.simplemap.gz").string()))
+    throw RobotError((out_dir / "map.simplemap.gz").string() + ": cannot write");
+  mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, 0.05f);
+  grid.loadFromSimpleMap(keyframes);
+  if (!grid.saveAsBitmapFile((out_dir / "grid.png").string()))
+    throw RobotError((out_dir / "grid.png").string() + ": cannot write");
+  std::ostringstream yaml;
+  yaml << "# ROS map_server form: the grid image, its cell size and its lower-left corner in the map frame\n"
+       << "image: grid.png\nresolution: " << grid.getResolution() << "\norigin: [" << grid.getXMin() << ", " << grid.getYMin()
+       << ", 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  config::write_file_atomically(out_dir / "grid.yaml", yaml.str());
+}
+
+void swap_into_place(const std::filesystem::path& work_dir, const std::filesystem::path& final_dir) {
+  std::error_code ec;
+  const std::filesystem::path old_dir = final_dir.string() + ".old-" + std::to_string(::getpid());
+  const bool had_old = std::filesystem::exists(final_dir, ec);
+  if (had_old) std::filesystem::rename(final_dir, old_dir, ec);
+  if (!ec) std::filesystem::rename(work_dir, final_dir, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    if (had_old && !std::filesystem::exists(final_dir)) std::filesystem::rename(old_dir, final_dir, ec);
+    std::filesystem::remove_all(work_dir, ec);
+    throw RobotError(final_dir.string() + ": cannot put the new map in place (" + why + "); the old one is unchanged");
+  }
+  std::filesystem::remove_all(old_dir, ec);
 }
 
 }  // namespace
@@ -144,13 +175,12 @@ void write_rawlog(const std::filesystem::path& path, const std::vector<RawlogSte
 }
 
 void write_trajectory(const std::filesystem::path& path, const std::vector<TrajectoryPoint>& trajectory) {
-  std::ofstream out(path);
-  if (!out) throw RobotError(path.string() + ": cannot write the trajectory");
+  std::ostringstream out;
   out << std::fixed;
   for (const auto& p : trajectory)
     out << std::setprecision(6) << p.timestamp_s << ' ' << std::setprecision(5) << p.pose.x_m << ' ' << p.pose.y_m << ' '
         << p.pose.theta_rad << '\n';
-  if (!out) throw RobotError(path.string() + ": write failed");
+  config::write_file_atomically(path, out.str());
 }
 
 std::vector<TrajectoryPoint> read_trajectory(const std::filesystem::path& path) {
@@ -208,20 +238,17 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
   builder.getCurrentlyBuiltMap(keyframes);
   result.keyframes = keyframes.size();
 
+  // The map is written whole into a folder beside out_dir, then swapped in: an old map stays usable
+  // until the new one is complete, and a failed write leaves it untouched.
+  std::filesystem::path final_dir = out_dir.lexically_normal();
+  if (!final_dir.has_filename()) final_dir = final_dir.parent_path();  // "map/" names the folder "map"
+  const std::filesystem::path work_dir = final_dir.string() + ".tmp-" + std::to_string(::getpid());
   std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
-  if (ec) throw RobotError(out_dir.string() + ": cannot create the map directory (" + ec.message() + ")");
-  if (!keyframes.saveToFile((out_dir / "map.simplemap.gz").string()))
-    throw RobotError((out_dir / "map.simplemap.gz").string() + ": cannot write");
-  mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, 0.05f);
-  grid.loadFromSimpleMap(keyframes);
-  if (!grid.saveAsBitmapFile((out_dir / "grid.png").string()))
-    throw RobotError((out_dir / "grid.png").string() + ": cannot write");
-  std::ofstream yaml(out_dir / "grid.yaml");
-  yaml << "# ROS map_server form: the grid image, its cell size and its lower-left corner in the map frame\n"
-       << "image: grid.png\nresolution: " << grid.getResolution() << "\norigin: [" << grid.getXMin() << ", " << grid.getYMin()
-       << ", 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
-  if (!yaml) throw RobotError((out_dir / "grid.yaml").string() + ": cannot write");
+  std::filesystem::remove_all(work_dir, ec);
+  std::filesystem::create_directories(work_dir, ec);
+  if (ec) throw RobotError(work_dir.string() + ": cannot create the map directory (" + ec.message() + ")");
+  write_map_files(work_dir, keyframes);
+  swap_into_place(work_dir, final_dir);
   result.seconds = ms_since(t0) / 1000.0;
   return result;
 }

@@ -115,7 +115,9 @@ const Command kAlign{
                                     {"rmse_mm", std::isfinite(r.rmse_mm) ? nlohmann::json(r.rmse_mm) : nlohmann::json(nullptr)},
                                     {"iterations", r.iterations},
                                     {"time_ms", r.time_ms},
-                                    {"reinitialised", r.reinitialised}};
+                                    {"reinitialised", r.reinitialised},
+                                    {"scan_valid_points", scan.finite_count()},
+                                    {"scan_points_used", r.scan_points}};
         std::cout << out.dump() << '\n';
       } else {
         std::cout << "T_scan_model (row-major, metres):\n";

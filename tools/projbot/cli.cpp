@@ -1,8 +1,13 @@
 #include "cli.hpp"
 
+#include <unistd.h>
+
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <sstream>
+
+#include "projbot/config/output_file.hpp"
 
 namespace projbot::cli {
 
@@ -51,6 +56,37 @@ int Args::get_int(const std::string& name, int fallback, int min_value, int max_
     throw UsageError("--" + name + " must be an integer in " + std::to_string(min_value) + ".." + std::to_string(max_value) +
                      ", got '" + *v + "'");
   return out;
+}
+
+void Args::check_output_files(const std::vector<std::string>& names) const {
+  for (const auto& name : names)
+    if (const auto value = get(name)) try {
+        config::check_writable(*value);
+      } catch (const config::OutputError& e) {
+        throw UsageError("--" + name + " " + e.what());
+      }
+}
+
+void Args::check_output_folders(const std::vector<std::string>& names) const {
+  namespace fs = std::filesystem;
+  for (const auto& name : names) {
+    const auto value = get(name);
+    if (!value) continue;
+    std::error_code ec;
+    const fs::path dir = fs::path(*value).lexically_normal();
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+      throw UsageError("--" + name + " " + *value + ": exists and is not a folder");
+    if (fs::is_directory(dir, ec)) {
+      if (::access(dir.c_str(), W_OK) != 0) throw UsageError("--" + name + " " + *value + ": the folder is not writable");
+      continue;
+    }
+    fs::path parent = dir.has_filename() ? dir.parent_path() : dir.parent_path().parent_path();
+    if (parent.empty()) parent = ".";
+    if (!fs::is_directory(parent, ec))
+      throw UsageError("--" + name + " " + *value + ": its parent folder " + parent.string() + " does not exist");
+    if (::access(parent.c_str(), W_OK) != 0)
+      throw UsageError("--" + name + " " + *value + ": its parent folder " + parent.string() + " is not writable");
+  }
 }
 
 double Args::get_double(const std::string& name, double fallback) const {

@@ -33,6 +33,11 @@ class Args {
   int get_int(const std::string& name, int fallback, int min_value, int max_value) const;
   double get_double(const std::string& name, double fallback) const;
   const std::vector<std::string>& positional() const { return positional_; }
+  /// Before long work: each given file option (`out`, `report`, ...) can be written (its folder exists
+  /// and is writable, it is no folder). Throws UsageError naming the option and the problem.
+  void check_output_files(const std::vector<std::string>& names) const;
+  /// Each given folder option exists as a folder, or can be created (its parent exists and is writable).
+  void check_output_folders(const std::vector<std::string>& names) const;
 
  private:
   std::map<std::string, std::string> values_;

@@ -87,6 +87,8 @@ const Command kSlam{
     [](const cli::Args& args) {
       for (const char* required : {"rawlog", "out-map", "out-trajectory"})
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
+      args.check_output_files({"out-trajectory"});
+      args.check_output_folders({"out-map"});
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
       std::optional<fs::path> ini;
       if (const auto c = args.get("config")) ini = *c;
@@ -126,6 +128,7 @@ const Command kLocalize{
     [](const cli::Args& args) {
       for (const char* required : {"map", "rawlog", "out-trajectory"})
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
+      args.check_output_files({"out-trajectory"});
       const Pose2D start = parse_pose(args.get_or("initial", "0 0 0"), "--initial");
       robot::Localizer loc = robot::Localizer::load(*args.get("map"));
       const auto steps = robot::read_rawlog(*args.get("rawlog"));

@@ -7,13 +7,16 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/latest_value.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
+#include "projbot/config/output_file.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
 #include "projbot/twin/world.hpp"
@@ -104,28 +107,32 @@ const Command kRun{
      {"headless", "", "draw offscreen at 60 Hz instead of a window (profiling without a display)"},
      {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
      {"profile", "FILE", "write one CSV row per frame: frame time and pose age"},
-     {"seconds", "S", "stop after S seconds (default: when the tour ends or the window is closed)"},
+     {"seconds", "S", "stop after S seconds (default 0: when the tour ends, the window is closed or Ctrl-C)"},
      {"visits", "N", "visits, cycling through the tour (default: the list once)"},
      {"dwell", "S", "seconds the robot projects at each stop (default 4)"},
      {"seed", "K", "seed of the twin's noise (default 1)"}},
     [](const cli::Args& args) {
+      catch_interrupts();  // Ctrl-C / SIGTERM: leave the frame loop at the next frame, then write what was measured
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
-      if (!args.flag("sim")) std::cout << "no robot or camera hardware configured: running against the digital twin (--sim)\n";
+      if (!args.flag("sim"))
+        std::cout << "no robot or camera hardware configured: running against the digital twin (--sim)" << std::endl;
       RunOptions o;
       o.visits = args.get_int("visits", 0, 1, 1000);
       o.dwell_s = args.get_double("dwell", 4.0);
       if (!(o.dwell_s > 0.0 && o.dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
       o.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
       const double seconds = args.get_double("seconds", 0.0);
-      if (!(seconds >= 0.0)) throw cli::UsageError("--seconds must be >= 0");
+      if (!(seconds >= 0.0 && seconds <= 1e6)) throw cli::UsageError("--seconds must be 0 (until the tour ends) to 1e6");
       const bool headless = args.flag("headless");
+      present_mode(args.get_or("present-mode", "fifo"));  // a bad mode is an error with --headless too
+      args.check_output_files({"profile"});
 
       engine::RendererOptions ro;
       ro.windowing = !headless;
       engine::Renderer renderer(ro);
-      std::cout << "device: " << renderer.device_info().name << '\n';
+      std::cout << "device: " << renderer.device_info().name << std::endl;  // flushed: a log shows it has started
       const auto items = upload_scene(renderer, scene);
       std::unique_ptr<engine::RenderTarget> target;
       if (headless) {
@@ -169,7 +176,7 @@ const Command kRun{
       const double t0 = now_s();
       std::size_t blank = 0;
       auto next_frame = Clock::now();
-      while (!target->poll_close() && !robot_done && (seconds == 0.0 || now_s() - t0 < seconds)) {
+      while (!interrupted() && !target->poll_close() && !robot_done && (seconds == 0.0 || now_s() - t0 < seconds)) {
         double used_capture = -1.0;
         state.read(robot);
         const auto read_poses = [&](std::vector<engine::DrawItem>& out) {
@@ -215,16 +222,16 @@ const Command kRun{
                 << engine::percentile(capture_ms, 0.95) << " ms of each pose's age); the tracker workers processed " << tracked
                 << "\n";
       if (const auto csv = args.get("profile")) {
-        std::ofstream f(*csv);
+        std::ostringstream f;
         f << "frame,start_ms,pose_age_ms,target\n";
         for (std::size_t i = 0; i < rows.size(); ++i)
           f << i << ',' << rows[i].start_ms << ',' << (rows[i].age_ms >= 0 ? std::to_string(rows[i].age_ms) : std::string())
             << ',' << (rows[i].target >= 0 ? scene.targets[static_cast<std::size_t>(rows[i].target)].name : std::string())
             << '\n';
-        if (!f) throw std::runtime_error(*csv + ": cannot write the profile");
+        config::write_file_atomically(*csv, f.str());
         std::cout << "per-frame profile written to " << *csv << '\n';
       }
-      return 0;
+      return interrupt_exit_code();  // 0, or 130 / 143 after Ctrl-C / SIGTERM
     }};
 
 }  // namespace projbot::tools

@@ -93,7 +93,15 @@ config::Scene scene_from_args(const cli::Args& args) {
     auto model = assets::load_gltf(scene.targets[0].model);
     assets::scale_and_recenter(model, 1.0, true);
     const double radius = 0.5 * model.bounds().diagonal().norm();
+    if (!(radius > 0.0) || !std::isfinite(radius))
+      throw config::ConfigError(*args.get("model") + ": the model has no extent to frame (size " + std::to_string(2 * radius) +
+                                " m)");
     scene.targets[0].T_projector_target = framing_pose(p, radius);
+    // Whatever its size, the whole bounding sphere lies between the clip planes (a 10 m far plane once
+    // cut models wider than about 3.4 m out of the frame), unless the user set them.
+    const double distance = scene.targets[0].T_projector_target(2, 3);
+    if (!args.get("near")) p.near_m = std::max(1e-4, 0.5 * (distance - radius));
+    if (!args.get("far")) p.far_m = std::max(p.near_m * 2.0, 1.5 * (distance + radius));
   }
   return scene;
 }
@@ -108,16 +116,12 @@ std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const con
   return items;
 }
 
-namespace {
-
 engine::PresentMode present_mode(const std::string& name) {
   if (name == "fifo") return engine::PresentMode::kFifo;
   if (name == "mailbox") return engine::PresentMode::kMailbox;
   if (name == "immediate") return engine::PresentMode::kImmediate;
   throw cli::UsageError("--present-mode must be fifo, mailbox or immediate, got '" + name + "'");
 }
-
-}  // namespace
 
 engine::WindowOptions window_options(const cli::Args& args, const config::ProjectorConfig& projector, std::string title) {
   engine::WindowOptions w;

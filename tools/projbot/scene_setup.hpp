@@ -29,6 +29,8 @@ Eigen::Matrix4d framing_pose(const config::ProjectorConfig& projector, double ra
 
 /// Loads, scales and recentres each target's model and uploads it; returns one DrawItem per target.
 std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene);
+/// fifo, mailbox or immediate. Throws cli::UsageError listing them for anything else.
+engine::PresentMode present_mode(const std::string& name);
 /// The projector window from --fullscreen, --monitor and --present-mode (fifo, mailbox or immediate), the
 /// projector's size when windowed. Throws cli::UsageError.
 engine::WindowOptions window_options(const cli::Args& args, const config::ProjectorConfig& projector, std::string title);

@@ -1,8 +1,10 @@
 // projbot tour: the paper's experiment in the digital twin, with its Table 1 beside ours.
 
+#include <iomanip>
 #include <iostream>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "projbot/twin/tour.hpp"
 #include "scene_setup.hpp"
 
@@ -49,14 +51,24 @@ const Command kTour{
       if (!(o.dwell_s >= 0.0 && o.dwell_s <= 600.0)) throw cli::UsageError("--dwell must be 0..600 seconds");
       o.frames_dir = args.get_or("frames", "");
       o.depth_noise = !args.flag("no-noise");
+      args.check_output_files({"report"});
+      args.check_output_folders({"frames"});
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "tour.yaml").string()));
+      catch_interrupts();  // Ctrl-C: stop after the visit in progress, keep the finished ones
+      o.stop_requested = [] { return interrupted(); };
+      o.on_visit = [](const twin::VisitReport& v) {
+        std::cout << "visit " << v.visit << " (" << v.target << ", " << v.target_visit
+                  << "): " << (v.projected ? "lit" : "blanked") << ", mean " << std::fixed << std::setprecision(1) << v.mean_mm
+                  << " mm, max " << v.max_mm << " mm, align " << std::setprecision(0) << v.align_ms << " ms" << std::endl;
+      };
       const twin::TourReport report = twin::run_tour(scene, o);
+      std::cout << '\n';
       twin::print_table(report, std::cout);
       if (const auto path = args.get("report")) {
         twin::write_report_json(report, *path);
-        std::cout << "Report: " << *path << '\n';
+        std::cout << "Report: " << *path << (report.interrupted ? " (interrupted: the finished visits)" : "") << '\n';
       }
-      return 0;
+      return report.interrupted ? interrupt_exit_code() : 0;
     }};
 
 }  // namespace projbot::tools

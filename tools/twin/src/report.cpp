@@ -9,6 +9,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "projbot/config/output_file.hpp"
 #include "projbot/twin/tour.hpp"
 #include "projbot/twin/world.hpp"
 
@@ -89,7 +90,8 @@ void print_table(const TourReport& report, std::ostream& out) {
           << (v.track_ms_mean > 0 ? fixed(v.track_ms_mean, 1) : std::string("-")) << " |\n";
     }
   }
-  out << "\nTour: " << report.visits.size() << " visits in " << fixed(report.wall_s, 1) << " s wall time.\n";
+  out << "\nTour: " << report.visits.size() << " visits in " << fixed(report.wall_s, 1) << " s wall time"
+      << (report.interrupted ? " (interrupted: the finished visits only)" : "") << ".\n";
 }
 
 void write_report_json(const TourReport& report, const std::filesystem::path& path) {
@@ -146,11 +148,9 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
        {{"width", k.width_px}, {"height", k.height_px}, {"fx", k.fx_px}, {"fy", k.fy_px}, {"cx", k.cx_px}, {"cy", k.cy_px}}},
       {"paper_table1_mm", {{"target1", kPaperMm[0]}, {"target2", kPaperMm[1]}}},
       {"wall_s", report.wall_s},
+      {"interrupted", report.interrupted},
       {"visits", visits}};
-  std::ofstream f(path);
-  if (!f) throw TwinError(path.string() + ": cannot write the report");
-  f << out.dump(2) << '\n';
-  if (!f) throw TwinError(path.string() + ": write failed");
+  config::write_file_atomically(path, out.dump(2) + '\n');
 }
 
 }  // namespace projbot::twin

@@ -95,7 +95,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   report.projector = scene.projector;
   const int visits = options.visits > 0 ? options.visits : static_cast<int>(scene.visits.size());
   std::vector<int> visit_count(targets.size(), 0);
-  for (int v = 0; v < visits; ++v) {
+  const auto stop = [&] { return options.stop_requested && options.stop_requested(); };
+  for (int v = 0; v < visits && !(report.interrupted = stop()); ++v) {
     const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
     const std::size_t i = twin.target_index(name);
     TwinTarget& target = targets[i];
@@ -167,7 +168,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
       if (r.moved) motion_end_s = target.config.motion->start_s + target.config.motion->duration_s;
       double back_under = -1.0;  // when the error went back under the goal for good, -1 while it is not
       bool ever_over = false;
-      for (int k = 1; k <= frames; ++k) {
+      for (int k = 1; k <= frames && !(report.interrupted = stop()); ++k) {
         const double t_s = k / kCameraHz;
         target.T_world_target_true = twin.scripted_pose(i, r.target_visit, t_s);
         // What the projector shows now was computed from the previous frame (one camera period of latency).
@@ -207,6 +208,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
         r.reconverge_s = -1.0;
     }
     twin.end_visit(i, r.target_visit);  // back home, or left where it was moved
+    if (report.interrupted) break;      // this visit did not finish: keep the finished ones only
+    if (options.on_visit) options.on_visit(r);
     report.visits.push_back(std::move(r));
   }
   report.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();

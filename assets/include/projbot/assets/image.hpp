@@ -24,10 +24,22 @@ struct Image {
   const std::uint8_t* pixel(int x, int y) const { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
 };
 
-/// Writes an RGBA8 PNG. Throws AssetError when the file cannot be written.
+/// Row-major 16-bit single-channel pixels (a depth image), top row first, values as stored.
+struct Gray16Image {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint16_t> values;  ///< width * height
+};
+
+/// Writes an RGBA8 PNG atomically (a temporary file beside it, checked, renamed over it): a failed write
+/// leaves any previous file unchanged. Throws AssetError naming the file.
 void write_png(const std::filesystem::path& path, const Image& image);
 
 /// Reads a PNG or JPEG into RGBA8. Throws AssetError naming the file.
 Image read_image(const std::filesystem::path& path);
+
+/// Reads a 16-bit single-channel PNG. Throws AssetError naming the file (and, for another kind of PNG,
+/// its channels and bit depth).
+Gray16Image read_png_gray16(const std::filesystem::path& path);
 
 }  // namespace projbot::assets

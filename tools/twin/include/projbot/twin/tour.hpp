@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -23,6 +24,8 @@ namespace projbot::twin {
 enum class TourMode { odometry, localized, tracking };
 const char* to_string(TourMode mode);
 
+struct VisitReport;
+
 struct TourOptions {
   TourMode mode = TourMode::localized;
   int visits = 0;                    ///< 0: the scene's tour.visits once; otherwise this many, cycling through them
@@ -30,6 +33,11 @@ struct TourOptions {
   std::filesystem::path frames_dir;  ///< when set, the projector frame of each visit as a PNG
   double dwell_s = 3.0;              ///< simulated projection time per visit (camera at 30 Hz), when tracking or moving
   bool depth_noise = true;
+  /// Asked between visits and between tracking frames: true ends the tour there, keeping the visits
+  /// finished so far (the unfinished one is dropped) and marking the report interrupted.
+  std::function<bool()> stop_requested;
+  /// Called with each visit as it finishes (progress for a person watching).
+  std::function<void(const VisitReport&)> on_visit;
 };
 
 /// The projection error at one instant while projecting.
@@ -69,8 +77,9 @@ struct TourReport {
   TourMode mode = TourMode::localized;
   std::uint64_t seed = 1;
   config::ProjectorConfig projector;
-  std::vector<VisitReport> visits;
+  std::vector<VisitReport> visits;  ///< the finished visits
   double wall_s = 0.0;
+  bool interrupted = false;  ///< stopped early (stop_requested), before all the visits asked for
 };
 
 /// Runs the tour on a scene with tour sections. Throws TwinError / ConfigError / EngineError naming

@@ -1,0 +1,76 @@
+#include "projbot/config/output_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <string>
+
+namespace projbot::config {
+
+namespace {
+
+std::string reason(int err) { return std::strerror(err); }
+
+// Writes all bytes to fd; returns 0 or the errno of the first failure.
+int write_all(int fd, const void* data, std::size_t size) {
+  const auto* p = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, p, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    p += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return 0;
+}
+
+std::filesystem::path temporary_beside(const std::filesystem::path& path) {
+  static std::atomic<unsigned> counter{0};
+  return path.parent_path() /
+         ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+}
+
+}  // namespace
+
+void write_file_atomically(const std::filesystem::path& path, const void* data, std::size_t size) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
+    if (std::filesystem::is_directory(st)) throw OutputError(path.string() + ": cannot write: it is a folder");
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);  // a device or FIFO: in place
+    if (fd < 0) throw OutputError(path.string() + ": cannot write: " + reason(errno));
+    const int err = write_all(fd, data, size);
+    const int close_err = ::close(fd) == 0 ? 0 : errno;
+    if (err != 0 || close_err != 0) throw OutputError(path.string() + ": cannot write: " + reason(err != 0 ? err : close_err));
+    return;
+  }
+  const std::filesystem::path tmp = temporary_beside(path);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw OutputError(path.string() + ": cannot write: " + reason(errno) + " (does the folder exist and is it writable?)");
+  int err = write_all(fd, data, size);
+  if (err == 0 && ::fsync(fd) != 0 && errno != EINVAL) err = errno;
+  if (::close(fd) != 0 && err == 0) err = errno;
+  if (err == 0 && std::rename(tmp.c_str(), path.c_str()) != 0) err = errno;
+  if (err != 0) {
+    ::unlink(tmp.c_str());
+    throw OutputError(path.string() + ": cannot write: " + reason(err) + " (the previous file, if any, is unchanged)");
+  }
+}
+
+void check_writable(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw OutputError(path.string() + ": is a folder, not a file to write");
+  const std::filesystem::path folder = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
+  if (!std::filesystem::is_directory(folder, ec))
+    throw OutputError(path.string() + ": the folder " + folder.string() + " does not exist");
+  if (::access(folder.c_str(), W_OK) != 0)
+    throw OutputError(path.string() + ": the folder " + folder.string() + " is not writable");
+}
+
+}  // namespace projbot::config

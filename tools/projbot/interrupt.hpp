@@ -1,0 +1,15 @@
+#pragma once
+// Ctrl-C and SIGTERM for the long commands (run, tour, slam, localize): the first signal asks the work
+// to stop at its next frame or visit boundary, so what was measured is still written; a second one
+// ends the process at once.
+
+namespace projbot::tools {
+
+/// Installs the SIGINT / SIGTERM handlers (idempotent).
+void catch_interrupts();
+/// A signal arrived since catch_interrupts().
+bool interrupted();
+/// The exit status for the signal that arrived: 130 (SIGINT), 143 (SIGTERM); 0 when none did.
+int interrupt_exit_code();
+
+}  // namespace projbot::tools
