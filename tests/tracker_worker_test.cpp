@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "projbot/alignment/equations.hpp"
+#include "projbot/alignment/verification.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/scene.hpp"
 
@@ -169,4 +170,48 @@ TEST(TrackerWorkerTest, AWrongSizedFrameEndsTheWorkerWithAnErrorAndLost) {
   ASSERT_TRUE(poll(worker, s, [](const PoseSample& p) { return p.lost; }));
   ASSERT_NE(worker.error(), nullptr);
   EXPECT_THROW(std::rethrow_exception(worker.error()), AlignmentError);
+}
+
+// A good fit to the wrong place cannot pass the free-space check: the cube estimated 10 cm nearer than
+// it is leaves the camera seeing through it; the right pose agrees; an occluder in front is neutral.
+TEST(FreeSpaceTest, SeesThroughAWrongPoseNotThroughAnOccludedOne) {
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  const ModelCloud model = cube_model();
+  const Eigen::Matrix4d truth = projbot::config::pose_from_xyz_rpy({0.05, -0.02, 1.2}, {20, 30, 10});
+  auto depth = cube_depth(truth, k, 0.0);
+  const FreeSpaceCheck right = check_free_space(model, truth, *depth, k);
+  EXPECT_GT(right.predicted, 2000U);
+  EXPECT_LT(right.behind_ratio(), 0.02);
+  Eigen::Matrix4d nearer = truth;
+  nearer(2, 3) -= 0.10;
+  EXPECT_GT(check_free_space(model, nearer, *depth, k).behind_ratio(), 0.8);
+  for (int y = 0; y < k.height_px / 2; ++y)  // a visitor's arm across the top half, 40 cm in front
+    for (int x = 0; x < k.width_px; ++x) depth->depth_m[static_cast<std::size_t>(y) * k.width_px + x] = 0.8F;
+  const FreeSpaceCheck occluded = check_free_space(model, truth, *depth, k);
+  EXPECT_GT(occluded.in_front, occluded.predicted / 4);
+  EXPECT_LT(occluded.behind_ratio(), 0.02);
+}
+
+// Searching for a target that is not there: one attempt per due frame, escalating and spaced out, the
+// model's features computed once however often the global search runs.
+TEST(TargetFollowerTest, AnAbsentTargetCostsABoundedNumberOfAttempts) {
+#if defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "the global search's FPFH runs OpenMP threads, outside ThreadSanitizer's view";
+#endif
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  TargetFollower follower(cube_model(), k);
+  follower.set_initial_guess(projbot::config::pose_from_xyz_rpy({0.0, 0.0, 1.2}, {20, 30, 10}));
+  auto wall = cube_depth(Eigen::Matrix4d::Identity(), k, 0.0);
+  std::fill(wall->depth_m.begin(), wall->depth_m.end(), 2.0F);  // nothing but a wall 2 m away
+  int lost = 0, found = 0;
+  for (int frame = 0; frame < 90; ++frame) {
+    wall->capture_time_s = frame / 30.0;
+    if (const auto s = follower.step(*wall)) (s->lost ? lost : found)++;
+  }
+  EXPECT_EQ(found, 0);
+  EXPECT_EQ(lost, 1);  // said once, at the first failed attempt
+  // Spacing {0, 3, 9, 15, 30}: attempts on frames 0, 1, 5, 15, 31 and 62 of 90.
+  EXPECT_EQ(follower.search_stats().attempts, 6);
+  EXPECT_EQ(follower.search_stats().frames_waited, 84);
+  EXPECT_EQ(follower.aligner().model_feature_computations(), 1);  // 4 global attempts, features once
 }

@@ -139,6 +139,12 @@ TEST(TwinSceneTest, BadToursAreNamed) {
             std::string::npos);
   EXPECT_NE(config_error("slip_scale: 0.01", "slip_scale: -0.01").find("robot.drift.slip_scale: must be >= 0"),
             std::string::npos);
+  EXPECT_NE(
+      config_error("stays: true}", "stays: true, removed: true}").find("targets[1].motion: a removed target cannot also stay"),
+      std::string::npos);
+  EXPECT_NE(config_error("stays: true}", "stays: maybe}").find("targets[1].motion.stays"), std::string::npos);
+  EXPECT_NE(config_error("    scale: 0.3\n", "    scale: 0.3\n    present: 2\n").find("targets[1].present"), std::string::npos);
+  EXPECT_FALSE(demo_with("    scale: 0.3\n", "    scale: 0.3\n    present: false\n").targets[1].present);
   EXPECT_NE(config_error("  width: 8\n", "  width: 0\n").find("room: width and depth must be 0.5..200 m"), std::string::npos);
   // A marker 5 cm off the Duck's surface: the twin names it and where the surface is.
   const std::string off = twin_error(demo_with("[-0.0024, -0.0389, 0.1421]", "[-0.0024, -0.0389, 0.1921]"));
@@ -231,6 +237,56 @@ TEST(TourTest, TrackingFollowsTheMovedTarget) {
   EXPECT_LT(moved.max_mm_moving, 15.0);
   EXPECT_LT(moved.timeline.back().mean_mm, 3.0);
   for (const auto& s : moved.timeline) EXPECT_TRUE(s.shown);
+}
+
+// A target that is not there (present: false) is searched for within the follower's budget and never
+// lit; the target before it is tracked on every frame of its dwell (counted in simulated time).
+TEST(TourTest, AnAbsentTargetIsNeverLitAndSearchedWithinItsBudget) {
+  const auto scene = demo_with("    model: ../models/BoxTextured/BoxTextured.gltf\n",
+                               "    model: ../models/BoxTextured/BoxTextured.gltf\n    present: false\n");
+  projbot::twin::TourOptions o;
+  o.mode = projbot::twin::TourMode::tracking;
+  o.visits = 2;
+  o.dwell_s = 1.0;
+  const auto report = projbot::twin::run_tour(scene, o);
+  ASSERT_EQ(report.visits.size(), 2U);
+  const auto& duck = report.visits[0];
+  const auto& box = report.visits[1];
+  EXPECT_TRUE(duck.target_present);
+  EXPECT_EQ(duck.lit_frames, 31);  // arrival + 30 frames: tracked on every one
+  EXPECT_DOUBLE_EQ(duck.first_light_s, 0.0);
+  EXPECT_FALSE(box.target_present);
+  EXPECT_EQ(box.lit_frames, 0);
+  EXPECT_LT(box.first_light_s, 0.0);
+  for (const auto& t : box.timeline) EXPECT_FALSE(t.shown);
+  // The spacing {0, 3, 9, 15, 30}: attempts at arrival and on frames 1, 5 and 15 of 30; 27 frames waited.
+  EXPECT_EQ(box.search.attempts, 4);
+  EXPECT_EQ(box.search.frames_waited, 27);
+  EXPECT_GT(box.free_space.behind_ratio(), 0.2);  // what the gate refused at arrival
+}
+
+// Someone carries the box away mid-visit: the light goes out within 100 ms of the first depth frame
+// that shows it gone, and its next visit finds it absent and never lights it.
+TEST(TourTest, ARemovedTargetIsBlankedWithin100ms) {
+  const auto scene = demo_with(
+      "motion: {visit: 2, start_s: 0.5, duration_s: 2.0, translation: [0.08, -0.06, 0.0], rpy_deg: [0, 0, 15], stays: true}",
+      "motion: {visit: 1, start_s: 0.5, duration_s: 0.2, removed: true}");
+  projbot::twin::TourOptions o;
+  o.mode = projbot::twin::TourMode::tracking;
+  o.dwell_s = 1.5;
+  o.visits = 4;
+  const auto report = projbot::twin::run_tour(scene, o);
+  ASSERT_EQ(report.visits.size(), 4U);
+  const auto& removed = report.visits[1];
+  ASSERT_EQ(removed.target, "box");
+  EXPECT_TRUE(removed.projected);
+  EXPECT_GE(removed.blank_after_removal_s, 0.0);
+  EXPECT_LE(removed.blank_after_removal_s, 0.1);
+  // Lit at arrival and on frames 1-20, before it goes at 0.7 s (frame 21), and until the blank shows.
+  EXPECT_GE(removed.lit_frames, 22);
+  EXPECT_LE(removed.lit_frames, 24);
+  EXPECT_FALSE(report.visits[3].target_present);
+  EXPECT_EQ(report.visits[3].lit_frames, 0);
 }
 
 }  // namespace

@@ -152,7 +152,8 @@ struct Aligner::Impl {
   CloudN::Ptr model;                     // all model samples, model frame: for the quality metrics
   CloudN::Ptr model_icp;                 // voxel-downsampled: ICP source
   CloudN::Ptr model_coarse;              // coarser: re-initialisation
-  mutable Features::Ptr model_features;  // computed on the first re-initialisation
+  mutable Features::Ptr model_features;  // computed on the first re-initialisation, then kept
+  mutable int feature_computations = 0;
   pcl::KdTreeFLANN<PointN> model_tree;
   pcl::search::KdTree<PointN>::Ptr model_icp_tree;
   Extent extent;
@@ -301,13 +302,29 @@ struct Aligner::Impl {
 
   bool passes(const AlignmentResult& r) const { return r.inlier_ratio >= cfg.min_inlier_ratio && r.rmse_mm <= cfg.max_rmse_mm; }
 
+  // The scan within `margin` of the model's sphere under T_init, on the coarse grid, thinned by a coarser
+  // grid until at most max_global_points remain: what a bounded global search works on.
+  pcl::PointCloud<pcl::PointXYZ>::Ptr global_points(const PointCloud& scan, const Eigen::Matrix4d& T_init, double margin,
+                                                    std::size_t max_points) const {
+    double leaf = coarse_leaf();
+    auto points = prepare(scan, extent.centre_in(T_init).cast<float>(), cfg.crop ? extent.radius + margin : 0.0, leaf);
+    while (points->size() > max_points && leaf < 0.05) {
+      leaf *= 1.4;
+      points = prepare(scan, extent.centre_in(T_init).cast<float>(), cfg.crop ? extent.radius + margin : 0.0, leaf);
+    }
+    return points;
+  }
+
   // Global re-initialisation: FPFH correspondences and SampleConsensusPrerejective over a wide region.
-  std::optional<Eigen::Matrix4d> reinitialise(const PointCloud& scan, const Eigen::Matrix4d& T_init) const {
-    const auto wide_points = prepare(scan, extent.centre_in(T_init).cast<float>(),
-                                     cfg.crop ? extent.radius + cfg.reinit_crop_margin_m : 0.0, coarse_leaf());
+  std::optional<Eigen::Matrix4d> reinitialise(const PointCloud& scan, const Eigen::Matrix4d& T_init, double margin,
+                                              std::size_t max_points) const {
+    const auto wide_points = global_points(scan, T_init, margin, max_points);
     if (wide_points->size() < cfg.min_points) return std::nullopt;
     const CloudN::Ptr wide = with_normals(wide_points, cfg.normal_neighbours);
-    if (!model_features) model_features = fpfh(model_coarse, cfg.feature_radius_m);
+    if (!model_features) {
+      model_features = fpfh(model_coarse, cfg.feature_radius_m);
+      ++feature_computations;
+    }
     const Features::Ptr scan_features = fpfh(wide, cfg.feature_radius_m);
     pcl::SampleConsensusPrerejective<PointN, PointN, pcl::FPFHSignature33> sac;
     sac.setInputSource(model_coarse);
@@ -451,7 +468,20 @@ AlignmentResult Aligner::score(const PointCloud& scan, const Eigen::Matrix4d& T_
   return r;
 }
 
-AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_init) const {
+int Aligner::model_feature_computations() const { return impl_->feature_computations; }
+
+namespace {
+
+// Keeps the better of two results: passing the gate first, then more inliers, then a lower RMSE.
+bool better_than(const AlignmentResult& r, const AlignmentResult& best) {
+  return (r.converged && !best.converged) ||
+         (r.converged == best.converged &&
+          (r.inlier_ratio > best.inlier_ratio + 0.02 || (r.inlier_ratio > best.inlier_ratio - 0.02 && r.rmse_mm < best.rmse_mm)));
+}
+
+}  // namespace
+
+AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage) const {
   const auto t0 = std::chrono::steady_clock::now();
   const Impl& m = *impl_;
   if (!T_init.allFinite()) throw AlignmentError("initial guess is not finite");
@@ -472,14 +502,11 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     m.evaluate(*m.near_scan(scan, r.T_scan_model, m.gate_margin()), r.T_scan_model, r);
     r.converged = icp_converged && m.passes(r);
     r.iterations = best.iterations;
-    const bool better =
-        (r.converged && !best.converged) ||
-        (r.converged == best.converged &&
-         (r.inlier_ratio > best.inlier_ratio + 0.02 || (r.inlier_ratio > best.inlier_ratio - 0.02 && r.rmse_mm < best.rmse_mm)));
-    if (better) best = r;
+    if (better_than(r, best)) best = r;
   };
-  attempt(T_init, false);
-  if (!best.converged && m.cfg.restart_angle_deg > 0.0) {
+  const bool local = stage == SearchStage::full || stage == SearchStage::refine || stage == SearchStage::local;
+  if (local) attempt(T_init, false);
+  if (!best.converged && m.cfg.restart_angle_deg > 0.0 && (stage == SearchStage::full || stage == SearchStage::local)) {
     // Local restarts: the guess turned about the target's centre, which ICP alone cannot leave.
     const Eigen::Vector3d c = m.extent.centre_in(T_init);
     for (int axis = 0; axis < 3 && !best.converged; ++axis)
@@ -492,8 +519,15 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
         if (best.converged) break;
       }
   }
-  if (!best.converged && m.cfg.reinitialise)
-    if (const auto T = m.reinitialise(scan, T_init)) attempt(*T, true);
+  // Global re-initialisation: in `full` after the local attempts failed (as many points as the region
+  // holds); as a stage of its own, bounded by max_global_points.
+  const bool global = m.cfg.reinitialise && ((stage == SearchStage::full && !best.converged) ||
+                                             stage == SearchStage::global_near || stage == SearchStage::global_wide);
+  if (global) {
+    const double margin = stage == SearchStage::global_wide ? m.cfg.wide_crop_margin_m : m.cfg.reinit_crop_margin_m;
+    const std::size_t cap = stage == SearchStage::full ? std::numeric_limits<std::size_t>::max() : m.cfg.max_global_points;
+    if (const auto T = m.reinitialise(scan, T_init, margin, cap)) attempt(*T, true);
+  }
   best.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return best;
 }

@@ -1,9 +1,13 @@
 #include "projbot/alignment/tracker_worker.hpp"
 
+#include <algorithm>
+#include <chrono>
+
 namespace projbot::alignment {
 
 TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config)
-    : aligner_(model, config.acquisition),
+    : model_(model),
+      aligner_(model, config.acquisition),
       tracker_(std::move(model), intrinsics, config.tracking),
       k_(intrinsics),
       cfg_(std::move(config)) {}
@@ -13,6 +17,10 @@ void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target) {
   have_guess_ = true;
   pose_.reset();
   rejected_ = 0;
+  lost_reported_ = false;
+  wait_ = 0;
+  stats_ = {};
+  last_attempt_.reset();
 }
 
 void TargetFollower::set_pose(const Eigen::Matrix4d& T_camera_target) {
@@ -20,34 +28,77 @@ void TargetFollower::set_pose(const Eigen::Matrix4d& T_camera_target) {
   pose_ = T_camera_target;
 }
 
+FreeSpaceCheck TargetFollower::verify(const DepthImage& frame, const Eigen::Matrix4d& T_camera_target) const {
+  return check_free_space(model_, T_camera_target, frame, k_);
+}
+
+bool TargetFollower::verified(const DepthImage& frame, const Eigen::Matrix4d& T) {
+  check_ = verify(frame, T);
+  return passes(check_);
+}
+
 std::optional<PoseSample> TargetFollower::step(const DepthImage& frame) {
   if (!have_guess_ && !pose_) return std::nullopt;  // nothing to start from yet
-  if (pose_) {
-    const TrackResult r = tracker_.track(frame, *pose_);
-    if (r.accepted) {
-      pose_ = r.T_camera_target;
-      rejected_ = 0;
-      return PoseSample{*pose_, 0, frame.capture_time_s, false, r.inlier_ratio, r.rmse_mm};
-    }
-    // The target moved more than tracking follows (or the worker fell behind and frames were dropped):
-    // acquire on this same frame, from where it was last seen.
-    guess_ = *pose_;
-  }
+  return pose_ ? track(frame) : search(frame);
+}
+
+std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage) {
   const PointCloud scan = depth_to_cloud(frame, k_);
-  std::optional<AlignmentResult> a;
-  if (scan.finite_count() >= aligner_.config().min_points) a = aligner_.align(scan, guess_);
-  if (a && a->converged) {
+  if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
+  last_attempt_ = aligner_.align(scan, from, stage);
+  return last_attempt_;
+}
+
+std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
+  const TrackResult r = tracker_.track(frame, *pose_);
+  if (r.accepted && verified(frame, r.T_camera_target)) {
+    pose_ = r.T_camera_target;
+    rejected_ = 0;
+    return PoseSample{*pose_, 0, frame.capture_time_s, false, r.inlier_ratio, r.rmse_mm};
+  }
+  // The target moved more than tracking follows (or frames were dropped): one ICP on this same frame
+  // from where it was last seen. Bounded: no restarts, no global search here.
+  const auto a = attempt(frame, *pose_, SearchStage::refine);
+  if (a && a->converged && verified(frame, a->T_scan_model)) {
     pose_ = a->T_scan_model;
     rejected_ = 0;
     return PoseSample{*pose_, 0, frame.capture_time_s, false, a->inlier_ratio, a->rmse_mm};
   }
-  // Neither tracking nor acquisition found it. After lost_after such frames, say so.
-  const bool was_tracking = pose_.has_value();
-  if (++rejected_ >= cfg_.lost_after && (was_tracking || rejected_ == cfg_.lost_after)) {
-    pose_.reset();
-    return PoseSample{guess_, 0, frame.capture_time_s, true, a ? a->inlier_ratio : 0.0, a ? a->rmse_mm : 0.0};
+  if (++rejected_ < cfg_.lost_after) return std::nullopt;  // one bad frame: keep showing the last pose
+  // Lost: blank it now and search from where it was last seen.
+  guess_ = *pose_;
+  pose_.reset();
+  wait_ = 0;
+  lost_reported_ = true;
+  return PoseSample{guess_, 0, frame.capture_time_s, true, a ? a->inlier_ratio : 0.0, a ? a->rmse_mm : 0.0};
+}
+
+std::optional<PoseSample> TargetFollower::search(const DepthImage& frame) {
+  if (wait_ > 0) {
+    --wait_;
+    ++stats_.frames_waited;
+    return std::nullopt;
   }
-  return std::nullopt;
+  static constexpr SearchStage kEscalation[] = {SearchStage::local, SearchStage::global_near, SearchStage::global_wide};
+  // Without global re-initialisation (AcquisitionConfig::reinitialise) every attempt is a local one.
+  const SearchStage stage = aligner_.config().reinitialise ? kEscalation[stats_.attempts % 3] : SearchStage::local;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto a = attempt(frame, guess_, stage);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  ++stats_.attempts;
+  stats_.total_ms += ms;
+  stats_.max_attempt_ms = std::max(stats_.max_attempt_ms, ms);
+  if (a && a->converged && verified(frame, a->T_scan_model)) {
+    pose_ = a->T_scan_model;
+    rejected_ = 0;
+    lost_reported_ = false;
+    return PoseSample{*pose_, 0, frame.capture_time_s, false, a->inlier_ratio, a->rmse_mm};
+  }
+  const auto& spacing = cfg_.search_spacing_frames;
+  if (!spacing.empty()) wait_ = spacing[std::min(static_cast<std::size_t>(stats_.attempts - 1), spacing.size() - 1)];
+  if (lost_reported_) return std::nullopt;
+  lost_reported_ = true;  // not found at this stop yet: say so once, so the renderer blanks it
+  return PoseSample{guess_, 0, frame.capture_time_s, true, a ? a->inlier_ratio : 0.0, a ? a->rmse_mm : 0.0};
 }
 
 TrackerWorker::TrackerWorker(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config)

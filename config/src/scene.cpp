@@ -266,6 +266,7 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
     target.scale = t.get<double>("scale", 1.0);
     if (!(target.scale > 0.0)) t.fail(targets[i]["scale"], path + ".scale", "must be > 0");
     target.recenter = t.get<bool>("recenter", false);
+    target.present = t.get<bool>("present", true);
     target.T_projector_target = read_pose(t, path + ".pose");
     if (t.has("world_pose")) target.T_world_target = read_pose(t, path + ".world_pose", "world_pose");
     if (t.has("map_pose")) {
@@ -294,6 +295,8 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
       if (YAML::Node tr = m.child("translation", false)) motion.translation_m = m.vector3(tr, m.key_path("translation"));
       if (YAML::Node rpy = m.child("rpy_deg", false)) motion.rpy_deg = m.vector3(rpy, m.key_path("rpy_deg"));
       motion.stays = m.get<bool>("stays", false);
+      motion.removed = m.get<bool>("removed", false);
+      if (motion.removed && motion.stays) m.fail(mo, path + ".motion", "a removed target cannot also stay: choose one");
       m.reject_unknown();
       target.motion = motion;
     }

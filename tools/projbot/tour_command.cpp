@@ -57,9 +57,18 @@ const Command kTour{
       catch_interrupts();  // Ctrl-C: stop after the visit in progress, keep the finished ones
       o.stop_requested = [] { return interrupted(); };
       o.on_visit = [](const twin::VisitReport& v) {
-        std::cout << "visit " << v.visit << " (" << v.target << ", " << v.target_visit
-                  << "): " << (v.projected ? "lit" : "blanked") << ", mean " << std::fixed << std::setprecision(1) << v.mean_mm
-                  << " mm, max " << v.max_mm << " mm, align " << std::setprecision(0) << v.align_ms << " ms" << std::endl;
+        std::cout << "visit " << v.visit << " (" << v.target << ", " << v.target_visit << "): " << std::fixed;
+        if (!v.target_present)
+          std::cout << "target absent, "
+                    << (v.lit_frames == 0 ? "never lit" : "LIT in " + std::to_string(v.lit_frames) + " frames");
+        else
+          std::cout << (v.projected ? "lit" : "blanked") << " at arrival, mean " << std::setprecision(1) << v.mean_mm
+                    << " mm, max " << v.max_mm << " mm";
+        std::cout << ", align " << std::setprecision(0) << v.align_ms << " ms";
+        if (v.first_light_s > 0) std::cout << ", first light after " << std::setprecision(2) << v.first_light_s << " s";
+        if (v.search.attempts > 0)
+          std::cout << ", " << v.search.attempts << " search attempts (" << std::setprecision(0) << v.search.total_ms << " ms)";
+        std::cout << std::endl;
       };
       const twin::TourReport report = twin::run_tour(scene, o);
       std::cout << '\n';

@@ -58,6 +58,8 @@ void print_table(const TourReport& report, std::ostream& out) {
                                    [&](const VisitReport& v) { return v.target == names[c] && v.target_visit == row; });
       if (it == report.visits.end())
         out << " - |";
+      else if (!it->target_present)
+        out << (it->lit_frames == 0 ? " absent, never lit |" : " absent, LIT (wrong) |");
       else if (!it->projected)
         out << " blanked (" << fixed(it->mean_mm, 1) << " / " << fixed(it->max_mm, 1) << " if shown) |";
       else
@@ -81,16 +83,28 @@ void print_table(const TourReport& report, std::ostream& out) {
   if (any_timeline) {
     out << "\nWhile projecting (" << to_string(report.mode)
         << "):\n\n| # | target | moved | worst mean mm while moving | "
-           "mean mm at the end | re-converged after the move, s | track ms/frame |\n|---|---|---|---|---|---|---|\n";
+           "mean mm at the end | re-converged after the move, s | track ms/frame | lit frames | first light s (wall ms) | "
+           "search attempts, ms (longest) |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& v : report.visits) {
       if (v.timeline.empty()) continue;
       out << "| " << v.visit << " | " << v.target << " | " << (v.moved ? "yes" : "no") << " | "
           << (v.moved ? fixed(v.max_mm_moving, 1) : std::string("-")) << " | " << fixed(v.timeline.back().mean_mm, 2) << " | "
           << (v.reconverge_s < 0 ? std::string("never") : fixed(v.reconverge_s, 2)) << " | "
-          << (v.track_ms_mean > 0 ? fixed(v.track_ms_mean, 1) : std::string("-")) << " |\n";
+          << (v.track_ms_mean > 0 ? fixed(v.track_ms_mean, 1) : std::string("-")) << " | " << v.lit_frames << "/"
+          << v.timeline.size() + 1 << " | "
+          << (v.first_light_s < 0 ? std::string("never")
+                                  : fixed(v.first_light_s, 2) + " (" + fixed(v.first_light_wall_ms, 0) + ")")
+          << " | "
+          << (v.search.attempts > 0 ? std::to_string(v.search.attempts) + ", " + fixed(v.search.total_ms, 0) + " (" +
+                                          fixed(v.search.max_attempt_ms, 0) + ")"
+                                    : std::string("-"))
+          << " |\n";
     }
   }
-  out << "\nTour: " << report.visits.size() << " visits in " << fixed(report.wall_s, 1) << " s wall time"
+  double simulated_s = 0.0;
+  for (const auto& v : report.visits) simulated_s += v.drive_s + static_cast<double>(v.timeline.size()) / 30.0;
+  out << "\nTour: " << report.visits.size() << " visits in " << fixed(report.wall_s, 1) << " s wall time, "
+      << fixed(simulated_s, 1) << " s simulated (driving and projecting)"
       << (report.interrupted ? " (interrupted: the finished visits only)" : "") << ".\n";
 }
 
@@ -123,6 +137,11 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
                         {"rmse_mm", finite_or_null(v.icp.rmse_mm)},
                         {"iterations", v.icp.iterations},
                         {"reinitialised", v.icp.reinitialised}}},
+                      {"free_space",
+                       {{"predicted_px", v.free_space.predicted},
+                        {"behind_px", v.free_space.behind},
+                        {"in_front_px", v.free_space.in_front},
+                        {"behind_ratio", v.free_space.behind_ratio()}}},
                       {"robot",
                        {{"base_error_cm", v.base_error_cm},
                         {"base_error_deg", v.base_error_deg},
@@ -138,6 +157,16 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
                       {"moved", v.moved},
                       {"max_mean_mm_while_moving", v.max_mm_moving},
                       {"reconverge_s", v.reconverge_s},
+                      {"target_present", v.target_present},
+                      {"lit_frames", v.lit_frames},
+                      {"first_light_s", v.first_light_s},
+                      {"first_light_wall_ms", v.first_light_wall_ms},
+                      {"search",
+                       {{"attempts", v.search.attempts},
+                        {"total_ms", v.search.total_ms},
+                        {"max_attempt_ms", v.search.max_attempt_ms},
+                        {"frames_waited", v.search.frames_waited}}},
+                      {"blank_after_removal_s", v.blank_after_removal_s},
                       {"timeline", timeline}});
   }
   const auto& k = report.projector;

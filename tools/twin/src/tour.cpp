@@ -38,6 +38,112 @@ Errors marker_errors(const Twin& twin, std::size_t target, const config::Project
   return e;
 }
 
+// One acquisition at arrival. Odometry and localized modes: the whole acquisition once (the paper's
+// one alignment per stop; odometry projects whatever it gives). Tracking mode: the follower's first
+// step, the bounded start of its search, as the live engine's worker does it.
+void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const alignment::DepthImage& depth,
+             const Eigen::Matrix4d& T_init, VisitReport& r) {
+  const auto t0 = Clock::now();
+  r.icp.T_scan_model = T_init;  // too little in view: nothing to align
+  r.icp.converged = false;
+  if (mode == TourMode::tracking) {
+    follower.set_initial_guess(T_init);
+    const auto sample = follower.step(depth);
+    if (follower.last_attempt()) r.icp = *follower.last_attempt();
+    r.free_space = follower.last_check();
+    r.projected = sample && !sample->lost;
+  } else {
+    try {
+      r.icp = follower.aligner().align(alignment::depth_to_cloud(depth, twin.camera()), T_init);
+    } catch (const alignment::AlignmentError&) {
+    }
+    // Ours also checks the estimate against free space; the paper's set-up projects whatever ICP gives.
+    r.free_space = follower.verify(depth, r.icp.T_scan_model);
+    if (mode == TourMode::localized && !follower.passes(r.free_space)) r.icp.converged = false;
+    r.projected = mode == TourMode::odometry || r.icp.converged;
+  }
+  r.align_ms = ms_since(t0);
+  if (r.projected) {
+    r.first_light_s = 0.0;
+    r.first_light_wall_ms = r.align_ms;
+    r.lit_frames = 1;
+  }
+}
+
+struct DwellContext {
+  Twin& twin;
+  std::size_t target;
+  const config::ProjectorConfig& projector;
+  const robot::HeadPoses& truth;
+  const TourOptions& options;
+  std::uint32_t noise_seed;
+};
+
+// Projection while the robot dwells at the stop: the timeline of errors at camera rate, the target
+// moved or taken away by its script, and in tracking mode the follower stepped on each frame. Returns
+// false when the tour was asked to stop in the middle.
+bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitReport& r) {
+  TwinTarget& target = c.twin.targets()[c.target];
+  const Eigen::Matrix4d& T_projector_camera = c.twin.scene().pan_tilt.T_projector_camera;
+  const Eigen::Matrix4d T_world_projector = c.truth.T_world_projector.matrix();
+  const bool tracking = c.options.mode == TourMode::tracking;
+  Eigen::Matrix4d T_camera_target = r.icp.T_scan_model;  // the newest estimate
+  bool shown = r.projected;
+  double track_ms = 0.0, wall_to_light_ms = r.align_ms;
+  const int frames = static_cast<int>(std::lround(c.options.dwell_s * kCameraHz));
+  const auto& motion = target.config.motion;
+  const double motion_end_s = r.moved ? motion->start_s + motion->duration_s : 0.0;
+  double back_under = -1.0;  // when the error went back under the goal for good, -1 while it is not
+  bool ever_over = false;
+  int gone_frame = -1;  // the first camera frame without the target (motion.removed)
+  for (int k = 1; k <= frames; ++k) {
+    if (c.options.stop_requested && c.options.stop_requested()) return false;
+    const double t_s = k / kCameraHz;
+    target.T_world_target_true = c.twin.scripted_pose(c.target, r.target_visit, t_s);
+    target.in_world = c.twin.scripted_presence(c.target, r.target_visit, t_s);
+    if (!target.in_world && r.target_present && gone_frame < 0) gone_frame = k;
+    // What the projector shows now was computed from the previous frame (one camera period of latency).
+    TimelineSample s;
+    s.t_s = t_s;
+    s.shown = shown;
+    s.moving = r.moved && t_s > motion->start_s && t_s <= motion_end_s;
+    const Errors now = marker_errors(c.twin, c.target, c.projector, T_world_projector,
+                                     alignment::projector_from_target(T_projector_camera, T_camera_target));
+    s.mean_mm = now.mean_mm;
+    s.max_mm = now.max_mm;
+    r.timeline.push_back(s);
+    r.lit_frames += shown ? 1 : 0;
+    if (shown && r.first_light_s < 0.0) {
+      r.first_light_s = t_s;
+      r.first_light_wall_ms = wall_to_light_ms;
+    }
+    if (!shown && gone_frame > 0 && r.blank_after_removal_s < 0.0) r.blank_after_removal_s = (k - gone_frame) / kCameraHz;
+    if (s.moving) r.max_mm_moving = std::max(r.max_mm_moving, s.mean_mm);
+    const bool good = shown && s.mean_mm <= kConvergedMm;
+    if (!good && target.in_world) {
+      ever_over = true;
+      back_under = -1.0;
+    } else if (good && back_under < 0.0 && t_s >= motion_end_s) {
+      back_under = t_s;
+    }
+    if (!tracking) continue;
+    const alignment::DepthImage frame =
+        c.twin.capture(c.truth.T_world_camera.matrix(), c.noise_seed + static_cast<std::uint32_t>(k));
+    const auto tt = Clock::now();
+    if (const auto sample = follower.step(frame)) {
+      shown = !sample->lost;
+      if (shown) T_camera_target = sample->T_camera_target;
+    }
+    const double step_ms = ms_since(tt);
+    track_ms += step_ms;
+    if (r.first_light_s < 0.0) wall_to_light_ms += step_ms;
+  }
+  r.track_ms_mean = tracking && frames > 0 ? track_ms / frames : 0.0;
+  if (tracking) r.search = follower.search_stats();
+  r.reconverge_s = !ever_over ? 0.0 : back_under >= 0.0 ? std::max(0.0, back_under - motion_end_s) : -1.0;
+  return true;
+}
+
 }  // namespace
 
 const char* to_string(TourMode mode) {
@@ -113,6 +219,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     r.base_error_deg = arrival.drive.error_rad * 180.0 / M_PI;
     r.odometry_error_cm = 100.0 * arrival.drive.odometry_error_m;
     const robot::HeadPoses& truth = arrival.truth;
+    target.in_world = twin.scripted_presence(i, r.target_visit, 0.0);
+    r.target_present = target.in_world;
 
     // Capture, Eq. 1, acquisition, Eq. 2.
     auto t0 = Clock::now();
@@ -124,15 +232,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     const Eigen::Matrix4d guess_error = alignment::rigid_inverse(T_camera_true) * T_init;
     r.guess_error_cm = 100.0 * alignment::translation_norm_m(guess_error);
     r.guess_error_deg = alignment::rotation_angle_deg(guess_error);
-    t0 = Clock::now();
-    try {
-      r.icp = followers[i].aligner().align(alignment::depth_to_cloud(depth, twin.camera()), T_init);
-    } catch (const alignment::AlignmentError&) {
-      r.icp.T_scan_model = T_init;  // too little of the target in view: nothing to align
-      r.icp.converged = false;
-    }
-    r.align_ms = ms_since(t0);
-    r.projected = options.mode == TourMode::odometry || r.icp.converged;
+    acquire(options.mode, followers[i], twin, depth, T_init, r);
     const Eigen::Matrix4d T_world_projector = truth.T_world_projector.matrix();
     r.T_projector_target_estimated = alignment::projector_from_target(rig.T_projector_camera, r.icp.T_scan_model);
     r.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;
@@ -153,60 +253,11 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
       assets::write_png(options.frames_dir / file, image);
     }
 
-    // Projecting: the target may be moved; the tracker (tracking mode) follows it at camera rate.
+    // Projecting: the target may be moved or taken away; the tracker (tracking mode) follows it at
+    // camera rate, and a lost or missing target is searched for within the follower's budget.
     r.moved = target.config.motion && target.config.motion->visit == r.target_visit;
-    if (options.mode == TourMode::tracking || r.moved) {
-      Eigen::Matrix4d T_camera_target = r.icp.T_scan_model;  // the newest estimate
-      bool shown = r.projected;
-      if (r.icp.converged)
-        followers[i].set_pose(T_camera_target);
-      else
-        followers[i].set_initial_guess(T_init);
-      double track_ms = 0.0;
-      const int frames = static_cast<int>(std::lround(options.dwell_s * kCameraHz));
-      double motion_end_s = 0.0;
-      if (r.moved) motion_end_s = target.config.motion->start_s + target.config.motion->duration_s;
-      double back_under = -1.0;  // when the error went back under the goal for good, -1 while it is not
-      bool ever_over = false;
-      for (int k = 1; k <= frames && !(report.interrupted = stop()); ++k) {
-        const double t_s = k / kCameraHz;
-        target.T_world_target_true = twin.scripted_pose(i, r.target_visit, t_s);
-        // What the projector shows now was computed from the previous frame (one camera period of latency).
-        TimelineSample s;
-        s.t_s = t_s;
-        s.shown = shown;
-        s.moving = r.moved && t_s > target.config.motion->start_s && t_s <= motion_end_s;
-        const Errors now = marker_errors(twin, i, scene.projector, T_world_projector,
-                                         alignment::projector_from_target(rig.T_projector_camera, T_camera_target));
-        s.mean_mm = now.mean_mm;
-        s.max_mm = now.max_mm;
-        r.timeline.push_back(s);
-        if (s.moving) r.max_mm_moving = std::max(r.max_mm_moving, s.mean_mm);
-        const bool good = shown && s.mean_mm <= kConvergedMm;
-        if (!good) {
-          ever_over = true;
-          back_under = -1.0;
-        } else if (back_under < 0.0 && t_s >= motion_end_s) {
-          back_under = t_s;
-        }
-        if (options.mode != TourMode::tracking) continue;
-        const alignment::DepthImage frame =
-            twin.capture(truth.T_world_camera.matrix(), noise_seed + static_cast<std::uint32_t>(k));
-        const auto tt = Clock::now();
-        if (const auto sample = followers[i].step(frame)) {
-          shown = !sample->lost;
-          if (shown) T_camera_target = sample->T_camera_target;
-        }
-        track_ms += ms_since(tt);
-      }
-      r.track_ms_mean = options.mode == TourMode::tracking && frames > 0 ? track_ms / frames : 0.0;
-      if (!ever_over)
-        r.reconverge_s = 0.0;
-      else if (back_under >= 0.0)
-        r.reconverge_s = std::max(0.0, back_under - motion_end_s);
-      else
-        r.reconverge_s = -1.0;
-    }
+    if (options.mode == TourMode::tracking || r.moved)
+      report.interrupted = !dwell(DwellContext{twin, i, scene.projector, truth, options, noise_seed}, followers[i], r);
     twin.end_visit(i, r.target_visit);  // back home, or left where it was moved
     if (report.interrupted) break;      // this visit did not finish: keep the finished ones only
     if (options.on_visit) options.on_visit(r);

@@ -92,6 +92,7 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     tt.pedestal_raycaster = std::make_unique<MeshRaycaster>(pedestal);
     tt.pedestal_id = renderer_.add_model(pedestal);
     target_ids_.push_back(renderer_.add_model(tt.model));
+    tt.in_world = t.present;
     home_.push_back(tt.T_world_target_true);
     targets_.push_back(std::move(tt));
   }
@@ -137,18 +138,27 @@ Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double
   return T;
 }
 
+bool Twin::scripted_presence(std::size_t target, int target_visit, double t_s) const {
+  const TwinTarget& t = targets_.at(target);
+  if (!t.config.present || gone_.contains(target)) return false;
+  const auto& m = t.config.motion;
+  return !(m && m->removed && m->visit == target_visit && t_s >= m->start_s + m->duration_s);
+}
+
 void Twin::end_visit(std::size_t target, int target_visit) {
   const auto& motion = targets_.at(target).config.motion;
   if (motion && motion->stays && motion->visit == target_visit)
     home_[target] = scripted_pose(target, target_visit, motion->start_s + motion->duration_s);
+  if (motion && motion->removed && motion->visit == target_visit) gone_.insert(target);
   targets_[target].T_world_target_true = home_[target];
+  targets_[target].in_world = scripted_presence(target, 0, 0.0);
 }
 
 alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
   const Eigen::Matrix4d T_camera_world = alignment::rigid_inverse(T_world_camera);
   std::vector<engine::DrawItem> items{{floor_id_, T_camera_world}};
   for (std::size_t i = 0; i < targets_.size(); ++i) {
-    items.push_back({target_ids_[i], T_camera_world * targets_[i].T_world_target_true});
+    if (targets_[i].in_world) items.push_back({target_ids_[i], T_camera_world * targets_[i].T_world_target_true});
     items.push_back({targets_[i].pedestal_id, T_camera_world * targets_[i].T_world_pedestal});
   }
   // Rendered from 0.3 to 8 m: the noise model, not the clip planes, drops what the Kinect cannot see.
@@ -165,7 +175,7 @@ alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::
 std::vector<PlacedMesh> Twin::true_scene(const Eigen::Matrix4d& T_frame_world) const {
   std::vector<PlacedMesh> out{{floor_ray_.get(), T_frame_world}};
   for (const auto& t : targets_) {
-    out.push_back({t.raycaster.get(), T_frame_world * t.T_world_target_true});
+    if (t.in_world) out.push_back({t.raycaster.get(), T_frame_world * t.T_world_target_true});
     out.push_back({t.pedestal_raycaster.get(), T_frame_world * t.T_world_pedestal});
   }
   return out;

@@ -50,9 +50,14 @@ struct AcquisitionConfig {
   double max_rmse_mm = 4.0;  ///< quality gate: RMS distance of the inliers
   /// When the gate fails: ICP again from the guess turned by +-this about each axis (0: never)...
   double restart_angle_deg = 25.0;
-  bool reinitialise = true;            ///< ...then FPFH + SampleConsensusPrerejective over a wide region
+  bool reinitialise = true;            ///< ...then FPFH + SampleConsensusPrerejective over a wide region (false: never global)
   double reinit_crop_margin_m = 0.35;  ///< re-initialisation searches model radius + this around the guess
   double feature_radius_m = 0.03;      ///< FPFH support radius
+  /// SearchStage::global_wide searches model radius + this around the guess: most of a room-scale view.
+  double wide_crop_margin_m = 1.0;
+  /// Global searches use at most this many scan points (a coarser voxel grid beyond), which bounds an
+  /// attempt's time: FPFH and RANSAC grow with the points.
+  std::size_t max_global_points = 6000;
   int ransac_iterations = 20000;
   std::size_t min_points = 30;  ///< fewer valid scan points than this is an error
 };
@@ -69,6 +74,16 @@ struct AlignmentResult {
   std::size_t scan_points = 0;  ///< scan points after cropping and filtering
 };
 
+/// Which part of the acquisition align() runs. `full` is one acquisition as `projbot align` and the
+/// localized tour do it; the tracker worker runs the others one at a time, each bounded, escalating.
+enum class SearchStage {
+  full,         ///< ICP from the guess, the local restarts, then the global search near the guess
+  refine,       ///< ICP from the guess only (a track lost on this frame)
+  local,        ///< ICP from the guess and from the guess turned +-restart_angle_deg about each axis
+  global_near,  ///< FPFH + SampleConsensusPrerejective within model radius + reinit_crop_margin_m, then ICP
+  global_wide,  ///< the same within model radius + wide_crop_margin_m
+};
+
 class Aligner {
  public:
   /// Prepares the model (downsampling, search structures). Throws AlignmentError for an empty model.
@@ -79,12 +94,14 @@ class Aligner {
 
   /// Refines T_init (model -> scan frame) against the scan. Throws AlignmentError when the scan has
   /// fewer than min_points valid points (after cropping) or T_init is not finite.
-  AlignmentResult align(const PointCloud& scan, const Eigen::Matrix4d& T_init) const;
+  AlignmentResult align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage = SearchStage::full) const;
 
   /// The quality-gate numbers of a given pose, without refining it (converged: the gate passes).
   AlignmentResult score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const;
 
   const AcquisitionConfig& config() const;
+  /// How often the model's FPFH features were computed: once per Aligner, at its first global search.
+  int model_feature_computations() const;
 
  private:
   struct Impl;

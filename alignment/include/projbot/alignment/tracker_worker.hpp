@@ -14,15 +14,34 @@
 #include "projbot/alignment/latest_value.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/tracker.hpp"
+#include "projbot/alignment/verification.hpp"
 
 namespace projbot::alignment {
 
 struct WorkerConfig {
   AcquisitionConfig acquisition;
   TrackerConfig tracking;
-  /// Consecutive frames in which neither tracking nor re-acquisition (from the last pose, on the same
-  /// frame) found the target, after which it is reported lost.
-  int lost_after = 5;
+  /// Consecutive frames in which neither tracking nor one ICP from the last pose (on the same frame)
+  /// found the target, after which it is reported lost and blanked: 2 frames at 30 Hz blank within
+  /// 100 ms of the first depth frame that shows it gone.
+  int lost_after = 2;
+  /// A lost or not-yet-found target is searched for by bounded attempts, escalating SearchStage::local ->
+  /// global_near -> global_wide and round again, one attempt per frame at most. After the n-th failed
+  /// attempt the next one waits search_spacing_frames[min(n - 1, size - 1)] frames, so an absent target
+  /// costs a bounded share of the worker's time.
+  std::vector<int> search_spacing_frames{0, 3, 9, 15, 30};
+  /// Every pose (tracked, refined or found) is checked against free space (verification.hpp): more than
+  /// this share of the predicted silhouette seen through rejects it. A box fitted onto the bare pedestal
+  /// it was taken from scores near 1; correct poses, partly occluded ones too, near 0.
+  double max_behind_ratio = 0.2;
+};
+
+/// What searching for a target has cost since its stop began.
+struct SearchStats {
+  int attempts = 0;             ///< bounded acquisition attempts (the same-frame refine excluded)
+  double total_ms = 0.0;        ///< their wall time, summed
+  double max_attempt_ms = 0.0;  ///< the longest one
+  int frames_waited = 0;        ///< frames skipped between attempts (spacing)
 };
 
 /// What the render thread reads: the newest accepted pose, or the news that the target is lost.
@@ -36,8 +55,10 @@ struct PoseSample {
 };
 
 /// The worker's policy for one frame, without the thread: track from the last pose; when tracking
-/// fails, acquire on the same frame from where the target was last seen; after `lost_after` frames in
-/// which neither found it, report it lost. The twin's tour runs it in simulated time. Not thread-safe.
+/// fails, one ICP on the same frame from where the target was last seen; after `lost_after` frames in
+/// which neither found it, report it lost (blank it) and search: bounded attempts, escalating and
+/// spaced out (WorkerConfig). A new stop's guess starts the search. The twin's tour runs it in simulated
+/// time. Not thread-safe.
 class TargetFollower {
  public:
   /// Throws AlignmentError for a bad model or intrinsics.
@@ -46,14 +67,24 @@ class TargetFollower {
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target);
   /// The target was already acquired at T_camera_target: the next frame tracks from there.
   void set_pose(const Eigen::Matrix4d& T_camera_target);
-  /// One frame: the sample to publish (sequence left 0), or nothing when there is no guess yet or the
-  /// frame was rejected without the target being lost yet.
+  /// One frame: the sample to publish (sequence left 0), or nothing when there is no guess yet, the
+  /// frame was rejected without the target being lost yet, or a search attempt is not due.
   std::optional<PoseSample> step(const DepthImage& frame);
+  /// The search since the last guess or pose was set.
+  const SearchStats& search_stats() const { return stats_; }
+  /// The newest acquisition attempt's result (refine or search stage), if any since the last guess.
+  const std::optional<AlignmentResult>& last_attempt() const { return last_attempt_; }
+  /// The free-space check of a pose on a frame, and whether it passes (see max_behind_ratio).
+  FreeSpaceCheck verify(const DepthImage& frame, const Eigen::Matrix4d& T_camera_target) const;
+  bool passes(const FreeSpaceCheck& check) const { return check.behind_ratio() <= cfg_.max_behind_ratio; }
+  /// The newest free-space check (of the last pose accepted or refused).
+  const FreeSpaceCheck& last_check() const { return check_; }
   /// The tracked pose, or the guess while acquiring.
   Eigen::Matrix4d last_pose() const { return pose_.value_or(guess_); }
   const Aligner& aligner() const { return aligner_; }
 
  private:
+  ModelCloud model_;  // for the free-space check
   Aligner aligner_;
   ProjectiveTracker tracker_;
   CameraIntrinsics k_;
@@ -62,6 +93,16 @@ class TargetFollower {
   Eigen::Matrix4d guess_ = Eigen::Matrix4d::Identity();
   bool have_guess_ = false;
   int rejected_ = 0;
+  bool lost_reported_ = false;
+  int wait_ = 0;  // frames until the next search attempt
+  SearchStats stats_;
+  std::optional<AlignmentResult> last_attempt_;
+  FreeSpaceCheck check_;
+  bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
+
+  std::optional<PoseSample> track(const DepthImage& frame);
+  std::optional<PoseSample> search(const DepthImage& frame);
+  std::optional<AlignmentResult> attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage);
 };
 
 class TrackerWorker {

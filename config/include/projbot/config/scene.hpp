@@ -44,6 +44,9 @@ struct TargetMotion {
   Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();  ///< world-frame shift, metres
   Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();        ///< world-frame turn, degrees
   bool stays = false;  ///< the target is left where it was moved: later visits find it away from its map pose
+  /// Someone carries it away: at start_s + duration_s (after moving as above) it leaves the world for
+  /// the rest of the tour.
+  bool removed = false;
 };
 
 /// One target object: its textured model and its pose in the projector frame.
@@ -52,6 +55,9 @@ struct TargetConfig {
   std::filesystem::path model;  ///< glTF (.gltf/.glb); relative paths resolved against the scene's folder
   double scale = 1.0;           ///< uniform scale applied to the model frame (> 0)
   bool recenter = false;        ///< move the model frame's origin to the surface centroid
+  /// The twin only: false leaves the target out of the world (its survey pose and stop stay), so a tour
+  /// checks that a missing target is searched for within its budget and never lit.
+  bool present = true;
   /// T_projector_target: maps model-frame points (metres) into the projector frame. Rigid.
   Eigen::Matrix4d T_projector_target = Eigen::Matrix4d::Identity();
 

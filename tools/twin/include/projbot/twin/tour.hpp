@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "projbot/alignment/registration.hpp"
+#include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/twin/raycast.hpp"
 
@@ -59,6 +60,7 @@ struct VisitReport {
   std::vector<MarkerError> markers;
   double mean_mm = 0.0, max_mm = 0.0;  ///< at acquisition (the paper's Table 1 figure)
   alignment::AlignmentResult icp;
+  alignment::FreeSpaceCheck free_space;                     ///< the estimate at arrival against the measured depth
   double base_error_cm = 0.0, base_error_deg = 0.0;         ///< believed vs true base pose at the stop
   double odometry_error_cm = 0.0;                           ///< raw wheel odometry vs truth
   double guess_error_cm = 0.0, guess_error_deg = 0.0;       ///< Eq. 1's initial guess vs the true T_camera_target
@@ -71,6 +73,16 @@ struct VisitReport {
   /// 0 when it never left, -1 when it never came back within the dwell.
   double reconverge_s = 0.0;
   double track_ms_mean = 0.0;  ///< tracking mode: wall time per frame
+  bool target_present = true;  ///< the target was in the world when the robot arrived
+  int lit_frames = 0;          ///< projector frames (camera rate) that showed the target, the first included
+  /// Simulated seconds from arrival to the first lit frame: 0 when the acquisition lit it at once, -1
+  /// when it never did.
+  double first_light_s = -1.0;
+  double first_light_wall_ms = -1.0;  ///< wall time spent in acquisition and search until then
+  alignment::SearchStats search;      ///< tracking mode: the bounded search's attempts and cost
+  /// motion.removed: seconds from the first depth frame without the target to the first blank
+  /// projector frame; -1 when it was never blanked (or nothing was removed).
+  double blank_after_removal_s = -1.0;
 };
 
 struct TourReport {

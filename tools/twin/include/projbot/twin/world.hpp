@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <set>
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
@@ -41,7 +42,11 @@ struct TwinTarget {
   std::unique_ptr<MeshRaycaster> raycaster;
   alignment::ModelCloud cloud;          ///< 50k surface samples for ICP and tracking
   Eigen::Matrix4d T_world_target_true;  ///< where it stands now (moves with its motion script)
-  Eigen::Matrix4d T_world_pedestal;     ///< the pedestal under it (a translation)
+  /// In the world now: false for a target that is not there (`present: false`) or was carried away
+  /// (`motion.removed`). An absent target is neither seen by the camera nor catches the projector's
+  /// light; its pedestal stays.
+  bool in_world = true;
+  Eigen::Matrix4d T_world_pedestal;  ///< the pedestal under it (a translation)
   std::unique_ptr<MeshRaycaster> pedestal_raycaster;
   std::size_t pedestal_id = 0;  ///< renderer model id
 };
@@ -80,7 +85,10 @@ class Twin {
   /// The target's pose `t_s` into a projection during its `target_visit`-th visit (motion script);
   /// visit 0 is where it stands between visits.
   Eigen::Matrix4d scripted_pose(std::size_t target, int target_visit, double t_s) const;
-  /// After a visit: a target whose motion `stays` is left where the motion took it.
+  /// Whether the target is in the world `t_s` into its `target_visit`-th visit (a `removed` motion
+  /// takes it away at its end).
+  bool scripted_presence(std::size_t target, int target_visit, double t_s) const;
+  /// After a visit: a target whose motion `stays` is left where the motion took it; one `removed` is gone.
   void end_visit(std::size_t target, int target_visit);
 
   /// Renders the true scene's depth from T_world_camera (Kinect v1 noise when enabled, seeded).
@@ -97,6 +105,7 @@ class Twin {
   engine::Renderer& renderer_;
   std::vector<TwinTarget> targets_;
   std::vector<Eigen::Matrix4d> home_;  // where each target stands between visits
+  std::set<std::size_t> gone_;         // targets carried away (motion.removed) on an earlier visit
   std::unique_ptr<MeshRaycaster> floor_ray_;
   std::vector<std::size_t> target_ids_;
   std::size_t floor_id_ = 0;

@@ -1,0 +1,59 @@
+#include "projbot/alignment/verification.hpp"
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace projbot::alignment {
+
+namespace {
+
+// The predicted depth image: nearest front-facing model sample per pixel, +inf where none lands.
+std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k) {
+  std::vector<float> z_buffer(static_cast<std::size_t>(k.width_px) * k.height_px, std::numeric_limits<float>::infinity());
+  const Eigen::Matrix3f R = T_camera_model.topLeftCorner<3, 3>().cast<float>();
+  const Eigen::Vector3f t = T_camera_model.topRightCorner<3, 1>().cast<float>();
+  for (std::size_t i = 0; i < model.points.size(); ++i) {
+    const Eigen::Vector3f p = R * model.points[i] + t;
+    if (!(p.z() > 0.05F) || (R * model.normals[i]).dot(p) >= 0.0F) continue;  // behind the camera, or a back face
+    const long u = std::lround(k.fx_px * p.x() / p.z() + k.cx_px);
+    const long v = std::lround(k.fy_px * p.y() / p.z() + k.cy_px);
+    if (u < 0 || v < 0 || u >= k.width_px || v >= k.height_px) continue;
+    float& z = z_buffer[static_cast<std::size_t>(v) * k.width_px + u];
+    z = std::min(z, p.z());
+  }
+  return z_buffer;
+}
+
+}  // namespace
+
+FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
+                                const CameraIntrinsics& k) {
+  FreeSpaceCheck c;
+  if (depth.width != k.width_px || depth.height != k.height_px || !T_camera_model.allFinite()) return c;
+  const std::vector<float> predicted = predicted_depth(model, T_camera_model, k);
+  const auto at = [&](int x, int y) { return predicted[static_cast<std::size_t>(y) * k.width_px + x]; };
+  constexpr int kRim = 2;  // pixels of the silhouette's rim left out
+  for (int y = kRim; y < k.height_px - kRim; ++y)
+    for (int x = kRim; x < k.width_px - kRim; ++x) {
+      const float z = at(x, y);
+      if (!std::isfinite(z)) continue;
+      // Interior only: the model covers the pixels kRim away on each side (sparse samples leave holes,
+      // so a neighbour counts when any pixel near it is covered).
+      bool interior = true;
+      for (const auto& [dx, dy] : {std::pair{-kRim, 0}, {kRim, 0}, {0, -kRim}, {0, kRim}})
+        interior = interior && (std::isfinite(at(x + dx, y + dy)) || std::isfinite(at(x + dx / 2, y + dy / 2)));
+      if (!interior) continue;
+      const float measured = depth.at(x, y);
+      if (!(measured > 0.0F) || !std::isfinite(measured)) continue;
+      ++c.predicted;
+      const float tolerance = 0.015F + 0.005F * z * z;
+      if (measured > z + tolerance)
+        ++c.behind;
+      else if (measured < z - tolerance)
+        ++c.in_front;
+    }
+  return c;
+}
+
+}  // namespace projbot::alignment
