@@ -10,6 +10,9 @@ function(projbot_target_options target)
   if(PROJBOT_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=${PROJBOT_SANITIZE} -fno-omit-frame-pointer)
     target_link_options(${target} PRIVATE -fsanitize=${PROJBOT_SANITIZE})
+    # Under ASan, Eigen stops trusting malloc's 16-byte alignment and over-allocates by hand, while the
+    # packaged PCL (no sanitizer) frees Eigen-allocated clouds with plain free: the two must agree.
+    target_compile_definitions(${target} PUBLIC EIGEN_MALLOC_ALREADY_ALIGNED=1)
   endif()
 endfunction()
 
