@@ -94,6 +94,10 @@ TEST(TrackerWorkerTest, AcquiresTracksAndReportsLost) {
   WorkerConfig cfg;
   cfg.lost_after = 3;
   cfg.acquisition.reinitialise = false;  // FPFH's OpenMP threads are outside ThreadSanitizer's view
+  // Time budgets off: under ThreadSanitizer (and a loaded CI machine) an attempt runs many times slower,
+  // and this test is about the hand-off, not about the search's budget (tested below).
+  cfg.acquisition.attempt_budget_ms = 1e9;
+  cfg.search_duty = 1.0;
   TrackerWorker worker(cube_model(), k, cfg);
   const auto truth = [](int f) {
     return projbot::config::pose_from_xyz_rpy({0.05 + 0.003 * f, -0.02, 1.0 + 0.002 * f}, {20 + 0.5 * f, 30, 10});
@@ -210,8 +214,13 @@ TEST(TargetFollowerTest, AnAbsentTargetCostsABoundedNumberOfAttempts) {
   }
   EXPECT_EQ(found, 0);
   EXPECT_EQ(lost, 1);  // said once, at the first failed attempt
-  // Spacing {0, 3, 9, 15, 30}: attempts on frames 0, 1, 5, 15, 31 and 62 of 90.
-  EXPECT_EQ(follower.search_stats().attempts, 6);
-  EXPECT_EQ(follower.search_stats().frames_waited, 84);
-  EXPECT_EQ(follower.aligner().model_feature_computations(), 1);  // 4 global attempts, features once
+  // Spacing {0, 3, 9, 15, 30}: attempts on frames 0, 1, 5, 15, 31 and 62 of 90 at most (the duty cycle
+  // may space them further); every frame is an attempt or a wait.
+  const SearchStats& stats = follower.search_stats();
+  EXPECT_GE(stats.attempts, 3);
+  EXPECT_LE(stats.attempts, 6);
+  EXPECT_EQ(stats.attempts + stats.frames_waited, 90);
+  // The wide global search (every third attempt) sees the wall: the model's features are computed then,
+  // once, however many global attempts follow.
+  EXPECT_EQ(follower.aligner().model_feature_computations(), 1);
 }

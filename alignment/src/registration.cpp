@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <optional>
 
 #include "file_kind.hpp"
@@ -228,10 +229,16 @@ struct Aligner::Impl {
   // Each stage crops the scan afresh around the current estimate: the first with the whole crop margin
   // (the initial guess may be that far off), later ones with their correspondence distance, so that
   // what the target stands on drops out as the estimate tightens.
-  Eigen::Matrix4d icp(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model_init, int& iterations, bool& converged) const {
+  // Out of time (a bounded attempt's deadline, checked between stages): not converged.
+  Eigen::Matrix4d icp(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model_init, int& iterations, bool& converged,
+                      const std::function<bool()>& out_of_time) const {
     Eigen::Matrix4f T_model_scan = rigid_inverse(T_scan_model_init).cast<float>();
     converged = true;
     for (std::size_t stage = 0; stage < cfg.icp_distances_m.size(); ++stage) {
+      if (stage > 0 && out_of_time()) {
+        converged = false;
+        break;
+      }
       const double distance = cfg.icp_distances_m[stage];
       // Coarse stages need fewer points: a leaf of a tenth of the correspondence distance, at least voxel_m.
       const auto near = near_scan(scan, rigid_inverse(T_model_scan.cast<double>()), stage == 0 ? cfg.crop_margin_m : distance,
@@ -317,7 +324,7 @@ struct Aligner::Impl {
 
   // Global re-initialisation: FPFH correspondences and SampleConsensusPrerejective over a wide region.
   std::optional<Eigen::Matrix4d> reinitialise(const PointCloud& scan, const Eigen::Matrix4d& T_init, double margin,
-                                              std::size_t max_points) const {
+                                              std::size_t max_points, const std::function<bool()>& out_of_time) const {
     const auto wide_points = global_points(scan, T_init, margin, max_points);
     if (wide_points->size() < cfg.min_points) return std::nullopt;
     const CloudN::Ptr wide = with_normals(wide_points, cfg.normal_neighbours);
@@ -331,16 +338,20 @@ struct Aligner::Impl {
     sac.setSourceFeatures(model_features);
     sac.setInputTarget(wide);
     sac.setTargetFeatures(scan_features);
-    sac.setMaximumIterations(cfg.ransac_iterations);
     sac.setNumberOfSamples(3);
     sac.setCorrespondenceRandomness(5);
     sac.setSimilarityThreshold(0.85F);
     sac.setMaxCorrespondenceDistance(2.0 * coarse_leaf());
     sac.setInlierFraction(0.2F);
+    // In rounds of at most 2000 iterations, so that a bounded attempt stops at its deadline (PCL's
+    // RANSAC has no time limit: 20000 iterations on a planar scene took up to 10 s).
     CloudN aligned;
-    sac.align(aligned);
-    if (!sac.hasConverged()) return std::nullopt;
-    return sac.getFinalTransformation().cast<double>();
+    for (int done = 0; done < cfg.ransac_iterations && !out_of_time(); done += 2000) {
+      sac.setMaximumIterations(std::min(2000, cfg.ransac_iterations - done));
+      sac.align(aligned);
+      if (sac.hasConverged()) return sac.getFinalTransformation().cast<double>();
+    }
+    return std::nullopt;
   }
 };
 
@@ -490,6 +501,11 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     throw AlignmentError("scan has " + std::to_string(valid) + " valid points; at least " + std::to_string(m.cfg.min_points) +
                          " are needed");
 
+  // A bounded stage stops starting new work once attempt_budget_ms has passed; `full` runs to the end.
+  const auto out_of_time = [&] {
+    return stage != SearchStage::full &&
+           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() > m.cfg.attempt_budget_ms;
+  };
   AlignmentResult best;
   best.T_scan_model = T_init;
   best.inlier_ratio = 0.0;
@@ -497,7 +513,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   const auto attempt = [&](const Eigen::Matrix4d& start, bool reinitialised) {
     AlignmentResult r;
     bool icp_converged = false;
-    r.T_scan_model = m.icp(scan, start, best.iterations, icp_converged);
+    r.T_scan_model = m.icp(scan, start, best.iterations, icp_converged, out_of_time);
     r.reinitialised = reinitialised;
     m.evaluate(*m.near_scan(scan, r.T_scan_model, m.gate_margin()), r.T_scan_model, r);
     r.converged = icp_converged && m.passes(r);
@@ -509,8 +525,9 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   if (!best.converged && m.cfg.restart_angle_deg > 0.0 && (stage == SearchStage::full || stage == SearchStage::local)) {
     // Local restarts: the guess turned about the target's centre, which ICP alone cannot leave.
     const Eigen::Vector3d c = m.extent.centre_in(T_init);
-    for (int axis = 0; axis < 3 && !best.converged; ++axis)
+    for (int axis = 0; axis < 3 && !best.converged && !out_of_time(); ++axis)
       for (const double sign : {1.0, -1.0}) {
+        if (out_of_time()) break;
         Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
         turn.topLeftCorner<3, 3>() =
             Eigen::AngleAxisd(sign * m.cfg.restart_angle_deg * M_PI / 180.0, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
@@ -526,7 +543,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   if (global) {
     const double margin = stage == SearchStage::global_wide ? m.cfg.wide_crop_margin_m : m.cfg.reinit_crop_margin_m;
     const std::size_t cap = stage == SearchStage::full ? std::numeric_limits<std::size_t>::max() : m.cfg.max_global_points;
-    if (const auto T = m.reinitialise(scan, T_init, margin, cap)) attempt(*T, true);
+    if (const auto T = m.reinitialise(scan, T_init, margin, cap, out_of_time)) attempt(*T, true);
   }
   best.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return best;

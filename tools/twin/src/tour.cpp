@@ -50,6 +50,12 @@ void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twi
     follower.set_initial_guess(T_init);
     const auto sample = follower.step(depth);
     if (follower.last_attempt()) r.icp = *follower.last_attempt();
+    if (sample && !sample->lost && !follower.last_attempt()) {  // the projective tracker found it from the guess
+      r.icp.T_scan_model = sample->T_camera_target;
+      r.icp.converged = true;
+      r.icp.inlier_ratio = sample->inlier_ratio;
+      r.icp.rmse_mm = sample->rmse_mm;
+    }
     r.free_space = follower.last_check();
     r.projected = sample && !sample->lost;
   } else {

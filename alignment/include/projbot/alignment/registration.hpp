@@ -59,6 +59,9 @@ struct AcquisitionConfig {
   /// attempt's time: FPFH and RANSAC grow with the points.
   std::size_t max_global_points = 6000;
   int ransac_iterations = 20000;
+  /// A bounded stage (not `full`) starts no further restart or RANSAC round after this many ms; the ICP
+  /// already running finishes, so an attempt ends within about this plus one ICP (about 0.5 s here).
+  double attempt_budget_ms = 500.0;
   std::size_t min_points = 30;  ///< fewer valid scan points than this is an error
 };
 

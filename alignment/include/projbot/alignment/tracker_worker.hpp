@@ -30,6 +30,10 @@ struct WorkerConfig {
   /// attempt the next one waits search_spacing_frames[min(n - 1, size - 1)] frames, so an absent target
   /// costs a bounded share of the worker's time.
   std::vector<int> search_spacing_frames{0, 3, 9, 15, 30};
+  /// ...and at least long enough that searching takes no more than this share of the worker's time:
+  /// an attempt of t ms is followed by t (1 / search_duty - 1) ms of frames (camera_hz) without one.
+  double search_duty = 0.25;
+  double camera_hz = 30.0;
   /// Every pose (tracked, refined or found) is checked against free space (verification.hpp): more than
   /// this share of the predicted silhouette seen through rejects it. A box fitted onto the bare pedestal
   /// it was taken from scores near 1; correct poses, partly occluded ones too, near 0.
@@ -38,10 +42,11 @@ struct WorkerConfig {
 
 /// What searching for a target has cost since its stop began.
 struct SearchStats {
-  int attempts = 0;             ///< bounded acquisition attempts (the same-frame refine excluded)
-  double total_ms = 0.0;        ///< their wall time, summed
-  double max_attempt_ms = 0.0;  ///< the longest one
-  int frames_waited = 0;        ///< frames skipped between attempts (spacing)
+  int attempts = 0;              ///< bounded acquisition attempts (the same-frame refine excluded)
+  double total_ms = 0.0;         ///< their wall time, summed
+  double max_attempt_ms = 0.0;   ///< the longest one
+  double last_attempt_ms = 0.0;  ///< the newest one
+  int frames_waited = 0;         ///< frames skipped between attempts (spacing)
 };
 
 /// What the render thread reads: the newest accepted pose, or the news that the target is lost.
