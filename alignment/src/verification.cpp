@@ -1,5 +1,6 @@
 #include "projbot/alignment/verification.hpp"
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -8,8 +9,11 @@ namespace projbot::alignment {
 
 namespace {
 
-// The predicted depth image: nearest front-facing model sample per pixel, +inf where none lands.
-std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k) {
+// The predicted depth image: nearest front-facing model sample per pixel, +inf where none lands; `box`
+// gets the pixel bounds of what landed (x0, y0, x1, y1, inclusive).
+std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k,
+                                   std::array<long, 4>& box) {
+  box = {k.width_px, k.height_px, -1, -1};
   std::vector<float> z_buffer(static_cast<std::size_t>(k.width_px) * k.height_px, std::numeric_limits<float>::infinity());
   const Eigen::Matrix3f R = T_camera_model.topLeftCorner<3, 3>().cast<float>();
   const Eigen::Vector3f t = T_camera_model.topRightCorner<3, 1>().cast<float>();
@@ -21,6 +25,7 @@ std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4
     if (u < 0 || v < 0 || u >= k.width_px || v >= k.height_px) continue;
     float& z = z_buffer[static_cast<std::size_t>(v) * k.width_px + u];
     z = std::min(z, p.z());
+    box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v)};
   }
   return z_buffer;
 }
@@ -31,11 +36,16 @@ FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& 
                                 const CameraIntrinsics& k) {
   FreeSpaceCheck c;
   if (depth.width != k.width_px || depth.height != k.height_px || !T_camera_model.allFinite()) return c;
-  const std::vector<float> predicted = predicted_depth(model, T_camera_model, k);
+  std::array<long, 4> box{};
+  const std::vector<float> predicted = predicted_depth(model, T_camera_model, k, box);
   const auto at = [&](int x, int y) { return predicted[static_cast<std::size_t>(y) * k.width_px + x]; };
   constexpr int kRim = 2;  // pixels of the silhouette's rim left out
-  for (int y = kRim; y < k.height_px - kRim; ++y)
-    for (int x = kRim; x < k.width_px - kRim; ++x) {
+  const int x0 = static_cast<int>(std::max<long>(box[0], kRim)),
+            x1 = static_cast<int>(std::min<long>(box[2], k.width_px - 1 - kRim));
+  const int y0 = static_cast<int>(std::max<long>(box[1], kRim)),
+            y1 = static_cast<int>(std::min<long>(box[3], k.height_px - 1 - kRim));
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
       const float z = at(x, y);
       if (!std::isfinite(z)) continue;
       // Interior only: the model covers the pixels kRim away on each side (sparse samples leave holes,
