@@ -145,6 +145,20 @@ TEST(TwinSceneTest, BadToursAreNamed) {
   EXPECT_NE(config_error("stays: true}", "stays: maybe}").find("targets[1].motion.stays"), std::string::npos);
   EXPECT_NE(config_error("    scale: 0.3\n", "    scale: 0.3\n    present: 2\n").find("targets[1].present"), std::string::npos);
   EXPECT_FALSE(demo_with("    scale: 0.3\n", "    scale: 0.3\n    present: false\n").targets[1].present);
+  // Where the robot can stand, and what a target needs.
+  EXPECT_NE(config_error("stop: [3.0, 1.8, 90]", "stop: [9.0, 1.8, 90]")
+                .find("targets[0].stop: the robot's stop lies outside the room"),
+            std::string::npos);
+  EXPECT_NE(config_error("stop: [3.0, 1.8, 90]", "stop: [0.3, 3.0, 90]").find("the robot's stop lies inside room.obstacles[2]"),
+            std::string::npos);
+  EXPECT_NE(config_error("start: [1.0, 1.0, 0]", "start: [7.0, 0.5, 0]")
+                .find("robot.start: the robot's start lies inside room.obstacles[1]"),
+            std::string::npos);
+  EXPECT_NE(config_error("    scale: 0.3\n", "    scale: 1e30\n").find("targets[1].scale: must be 0.0001..10000"),
+            std::string::npos);
+  EXPECT_NE(config_error("    world_pose: {translation: [3.0, 3.2, 0.9], rpy_deg: [90, 0, -20]}\n", "")
+                .find("targets[0]: needs a pose (where it stands in the projector frame) or a world_pose"),
+            std::string::npos);
   EXPECT_NE(config_error("  width: 8\n", "  width: 0\n").find("room: width and depth must be 0.5..200 m"), std::string::npos);
   // A marker 5 cm off the Duck's surface: the twin names it and where the surface is.
   const std::string off = twin_error(demo_with("[-0.0024, -0.0389, 0.1421]", "[-0.0024, -0.0389, 0.1921]"));

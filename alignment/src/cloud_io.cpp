@@ -15,6 +15,7 @@ namespace projbot::alignment {
 
 PointCloud read_cloud(const std::filesystem::path& path) {
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw AlignmentError(path.string() + ": is a folder, not a point cloud file");
   if (!std::filesystem::is_regular_file(path, ec)) throw AlignmentError(path.string() + ": no such point cloud file");
   const std::string ext = detail::lower_extension(path);
   pcl::PointCloud<pcl::PointXYZ> cloud;

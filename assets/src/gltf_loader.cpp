@@ -4,6 +4,7 @@
 
 #include <tiny_gltf.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -442,7 +443,12 @@ bool is_glb(const std::filesystem::path& path) {
 Model load_gltf(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw AssetError(file + ": is a folder, not a model file (.gltf or .glb)");
   if (!std::filesystem::is_regular_file(path, ec)) throw AssetError(file + ": no such model file");
+  std::string ext = path.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".glb" && !is_glb(path))
+    throw AssetError(file + ": not a binary glTF: a .glb file starts with the bytes 'glTF' (wrong extension, or not a model?)");
   tinygltf::TinyGLTF loader;
   tinygltf::Model gltf;
   std::string err;

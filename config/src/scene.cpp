@@ -125,6 +125,17 @@ ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std:
   return p;
 }
 
+// Where the robot can stand: inside the room and outside every obstacle. Empty when it can.
+std::string place_problem(const RoomSpec& room, double x, double y) {
+  if (!(x > 0.0 && x < room.width_m && y > 0.0 && y < room.depth_m))
+    return "lies outside the room (0.." + std::to_string(room.width_m) + " x 0.." + std::to_string(room.depth_m) + " m)";
+  for (std::size_t i = 0; i < room.obstacles.size(); ++i) {
+    const auto& o = room.obstacles[i];
+    if (x >= o[0] && x <= o[2] && y >= o[1] && y <= o[3]) return "lies inside room.obstacles[" + std::to_string(i) + "]";
+  }
+  return {};
+}
+
 Eigen::Matrix4d read_pose(MapReader& target, const std::string& path, const std::string& key = "pose",
                           const Eigen::Matrix4d& fallback = Eigen::Matrix4d::Identity()) {
   YAML::Node node = target.child(key, false);
@@ -248,6 +259,10 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
     }
     m.reject_unknown();
   }
+  if (root["robot"] && root["robot"].IsMap() && root["robot"]["start"]) {
+    if (const std::string why = place_problem(scene.room, scene.robot_start.x(), scene.robot_start.y()); !why.empty())
+      r.fail(root["robot"]["start"], "robot.start", "the robot's start " + why);
+  }
 
   YAML::Node targets = r.child("targets", true);
   if (!targets.IsSequence()) r.fail(targets, "targets", "expected a list of targets");
@@ -264,7 +279,8 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
     if (model.empty()) t.fail(targets[i], path + ".model", "must not be empty");
     target.model = std::filesystem::path(model).is_absolute() ? std::filesystem::path(model) : base / model;
     target.scale = t.get<double>("scale", 1.0);
-    if (!(target.scale > 0.0)) t.fail(targets[i]["scale"], path + ".scale", "must be > 0");
+    if (!(target.scale >= 1e-4 && target.scale <= 1e4))
+      t.fail(targets[i]["scale"], path + ".scale", "must be 0.0001..10000 (a uniform factor on the model's metres)");
     target.recenter = t.get<bool>("recenter", false);
     target.present = t.get<bool>("present", true);
     target.T_projector_target = read_pose(t, path + ".pose");
@@ -276,6 +292,8 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
     if (YAML::Node st = t.child("stop", false)) {
       target.stop = t.vector3(st, path + ".stop");
       target.stop->z() *= std::numbers::pi / 180.0;
+      if (const std::string why = place_problem(scene.room, target.stop->x(), target.stop->y()); !why.empty())
+        t.fail(st, path + ".stop", "the robot's stop " + why);
     }
     if (YAML::Node mk = t.child("markers", false)) {
       if (!mk.IsSequence() || mk.size() == 0) t.fail(mk, path + ".markers", "expected a non-empty list of [x, y, z]");
@@ -303,6 +321,10 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
     t.reject_unknown();
     scene.targets.push_back(std::move(target));
   }
+  for (std::size_t i = 0; i < targets.size(); ++i)  // after the keys and names are known to be right
+    if (!targets[i]["pose"] && !scene.targets[i].T_world_target)
+      r.fail(targets[i], "targets[" + std::to_string(i) + "]",
+             "needs a pose (where it stands in the projector frame) or a world_pose (a tour's map frame)");
   if (YAML::Node tour = r.child("tour", false)) {
     MapReader m(tour, "tour", file);
     YAML::Node visits = m.child("visits", true);
@@ -330,6 +352,8 @@ int Scene::target_index(std::string_view name) const {
 }
 
 Scene load_scene(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ConfigError(path.string() + ": is a folder, not a scene file (.yaml)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path.string() + ": cannot open scene file");
   std::ostringstream text;

@@ -3,6 +3,7 @@
 #include <malloc.h>
 
 #include <iostream>
+#include <new>
 
 #include "commands.hpp"
 
@@ -85,6 +86,9 @@ int main(int argc, char** argv) {
     const projbot::cli::Args args(cmd->options, argc, argv, first);
     if (!args.positional().empty()) throw projbot::cli::UsageError("unexpected argument '" + args.positional().front() + "'");
     return cmd->run(args);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "projbot " << name << ": out of memory: an input is larger than this machine can hold\n";
+    return 1;
   } catch (const projbot::cli::UsageError& e) {
     std::cerr << "projbot " << name << ": " << e.what() << " (see projbot " << name << " --help)\n";
     return 2;
