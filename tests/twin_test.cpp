@@ -253,16 +253,20 @@ TEST(TourTest, TrackingFollowsTheMovedTarget) {
   for (const auto& s : moved.timeline) EXPECT_TRUE(s.shown);
 }
 
+projbot::twin::TourReport tracking_tour(const projbot::config::Scene& scene, int visits, double dwell_s) {
+  projbot::twin::TourOptions o;
+  o.mode = projbot::twin::TourMode::tracking;
+  o.visits = visits;
+  o.dwell_s = dwell_s;
+  return projbot::twin::run_tour(scene, o);
+}
+
 // A target that is not there (present: false) is searched for within the follower's budget and never
 // lit; the target before it is tracked on every frame of its dwell (counted in simulated time).
 TEST(TourTest, AnAbsentTargetIsNeverLitAndSearchedWithinItsBudget) {
   const auto scene = demo_with("    model: ../models/BoxTextured/BoxTextured.gltf\n",
                                "    model: ../models/BoxTextured/BoxTextured.gltf\n    present: false\n");
-  projbot::twin::TourOptions o;
-  o.mode = projbot::twin::TourMode::tracking;
-  o.visits = 2;
-  o.dwell_s = 1.0;
-  const auto report = projbot::twin::run_tour(scene, o);
+  const auto report = tracking_tour(scene, 2, 1.0);
   ASSERT_EQ(report.visits.size(), 2U);
   const auto& duck = report.visits[0];
   const auto& box = report.visits[1];
@@ -287,11 +291,7 @@ TEST(TourTest, ARemovedTargetIsBlankedWithin100ms) {
   const auto scene = demo_with(
       "motion: {visit: 2, start_s: 0.5, duration_s: 2.0, translation: [0.08, -0.06, 0.0], rpy_deg: [0, 0, 15], stays: true}",
       "motion: {visit: 1, start_s: 0.5, duration_s: 0.2, removed: true}");
-  projbot::twin::TourOptions o;
-  o.mode = projbot::twin::TourMode::tracking;
-  o.dwell_s = 1.5;
-  o.visits = 4;
-  const auto report = projbot::twin::run_tour(scene, o);
+  const auto report = tracking_tour(scene, 4, 1.5);
   ASSERT_EQ(report.visits.size(), 4U);
   const auto& removed = report.visits[1];
   ASSERT_EQ(removed.target, "box");
