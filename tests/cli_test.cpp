@@ -266,6 +266,28 @@ TEST_F(CliTest, TourInterruptedKeepsTheFinishedVisits) {
   EXPECT_NE(tour.output().find("interrupted"), std::string::npos);
 }
 
+// Ctrl-C in ICP-SLAM: the scans done so far are mapped and their trajectory written; exit 130.
+TEST_F(CliTest, SlamInterruptedKeepsTheScansDone) {
+  const std::string rawlog = std::string(PROJBOT_SHARED_DATA) + "/mrpt/range_030_bearing_015.rawlog";  // 1460 scans, ~2.5 s
+  const fs::path trajectory = dir_ / "t.txt";
+  Background slam({"slam", "--rawlog", rawlog, "--out-map", (dir_ / "map").string(), "--out-trajectory", trajectory.string()},
+                  dir_ / "slam.log");
+  ASSERT_GT(slam.pid, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  const auto [code, seconds] = slam.signal_and_wait(SIGINT, std::chrono::seconds(30));
+  if (code == 0) GTEST_SKIP() << "the run ended before the signal (a very fast machine): " << slam.output();
+  EXPECT_EQ(code, 130) << slam.output();
+  EXPECT_NE(slam.output().find("ICP-SLAM interrupted after"), std::string::npos) << slam.output();
+  EXPECT_TRUE(fs::exists(dir_ / "map" / "map.simplemap.gz"));
+  std::ifstream in(trajectory);
+  int lines = 0;
+  for (std::string line; std::getline(in, line); ++lines) {
+    double ts, x, y, phi;
+    EXPECT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf %lf", &ts, &x, &y, &phi), 4) << line;
+  }
+  EXPECT_LT(lines, 1460);
+}
+
 // Hostile point clouds through the executable: one line naming the file, exit 1, never a signal; the
 // one claiming 2e9 points is refused within a second and in little memory.
 TEST_F(CliTest, HostilePcdFilesAreRefused) {

@@ -203,7 +203,7 @@ std::vector<TrajectoryPoint> read_trajectory(const std::filesystem::path& path) 
 }
 
 SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,
-                     const std::filesystem::path& out_dir) {
+                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested) {
   const auto t0 = Clock::now();
   mrpt::slam::CMetricMapBuilderICP builder;
   builder.setVerbosityLevel(mrpt::system::LVL_ERROR);
@@ -229,6 +229,10 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
 
   SlamResult result;
   for (const RawlogStep& step : steps) {
+    if (stop_requested && stop_requested()) {
+      result.interrupted = true;
+      break;
+    }
     mrpt::obs::CSensoryFrame frame;
     frame.insert(detail::to_mrpt(step.scan));
     builder.processActionObservation(*odometry_action(step.odometry_increment.value_or(Pose2D{}), step.timestamp_s), frame);

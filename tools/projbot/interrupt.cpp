@@ -13,7 +13,8 @@ static_assert(std::atomic<int>::is_always_lock_free, "used from a signal handler
 
 extern "C" void on_signal(int sig) {
   if (g_signal.exchange(sig) != 0) _exit(128 + sig);  // the second one: at once
-  constexpr char kMsg[] = "\nprojbot: stopping at the next frame or visit and writing what was measured (again to quit now)\n";
+  constexpr char kMsg[] =
+      "\nprojbot: stopping after the current frame, visit or scan, and writing what was measured (Ctrl-C again quits now)\n";
   [[maybe_unused]] const auto n = ::write(STDERR_FILENO, kMsg, sizeof kMsg - 1);
 }
 

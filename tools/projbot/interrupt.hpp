@@ -1,7 +1,7 @@
 #pragma once
 // Ctrl-C and SIGTERM for the long commands (run, tour, slam, localize): the first signal asks the work
-// to stop at its next frame or visit boundary, so what was measured is still written; a second one
-// ends the process at once.
+// to stop at its next frame, visit or scan, so what was measured is still written; a second one ends
+// the process at once.
 
 namespace projbot::tools {
 

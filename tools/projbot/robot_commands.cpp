@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/localization.hpp"
 #include "projbot/robot/sim_tour.hpp"
@@ -89,11 +90,18 @@ const Command kSlam{
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
       args.check_output_files({"out-trajectory"});
       args.check_output_folders({"out-map"});
+      catch_interrupts();  // Ctrl-C: map and write the scans done so far, then exit 130
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
       std::optional<fs::path> ini;
       if (const auto c = args.get("config")) ini = *c;
-      const robot::SlamResult r = robot::build_map(steps, ini, *args.get("out-map"));
+      const robot::SlamResult r = robot::build_map(steps, ini, *args.get("out-map"), [] { return interrupted(); });
       robot::write_trajectory(*args.get("out-trajectory"), r.trajectory);
+      if (r.interrupted) {
+        std::cout << "ICP-SLAM interrupted after " << r.trajectory.size() << " of " << steps.size()
+                  << " scans; wrote the map of those to " << *args.get("out-map") << " and their trajectory to "
+                  << *args.get("out-trajectory") << '\n';
+        return interrupt_exit_code();
+      }
       std::cout << std::fixed << std::setprecision(2) << "ICP-SLAM: " << steps.size() << " scans, " << r.keyframes
                 << " keyframes, " << r.seconds << " s (" << r.seconds * 1000 / static_cast<double>(steps.size())
                 << " ms per scan)\n";
@@ -129,6 +137,7 @@ const Command kLocalize{
       for (const char* required : {"map", "rawlog", "out-trajectory"})
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
       args.check_output_files({"out-trajectory"});
+      catch_interrupts();  // Ctrl-C: write the trajectory of the scans done, then exit 130
       const Pose2D start = parse_pose(args.get_or("initial", "0 0 0"), "--initial");
       robot::Localizer loc = robot::Localizer::load(*args.get("map"));
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
@@ -137,6 +146,7 @@ const Command kLocalize{
       int accepted = 0;
       double ms = 0;
       for (const auto& s : steps) {
+        if (interrupted()) break;
         if (s.odometry_increment) loc.predict(*s.odometry_increment);
         const auto u = loc.correct(s.scan);
         accepted += u.accepted;
@@ -144,6 +154,11 @@ const Command kLocalize{
         out.push_back({s.timestamp_s, loc.pose()});
       }
       robot::write_trajectory(*args.get("out-trajectory"), out);
+      if (interrupted()) {
+        std::cout << "localisation interrupted after " << out.size() << " of " << steps.size()
+                  << " scans; their trajectory is in " << *args.get("out-trajectory") << '\n';
+        return interrupt_exit_code();
+      }
       std::cout << std::fixed << std::setprecision(2) << "localised " << steps.size() << " scans against " << loc.map_points()
                 << " map points: " << accepted << " accepted, " << ms / static_cast<double>(steps.size()) << " ms per scan\n";
       if (const auto gt = args.get("ground-truth")) {

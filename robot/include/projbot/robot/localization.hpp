@@ -3,6 +3,7 @@
 // prediction; rawlogs and trajectories on disk.
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -38,14 +39,17 @@ struct SlamResult {
   std::vector<TrajectoryPoint> trajectory;  ///< the corrected pose after every step
   std::size_t keyframes = 0;                ///< scans inserted into the map
   double seconds = 0.0;                     ///< wall time of the run
+  bool interrupted = false;                 ///< stopped early: the map and trajectory of the steps done
 };
 
 /// Builds the map with mrpt::slam::CMetricMapBuilderICP from rawlog steps. `ini` is an icp-slam
 /// configuration ([MappingApplication] and [ICP] sections, as MRPT's icp-slam app reads);
 /// without one, the defaults of MRPT's icp-slam_demo_classic.ini apply. Writes to `out_dir`:
 /// map.simplemap.gz (keyframes: poses and scans), grid.png and grid.yaml (ROS map_server form).
+/// `stop_requested`, asked before each step, ends the run there (Ctrl-C): the steps done are mapped and
+/// written as for a whole run.
 SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,
-                     const std::filesystem::path& out_dir);
+                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested = {});
 
 /// Localiser settings.
 struct LocalizerConfig {
