@@ -78,10 +78,20 @@ mrpt::obs::CActionCollection::Ptr odometry_action(const Pose2D& increment, doubl
   return actions;
 }
 
-// MRPT's exception texts carry a call stack after the first line; users get the first line.
+// MRPT's exception texts open with a "==== MRPT exception ====" banner and carry a call stack; users
+// get the first line that says something: not the banner, not a source location.
 std::string first_line(const std::exception& e) {
-  const std::string what = e.what();
-  return what.substr(0, what.find('\n'));
+  std::istringstream lines(e.what());
+  for (std::string line; std::getline(lines, line);) {
+    const auto start = line.find_first_not_of(" \t");
+    if (start == std::string::npos || line[start] == '=') continue;
+    line = line.substr(start);
+    if (line.rfind("Message:", 0) == 0) line = line.substr(line.find_first_not_of(" \t", 8));
+    if (line.find(".cpp:") != std::string::npos || line.find(".h:") != std::string::npos || line.rfind("Location", 0) == 0)
+      continue;
+    if (!line.empty()) return line;
+  }
+  return "unreadable (MRPT gave no message)";
 }
 
 void write_map_files(const std::filesystem::path& out_dir, const mrpt::maps::CSimpleMap& keyframes) {
