@@ -109,9 +109,8 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       const Eigen::Vector3d x = R * model_.points[i].cast<double>() + t;
       const Eigen::Vector3d nrm = R * model_.normals[i].cast<double>();
       if (x.z() <= 0.05 || nrm.dot(x) >= 0.0) continue;  // behind the camera, or facing away
-      const int u = static_cast<int>(std::lround(lv.k.fx_px * x.x() / x.z() + lv.k.cx_px));
-      const int v = static_cast<int>(std::lround(lv.k.fy_px * x.y() / x.z() + lv.k.cy_px));
-      if (u < 0 || v < 0 || u >= lv.k.width_px || v >= lv.k.height_px) continue;
+      int u = 0, v = 0;
+      if (!lv.k.nearest_pixel(x, u, v)) continue;
       const float zs = lv.z[static_cast<std::size_t>(v) * lv.k.width_px + u];
       if (zs <= 0.0F) continue;
       if (zs < x.z() - cfg_.occlusion_margin_m) continue;  // something in front of the model: occluded

@@ -12,19 +12,18 @@ namespace {
 // The predicted depth image: nearest front-facing model sample per pixel, +inf where none lands; `box`
 // gets the pixel bounds of what landed (x0, y0, x1, y1, inclusive).
 std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k,
-                                   std::array<long, 4>& box) {
+                                   std::array<int, 4>& box) {
   box = {k.width_px, k.height_px, -1, -1};
   std::vector<float> z_buffer(static_cast<std::size_t>(k.width_px) * k.height_px, std::numeric_limits<float>::infinity());
-  const Eigen::Matrix3f R = T_camera_model.topLeftCorner<3, 3>().cast<float>();
-  const Eigen::Vector3f t = T_camera_model.topRightCorner<3, 1>().cast<float>();
+  const Eigen::Matrix3d R = T_camera_model.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T_camera_model.topRightCorner<3, 1>();
   for (std::size_t i = 0; i < model.points.size(); ++i) {
-    const Eigen::Vector3f p = R * model.points[i] + t;
-    if (!(p.z() > 0.05F) || (R * model.normals[i]).dot(p) >= 0.0F) continue;  // behind the camera, or a back face
-    const long u = std::lround(k.fx_px * p.x() / p.z() + k.cx_px);
-    const long v = std::lround(k.fy_px * p.y() / p.z() + k.cy_px);
-    if (u < 0 || v < 0 || u >= k.width_px || v >= k.height_px) continue;
+    const Eigen::Vector3d p = R * model.points[i].cast<double>() + t;
+    if (!(p.z() > 0.05) || (R * model.normals[i].cast<double>()).dot(p) >= 0.0) continue;  // behind the camera, or a back face
+    int u = 0, v = 0;
+    if (!k.nearest_pixel(p, u, v)) continue;
     float& z = z_buffer[static_cast<std::size_t>(v) * k.width_px + u];
-    z = std::min(z, p.z());
+    z = std::min(z, static_cast<float>(p.z()));
     box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v)};
   }
   return z_buffer;
@@ -36,14 +35,12 @@ FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& 
                                 const CameraIntrinsics& k) {
   FreeSpaceCheck c;
   if (depth.width != k.width_px || depth.height != k.height_px || !T_camera_model.allFinite()) return c;
-  std::array<long, 4> box{};
+  std::array<int, 4> box{};
   const std::vector<float> predicted = predicted_depth(model, T_camera_model, k, box);
   const auto at = [&](int x, int y) { return predicted[static_cast<std::size_t>(y) * k.width_px + x]; };
   constexpr int kRim = 2;  // pixels of the silhouette's rim left out
-  const int x0 = static_cast<int>(std::max<long>(box[0], kRim)),
-            x1 = static_cast<int>(std::min<long>(box[2], k.width_px - 1 - kRim));
-  const int y0 = static_cast<int>(std::max<long>(box[1], kRim)),
-            y1 = static_cast<int>(std::min<long>(box[3], k.height_px - 1 - kRim));
+  const int x0 = std::max(box[0], kRim), x1 = std::min(box[2], k.width_px - 1 - kRim);
+  const int y0 = std::max(box[1], kRim), y1 = std::min(box[3], k.height_px - 1 - kRim);
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       const float z = at(x, y);

@@ -3,6 +3,7 @@
 // camera intrinsics. Plain types only; PCL stays inside src/.
 
 #include <Eigen/Core>
+#include <cmath>
 #include <filesystem>
 #include <stdexcept>
 #include <vector>
@@ -27,6 +28,14 @@ struct CameraIntrinsics {
   /// Kinect v1 / PrimeSense depth camera defaults: 640x480, f = 525 px, principal point at the image
   /// centre (the TUM RGB-D and Open3D defaults; PCL's OpenNI grabber reports cx 320, cy 240).
   static CameraIntrinsics kinect_v1() { return {}; }
+
+  /// The pixel whose centre is nearest to where camera-frame point p (z > 0) projects; false when it
+  /// falls outside the image.
+  bool nearest_pixel(const Eigen::Vector3d& p, int& u, int& v) const {
+    u = static_cast<int>(std::lround(fx_px * p.x() / p.z() + cx_px));
+    v = static_cast<int>(std::lround(fy_px * p.y() / p.z() + cy_px));
+    return u >= 0 && v >= 0 && u < width_px && v < height_px;
+  }
 };
 
 /// A depth image in metres, row-major, top row first; 0 or NaN marks a missing measurement.
