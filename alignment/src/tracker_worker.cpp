@@ -39,6 +39,13 @@ bool TargetFollower::verified(const DepthImage& frame, const Eigen::Matrix4d& T)
   return passes(check_);
 }
 
+PoseSample TargetFollower::found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm) {
+  pose_ = T;
+  rejected_ = 0;
+  lost_reported_ = false;
+  return PoseSample{T, 0, frame.capture_time_s, false, inlier_ratio, rmse_mm};
+}
+
 std::optional<PoseSample> TargetFollower::step(const DepthImage& frame) {
   if (!have_guess_ && !pose_) return std::nullopt;  // nothing to start from yet
   return pose_ ? track(frame) : search(frame);
@@ -53,19 +60,11 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
 
 std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
   const TrackResult r = tracker_.track(frame, *pose_);
-  if (r.accepted && verified(frame, r.T_camera_target)) {
-    pose_ = r.T_camera_target;
-    rejected_ = 0;
-    return PoseSample{*pose_, 0, frame.capture_time_s, false, r.inlier_ratio, r.rmse_mm};
-  }
+  if (r.accepted && verified(frame, r.T_camera_target)) return found(frame, r.T_camera_target, r.inlier_ratio, r.rmse_mm);
   // The target moved more than tracking follows (or frames were dropped): one ICP on this same frame
   // from where it was last seen. Bounded: no restarts, no global search here.
   const auto a = attempt(frame, *pose_, SearchStage::refine);
-  if (a && a->converged && verified(frame, a->T_scan_model)) {
-    pose_ = a->T_scan_model;
-    rejected_ = 0;
-    return PoseSample{*pose_, 0, frame.capture_time_s, false, a->inlier_ratio, a->rmse_mm};
-  }
+  if (a && a->converged && verified(frame, a->T_scan_model)) return found(frame, a->T_scan_model, a->inlier_ratio, a->rmse_mm);
   if (++rejected_ < cfg_.lost_after) return std::nullopt;  // one bad frame: keep showing the last pose
   // Lost: blank it now and search from where it was last seen.
   guess_ = *pose_;
@@ -100,19 +99,11 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame) {
   if (quick.accepted && quick.inlier_ratio >= 0.95 && translation_norm_m(correction) < 0.02 &&
       rotation_angle_deg(correction) < 3.0 && verified(frame, quick.T_camera_target) && check_.behind_ratio() < 0.05) {
     elapsed();
-    pose_ = quick.T_camera_target;
-    rejected_ = 0;
-    lost_reported_ = false;
-    return PoseSample{*pose_, 0, frame.capture_time_s, false, quick.inlier_ratio, quick.rmse_mm};
+    return found(frame, quick.T_camera_target, quick.inlier_ratio, quick.rmse_mm);
   }
   const auto a = attempt(frame, guess_, stage);
   elapsed();
-  if (a && a->converged && verified(frame, a->T_scan_model)) {
-    pose_ = a->T_scan_model;
-    rejected_ = 0;
-    lost_reported_ = false;
-    return PoseSample{*pose_, 0, frame.capture_time_s, false, a->inlier_ratio, a->rmse_mm};
-  }
+  if (a && a->converged && verified(frame, a->T_scan_model)) return found(frame, a->T_scan_model, a->inlier_ratio, a->rmse_mm);
   const auto& spacing = cfg_.search_spacing_frames;
   if (!spacing.empty()) wait_ = spacing[std::min(static_cast<std::size_t>(stats_.attempts - 1), spacing.size() - 1)];
   const double last_ms = stats_.last_attempt_ms;

@@ -104,6 +104,8 @@ class TargetFollower {
   std::optional<AlignmentResult> last_attempt_;
   FreeSpaceCheck check_;
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
+  // The target is at T (tracked, refined or found): the sample to publish.
+  PoseSample found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm);
 
   std::optional<PoseSample> track(const DepthImage& frame);
   std::optional<PoseSample> search(const DepthImage& frame);
