@@ -102,7 +102,7 @@ void print_table(const TourReport& report, std::ostream& out) {
     }
   }
   double simulated_s = 0.0;
-  for (const auto& v : report.visits) simulated_s += v.drive_s + static_cast<double>(v.timeline.size()) / 30.0;
+  for (const auto& v : report.visits) simulated_s += v.drive_s + (v.timeline.empty() ? 0.0 : v.timeline.back().t_s);
   out << "\nTour: " << report.visits.size() << " visits in " << fixed(report.wall_s, 1) << " s wall time, "
       << fixed(simulated_s, 1) << " s simulated (driving and projecting)"
       << (report.interrupted ? " (interrupted: the finished visits only)" : "") << ".\n";
