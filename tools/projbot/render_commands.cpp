@@ -63,14 +63,11 @@ const Command kRender{"render", "render the projector image headless (offscreen)
                         renderer.finish(*target);
                         const assets::Image image = target->read_back();
                         assets::write_png(*out, image);
-                        std::size_t lit = 0;
-                        for (std::size_t i = 0; i < image.rgba.size(); i += 4)
-                          lit += (image.rgba[i] | image.rgba[i + 1] | image.rgba[i + 2]) != 0 ? 1 : 0;
                         std::cout << "wrote " << *out << " (" << scene.projector.width_px << "x" << scene.projector.height_px
                                   << ", " << scene.targets.size() << " target" << (scene.targets.size() == 1 ? "" : "s") << ")\n";
                         finish_profile(args, profiler);
                         if (!report_validation(args, renderer)) return 1;
-                        if (lit == 0 && !scene.targets.empty()) {
+                        if (image.lit_pixels() == 0 && !scene.targets.empty()) {
                           std::cerr << "projbot render: warning: the frame is empty: no target is in the projector's view "
                                        "(check the poses, --near / --far and the intrinsics)\n";
                           return 3;

@@ -22,6 +22,12 @@ struct Image {
 
   std::uint8_t* pixel(int x, int y) { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
   const std::uint8_t* pixel(int x, int y) const { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
+  /// Pixels that are not black (any of R, G, B non-zero): how much of a projector frame carries light.
+  std::size_t lit_pixels() const {
+    std::size_t lit = 0;
+    for (std::size_t i = 0; i + 3 < rgba.size(); i += 4) lit += (rgba[i] | rgba[i + 1] | rgba[i + 2]) != 0 ? 1 : 0;
+    return lit;
+  }
 };
 
 /// Row-major 16-bit single-channel pixels (a depth image), top row first, values as stored.
