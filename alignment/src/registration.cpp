@@ -313,12 +313,11 @@ struct Aligner::Impl {
   // grid until at most max_global_points remain: what a bounded global search works on.
   pcl::PointCloud<pcl::PointXYZ>::Ptr global_points(const PointCloud& scan, const Eigen::Matrix4d& T_init, double margin,
                                                     std::size_t max_points) const {
+    const Eigen::Vector3f centre = extent.centre_in(T_init).cast<float>();
+    const double radius = cfg.crop ? extent.radius + margin : 0.0;
     double leaf = coarse_leaf();
-    auto points = prepare(scan, extent.centre_in(T_init).cast<float>(), cfg.crop ? extent.radius + margin : 0.0, leaf);
-    while (points->size() > max_points && leaf < 0.05) {
-      leaf *= 1.4;
-      points = prepare(scan, extent.centre_in(T_init).cast<float>(), cfg.crop ? extent.radius + margin : 0.0, leaf);
-    }
+    auto points = prepare(scan, centre, radius, leaf);
+    while (points->size() > max_points && leaf < 0.05) points = prepare(scan, centre, radius, leaf *= 1.4);
     return points;
   }
 
