@@ -204,6 +204,23 @@ TEST_F(CliTest, AlignPrintsJson) {
   EXPECT_NEAR(m00, 0.825, 0.02);  // cos(34.4 degrees)
 }
 
+// Standard output on a full device is an error, not a silent exit 0 (`--json >/dev/full`).
+TEST_F(CliTest, FullStandardOutputIsAnError) {
+  const std::string bunny = std::string(PROJBOT_SHARED_DATA) + "/bunny/";
+  for (const std::string& args :
+       {"align --model " + bunny + "bun0.pcd --scan " + bunny + "bun4.pcd --no-crop --json", std::string("--help")}) {
+    const std::string cmd = std::string(PROJBOT_EXE) + " " + args + " 2>&1 >/dev/full";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string out;
+    std::array<char, 512> buf{};
+    while (fgets(buf.data(), buf.size(), pipe) != nullptr) out += buf.data();
+    const int status = pclose(pipe);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << args << ": " << out;
+    EXPECT_NE(out.find("cannot write to standard output: No space left on device"), std::string::npos) << out;
+  }
+}
+
 // A 16-bit depth PNG read by the executable itself: libraries projbot links (MRPT's nanogui, draco)
 // export older stb functions that once took the place of ours and refused every 16-bit PNG.
 TEST_F(CliTest, AlignReadsA16BitDepthPng) {

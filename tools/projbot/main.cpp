@@ -2,6 +2,9 @@
 
 #include <malloc.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <new>
 
@@ -45,7 +48,8 @@ void print_help() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// Runs the command argv names; its exit status.
+static int dispatch(int argc, char** argv) {
   // Lavapipe allocates its per-frame binning memory anew each frame. By default glibc returns such large
   // blocks to the kernel on free and the next frame faults them in again, zeroed; keeping them in the
   // heap took the 100k-triangle 1080p benchmark from p99 23 ms to 18 ms (tools/bench-vs-vkcube.sh,
@@ -96,4 +100,16 @@ int main(int argc, char** argv) {
     std::cerr << "projbot " << name << ": " << e.what() << '\n';
     return 1;
   }
+}
+
+int main(int argc, char** argv) {
+  const int code = dispatch(argc, argv);
+  // What went to standard output must have arrived: `align --json >/dev/full` once exited 0 with
+  // nothing written. Every command and --help / --version end here.
+  if (std::cout.flush(), std::fflush(stdout) != 0 || !std::cout) {
+    std::cerr << "projbot" << (argc > 1 ? std::string(" ") + argv[1] : std::string())
+              << ": cannot write to standard output: " << std::strerror(errno) << '\n';
+    return 1;
+  }
+  return code;
 }
