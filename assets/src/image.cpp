@@ -74,7 +74,8 @@ Gray16Image read_png_gray16(const std::filesystem::path& path) {
     throw AssetError(path.string() + ": a depth PNG must be 16-bit single-channel (this one has " + std::to_string(comps) +
                      " channel(s), " + (sixteen ? "16" : "8") + " bits)");
   std::unique_ptr<stbi_us, void (*)(void*)> data(stbi_load_16(path.c_str(), &w, &h, &comps, 1), stbi_image_free);
-  if (!data) throw AssetError(path.string() + ": cannot decode PNG: " + stbi_failure_reason());
+  if (!data)
+    throw AssetError(path.string() + ": cannot decode PNG (truncated or corrupt; stb says: " + stbi_failure_reason() + ")");
   Gray16Image img;
   img.width = w;
   img.height = h;
