@@ -25,7 +25,9 @@ const Command kTour{
     "Modes: odometry = the paper's set-up (odometry only, one plain point-to-point ICP per stop, always\n"
     "projected; assets/scenes/paper.yaml is the paper's experiment, nothing moved); localized = MRPT\n"
     "localisation and robust acquisition with a quality gate (rejected estimates are blanked); tracking =\n"
-    "localized, and the projective tracker follows the target at 30 Hz while projecting.\n",
+    "localized, and the projective tracker follows the target at 30 Hz while projecting.\n\n"
+    "A line per visit is printed as it finishes. Ctrl-C stops after the visit in progress, prints and writes\n"
+    "the finished visits (the report says \"interrupted\": true) and exits 130.\n",
     {{"scene", "FILE", "tour scene (default: the shipped demo tour, assets/scenes/tour.yaml)"},
      {"visits", "N", "number of visits, cycling through the scene's list (default: the list once)"},
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
