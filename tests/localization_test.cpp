@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <numbers>
 
 #include "projbot/robot/sim_tour.hpp"
@@ -58,6 +59,42 @@ TEST(Rawlog, BadFilesAreNamed) {
     EXPECT_LT(steps.size(), 37u);
   } catch (const RobotError& e) {
     EXPECT_NE(std::string(e.what()).find("cut.rawlog"), std::string::npos);
+  }
+  fs::remove_all(dir);
+}
+
+// 100 bytes of a real rawlog with flipped bits on which MRPT's own deserialiser dies with SIGSEGV (in
+// CActionRobotMovement2D): the reader runs in a child process, and the crash is an error naming the file.
+TEST(Rawlog, ACrashOfMrptsReaderIsAnError) {
+  const fs::path file = fs::path(PROJBOT_SOURCE_DIR) / "tests" / "hostile" / "mrpt_reader_crash.rawlog";
+  try {
+    read_rawlog(file);
+    FAIL() << "a corrupt rawlog was read";
+  } catch (const RobotError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("mrpt_reader_crash.rawlog: corrupt MRPT rawlog: MRPT's reader crashed on it (signal 11"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("after 0 objects, at byte 0"), std::string::npos) << what;
+  }
+  // The reader still works after a crash in its child, and gives the same steps as before.
+  EXPECT_EQ(read_rawlog(kData / "localization_demo.rawlog").size(), 37u);
+}
+
+// Bits flipped in a scan's ranges make values no laser reports: named by scan and ray, not mapped.
+TEST(Rawlog, ImpossibleValuesAreCorruption) {
+  const fs::path dir = temp_dir("impossible");
+  auto steps = read_rawlog(kData / "localization_demo.rawlog");
+  steps[3].scan.ranges_m[7] = -std::numeric_limits<float>::infinity();
+  steps[3].scan.valid[7] = 1;
+  write_rawlog(dir / "bad.rawlog", steps);
+  try {
+    read_rawlog(dir / "bad.rawlog");
+    FAIL();
+  } catch (const RobotError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.rawlog: corrupt MRPT rawlog: scan 4 has an impossible range of ray"),
+              std::string::npos)
+        << e.what();
   }
   fs::remove_all(dir);
 }

@@ -23,10 +23,12 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
 
+#include "isolated_read.hpp"
 #include "mrpt_convert.hpp"
 #include "projbot/config/output_file.hpp"
 
@@ -125,48 +127,132 @@ void swap_into_place(const std::filesystem::path& work_dir, const std::filesyste
 
 }  // namespace
 
+namespace {
+
+bool is_gzip(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[2] = {};
+  return in.read(magic, 2) && magic[0] == '\x1f' && magic[1] == '\x8b';
+}
+
+// MRPT's reader, object by object (not CRawlog's pair reader, which drops a sensory frame that comes
+// before the first action) until the end of the file. Runs in the isolated child.
+std::vector<RawlogStep> read_rawlog_objects(const std::filesystem::path& path, detail::ReadProgress& progress) {
+  std::vector<RawlogStep> steps;
+  const bool gzip = is_gzip(path);
+  mrpt::io::CFileGZInputStream in(path.string());
+  auto archive = mrpt::serialization::archiveFrom(in);
+  std::optional<Pose2D> pending_odometry;             // action-observation format
+  std::optional<mrpt::poses::CPose2D> last_absolute;  // observation-only format
+  for (;; ++progress.objects) {
+    if (!gzip) progress.offset = in.getPosition();
+    mrpt::serialization::CSerializable::Ptr object;
+    try {
+      object = archive.ReadObject();
+    } catch (const mrpt::serialization::CExceptionEOF&) {
+      break;
+    }
+    mrpt::obs::CObservation2DRangeScan::Ptr scan;
+    if (auto actions = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(object)) {
+      if (auto move = actions->getBestMovementEstimation()) pending_odometry = detail::from_mrpt(move->poseChange->getMeanVal());
+    } else if (auto frame = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(object)) {
+      scan = frame->getObservationByClass<mrpt::obs::CObservation2DRangeScan>();
+    } else if (auto odo = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(object)) {
+      if (last_absolute) {
+        const Pose2D inc = detail::from_mrpt(odo->odometry - *last_absolute);
+        pending_odometry = pending_odometry ? compose(*pending_odometry, inc) : inc;
+      }
+      last_absolute = odo->odometry;
+    } else {
+      scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(object);
+    }
+    if (!scan) continue;
+    RawlogStep step;
+    step.scan = detail::from_mrpt(*scan);
+    step.timestamp_s = step.scan.timestamp_s;
+    step.odometry_increment = pending_odometry;
+    pending_odometry.reset();
+    steps.push_back(std::move(step));
+  }
+  return steps;
+}
+
+void put_scan(detail::Bytes& out, const LaserScan& s) {
+  out.put(s.timestamp_s);
+  out.put(s.sensor_on_base);
+  out.put(s.aperture_rad);
+  out.put(s.max_range_m);
+  out.put_vector(s.ranges_m);
+  out.put_vector(s.valid);
+}
+
+LaserScan get_scan(detail::BytesReader& in) {
+  LaserScan s;
+  s.timestamp_s = in.get<double>();
+  s.sensor_on_base = in.get<Pose2D>();
+  s.aperture_rad = in.get<double>();
+  s.max_range_m = in.get<double>();
+  s.ranges_m = in.get_vector<float>();
+  s.valid = in.get_vector<std::uint8_t>();
+  if (s.valid.size() != s.ranges_m.size()) throw RobotError("isolated read: scan with mismatched sizes");
+  return s;
+}
+
+// What a laser and odometry can report; a step outside it is corruption, named by its number.
+void check_step(const std::filesystem::path& path, std::size_t index, const RawlogStep& step) {
+  const auto& s = step.scan;
+  const Pose2D odo = step.odometry_increment.value_or(Pose2D{});
+  std::string wrong;
+  if (!std::isfinite(step.timestamp_s) || step.timestamp_s < 0)
+    wrong = "timestamp";
+  else if (!std::isfinite(odo.x_m + odo.y_m + odo.theta_rad) || std::hypot(odo.x_m, odo.y_m) > 1e3)
+    wrong = "odometry";
+  else if (!(s.aperture_rad > 0 && s.aperture_rad <= 2 * M_PI + 1e-3))
+    wrong = "aperture";
+  else if (!(s.max_range_m > 0 && s.max_range_m <= 1e3))
+    wrong = "maximum range";
+  else if (s.ranges_m.empty() || s.ranges_m.size() > 100000)
+    wrong = "number of rays";
+  else if (!std::isfinite(s.sensor_on_base.x_m + s.sensor_on_base.y_m + s.sensor_on_base.theta_rad))
+    wrong = "sensor pose";
+  for (std::size_t i = 0; wrong.empty() && i < s.ranges_m.size(); ++i)
+    if (s.valid[i] != 0 && !(std::isfinite(s.ranges_m[i]) && s.ranges_m[i] >= 0)) wrong = "range of ray " + std::to_string(i);
+  if (!wrong.empty())
+    throw RobotError(path.string() + ": corrupt MRPT rawlog: scan " + std::to_string(index + 1) + " has an impossible " + wrong);
+}
+
+}  // namespace
+
 std::vector<RawlogStep> read_rawlog(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path)) throw RobotError(path.string() + ": no such rawlog file");
-  std::vector<RawlogStep> steps;
-  try {
-    mrpt::io::CFileGZInputStream in(path.string());
-    auto archive = mrpt::serialization::archiveFrom(in);
-    std::optional<Pose2D> pending_odometry;             // action-observation format
-    std::optional<mrpt::poses::CPose2D> last_absolute;  // observation-only format
-    // Object by object (not CRawlog's pair reader, which drops a sensory frame that comes before
-    // the first action) until the end of the file.
-    for (;;) {
-      mrpt::serialization::CSerializable::Ptr object;
-      try {
-        object = archive.ReadObject();
-      } catch (const mrpt::serialization::CExceptionEOF&) {
-        break;
+  // MRPT's deserialiser crashes on corrupt archives (flipped bits): it reads in a child process.
+  const std::string bytes = detail::read_isolated(path, "MRPT rawlog", [&](detail::ReadProgress& progress) {
+    detail::Bytes out;
+    try {
+      for (const RawlogStep& step : read_rawlog_objects(path, progress)) {
+        out.put(step.timestamp_s);
+        out.put<std::uint8_t>(step.odometry_increment ? 1 : 0);
+        out.put(step.odometry_increment.value_or(Pose2D{}));
+        put_scan(out, step.scan);
       }
-      mrpt::obs::CObservation2DRangeScan::Ptr scan;
-      if (auto actions = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(object)) {
-        if (auto move = actions->getBestMovementEstimation())
-          pending_odometry = detail::from_mrpt(move->poseChange->getMeanVal());
-      } else if (auto frame = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(object)) {
-        scan = frame->getObservationByClass<mrpt::obs::CObservation2DRangeScan>();
-      } else if (auto odo = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(object)) {
-        if (last_absolute) {
-          const Pose2D inc = detail::from_mrpt(odo->odometry - *last_absolute);
-          pending_odometry = pending_odometry ? compose(*pending_odometry, inc) : inc;
-        }
-        last_absolute = odo->odometry;
-      } else {
-        scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(object);
-      }
-      if (!scan) continue;
-      RawlogStep step;
-      step.scan = detail::from_mrpt(*scan);
-      step.timestamp_s = step.scan.timestamp_s;
-      step.odometry_increment = pending_odometry;
-      pending_odometry.reset();
-      steps.push_back(std::move(step));
+    } catch (const std::bad_alloc&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw RobotError(path.string() + ": not a readable MRPT rawlog (" + first_line(e) + ")");
     }
-  } catch (const std::exception& e) {
-    throw RobotError(path.string() + ": not a readable MRPT rawlog (" + first_line(e) + ")");
+    return out.take();
+  });
+  std::vector<RawlogStep> steps;
+  detail::BytesReader in(bytes);
+  while (!in.done()) {
+    RawlogStep step;
+    step.timestamp_s = in.get<double>();
+    const bool has_odometry = in.get<std::uint8_t>() != 0;
+    const auto odometry = in.get<Pose2D>();
+    if (has_odometry) step.odometry_increment = odometry;
+    step.scan = get_scan(in);
+    check_step(path, steps.size(), step);
+    steps.push_back(std::move(step));
   }
   if (steps.empty()) throw RobotError(path.string() + ": the rawlog holds no 2-D laser scans");
   return steps;
@@ -303,16 +389,41 @@ Localizer::Localizer(const std::vector<std::pair<Pose2D, LaserScan>>& keyframes,
 Localizer Localizer::load(const std::filesystem::path& map_dir, const LocalizerConfig& config) {
   const auto file = map_dir / "map.simplemap.gz";
   if (!std::filesystem::is_regular_file(file)) throw RobotError(file.string() + ": no such map (run projbot slam first)");
-  mrpt::maps::CSimpleMap keyframes;
-  bool ok = false;
-  try {
-    ok = keyframes.loadFromFile(file.string());
-  } catch (const std::exception&) {
-    ok = false;
-  }
-  if (!ok || keyframes.empty()) throw RobotError(file.string() + ": not a readable MRPT simplemap");
+  // MRPT's deserialiser crashes on corrupt archives: the child reads the keyframes and builds the
+  // points map; its points come back.
+  const std::string bytes = detail::read_isolated(file, "MRPT simplemap", [&](detail::ReadProgress&) {
+    mrpt::maps::CSimpleMap keyframes;
+    bool ok = false;
+    try {
+      ok = keyframes.loadFromFile(file.string());
+    } catch (const std::bad_alloc&) {
+      throw;
+    } catch (const std::exception&) {
+      ok = false;
+    }
+    if (!ok || keyframes.empty()) throw RobotError(file.string() + ": not a readable MRPT simplemap");
+    Impl built(config);
+    built.map.loadFromSimpleMap(keyframes);
+    std::vector<float> xyz;
+    xyz.reserve(3 * built.map.size());
+    for (std::size_t i = 0; i < built.map.size(); ++i) {
+      float x, y, z;
+      built.map.getPoint(i, x, y, z);
+      xyz.insert(xyz.end(), {x, y, z});
+    }
+    detail::Bytes out;
+    out.put_vector(xyz);
+    return out.take();
+  });
+  detail::BytesReader in(bytes);
+  const auto xyz = in.get_vector<float>();
   auto impl = std::make_unique<Impl>(config);
-  impl->map.loadFromSimpleMap(keyframes);
+  impl->map.reserve(xyz.size() / 3);
+  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) {
+    if (!std::isfinite(xyz[i] + xyz[i + 1] + xyz[i + 2]))
+      throw RobotError(file.string() + ": corrupt MRPT simplemap: point " + std::to_string(i / 3 + 1) + " is not finite");
+    impl->map.insertPoint(xyz[i], xyz[i + 1], xyz[i + 2]);
+  }
   if (impl->map.size() < 10) throw RobotError(file.string() + ": the map has fewer than 10 points");
   return Localizer(std::move(impl));
 }

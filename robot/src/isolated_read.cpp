@@ -1,0 +1,132 @@
+#include "isolated_read.hpp"
+
+#include <sys/mman.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <new>
+
+namespace projbot::robot::detail {
+namespace {
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
+bool write_all(int fd, const char* data, std::size_t size) {
+  while (size > 0) {
+    const ssize_t n = ::write(fd, data, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    data += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+std::string read_all(int fd) {
+  std::string out;
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return out;
+    out.append(buf, static_cast<std::size_t>(n));
+  }
+}
+
+// The child's memory: what it has now (the program, its libraries) plus what reading `file` may fairly
+// need. A corrupt length that asks for gigabytes fails there as bad_alloc.
+void limit_memory(const std::filesystem::path& file) {
+  if (kAddressSanitizer) return;
+  std::ifstream statm("/proc/self/statm");
+  unsigned long long pages = 0;
+  if (!(statm >> pages)) return;
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(file, ec);
+  const rlim_t limit = pages * static_cast<unsigned long long>(::sysconf(_SC_PAGESIZE)) + (1ULL << 30) + (ec ? 0 : 64 * size);
+  const rlimit r{limit, limit};
+  ::setrlimit(RLIMIT_AS, &r);
+}
+
+// Child: 'R' + result, or 'E' + the message of what it threw; then _exit (no atexit handlers, no
+// flushing of the parent's buffered output a second time).
+[[noreturn]] void run_child(int fd, const std::filesystem::path& file, ReadProgress& progress,
+                            const std::function<std::string(ReadProgress&)>& read) {
+  limit_memory(file);
+  std::string reply;
+  try {
+    reply = "R" + read(progress);
+  } catch (const std::bad_alloc&) {
+    reply = "M";
+  } catch (const std::exception& e) {
+    reply = std::string("E") + e.what();
+  } catch (...) {
+    reply = "Eunknown error";
+  }
+  _exit(write_all(fd, reply.data(), reply.size()) ? 0 : 3);
+}
+
+std::string where(const ReadProgress& p) {
+  std::string s = "after " + std::to_string(p.objects) + (p.objects == 1 ? " object" : " objects");
+  if (p.offset != UINT64_MAX) s += ", at byte " + std::to_string(p.offset);
+  return s;
+}
+
+std::string how_it_died(int status) {
+  if (WIFSIGNALED(status)) {
+    const char* name = ::strsignal(WTERMSIG(status));
+    return "signal " + std::to_string(WTERMSIG(status)) + (name != nullptr ? std::string(", ") + name : "");
+  }
+  return "exit " + std::to_string(WEXITSTATUS(status));
+}
+
+}  // namespace
+
+std::string read_isolated(const std::filesystem::path& file, const std::string& kind,
+                          const std::function<std::string(ReadProgress&)>& read) {
+  void* shared = ::mmap(nullptr, sizeof(ReadProgress), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  if (shared == MAP_FAILED) throw RobotError(file.string() + ": cannot set up the isolated reader (mmap)");
+  auto* progress = new (shared) ReadProgress{};
+  int fds[2];
+  if (::pipe(fds) != 0) {
+    ::munmap(shared, sizeof(ReadProgress));
+    throw RobotError(file.string() + ": cannot set up the isolated reader (pipe)");
+  }
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::close(fds[0]);
+    run_child(fds[1], file, *progress, read);
+  }
+  ::close(fds[1]);
+  const std::string reply = pid > 0 ? read_all(fds[0]) : std::string();
+  ::close(fds[0]);
+  int status = 0;
+  while (pid > 0 && ::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  const ReadProgress at = *progress;
+  ::munmap(shared, sizeof(ReadProgress));
+  if (pid < 0) throw RobotError(file.string() + ": cannot set up the isolated reader (fork)");
+  if (!reply.empty() && reply[0] == 'R' && WIFEXITED(status) && WEXITSTATUS(status) == 0) return reply.substr(1);
+  if (!reply.empty() && reply[0] == 'E') throw RobotError(reply.substr(1));
+  if (!reply.empty() && reply[0] == 'M')
+    throw RobotError(file.string() + ": out of memory reading it (a corrupt " + kind + "? " + where(at) + ")");
+  throw RobotError(file.string() + ": corrupt " + kind + ": MRPT's reader crashed on it (" + how_it_died(status) + ", " +
+                   where(at) + ")");
+}
+
+}  // namespace projbot::robot::detail

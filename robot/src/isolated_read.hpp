@@ -1,0 +1,81 @@
+#pragma once
+// Reading files whose third-party reader is not safe on corrupt input (MRPT's deserialisers follow
+// lengths and class tags they never check, and die with SIGSEGV on a few flipped bits), in a child
+// process: a crash there is an error message here. Not for use while other threads run (fork).
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "projbot/robot/error.hpp"
+
+namespace projbot::robot::detail {
+
+/// How far the child's reader had got, kept in memory shared with the parent: a crash names it.
+struct ReadProgress {
+  std::uint64_t objects = 0;          ///< objects read whole
+  std::uint64_t offset = UINT64_MAX;  ///< the file's byte where the next object starts, where known
+};
+
+/// Runs `read` in a forked child and returns the bytes it produced. An exception in `read` comes back
+/// as a RobotError with the same message; a child that dies (signal, out of its memory limit) is a
+/// RobotError naming `file`, `kind` and the progress. The child's address space is capped at what it
+/// has plus 1 GiB plus 64 bytes per byte of `file` (not under AddressSanitizer, which reserves more).
+std::string read_isolated(const std::filesystem::path& file, const std::string& kind,
+                          const std::function<std::string(ReadProgress&)>& read);
+
+/// Plain values and vectors of them, appended to and taken from a byte string in host order (the bytes
+/// never leave the machine: child to parent only).
+class Bytes {
+ public:
+  template <typename T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    data_.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  template <typename T>
+  void put_vector(const std::vector<T>& v) {
+    put<std::uint64_t>(v.size());
+    data_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+  std::string take() { return std::move(data_); }
+
+ private:
+  std::string data_;
+};
+
+class BytesReader {
+ public:
+  explicit BytesReader(const std::string& data) : data_(data) {}
+  bool done() const { return at_ == data_.size(); }
+  template <typename T>
+  T get() {
+    T v{};
+    need(sizeof v);
+    std::memcpy(&v, data_.data() + at_, sizeof v);
+    at_ += sizeof v;
+    return v;
+  }
+  template <typename T>
+  std::vector<T> get_vector() {
+    const auto n = get<std::uint64_t>();
+    if (n > (data_.size() - at_) / sizeof(T)) throw RobotError("isolated read: truncated result from the child");
+    std::vector<T> v(n);
+    if (n > 0) std::memcpy(v.data(), data_.data() + at_, n * sizeof(T));
+    at_ += n * sizeof(T);
+    return v;
+  }
+
+ private:
+  void need(std::size_t n) const {
+    if (data_.size() - at_ < n) throw RobotError("isolated read: truncated result from the child");
+  }
+  const std::string& data_;
+  std::size_t at_ = 0;
+};
+
+}  // namespace projbot::robot::detail
