@@ -515,7 +515,7 @@ INSTANTIATE_TEST_SUITE_P(
                "slam --rawlog " + kRawlog + " --config {dir}/bad.yaml --out-map {dir}/m --out-trajectory {dir}/t.txt",
                "a: 1\n",
                1,
-               {"bad.yaml", "[MappingApplication]"}},
+               {"bad.yaml:1:", "expected 'key = value'"}},
         BadRun{"localize_missing_map",
                "localize --map {dir}/nomap --rawlog " + kRawlog + " --out-trajectory {dir}/t.txt",
                "",

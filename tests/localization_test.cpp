@@ -10,6 +10,7 @@
 #include <iostream>
 #include <limits>
 #include <numbers>
+#include <tuple>
 
 #include "projbot/robot/sim_tour.hpp"
 
@@ -210,6 +211,47 @@ TEST(IcpSlam, RealDatasetClosesItsLoop) {
   }
   EXPECT_GE(accepted, static_cast<int>(steps.size() * 95 / 100));
   EXPECT_LT(worst, 0.5);
+  fs::remove_all(dir);
+}
+
+// Every value of the icp-slam .ini is read strictly: MRPT itself reads "abc" as 0. The error names the
+// file, the line and the key; a misspelt [ICP] key is a warning.
+TEST(IcpSlam, ConfigValuesAreParsedStrictly) {
+  const fs::path dir = temp_dir("strictini");
+  std::ifstream in(kData / "icp-slam_demo_classic.ini");
+  const std::string good((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_TRUE(check_icp_slam_config(kData / "icp-slam_demo_classic.ini").empty());
+  EXPECT_TRUE(check_icp_slam_config(kData / "icp-slam_demo_LM.ini").empty());
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases{
+      {"maxIterations    = 80", "maxIterations = abc", ":13: [ICP] maxIterations = 'abc' is not a whole number"},
+      {"maxIterations    = 80", "maxIterations = 8.5", "maxIterations = '8.5' is not a whole number"},
+      {"thresholdDist    = 0.3", "thresholdDist = 0.3x", "[ICP] thresholdDist = '0.3x' is not a finite number"},
+      {"thresholdDist    = 0.3", "thresholdDist = inf", "thresholdDist = 'inf' is not a finite number"},
+      {"ICP_algorithm = icpClassic", "ICP_algorithm = icpFast", "'icpFast' is not one of icpClassic, icpLevenbergMarquardt"},
+      {"matchAgainstTheGrid = 0", "matchAgainstTheGrid = maybe", "[MappingApplication] matchAgainstTheGrid = 'maybe'"},
+      {"insertionLinDistance\t= 1.2", "insertionLinDistance = ", "insertionLinDistance = '' is not a finite number"},
+      {"ALFA             = 0.8", "ALFA 0.8", "expected 'key = value' or '[section]', not 'ALFA 0.8'"},
+      {"\n[ICP]\n", "\n[ICP\n", "a section is '[name]'"}};
+  for (const auto& [from, to, message] : cases) {
+    std::string text = good;
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    std::ofstream(dir / "bad.ini") << text;
+    try {
+      check_icp_slam_config(dir / "bad.ini");
+      ADD_FAILURE() << to << " was accepted";
+    } catch (const RobotError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.ini:"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+  std::string misspelt = good;
+  misspelt.replace(misspelt.find("maxIterations    = 80"), 21, "maxIteratons = 80");
+  std::ofstream(dir / "typo.ini") << misspelt;
+  const auto warnings = check_icp_slam_config(dir / "typo.ini");
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("typo.ini:13: [ICP] maxIteratons: not a setting of MRPT's ICP"), std::string::npos) << warnings[0];
   fs::remove_all(dir);
 }
 

@@ -28,6 +28,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "icp_slam_ini.hpp"
 #include "isolated_read.hpp"
 #include "mrpt_convert.hpp"
 #include "projbot/config/output_file.hpp"
@@ -37,38 +38,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-// MRPT's icp-slam_demo_classic.ini, the settings its demo uses for a 2-D laser in a building.
-constexpr const char* kDefaultIcpSlamIni = R"ini(
-[MappingApplication]
-localizationLinDistance = 0.2
-localizationAngDistance = 5
-insertionLinDistance = 1.2
-insertionAngDistance = 45.0
-minICPgoodnessToAccept = 0.40
-matchAgainstTheGrid = 0
-occupancyGrid_count = 0
-gasGrid_count = 0
-beaconMap_count = 0
-pointsMap_count = 1
-likelihoodMapSelection = -1
-[MappingApplication_pointsMap_00_insertOpts]
-minDistBetweenLaserPoints = 0.05
-fuseWithExisting = false
-isPlanarMap = 1
-[ICP]
-maxIterations = 80
-minAbsStep_trans = 1e-6
-minAbsStep_rot = 1e-6
-thresholdDist = 0.3
-thresholdAng_DEG = 5
-ALFA = 0.8
-smallestThresholdDist = 0.05
-onlyClosestCorrespondences = true
-onlyUniqueRobust = true
-ICP_algorithm = icpClassic
-corresponding_points_decimation = 5
-)ini";
 
 mrpt::obs::CActionCollection::Ptr odometry_action(const Pose2D& increment, double timestamp_s) {
   mrpt::obs::CActionRobotMovement2D move;
@@ -305,14 +274,12 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
   builder.setVerbosityLevel(mrpt::system::LVL_ERROR);
   try {
     if (ini) {
-      if (!std::filesystem::is_regular_file(*ini)) throw RobotError(ini->string() + ": no such icp-slam config");
+      check_icp_slam_config(*ini);
       mrpt::config::CConfigFile file(ini->string());
-      if (!file.sectionExists("MappingApplication") || !file.sectionExists("ICP"))
-        throw RobotError(ini->string() + ": an icp-slam config needs [MappingApplication] and [ICP] sections");
       builder.ICP_options.loadFromConfigFile(file, "MappingApplication");
       builder.ICP_params.loadFromConfigFile(file, "ICP");
     } else {
-      mrpt::config::CConfigFileMemory file(kDefaultIcpSlamIni);
+      mrpt::config::CConfigFileMemory file(detail::kDefaultIcpSlamIni);
       builder.ICP_options.loadFromConfigFile(file, "MappingApplication");
       builder.ICP_params.loadFromConfigFile(file, "ICP");
     }

@@ -90,10 +90,12 @@ const Command kSlam{
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
       args.check_output_files({"out-trajectory"});
       args.check_output_folders({"out-map"});
-      catch_interrupts();  // Ctrl-C: map and write the scans done so far, then exit 130
-      const auto steps = robot::read_rawlog(*args.get("rawlog"));
       std::optional<fs::path> ini;
       if (const auto c = args.get("config")) ini = *c;
+      if (ini)
+        for (const auto& warning : robot::check_icp_slam_config(*ini)) std::cerr << "projbot slam: warning: " << warning << '\n';
+      catch_interrupts();  // Ctrl-C: map and write the scans done so far, then exit 130
+      const auto steps = robot::read_rawlog(*args.get("rawlog"));
       const robot::SlamResult r = robot::build_map(steps, ini, *args.get("out-map"), [] { return interrupted(); });
       robot::write_trajectory(*args.get("out-trajectory"), r.trajectory);
       if (r.interrupted) {

@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "projbot/robot/laser.hpp"
@@ -41,6 +42,12 @@ struct SlamResult {
   double seconds = 0.0;                     ///< wall time of the run
   bool interrupted = false;                 ///< stopped early: the map and trajectory of the steps done
 };
+
+/// Checks an icp-slam configuration strictly, before any work: every line a section, a comment or
+/// `key = value`; every value of a key MRPT knows of the kind MRPT reads (whole number, number,
+/// true/false, one of its names); [MappingApplication] and [ICP] present. Throws RobotError naming the
+/// file, line and key; returns a warning per [ICP] key that MRPT does not know (a misspelling?).
+std::vector<std::string> check_icp_slam_config(const std::filesystem::path& ini);
 
 /// Builds the map with mrpt::slam::CMetricMapBuilderICP from rawlog steps. `ini` is an icp-slam
 /// configuration ([MappingApplication] and [ICP] sections, as MRPT's icp-slam app reads);
