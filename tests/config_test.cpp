@@ -1,9 +1,15 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <chrono>
 #include <cmath>
+#include <csignal>
+#include <fstream>
+#include <functional>
 #include <numbers>
 
+#include "projbot/config/isolated_read.hpp"
 #include "projbot/config/scene.hpp"
 
 using projbot::config::ConfigError;
@@ -214,4 +220,50 @@ TEST(NumberListTest, ParsesAndRejects) {
   EXPECT_THROW(projbot::config::parse_number_list("1,two,3", 3, "--x"), ConfigError);
   EXPECT_THROW(projbot::config::parse_number_list("1,nan,3", 3, "--x"), ConfigError);
   EXPECT_THROW(projbot::config::parse_number_list("", 1, "--x"), ConfigError);
+}
+
+// The isolated reader: what the child returns comes back; its exception, its crash, its running out of
+// memory and its taking too long each become one error naming the file; the parent lives on.
+TEST(IsolatedRead, EveryWayTheChildEndsIsNamed) {
+  using namespace projbot::config;
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "projbot_isolated.bin";
+  std::ofstream(file) << "data";
+  const IsolatedReader what{"test file", "the test reader", std::chrono::milliseconds(300)};
+  const auto message = [&](const std::function<std::string(ReadProgress&)>& read) {
+    try {
+      read_isolated(file, what, read);
+    } catch (const IsolatedReadError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  Bytes out;
+  out.put<double>(2.5);
+  out.put_vector(std::vector<float>{1.f, 2.f, 3.f});
+  const std::string bytes = read_isolated(file, what, [&](ReadProgress&) { return out.take(); });
+  BytesReader in(bytes);
+  EXPECT_EQ(in.get<double>(), 2.5);
+  EXPECT_EQ(in.get_vector<float>(), (std::vector<float>{1.f, 2.f, 3.f}));
+  EXPECT_TRUE(in.done());
+  EXPECT_THROW(in.get<int>(), IsolatedReadError);
+
+  EXPECT_EQ(message([](ReadProgress&) -> std::string { throw std::runtime_error("f: bad field 3"); }), "f: bad field 3");
+  const std::string crash = message([](ReadProgress& p) -> std::string {
+    p.objects = 4;
+    p.offset = 96;
+    std::raise(SIGSEGV);
+    return "";
+  });
+  EXPECT_NE(crash.find("projbot_isolated.bin: corrupt test file: the test reader crashed on it (signal 11"), std::string::npos)
+      << crash;
+  EXPECT_NE(crash.find("after 4 objects, at byte 96)"), std::string::npos) << crash;
+  const std::string oom = message([](ReadProgress&) -> std::string { throw std::bad_alloc(); });
+  EXPECT_NE(oom.find("projbot_isolated.bin: out of memory reading it (a corrupt test file?)"), std::string::npos) << oom;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string slow = message([](ReadProgress&) -> std::string {
+    for (;;) ::pause();
+  });
+  EXPECT_NE(slow.find("projbot_isolated.bin: the test reader took longer than 0.30 s on it"), std::string::npos) << slow;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  std::filesystem::remove(file);
 }

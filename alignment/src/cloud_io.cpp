@@ -10,8 +10,46 @@
 #include "file_kind.hpp"
 #include "pcd_header.hpp"
 #include "projbot/alignment/depth.hpp"
+#include "projbot/config/isolated_read.hpp"
 
 namespace projbot::alignment {
+namespace {
+
+// PCL's PLY parser asserts (abort) on a face list that names a missing vertex, and we read only the
+// vertices: it runs in a child process, whose cloud comes back as width, height and x y z floats.
+int load_ply_isolated(const std::filesystem::path& path, pcl::PointCloud<pcl::PointXYZ>& cloud) {
+  std::string bytes;
+  try {
+    bytes = config::read_isolated(path, {"PLY file", "PCL's PLY reader"}, [&](config::ReadProgress&) {
+      pcl::PointCloud<pcl::PointXYZ> read;
+      config::Bytes out;
+      out.put<std::int32_t>(pcl::io::loadPLYFile(path.string(), read));
+      out.put<std::uint32_t>(read.width);
+      out.put<std::uint32_t>(read.height);
+      std::vector<float> xyz;
+      xyz.reserve(3 * read.size());
+      for (const auto& p : read) xyz.insert(xyz.end(), {p.x, p.y, p.z});
+      out.put_vector(xyz);
+      return out.take();
+    });
+    config::BytesReader in(bytes);
+    const auto rc = in.get<std::int32_t>();
+    const auto width = in.get<std::uint32_t>();
+    const auto height = in.get<std::uint32_t>();
+    const auto xyz = in.get_vector<float>();
+    cloud.clear();
+    for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) cloud.push_back({xyz[i], xyz[i + 1], xyz[i + 2]});
+    if (static_cast<std::size_t>(width) * height == cloud.size()) {
+      cloud.width = width;
+      cloud.height = height;
+    }
+    return rc;
+  } catch (const config::IsolatedReadError& e) {
+    throw AlignmentError(e.what());
+  }
+}
+
+}  // namespace
 
 PointCloud read_cloud(const std::filesystem::path& path) {
   std::error_code ec;
@@ -30,7 +68,7 @@ PointCloud read_cloud(const std::filesystem::path& path) {
         throw AlignmentError(path.string() + ": read " + std::to_string(cloud.size()) + " points, the header claims " +
                              std::to_string(header.points) + " (malformed data section?)");
     } else if (ext == ".ply") {
-      rc = pcl::io::loadPLYFile(path.string(), cloud);
+      rc = load_ply_isolated(path, cloud);
     } else {
       throw AlignmentError(path.string() + ": unknown point cloud format (use .pcd or .ply)");
     }
@@ -38,6 +76,10 @@ PointCloud read_cloud(const std::filesystem::path& path) {
     throw AlignmentError(path.string() + ": cannot read point cloud: " + e.what());
   } catch (const std::bad_alloc&) {
     throw AlignmentError(path.string() + ": out of memory reading the point cloud");
+  } catch (const AlignmentError&) {
+    throw;
+  } catch (const std::exception& e) {  // PCL's header parser lets std::stoi's and boost's exceptions out
+    throw AlignmentError(path.string() + ": malformed " + ext.substr(1) + " file (PCL's reader failed on it: " + e.what() + ")");
   }
   if (rc < 0) throw AlignmentError(path.string() + ": cannot read point cloud (malformed " + ext.substr(1) + " file?)");
   if (cloud.empty()) throw AlignmentError(path.string() + ": the point cloud holds no points (malformed or empty file?)");

@@ -25,6 +25,8 @@
 #pragma GCC diagnostic pop
 #endif
 
+#include <cstdint>
+#include <fstream>
 #include <memory>
 
 #include "projbot/config/output_file.hpp"
@@ -54,8 +56,50 @@ void write_png(const std::filesystem::path& path, const Image& image) {
   }
 }
 
+namespace {
+
+// stb allocates what the header claims before it inflates a byte. Deflate packs at most 1032 bytes into
+// one, so a header that claims more than that from this file's size is corrupt: refused before stb
+// allocates it (a 100-byte PNG claiming 20000x20000 pixels once took 550 MB).
+void check_claimed_size(const std::filesystem::path& path, int w, int h, int bytes_per_pixel) {
+  std::error_code ec;
+  const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
+  const double pixels = static_cast<double>(w) * h;
+  if (!ec && (pixels > 1e8 || pixels * bytes_per_pixel > 1032.0 * file_bytes + 65536.0))
+    throw AssetError(path.string() + ": the header claims " + std::to_string(w) + "x" + std::to_string(h) +
+                     " pixels, more than a " + std::to_string(static_cast<long long>(file_bytes)) +
+                     "-byte image file can hold (corrupt header)");
+}
+
+// stb allocates what a PNG chunk's length claims before reading it (a 73-byte file claiming a 553 MB
+// IDAT): every chunk must fit in the file. Files that are not PNG are left to stb.
+void check_png_chunks(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char sig[8] = {};
+  if (!in.read(reinterpret_cast<char*>(sig), 8) || sig[0] != 0x89 || sig[1] != 'P' || sig[2] != 'N' || sig[3] != 'G') return;
+  std::error_code ec;
+  const std::uint64_t size = std::filesystem::file_size(path, ec);
+  for (std::uint64_t at = 8; !ec && at < size;) {
+    unsigned char head[8] = {};
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(head), 8))
+      throw AssetError(path.string() + ": corrupt PNG: the file ends inside a chunk header at byte " + std::to_string(at));
+    const std::uint64_t length = (std::uint64_t{head[0]} << 24) | (head[1] << 16) | (head[2] << 8) | head[3];
+    if (at + 12 + length > size)
+      throw AssetError(path.string() + ": corrupt PNG: the " + std::string(reinterpret_cast<char*>(head) + 4, 4) +
+                       " chunk at byte " + std::to_string(at) + " claims " + std::to_string(length) +
+                       " bytes, more than the file holds (truncated?)");
+    at += 12 + length;
+  }
+}
+
+}  // namespace
+
 Image read_image(const std::filesystem::path& path) {
   int w = 0, h = 0, comps = 0;
+  check_png_chunks(path);
+  if (!stbi_info(path.c_str(), &w, &h, &comps)) throw AssetError(path.string() + ": cannot read image: " + stbi_failure_reason());
+  check_claimed_size(path, w, h, 4);
   unsigned char* data = stbi_load(path.c_str(), &w, &h, &comps, 4);
   if (data == nullptr) throw AssetError(path.string() + ": cannot read image: " + stbi_failure_reason());
   Image img;
@@ -68,11 +112,13 @@ Image read_image(const std::filesystem::path& path) {
 
 Gray16Image read_png_gray16(const std::filesystem::path& path) {
   int w = 0, h = 0, comps = 0;
+  check_png_chunks(path);
   if (!stbi_info(path.c_str(), &w, &h, &comps)) throw AssetError(path.string() + ": cannot read PNG: " + stbi_failure_reason());
   const bool sixteen = stbi_is_16_bit(path.c_str()) != 0;
   if (!sixteen || comps != 1)
     throw AssetError(path.string() + ": a depth PNG must be 16-bit single-channel (this one has " + std::to_string(comps) +
                      " channel(s), " + (sixteen ? "16" : "8") + " bits)");
+  check_claimed_size(path, w, h, 2);
   std::unique_ptr<stbi_us, void (*)(void*)> data(stbi_load_16(path.c_str(), &w, &h, &comps, 1), stbi_image_free);
   if (!data)
     throw AssetError(path.string() + ": cannot decode PNG (truncated or corrupt; stb says: " + stbi_failure_reason() + ")");

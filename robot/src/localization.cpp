@@ -29,8 +29,8 @@
 #include <sstream>
 
 #include "icp_slam_ini.hpp"
-#include "isolated_read.hpp"
 #include "mrpt_convert.hpp"
+#include "projbot/config/isolated_read.hpp"
 #include "projbot/config/output_file.hpp"
 
 namespace projbot::robot {
@@ -106,7 +106,7 @@ bool is_gzip(const std::filesystem::path& path) {
 
 // MRPT's reader, object by object (not CRawlog's pair reader, which drops a sensory frame that comes
 // before the first action) until the end of the file. Runs in the isolated child.
-std::vector<RawlogStep> read_rawlog_objects(const std::filesystem::path& path, detail::ReadProgress& progress) {
+std::vector<RawlogStep> read_rawlog_objects(const std::filesystem::path& path, config::ReadProgress& progress) {
   std::vector<RawlogStep> steps;
   const bool gzip = is_gzip(path);
   mrpt::io::CFileGZInputStream in(path.string());
@@ -146,7 +146,7 @@ std::vector<RawlogStep> read_rawlog_objects(const std::filesystem::path& path, d
   return steps;
 }
 
-void put_scan(detail::Bytes& out, const LaserScan& s) {
+void put_scan(config::Bytes& out, const LaserScan& s) {
   out.put(s.timestamp_s);
   out.put(s.sensor_on_base);
   out.put(s.aperture_rad);
@@ -155,7 +155,7 @@ void put_scan(detail::Bytes& out, const LaserScan& s) {
   out.put_vector(s.valid);
 }
 
-LaserScan get_scan(detail::BytesReader& in) {
+LaserScan get_scan(config::BytesReader& in) {
   LaserScan s;
   s.timestamp_s = in.get<double>();
   s.sensor_on_base = in.get<Pose2D>();
@@ -165,6 +165,16 @@ LaserScan get_scan(detail::BytesReader& in) {
   s.valid = in.get_vector<std::uint8_t>();
   if (s.valid.size() != s.ranges_m.size()) throw RobotError("isolated read: scan with mismatched sizes");
   return s;
+}
+
+// config::read_isolated, its errors as the robot module's.
+std::string read_isolated(const std::filesystem::path& file, const config::IsolatedReader& what,
+                          const std::function<std::string(config::ReadProgress&)>& read) {
+  try {
+    return config::read_isolated(file, what, read);
+  } catch (const config::IsolatedReadError& e) {
+    throw RobotError(e.what());
+  }
 }
 
 // What a laser and odometry can report; a step outside it is corruption, named by its number.
@@ -195,8 +205,8 @@ void check_step(const std::filesystem::path& path, std::size_t index, const Rawl
 std::vector<RawlogStep> read_rawlog(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path)) throw RobotError(path.string() + ": no such rawlog file");
   // MRPT's deserialiser crashes on corrupt archives (flipped bits): it reads in a child process.
-  const std::string bytes = detail::read_isolated(path, "MRPT rawlog", [&](detail::ReadProgress& progress) {
-    detail::Bytes out;
+  const std::string bytes = read_isolated(path, {"MRPT rawlog", "MRPT's reader"}, [&](config::ReadProgress& progress) {
+    config::Bytes out;
     try {
       for (const RawlogStep& step : read_rawlog_objects(path, progress)) {
         out.put(step.timestamp_s);
@@ -212,7 +222,7 @@ std::vector<RawlogStep> read_rawlog(const std::filesystem::path& path) {
     return out.take();
   });
   std::vector<RawlogStep> steps;
-  detail::BytesReader in(bytes);
+  config::BytesReader in(bytes);
   while (!in.done()) {
     RawlogStep step;
     step.timestamp_s = in.get<double>();
@@ -358,7 +368,7 @@ Localizer Localizer::load(const std::filesystem::path& map_dir, const LocalizerC
   if (!std::filesystem::is_regular_file(file)) throw RobotError(file.string() + ": no such map (run projbot slam first)");
   // MRPT's deserialiser crashes on corrupt archives: the child reads the keyframes and builds the
   // points map; its points come back.
-  const std::string bytes = detail::read_isolated(file, "MRPT simplemap", [&](detail::ReadProgress&) {
+  const std::string bytes = read_isolated(file, {"MRPT simplemap", "MRPT's reader"}, [&](config::ReadProgress&) {
     mrpt::maps::CSimpleMap keyframes;
     bool ok = false;
     try {
@@ -378,11 +388,11 @@ Localizer Localizer::load(const std::filesystem::path& map_dir, const LocalizerC
       built.map.getPoint(i, x, y, z);
       xyz.insert(xyz.end(), {x, y, z});
     }
-    detail::Bytes out;
+    config::Bytes out;
     out.put_vector(xyz);
     return out.take();
   });
-  detail::BytesReader in(bytes);
+  config::BytesReader in(bytes);
   const auto xyz = in.get_vector<float>();
   auto impl = std::make_unique<Impl>(config);
   impl->map.reserve(xyz.size() / 3);

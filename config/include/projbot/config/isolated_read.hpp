@@ -1,19 +1,20 @@
 #pragma once
-// Reading files whose third-party reader is not safe on corrupt input (MRPT's deserialisers follow
-// lengths and class tags they never check, and die with SIGSEGV on a few flipped bits), in a child
-// process: a crash there is an error message here. Not for use while other threads run (fork).
+// Reading files whose third-party reader is not safe on corrupt input, in a child process: a crash there
+// is an error message here. MRPT's deserialisers follow lengths and class tags they never check and die
+// with SIGSEGV on a few flipped bits; PCL's PLY reader asserts (abort) on a bad face list. Not for use
+// while other threads run (fork).
 
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
 
-#include "projbot/robot/error.hpp"
-
-namespace projbot::robot::detail {
+namespace projbot::config {
 
 /// How far the child's reader had got, kept in memory shared with the parent: a crash names it.
 struct ReadProgress {
@@ -21,11 +22,26 @@ struct ReadProgress {
   std::uint64_t offset = UINT64_MAX;  ///< the file's byte where the next object starts, where known
 };
 
+/// A file the isolated reader could not read; the message names it. Callers pass it on as their own
+/// module's error type.
+class IsolatedReadError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// What is read, for messages: "MRPT rawlog" read by "MRPT's reader".
+struct IsolatedReader {
+  std::string kind;
+  std::string reader;
+  std::chrono::milliseconds time_limit{0};  ///< 0: 5 s plus 10 s per MB of the file
+};
+
 /// Runs `read` in a forked child and returns the bytes it produced. An exception in `read` comes back
-/// as a RobotError with the same message; a child that dies (signal, out of its memory limit) is a
-/// RobotError naming `file`, `kind` and the progress. The child's address space is capped at what it
-/// has plus 1 GiB plus 64 bytes per byte of `file` (not under AddressSanitizer, which reserves more).
-std::string read_isolated(const std::filesystem::path& file, const std::string& kind,
+/// as an IsolatedReadError with the same message; a child that dies (signal, out of its memory limit)
+/// or takes longer than its time limit is killed and named with `file`, `what` and the
+/// progress. The child's address space is capped at what it has plus 1 GiB plus 64 bytes per byte of
+/// `file` (not under AddressSanitizer, which reserves more; the time limit holds there too).
+std::string read_isolated(const std::filesystem::path& file, const IsolatedReader& what,
                           const std::function<std::string(ReadProgress&)>& read);
 
 /// Plain values and vectors of them, appended to and taken from a byte string in host order (the bytes
@@ -63,7 +79,7 @@ class BytesReader {
   template <typename T>
   std::vector<T> get_vector() {
     const auto n = get<std::uint64_t>();
-    if (n > (data_.size() - at_) / sizeof(T)) throw RobotError("isolated read: truncated result from the child");
+    if (n > (data_.size() - at_) / sizeof(T)) throw IsolatedReadError("isolated read: truncated result from the child");
     std::vector<T> v(n);
     if (n > 0) std::memcpy(v.data(), data_.data() + at_, n * sizeof(T));
     at_ += n * sizeof(T);
@@ -72,10 +88,10 @@ class BytesReader {
 
  private:
   void need(std::size_t n) const {
-    if (data_.size() - at_ < n) throw RobotError("isolated read: truncated result from the child");
+    if (data_.size() - at_ < n) throw IsolatedReadError("isolated read: truncated result from the child");
   }
   const std::string& data_;
   std::size_t at_ = 0;
 };
 
-}  // namespace projbot::robot::detail
+}  // namespace projbot::config
