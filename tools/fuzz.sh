@@ -1,12 +1,48 @@
 #!/usr/bin/env bash
-# Fuzzes the glTF loader with libFuzzer (clang) for SECONDS (default 60), seeded with the shared models.
+# Fuzzes one reader of user files with libFuzzer (clang + AddressSanitizer):
+#   tools/fuzz.sh TARGET [SECONDS]     TARGET: gltf scene pcd ply depth_png depth_tiff rawlog ini, or all
+# Seeds: tests/fuzz/corpus/TARGET (committed) plus, for gltf, the shared models. The growing corpus is
+# build/fuzz/corpus/TARGET; a finding (crash, ASan report, allocation over 512 MB, 10 s on one input) is
+# saved under build/fuzz/findings/TARGET/ and the script exits 1: make it a regression test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds=${1:-60}
+targets=(gltf scene pcd ply depth_png depth_tiff rawlog ini)
+usage() { echo "usage: tools/fuzz.sh TARGET [SECONDS]   (TARGET: ${targets[*]} or all; SECONDS default 60)"; exit 2; }
+[[ $# -ge 1 ]] || usage
+target=$1
+seconds=${2:-60}
+[[ $seconds =~ ^[0-9]+$ && $seconds -gt 0 ]] || { echo "fuzz: SECONDS must be a whole number > 0, not '$seconds'"; exit 2; }
+if [[ $target == all ]]; then
+  for t in "${targets[@]}"; do bash "$0" "$t" "$seconds"; done
+  exit 0
+fi
+[[ " ${targets[*]} " == *" $target "* ]] || { echo "fuzz: unknown target '$target'"; usage; }
 command -v clang++ >/dev/null || { echo "fuzz: needs clang (apt-get install clang)"; exit 1; }
+export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
 cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz --target fuzz_gltf
-corpus=build/fuzz/corpus
-mkdir -p "$corpus"
-find ../shared/data/gltf -name '*.gl*' -exec cp -n {} "$corpus/" \; 2>/dev/null || true
-./build/fuzz/tests/fuzz/fuzz_gltf -max_total_time="$seconds" -max_len=200000 -rss_limit_mb=4096 "$corpus"
+cmake --build --preset fuzz --target "fuzz_$target" | grep -v '^\[' || true
+[[ -x build/fuzz/tests/fuzz/fuzz_$target ]] || { echo "fuzz: fuzz_$target did not build"; exit 1; }
+
+corpus=build/fuzz/corpus/$target
+findings=build/fuzz/findings/$target
+mkdir -p "$corpus" "$findings"
+cp -n tests/fuzz/corpus/"$target"/* "$corpus"/
+if [[ $target == gltf ]]; then find ../shared/data/gltf -name '*.gl*' -size -300k -exec cp -n {} "$corpus/" \; 2>/dev/null || true; fi
+# Readers must refuse what would need more than 512 MB for one allocation (a length field's claim). The
+# rawlog reader's MRPT child is capped like the release build's address-space limit: ASan fails an
+# allocation over 1 GB with bad_alloc, which the child reports as an error.
+export ASAN_OPTIONS="allocator_may_return_null=1:max_allocation_size_mb=1024:detect_leaks=0:${ASAN_OPTIONS:-}"
+malloc_limit=512
+[[ $target == rawlog ]] && malloc_limit=2048
+log=build/fuzz/$target.log
+set +e
+"./build/fuzz/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=3072 \
+  -malloc_limit_mb=$malloc_limit -artifact_prefix="$findings/" -print_final_stats=1 "$corpus" >"$log" 2>&1
+status=$?
+set -e
+runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1 || echo 0)
+echo "fuzz $target: $runs inputs in $seconds s ($((runs / seconds)) per second), corpus $(ls "$corpus" | wc -l) files, exit $status (log: $log)"
+if [[ $status -ne 0 ]]; then
+  grep -E 'ERROR|SUMMARY|Test unit written' "$log" | head -5
+  exit 1
+fi
