@@ -4,6 +4,7 @@
 #include <poll.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,6 +14,9 @@
 #include <cstdio>
 #include <fstream>
 #include <new>
+
+// A fuzzer's or sanitizer's report-and-exit hook, present only in such builds.
+extern "C" __attribute__((weak)) void __sanitizer_set_death_callback(void (*callback)());
 
 namespace projbot::config {
 namespace {
@@ -72,13 +76,26 @@ void limit_memory(const std::filesystem::path& file) {
   ::setrlimit(RLIMIT_AS, &r);
 }
 
+// The default action for `sig`, set with the system call itself: a sanitizer's sigaction interceptor may
+// keep its own handler in place.
+void default_action(int sig) {
+  struct {
+    void (*handler)(int);
+    unsigned long flags;
+    void (*restorer)();
+    unsigned long mask;
+  } action{SIG_DFL, 0, nullptr, 0};
+  ::syscall(SYS_rt_sigaction, sig, &action, nullptr, sizeof(unsigned long));
+}
+
 // Child: 'R' + result, or 'E' + the message of what it threw; then _exit (no atexit handlers, no
 // flushing of the parent's buffered output a second time).
 [[noreturn]] void run_child(int fd, const std::filesystem::path& file, ReadProgress& progress,
                             const std::function<std::string(ReadProgress&)>& read) {
   // A fault here ends this child plainly, for the parent to report: not through a crash handler
   // inherited from the parent (a sanitizer's or a fuzzer's would report it as the parent's own).
-  for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
+  for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) default_action(sig);
+  if (&__sanitizer_set_death_callback != nullptr) __sanitizer_set_death_callback(nullptr);
   // The reader's own complaints (PCL's failed assertion, MRPT's banner) would only confuse: the parent
   // says what happened, naming the file.
   if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) {
@@ -139,7 +156,7 @@ std::string read_isolated(const std::filesystem::path& file, const IsolatedReade
   const auto size = std::filesystem::file_size(file, ec);
   const std::chrono::milliseconds limit = what.time_limit.count() > 0
                                               ? what.time_limit
-                                              : std::chrono::milliseconds(5000 + (ec ? 0 : static_cast<long long>(size / 100)));
+                                              : std::chrono::milliseconds(1000 + (ec ? 0 : static_cast<long long>(size / 200)));
   std::fflush(nullptr);
   const pid_t pid = ::fork();
   if (pid == 0) {

@@ -66,14 +66,28 @@ void write_file_atomically(const std::filesystem::path& path, const void* data, 
   }
 }
 
+void check_folder_writable(const std::filesystem::path& folder) {
+  // access(W_OK) says yes to root everywhere, /proc included: only creating a file there tells.
+  const std::filesystem::path probe = folder / (".projbot-probe-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) throw OutputError("the folder " + folder.string() + " is not writable (" + reason(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
 void check_writable(const std::filesystem::path& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw OutputError(path.string() + ": is a folder, not a file to write");
+  // A device or FIFO (/dev/stdout) is written in place, not beside.
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) return;
   const std::filesystem::path folder = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
   if (!std::filesystem::is_directory(folder, ec))
     throw OutputError(path.string() + ": the folder " + folder.string() + " does not exist");
-  if (::access(folder.c_str(), W_OK) != 0)
-    throw OutputError(path.string() + ": the folder " + folder.string() + " is not writable");
+  try {
+    check_folder_writable(folder);
+  } catch (const OutputError& e) {
+    throw OutputError(path.string() + ": " + e.what());
+  }
 }
 
 }  // namespace projbot::config

@@ -25,5 +25,7 @@ inline void write_file_atomically(const std::filesystem::path& path, std::string
 /// Checks before long work that `path` can be written later: its folder exists and is writable, and it
 /// is not a folder itself. Throws OutputError naming the file and what is wrong.
 void check_writable(const std::filesystem::path& path);
+/// Checks that files can be created in `folder` (by creating and removing one). Throws OutputError.
+void check_folder_writable(const std::filesystem::path& folder);
 
 }  // namespace projbot::config
