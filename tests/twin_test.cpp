@@ -147,9 +147,10 @@ TEST(TwinSceneTest, BadToursAreNamed) {
   EXPECT_FALSE(demo_with("    scale: 0.3\n", "    scale: 0.3\n    present: false\n").targets[1].present);
   // Where the robot can stand, and what a target needs.
   EXPECT_NE(config_error("stop: [3.0, 1.8, 90]", "stop: [9.0, 1.8, 90]")
-                .find("targets[0].stop: the robot's stop lies outside the room"),
+                .find("targets[0].stop: the robot's stop for 'duck' lies outside the room"),
             std::string::npos);
-  EXPECT_NE(config_error("stop: [3.0, 1.8, 90]", "stop: [0.3, 3.0, 90]").find("the robot's stop lies inside room.obstacles[2]"),
+  EXPECT_NE(config_error("stop: [3.0, 1.8, 90]", "stop: [0.3, 3.0, 90]")
+                .find("the robot's stop for 'duck' lies inside room.obstacles[2]"),
             std::string::npos);
   EXPECT_NE(config_error("start: [1.0, 1.0, 0]", "start: [7.0, 0.5, 0]")
                 .find("robot.start: the robot's start lies inside room.obstacles[1]"),

@@ -126,9 +126,15 @@ ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std:
 }
 
 // Where the robot can stand: inside the room and outside every obstacle. Empty when it can.
+std::string metres(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
 std::string place_problem(const RoomSpec& room, double x, double y) {
   if (!(x > 0.0 && x < room.width_m && y > 0.0 && y < room.depth_m))
-    return "lies outside the room (0.." + std::to_string(room.width_m) + " x 0.." + std::to_string(room.depth_m) + " m)";
+    return "lies outside the room (0.." + metres(room.width_m) + " x 0.." + metres(room.depth_m) + " m)";
   for (std::size_t i = 0; i < room.obstacles.size(); ++i) {
     const auto& o = room.obstacles[i];
     if (x >= o[0] && x <= o[2] && y >= o[1] && y <= o[3]) return "lies inside room.obstacles[" + std::to_string(i) + "]";
@@ -293,7 +299,7 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
       target.stop = t.vector3(st, path + ".stop");
       target.stop->z() *= std::numbers::pi / 180.0;
       if (const std::string why = place_problem(scene.room, target.stop->x(), target.stop->y()); !why.empty())
-        t.fail(st, path + ".stop", "the robot's stop " + why);
+        t.fail(st, path + ".stop", "the robot's stop for '" + target.name + "' " + why);
     }
     if (YAML::Node mk = t.child("markers", false)) {
       if (!mk.IsSequence() || mk.size() == 0) t.fail(mk, path + ".markers", "expected a non-empty list of [x, y, z]");

@@ -94,10 +94,10 @@ StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
   return r;
 }
 
-std::vector<StopReport> run_sim_tour(const SimTourConfig& c) {
+std::vector<StopReport> run_sim_tour(const SimTourConfig& c, const std::function<bool()>& stop_requested) {
   SimRobot robot(c);
   std::vector<StopReport> reports;
-  for (int i = 0; i < c.stop_count && !c.stops.empty(); ++i)
+  for (int i = 0; i < c.stop_count && !c.stops.empty() && !(stop_requested && stop_requested()); ++i)
     reports.push_back(robot.drive_to(c.stops[static_cast<std::size_t>(i) % c.stops.size()], i));
   return reports;
 }

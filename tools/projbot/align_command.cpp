@@ -41,6 +41,17 @@ alignment::PointCloud load_scan(const cli::Args& args) {
   } else {
     std::cerr << "projbot align: no --intrinsics, using the Kinect v1 defaults (fx = fy = 525, cx = 319.5, cy = 239.5)\n";
   }
+  // Intrinsics belong to one image size: a depth image of another size would back-project to a wrong,
+  // plausible-looking cloud.
+  const std::string size = std::to_string(depth.width) + "x" + std::to_string(depth.height);
+  if (!args.get("intrinsics") && (depth.width != 640 || depth.height != 480))
+    throw alignment::AlignmentError(scan.string() + ": the depth image is " + size +
+                                    " pixels, the Kinect v1 default intrinsics are for 640x480: give --intrinsics "
+                                    "fx,fy,cx,cy of the camera that took it");
+  if (!(k.cx_px > 0 && k.cx_px < depth.width && k.cy_px > 0 && k.cy_px < depth.height))
+    throw alignment::AlignmentError(scan.string() + ": the depth image is " + size +
+                                    " pixels, but --intrinsics put its principal point outside it (cx, cy = " +
+                                    std::to_string(k.cx_px) + ", " + std::to_string(k.cy_px) + ")");
   k.width_px = depth.width;
   k.height_px = depth.height;
   return alignment::depth_to_cloud(depth, k);

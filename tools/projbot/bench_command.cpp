@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
@@ -44,6 +45,12 @@ std::vector<std::pair<int, int>> parse_sizes(const std::string& text) {
   return out;
 }
 
+// Ctrl-C in a benchmark: the rows printed are whole measurements; the run under way is not one.
+int bench_interrupted(std::size_t measured, int planned) {
+  std::printf("interrupted after %zu of %d frames of this run (not reported); the rows above are complete\n", measured, planned);
+  return interrupt_exit_code();
+}
+
 }  // namespace
 
 const Command kBenchRender{
@@ -61,6 +68,8 @@ const Command kBenchRender{
     [](const cli::Args& args) {
       const int frames = args.get_int("frames", 300, 1, 1000000);
       const auto sizes = parse_sizes(args.get_or("sizes", "1280x800,1920x1080"));
+      if (args.flag("offscreen-only") && args.flag("windowed-only"))
+        throw cli::UsageError("--offscreen-only and --windowed-only together leave nothing to measure: give one");
       const bool want_offscreen = !args.flag("windowed-only");
       const char* display = std::getenv("DISPLAY");
       bool want_window = !args.flag("offscreen-only");
@@ -77,6 +86,7 @@ const Command kBenchRender{
       ro.windowing = want_window;
       ro.device_index = args.get_int("device", -1, -1, 64);
       engine::Renderer renderer(ro);
+      catch_interrupts();  // Ctrl-C: the rows printed are whole; the run under way is dropped; exit 130
       std::cout << "device: " << renderer.device_info().name << " (" << renderer.device_info().driver << ")\n";
       std::printf("%-11s %8s %10s %-9s %8s %8s %8s %8s %8s %8s\n", "model", "tris", "size", "target", "fps", "p50_ms", "p95_ms",
                   "p99_ms", "max_ms", "gpu_p50");
@@ -99,18 +109,19 @@ const Command kBenchRender{
             } else {
               target = renderer.make_offscreen(w, h);
             }
-            for (int i = 0; i < 20; ++i) {
+            for (int i = 0; i < 20 && !interrupted(); ++i) {
               target->poll_close();
               renderer.draw_frame(*target, projector, items);
             }
             renderer.finish(*target);
             engine::FrameProfiler profiler;
-            for (int i = 0; i < frames; ++i) {
+            for (int i = 0; i < frames && !interrupted(); ++i) {
               target->poll_close();
               renderer.draw_frame(*target, projector, items, &profiler);
             }
             renderer.finish(*target);
             const auto s = profiler.summary();
+            if (interrupted()) return bench_interrupted(s.frames, frames);
             char size[32];
             std::snprintf(size, sizeof size, "%dx%d", w, h);
             std::printf("%-11s %8zu %10s %-9s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f\n", m.name.c_str(), m.model.triangle_count(),

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/alignment/tracker.hpp"
@@ -17,6 +18,11 @@
 
 namespace projbot::tools {
 namespace {
+
+int interrupted_at(const char* what, int frame, int frames) {
+  std::printf("interrupted while %s (frame %d of %d); the rows above are complete\n", what, frame, frames);
+  return interrupt_exit_code();
+}
 
 struct Stats {
   std::vector<double> ms, err_mm, err_deg;
@@ -64,9 +70,12 @@ const Command kBenchTrack{
       auto camera = renderer.make_depth_camera(k.width_px, k.height_px);
 
       std::printf("rendering %d frames at %.1f m...\n", frames, distance);
+      std::fflush(stdout);
       std::vector<Eigen::Matrix4d> truth;
       std::vector<alignment::DepthImage> depth;
+      catch_interrupts();  // Ctrl-C: the methods measured are printed whole, the one under way is dropped; exit 130
       for (int f = 0; f < frames; ++f) {
+        if (interrupted()) return interrupted_at("rendering the depth sequence", f, frames);
         const double t = f / 30.0;  // a smooth path: up to 1 cm and 2 degrees per frame at 30 Hz
         const Eigen::Matrix4d T =
             config::pose_from_xyz_rpy({0.12 * std::sin(2.0 * t), 0.06 * std::sin(1.3 * t), distance + 0.1 * std::sin(0.9 * t)},
@@ -82,7 +91,7 @@ const Command kBenchTrack{
       const auto measure = [&](const std::function<Eigen::Matrix4d(int, const Eigen::Matrix4d&)>& step) {
         Stats s;
         Eigen::Matrix4d estimate = truth[0];
-        for (int f = 1; f < frames; ++f) {
+        for (int f = 1; f < frames && !interrupted(); ++f) {
           const auto t0 = std::chrono::steady_clock::now();
           estimate = step(f, estimate);
           s.ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
@@ -98,6 +107,7 @@ const Command kBenchTrack{
       const Stats ours = measure([&](int f, const Eigen::Matrix4d& prev) {
         return tracker.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target;
       });
+      if (interrupted()) return interrupted_at("measuring", static_cast<int>(ours.ms.size()) + 1, frames);
       ours.print("projective (20k of 50k)");
       alignment::TrackerConfig all_points;
       all_points.model_points = {5000, 15000, 50000};
@@ -105,11 +115,13 @@ const Command kBenchTrack{
       const Stats ours_all = measure([&](int f, const Eigen::Matrix4d& prev) {
         return tracker_all.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target;
       });
+      if (interrupted()) return interrupted_at("measuring", static_cast<int>(ours_all.ms.size()) + 1, frames);
       ours_all.print("projective (all 50k)");
       const alignment::PclIcpBaseline pcl_icp(model);
       const Stats base = measure([&](int f, const Eigen::Matrix4d& prev) {
         return pcl_icp.track(alignment::depth_to_cloud(depth[static_cast<std::size_t>(f)], k), prev);
       });
+      if (interrupted()) return interrupted_at("measuring", static_cast<int>(base.ms.size()) + 1, frames);
       base.print("pcl IterativeClosestPoint");
       const auto mean = [](const std::vector<double>& v) {
         return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());

@@ -76,16 +76,22 @@ void Args::check_output_folders(const std::vector<std::string>& names) const {
     const fs::path dir = fs::path(*value).lexically_normal();
     if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
       throw UsageError("--" + name + " " + *value + ": exists and is not a folder");
+    const auto check = [&](const fs::path& folder) {
+      try {
+        config::check_folder_writable(folder);
+      } catch (const config::OutputError& e) {
+        throw UsageError("--" + name + " " + *value + ": " + e.what());
+      }
+    };
     if (fs::is_directory(dir, ec)) {
-      if (::access(dir.c_str(), W_OK) != 0) throw UsageError("--" + name + " " + *value + ": the folder is not writable");
+      check(dir);
       continue;
     }
     fs::path parent = dir.has_filename() ? dir.parent_path() : dir.parent_path().parent_path();
     if (parent.empty()) parent = ".";
     if (!fs::is_directory(parent, ec))
       throw UsageError("--" + name + " " + *value + ": its parent folder " + parent.string() + " does not exist");
-    if (::access(parent.c_str(), W_OK) != 0)
-      throw UsageError("--" + name + " " + *value + ": its parent folder " + parent.string() + " is not writable");
+    check(parent);
   }
 }
 

@@ -61,6 +61,10 @@ static int dispatch(int argc, char** argv) {
     return argc < 2 ? 2 : 0;
   }
   if (std::string(argv[1]) == "--version") {
+    if (argc > 2) {
+      std::cerr << "projbot: --version takes nothing after it, got '" << argv[2] << "'\n";
+      return 2;
+    }
     std::cout << "projbot " << PROJBOT_VERSION << '\n';
     return 0;
   }
@@ -68,7 +72,9 @@ static int dispatch(int argc, char** argv) {
   int first = 2;
   if (name == "bench") {  // "bench render", "bench track", "bench localize": the benchmark of a subsystem
     if (argc < 3 || (std::string(argv[2]) != "render" && std::string(argv[2]) != "track" && std::string(argv[2]) != "localize")) {
-      std::cerr << "projbot bench: say what to benchmark: projbot bench render | track | localize\n";
+      std::cerr << "projbot bench: "
+                << (argc < 3 ? std::string("say what to benchmark") : "no benchmark '" + std::string(argv[2]) + "'")
+                << ": projbot bench render | track | localize\n";
       return 2;
     }
     name = std::string("bench ") + argv[2];

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 
 #include "commands.hpp"
@@ -39,41 +40,44 @@ void finish_profile(const cli::Args& args, const engine::FrameProfiler& profiler
 
 }  // namespace
 
-const Command kRender{"render", "render the projector image headless (offscreen) to a PNG",
-                      "projbot render [--scene S.yaml] --out frame.png [--frames N] [--profile p.csv] [overrides]\n\n"
-                      "Draws every target of the scene through the projector's intrinsics, with no window system, and\n"
-                      "writes the last frame as an RGBA PNG: exactly the image the projector must show. With --model\n"
-                      "alone the model is framed whole, seen from its front (glTF +Z). Exit status 3: the frame came\n"
-                      "out empty (written all the same).\n",
-                      with_scene_options({{"out", "FILE", "PNG to write (required)"},
-                                          {"frames", "N", "frames to draw, for timing (default 1)"},
-                                          {"profile", "FILE", "write one CSV row of timings per frame"}}),
-                      [](const cli::Args& args) {
-                        const auto out = args.get("out");
-                        if (!out) throw cli::UsageError("--out FILE is required");
-                        args.check_output_files({"out", "profile"});
-                        const int frames = args.get_int("frames", 1, 1, 1000000);
-                        const config::Scene scene = scene_from_args(args);
-                        engine::Renderer renderer(renderer_options(args, false));
-                        std::cout << "device: " << renderer.device_info().name << '\n';
-                        const auto items = upload_scene(renderer, scene);
-                        auto target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
-                        engine::FrameProfiler profiler;
-                        for (int i = 0; i < frames; ++i) renderer.draw_frame(*target, scene.projector, items, &profiler);
-                        renderer.finish(*target);
-                        const assets::Image image = target->read_back();
-                        assets::write_png(*out, image);
-                        std::cout << "wrote " << *out << " (" << scene.projector.width_px << "x" << scene.projector.height_px
-                                  << ", " << scene.targets.size() << " target" << (scene.targets.size() == 1 ? "" : "s") << ")\n";
-                        finish_profile(args, profiler);
-                        if (!report_validation(args, renderer)) return 1;
-                        if (image.lit_pixels() == 0 && !scene.targets.empty()) {
-                          std::cerr << "projbot render: warning: the frame is empty: no target is in the projector's view "
-                                       "(check the poses, --near / --far and the intrinsics)\n";
-                          return 3;
-                        }
-                        return 0;
-                      }};
+const Command kRender{
+    "render", "render the projector image headless (offscreen) to a PNG",
+    "projbot render [--scene S.yaml] --out frame.png [--frames N] [--profile p.csv] [overrides]\n\n"
+    "Draws every target of the scene through the projector's intrinsics, with no window system, and\n"
+    "writes the last frame as an RGBA PNG: exactly the image the projector must show. With --model\n"
+    "alone the model is framed whole, seen from its front (glTF +Z). Exit status 3: the frame came\n"
+    "out empty (written all the same).\n",
+    with_scene_options({{"out", "FILE", "PNG to write (required)"},
+                        {"frames", "N", "frames to draw, for timing (default 1)"},
+                        {"profile", "FILE", "write one CSV row of timings per frame"}}),
+    [](const cli::Args& args) {
+      const auto out = args.get("out");
+      if (!out) throw cli::UsageError("--out FILE is required");
+      args.check_output_files({"out", "profile"});
+      if (std::filesystem::path(*out).extension() != ".png" && std::filesystem::path(*out).extension() != ".PNG")
+        throw cli::UsageError("--out must name a .png file, got '" + *out + "'");
+      const int frames = args.get_int("frames", 1, 1, 1000000);
+      const config::Scene scene = scene_from_args(args);
+      engine::Renderer renderer(renderer_options(args, false));
+      std::cout << "device: " << renderer.device_info().name << '\n';
+      const auto items = upload_scene(renderer, scene);
+      auto target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+      engine::FrameProfiler profiler;
+      for (int i = 0; i < frames; ++i) renderer.draw_frame(*target, scene.projector, items, &profiler);
+      renderer.finish(*target);
+      const assets::Image image = target->read_back();
+      assets::write_png(*out, image);
+      std::cout << "wrote " << *out << " (" << scene.projector.width_px << "x" << scene.projector.height_px << ", "
+                << scene.targets.size() << " target" << (scene.targets.size() == 1 ? "" : "s") << ")\n";
+      finish_profile(args, profiler);
+      if (!report_validation(args, renderer)) return 1;
+      if (image.lit_pixels() == 0 && !scene.targets.empty()) {
+        std::cerr << "projbot render: warning: the frame is empty: no target is in the projector's view "
+                     "(check the poses, --near / --far and the intrinsics)\n";
+        return 3;
+      }
+      return 0;
+    }};
 
 const Command kShow{"show", "open the projector output in a window (fullscreen on a projector, or a preview)",
                     "projbot show [--scene S.yaml] [--fullscreen] [--monitor N] [--present-mode fifo|mailbox|immediate]\n\n"

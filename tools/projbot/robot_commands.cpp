@@ -1,12 +1,15 @@
 // projbot slam / localize / bench localize: the robot's map, its self-localisation, and how well
 // localisation holds up over simulated tours.
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "commands.hpp"
@@ -94,8 +97,11 @@ const Command kSlam{
       if (const auto c = args.get("config")) ini = *c;
       if (ini)
         for (const auto& warning : robot::check_icp_slam_config(*ini)) std::cerr << "projbot slam: warning: " << warning << '\n';
+      std::optional<std::vector<robot::TrajectoryPoint>> truth;  // read before the work: a bad file costs nothing
+      if (const auto gt = args.get("ground-truth")) truth = robot::read_trajectory(*gt);
       catch_interrupts();  // Ctrl-C: map and write the scans done so far, then exit 130
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
+      std::cout << "mapping " << steps.size() << " scans (Ctrl-C stops and keeps the map of the scans done)..." << std::endl;
       const robot::SlamResult r = robot::build_map(steps, ini, *args.get("out-map"), [] { return interrupted(); });
       robot::write_trajectory(*args.get("out-trajectory"), r.trajectory);
       if (r.interrupted) {
@@ -108,10 +114,9 @@ const Command kSlam{
                 << " keyframes, " << r.seconds << " s (" << r.seconds * 1000 / static_cast<double>(steps.size())
                 << " ms per scan)\n";
       const auto odometry = dead_reckoning(steps, r.trajectory.front().pose);
-      if (const auto gt = args.get("ground-truth")) {
-        const auto truth = robot::read_trajectory(*gt);
-        print_errors("ICP-SLAM vs ground truth", compare(r.trajectory, truth));
-        print_errors("odometry vs ground truth", compare(odometry, truth));
+      if (truth) {
+        print_errors("ICP-SLAM vs ground truth", compare(r.trajectory, *truth));
+        print_errors("odometry vs ground truth", compare(odometry, *truth));
       } else {
         const auto gap = [](const std::vector<robot::TrajectoryPoint>& t) {
           return robot::distance_m(t.front().pose, t.back().pose);
@@ -139,8 +144,10 @@ const Command kLocalize{
       for (const char* required : {"map", "rawlog", "out-trajectory"})
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
       args.check_output_files({"out-trajectory"});
-      catch_interrupts();  // Ctrl-C: write the trajectory of the scans done, then exit 130
       const Pose2D start = parse_pose(args.get_or("initial", "0 0 0"), "--initial");
+      std::optional<std::vector<robot::TrajectoryPoint>> truth;  // read before the work
+      if (const auto gt = args.get("ground-truth")) truth = robot::read_trajectory(*gt);
+      catch_interrupts();  // Ctrl-C: write the trajectory of the scans done, then exit 130
       robot::Localizer loc = robot::Localizer::load(*args.get("map"));
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
       loc.reset(start);
@@ -163,13 +170,42 @@ const Command kLocalize{
       }
       std::cout << std::fixed << std::setprecision(2) << "localised " << steps.size() << " scans against " << loc.map_points()
                 << " map points: " << accepted << " accepted, " << ms / static_cast<double>(steps.size()) << " ms per scan\n";
-      if (const auto gt = args.get("ground-truth")) {
-        const auto truth = robot::read_trajectory(*gt);
-        print_errors("localisation vs ground truth", compare(out, truth));
-        print_errors("odometry vs ground truth", compare(dead_reckoning(steps, start), truth));
+      if (truth) {
+        print_errors("localisation vs ground truth", compare(out, *truth));
+        print_errors("odometry vs ground truth", compare(dead_reckoning(steps, start), *truth));
       }
       return 0;
     }};
+
+// One row of the simulated-tour table of bench localize.
+// Returns false, printing nothing, when the tour was interrupted.
+bool print_sim_tour_row(int n, robot::PoseSource source, int seed) {
+  robot::SimTourConfig cfg = robot::default_sim_tour();
+  cfg.stop_count = n;
+  cfg.source = source;
+  cfg.errors.seed = static_cast<std::uint64_t>(seed);
+  const auto reports = robot::run_sim_tour(cfg, [] { return interrupted(); });
+  if (interrupted()) return false;
+  double mean_m = 0, max_m = 0, mean_r = 0, max_r = 0, ms = 0;
+  // The error of what the robot believes: with odometry alone that is the odometry's drift.
+  for (const auto& r : reports) {
+    mean_m += r.error_m, max_m = std::max(max_m, r.error_m);
+    mean_r += r.error_rad, max_r = std::max(max_r, r.error_rad);
+    ms += r.correct_ms_mean;
+  }
+  const double k = static_cast<double>(reports.size());
+  std::cout << std::fixed << std::setprecision(2) << "| " << n << " | "
+            << (source == robot::PoseSource::localized ? "MRPT localisation" : "odometry alone") << " | " << mean_m / k * 100
+            << " | " << max_m * 100 << " | " << mean_r / k * kDeg << " | " << max_r * kDeg << " | "
+            << reports.back().odometry_error_m * 100 << " / " << reports.back().odometry_error_rad * kDeg << " | "
+            << (source == robot::PoseSource::localized ? ms / k : 0.0) << " |" << std::endl;
+  return true;
+}
+
+int bench_interrupted() {
+  std::cout << "interrupted: the rows above are complete; the rest was not measured\n";
+  return interrupt_exit_code();
+}
 
 const Command kBenchLocalize{
     "bench localize",
@@ -200,43 +236,32 @@ const Command kBenchLocalize{
         }
       }
       const int seed = args.get_int("seed", 1, 0, 1 << 30);
+      // The ICP-SLAM dataset, read before the tours: a file the user named must be there and readable.
+      if (args.get("ground-truth") && !args.get("rawlog"))
+        throw cli::UsageError("--ground-truth needs --rawlog (the rawlog it is the truth of)");
+      const fs::path rawlog = args.get_or("rawlog", kDefaultGtRawlog.string());
+      const fs::path gt = args.get_or("ground-truth", rawlog.string() + ".GT.txt");
+      std::optional<std::pair<std::vector<robot::RawlogStep>, std::vector<robot::TrajectoryPoint>>> dataset;
+      if (args.get("rawlog") || (fs::exists(rawlog) && fs::exists(gt)))
+        dataset.emplace(robot::read_rawlog(rawlog), robot::read_trajectory(gt));
+      catch_interrupts();  // Ctrl-C: the rows printed so far are whole; exit 130
       std::cout << "Simulated tours (youBot with 2 % slip, 1 % wheel radii, 0.01 rad/m heading bias; UTM-30LX 1 cm noise)\n"
                 << "| stops | closes the loop on | mean cm | max cm | mean deg | max deg | odometry drift at last stop cm / deg "
                    "| ms per scan |\n"
                 << "|---|---|---|---|---|---|---|---|\n";
-      for (const int n : counts) {
+      for (const int n : counts)
         for (const auto source : {robot::PoseSource::localized, robot::PoseSource::odometry}) {
-          robot::SimTourConfig cfg = robot::default_sim_tour();
-          cfg.stop_count = n;
-          cfg.source = source;
-          cfg.errors.seed = static_cast<std::uint64_t>(seed);
-          const auto reports = robot::run_sim_tour(cfg);
-          double mean_m = 0, max_m = 0, mean_r = 0, max_r = 0, ms = 0;
-          // The error of what the robot believes: with odometry alone that is the odometry's drift.
-          for (const auto& r : reports) {
-            mean_m += r.error_m, max_m = std::max(max_m, r.error_m);
-            mean_r += r.error_rad, max_r = std::max(max_r, r.error_rad);
-            ms += r.correct_ms_mean;
-          }
-          const double k = static_cast<double>(reports.size());
-          std::cout << std::fixed << std::setprecision(2) << "| " << n << " | "
-                    << (source == robot::PoseSource::localized ? "MRPT localisation" : "odometry alone") << " | "
-                    << mean_m / k * 100 << " | " << max_m * 100 << " | " << mean_r / k * kDeg << " | " << max_r * kDeg << " | "
-                    << reports.back().odometry_error_m * 100 << " / " << reports.back().odometry_error_rad * kDeg << " | "
-                    << (source == robot::PoseSource::localized ? ms / k : 0.0) << " |\n";
+          if (!print_sim_tour_row(n, source, seed)) return bench_interrupted();
         }
-      }
-      const fs::path rawlog = args.get_or("rawlog", kDefaultGtRawlog.string());
-      const fs::path gt = args.get_or("ground-truth", rawlog.string() + ".GT.txt");
-      if (!fs::exists(rawlog) || !fs::exists(gt)) {
+      if (!dataset) {
         std::cout << "\nICP-SLAM part skipped: " << rawlog << " or " << gt << " not found\n";
         return 0;
       }
-      const auto steps = robot::read_rawlog(rawlog);
-      const fs::path dir = fs::temp_directory_path() / "projbot_bench_slam";
-      const auto r = robot::build_map(steps, std::nullopt, dir);
+      const auto& [steps, truth] = *dataset;
+      const fs::path dir = fs::temp_directory_path() / ("projbot_bench_slam_" + std::to_string(::getpid()));
+      const auto r = robot::build_map(steps, std::nullopt, dir, [] { return interrupted(); });
       fs::remove_all(dir);
-      const auto truth = robot::read_trajectory(gt);
+      if (r.interrupted) return bench_interrupted();
       std::cout << "\nICP-SLAM on " << rawlog.filename() << " (" << steps.size() << " scans, " << r.keyframes << " keyframes, "
                 << r.seconds * 1000 / static_cast<double>(steps.size()) << " ms per scan):\n";
       print_errors("ICP-SLAM vs ground truth", compare(r.trajectory, truth));

@@ -127,6 +127,7 @@ const Command kRun{
       if (!(seconds >= 0.0 && seconds <= 1e6)) throw cli::UsageError("--seconds must be 0 (until the tour ends) to 1e6");
       const bool headless = args.flag("headless");
       present_mode(args.get_or("present-mode", "fifo"));  // a bad mode is an error with --headless too
+      args.get_int("monitor", 0, 0, 64);                  // so is a bad monitor
       args.check_output_files({"profile"});
 
       engine::RendererOptions ro;

@@ -67,6 +67,8 @@ config::Scene scene_from_args(const cli::Args& args) {
     if (x == std::string::npos) throw cli::UsageError("--size must look like 1920x1080, got '" + *size + "'");
     const auto wh = config::parse_number_list(size->substr(0, x) + "," + size->substr(x + 1), 2, "--size");
     if (wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1])) throw cli::UsageError("--size needs whole pixels");
+    if (wh[0] < 1 || wh[1] < 1 || wh[0] > 16384 || wh[1] > 16384)
+      throw cli::UsageError("--size must be 1..16384 pixels each way, got '" + *size + "'");
     p.width_px = static_cast<int>(wh[0]);
     p.height_px = static_cast<int>(wh[1]);
   }

@@ -4,6 +4,7 @@
 // compared with the ground truth. Used by the tests, `projbot bench localize` and the twin.
 
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -73,8 +74,9 @@ class SimRobot {
   double time_s_ = 0.0;
 };
 
-/// Runs the tour. Deterministic for a given config (all noise is seeded).
-std::vector<StopReport> run_sim_tour(const SimTourConfig& config);
+/// Runs the tour. Deterministic for a given config (all noise is seeded). `stop_requested`, asked before
+/// each stop, ends the tour there (Ctrl-C): the reports of the stops reached.
+std::vector<StopReport> run_sim_tour(const SimTourConfig& config, const std::function<bool()>& stop_requested = {});
 
 /// The built-in demo room (8 x 6 m with furniture) and a ring of stops in it.
 SimTourConfig default_sim_tour();
