@@ -1,0 +1,737 @@
+// The hostile-input suite (ctest label `hostile`, also run under ASan/UBSan): bad files of every format
+// projbot reads and bad arguments of every command, through the executable. Every case must end with
+// exit 1 (bad input) or 2 (bad usage), never a signal; print a message naming the file or option; and
+// leave its scratch folder exactly as it was (no output created, no previous output changed).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include "cli_run.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Files written into the scratch folder before a case runs; a plain string is the scene `bad.yaml`.
+// A content "@head:N:PATH" is the first N bytes of PATH, "@random:N" N random bytes; {dir}, {data} and
+// {src} are replaced in paths and contents.
+struct Files {
+  std::vector<std::pair<std::string, std::string>> list;
+  Files() = default;
+  Files(const char* yaml) : Files(std::string(yaml)) {}
+  Files(const std::string& yaml) {
+    if (!yaml.empty()) list.emplace_back("bad.yaml", yaml);
+  }
+  Files(std::initializer_list<std::pair<std::string, std::string>> files) : list(files) {}
+};
+
+struct Hostile {
+  std::string name;
+  std::string args;
+  Files files;
+  int code;  // 1: bad input, 2: bad usage
+  std::vector<std::string> must_contain;
+};
+
+std::string replace_all(std::string s, const std::string& from, const std::string& to) {
+  for (std::size_t at = 0; (at = s.find(from, at)) != std::string::npos; at += to.size()) s.replace(at, from.size(), to);
+  return s;
+}
+
+std::string expand(std::string s, const fs::path& dir) {
+  s = replace_all(s, "{duck}", "{data}/gltf/Duck/glTF-Binary/Duck.glb");
+  s = replace_all(s, "{rawlog}", "{data}/mrpt/localization_demo.rawlog");
+  s = replace_all(s, "{dir}", dir.string());
+  s = replace_all(s, "{data}", PROJBOT_SHARED_DATA);
+  return replace_all(s, "{src}", PROJBOT_SOURCE_DIR);
+}
+
+std::string content(const std::string& spec) {
+  if (spec.rfind("@random:", 0) == 0) {
+    std::mt19937 rng(7);
+    std::string bytes(std::stoul(spec.substr(8)), '\0');
+    for (auto& c : bytes) c = static_cast<char>(rng() & 0xff);
+    return bytes;
+  }
+  if (spec.rfind("@head:", 0) == 0) {
+    const auto colon = spec.find(':', 6);
+    std::ifstream in(spec.substr(colon + 1), std::ios::binary);
+    std::string bytes(std::stoul(spec.substr(6, colon - 6)), '\0');
+    in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    bytes.resize(static_cast<std::size_t>(in.gcount()));
+    return bytes;
+  }
+  return spec;
+}
+
+// Every file under `dir`: its path, size and bytes.
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    std::string bytes;
+    if (e.is_regular_file()) {
+      std::ifstream in(e.path(), std::ios::binary);
+      std::stringstream s;
+      s << in.rdbuf();
+      bytes = s.str();
+    }
+    files[e.path().string()] = (e.is_directory() ? "dir:" : "file:") + bytes;
+  }
+  return files;
+}
+
+class HostileTest : public ::testing::TestWithParam<Hostile> {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("projbot_hostile_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "goodmap");
+    // Outputs of an earlier run, which a failed run must leave as they are.
+    for (const char* name : {"prev.png", "prev.json", "prev.csv", "prev.txt"}) std::ofstream(dir_ / name) << "earlier output\n";
+    fs::copy_file(fs::path(PROJBOT_SHARED_DATA) / "mrpt" / "localization_demo.simplemap.gz",
+                  dir_ / "goodmap" / "map.simplemap.gz");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_P(HostileTest, ExitsCleanlyNamingTheProblemAndWritesNothing) {
+  const Hostile& h = GetParam();
+  for (const auto& [name, spec] : h.files.list) {
+    fs::create_directories((dir_ / name).parent_path());
+    std::ofstream(dir_ / name, std::ios::binary) << content(expand(spec, dir_));
+  }
+  const auto before = snapshot(dir_);
+  const CliRun r = run_projbot(expand(h.args, dir_), 120);
+  EXPECT_EQ(r.code, h.code) << r.output;
+  EXPECT_TRUE(r.code == 1 || r.code == 2) << "exit " << r.code << ": " << r.output;
+  for (const auto& part : h.must_contain)
+    EXPECT_NE(r.output.find(expand(part, dir_)), std::string::npos) << "'" << part << "' not in: " << r.output;
+  for (const char* crash : {"terminate called", "AddressSanitizer", "runtime error:", "Assertion", "core dumped"})
+    EXPECT_EQ(r.output.find(crash), std::string::npos) << crash << " in: " << r.output;
+  const auto after = snapshot(dir_);
+  for (const auto& [path, bytes] : after) {
+    const auto was = before.find(path);
+    EXPECT_TRUE(was != before.end()) << path << " was created";
+    if (was != before.end()) {
+      EXPECT_TRUE(was->second == bytes) << path << " was changed";
+    }
+  }
+  for (const auto& [path, bytes] : before) EXPECT_TRUE(after.count(path) == 1) << path << " was removed";
+}
+
+const std::string kProj = "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\n";
+const std::string kRoom =
+    "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24, near: 0.1, far: 10}\n"
+    "room: {width: 6, depth: 5, obstacles: [[0, 0, 1, 1]]}\n";
+const std::string kDuckTarget =
+    "  - {name: duck, model: {data}/gltf/Duck/glTF-Binary/Duck.glb, scale: 0.25, recenter: true,\n"
+    "     world_pose: {translation: [3, 3.5, 0.9], rpy_deg: [90, 0, 0]}, stop: [3, 2, 90]}\n";
+const std::string kTour = kRoom + "robot: {start: [2, 2, 0]}\ntargets:\n" + kDuckTarget + "tour: {visits: [duck]}\n";
+std::string with(const std::string& text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  if (at == std::string::npos) throw std::logic_error("hostile_test: '" + from + "' not in the scene");
+  return text.substr(0, at) + to + text.substr(at + from.size());
+}
+
+std::string pcd(const std::string& fields, const std::string& dims, const std::string& data, const std::string& body) {
+  return "VERSION 0.7\n" + fields + dims + "VIEWPOINT 0 0 0 1 0 0 0\nDATA " + data + "\n" + body;
+}
+const std::string kXyz = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
+std::string dims(long long w, long long h, long long n) {
+  return "WIDTH " + std::to_string(w) + "\nHEIGHT " + std::to_string(h) + "\nPOINTS " + std::to_string(n) + "\n";
+}
+const std::string kPly =
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+const std::string kGood16 = "{src}/tests/fuzz/corpus/depth_png/gray16_4x3.png";
+const std::string kIni = "[MappingApplication]\nlocalizationLinDistance = 0.2\n[ICP]\nmaxIterations = 80\nthresholdDist = 0.3\n";
+
+// Point clouds: the file as --scan (model: the Duck) and as --model (scan: a real bunny scan).
+std::vector<Hostile> cloud_cases() {
+  const std::vector<std::tuple<std::string, std::string, std::string>> files{
+      {"empty.pcd", "", "malformed PCD file"},
+      {"header_only.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 5\nHEIGHT 1\n", "malformed PCD file"},
+      {"random.pcd", "@random:3000", "malformed PCD file"},
+      {"huge_claim.pcd", pcd(kXyz, dims(2000000000, 1, 2000000000), "binary", std::string(4800, '\x01')), "malformed PCD file"},
+      {"no_xyz.pcd", pcd("FIELDS a b c\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n", dims(1, 1, 1), "ascii", "1 2 3\n"),
+       "needs x, y and z"},
+      {"wh_mismatch.pcd", pcd(kXyz, dims(3, 2, 5), "ascii", "1 2 3\n"), "malformed PCD file"},
+      {"binary_short.pcd", pcd(kXyz, dims(4, 1, 4), "binary", std::string(20, '\x02')), "malformed PCD file"},
+      {"compressed_short.pcd", pcd(kXyz, dims(4, 1, 4), "binary_compressed", std::string(8, '\x03')), "malformed PCD file"},
+      {"bad_type.pcd", pcd("FIELDS x y z\nSIZE 4 4 4\nTYPE F F Q\nCOUNT 1 1 1\n", dims(1, 1, 1), "ascii", "1 2 3\n"),
+       "malformed PCD file"},
+      {"negative_width.pcd", pcd(kXyz, "WIDTH -4\nHEIGHT 1\nPOINTS 4\n", "ascii", "1 2 3\n"), "malformed PCD file"},
+      {"words.pcd", pcd(kXyz, dims(2, 1, 2), "ascii", "a b c\nd e f\n"), "pcd"},
+      {"sizes_short.pcd", pcd("FIELDS x y z\nSIZE 4 4\nTYPE F F F\nCOUNT 1 1 1\n", dims(1, 1, 1), "ascii", "1 2 3\n"),
+       "malformed PCD file"},
+      {"all_nan.pcd", pcd(kXyz, dims(2, 1, 2), "ascii", "nan nan nan\nnan nan nan\n"), "0 valid points"},
+      {"stoi.pcd", "@head:100000:{src}/tests/hostile/pcd_header_stoi.pcd", "malformed pcd file"},
+      {"empty.ply", "", "ply"},
+      {"header_only.ply", kPly, "ply"},
+      {"random.ply", "@random:2000", "ply"},
+      {"assert.ply", "@head:100000:{src}/tests/hostile/pcl_ply_assert.ply", "PCL's PLY reader crashed on it"},
+      {"short.ply", kPly + "0 0 1\n1 0 1\n", "ply"},
+      {"binary_short.ply", replace_all(kPly, "ascii", "binary_little_endian") + std::string(10, '\x01'), "ply"}};
+  std::vector<Hostile> cases;
+  for (const auto& [name, bytes, message] : files) {
+    const std::string id = replace_all(name, ".", "_");
+    cases.push_back({"scan_" + id, "align --model {duck} --scan {dir}/" + name, Files{{name, bytes}}, 1, {name, message}});
+    cases.push_back({"model_" + id,
+                     "align --model {dir}/" + name + " --scan {data}/bunny/bun4.pcd",
+                     Files{{name, bytes}},
+                     1,
+                     {name, message}});
+  }
+  return cases;
+}
+
+// Depth images, 3-D models, scenes, rawlogs, .ini files, maps and trajectories.
+const std::vector<Hostile> kFileCases{
+    Hostile{"pcd_folder", "align --model {duck} --scan {dir}/goodmap", {}, 2, {"goodmap", "--scan must be"}},
+    Hostile{"png_8bit",
+            "align --model {duck} --scan {dir}/rgba.png",
+            Files{{"rgba.png", "@head:100000:{data}/gltf/BoxTextured/glTF/CesiumLogoFlat.png"}},
+            1,
+            {"rgba.png", "16-bit single-channel"}},
+    Hostile{"png_truncated",
+            "align --model {duck} --scan {dir}/cut.png",
+            Files{{"cut.png", "@head:40:" + kGood16}},
+            1,
+            {"cut.png", "corrupt PNG"}},
+    Hostile{"png_huge_idat",
+            "align --model {duck} --scan {src}/tests/hostile/png_huge_idat.png",
+            {},
+            1,
+            {"png_huge_idat.png", "claims 553670912 bytes"}},
+    Hostile{"png_truncated_chunk",
+            "align --model {duck} --scan {src}/tests/hostile/png_truncated_chunk.png",
+            {},
+            1,
+            {"png_truncated_chunk.png", "corrupt PNG"}},
+    Hostile{"png_random",
+            "align --model {duck} --scan {dir}/r.png",
+            Files{{"r.png", "@random:5000"}},
+            1,
+            {"r.png", "cannot read PNG"}},
+    Hostile{"png_empty", "align --model {duck} --scan {dir}/e.png", Files{{"e.png", ""}}, 1, {"e.png"}},
+    Hostile{
+        "png_too_small_for_intrinsics", "align --model {duck} --scan " + kGood16, {}, 1, {"gray16_4x3.png", "4x3", "640x480"}},
+    Hostile{"tiff_random", "align --model {duck} --scan {dir}/r.tiff", Files{{"r.tiff", "@random:5000"}}, 1, {"r.tiff"}},
+    Hostile{"tiff_empty", "align --model {duck} --scan {dir}/e.tiff", Files{{"e.tiff", ""}}, 1, {"e.tiff"}},
+    Hostile{"tiff_truncated",
+            "align --model {duck} --scan {dir}/cut.tiff",
+            Files{{"cut.tiff", "@head:30:{src}/tests/fuzz/corpus/depth_tiff/gray16_4x3.tiff"}},
+            1,
+            {"cut.tiff"}},
+    Hostile{"tiff_size_mismatch",
+            "align --model {duck} --scan {src}/tests/fuzz/corpus/depth_tiff/gray16_4x3.tiff",
+            {},
+            1,
+            {"gray16_4x3.tiff", "4x3", "640x480"}},
+    Hostile{"glb_bad_magic",
+            "render --model {dir}/m.glb --out {dir}/prev.png",
+            Files{{"m.glb", "glTX" + std::string(60, '\0')}},
+            1,
+            {"m.glb"}},
+    Hostile{
+        "glb_truncated", "render --model {dir}/m.glb --out {dir}/prev.png", Files{{"m.glb", "@head:300:{duck}"}}, 1, {"m.glb"}},
+    Hostile{"gltf_empty", "render --model {dir}/m.gltf --out {dir}/prev.png", Files{{"m.gltf", ""}}, 1, {"m.gltf"}},
+    Hostile{"gltf_garbage",
+            "render --model {dir}/m.gltf --out {dir}/prev.png",
+            Files{{"m.gltf", "{\"asset\": [1, 2"}},
+            1,
+            {"m.gltf"}},
+    Hostile{"gltf_missing_buffer",
+            "render --model {dir}/m.gltf --out {dir}/prev.png",
+            Files{{"m.gltf", "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":36,\"uri\":\"nothere.bin\"}]}"}},
+            1,
+            {"m.gltf"}},
+    Hostile{"gltf_no_meshes",
+            "render --model {dir}/m.gltf --out {dir}/prev.png",
+            Files{{"m.gltf", "{\"asset\":{\"version\":\"2.0\"}}"}},
+            1,
+            {"m.gltf"}},
+    Hostile{"gltf_index_out_of_range",
+            "render --model {src}/tests/hostile/gltf_index_out_of_range.gltf --out {dir}/prev.png",
+            {},
+            1,
+            {"gltf_index_out_of_range.gltf"}},
+    Hostile{"gltf_accessor_beyond_buffer",
+            "render --model {src}/tests/hostile/gltf_accessor_beyond_buffer.gltf --out {dir}/prev.png",
+            {},
+            1,
+            {"gltf_accessor_beyond_buffer.gltf"}},
+    Hostile{"gltf_folder", "render --model {dir}/goodmap --out {dir}/prev.png", {}, 1, {"goodmap", "folder"}},
+    Hostile{"gltf_random_as_align_model",
+            "align --model {dir}/m.glb --scan {data}/bunny/bun4.pcd",
+            Files{{"m.glb", "@random:4000"}},
+            1,
+            {"m.glb"}},
+    Hostile{"scene_empty", "render --scene {dir}/bad.yaml --out {dir}/prev.png", Files{{"bad.yaml", ""}}, 1, {"bad.yaml"}},
+    Hostile{"scene_syntax", "render --scene {dir}/bad.yaml --out {dir}/prev.png", "projector: {width: 64\n", 1, {"bad.yaml"}},
+    Hostile{"scene_binary",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            Files{{"bad.yaml", "@random:3000"}},
+            1,
+            {"bad.yaml"}},
+    Hostile{"scene_wrong_type",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            with(kProj, "width: 64", "width: wide") + "targets: []\n",
+            1,
+            {"bad.yaml:1", "width"}},
+    Hostile{"scene_negative_width",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            with(kProj, "width: 64", "width: -64") + "targets: []\n",
+            1,
+            {"bad.yaml", "size -64x48"}},
+    Hostile{"scene_nan_fx",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            with(kProj, "fx: 50", "fx: .nan") + "targets: []\n",
+            1,
+            {"bad.yaml", "fx"}},
+    Hostile{"scene_inf_far",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            with(kProj, "cy: 24", "cy: 24, far: .inf") + "targets: []\n",
+            1,
+            {"bad.yaml", "far"}},
+    Hostile{"scene_near_beyond_far",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            with(kProj, "cy: 24", "cy: 24, near: 5, far: 1") + "targets: []\n",
+            1,
+            {"bad.yaml", "near"}},
+    Hostile{"scene_scale_huge",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, "scale: 0.25", "scale: 1e30"),
+            1,
+            {"bad.yaml", "scale"}},
+    Hostile{"scene_scale_zero",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, "scale: 0.25", "scale: 0"),
+            1,
+            {"bad.yaml", "scale"}},
+    Hostile{"scene_target_without_pose",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            kProj + "targets:\n  - {name: a, model: {duck}}\n",
+            1,
+            {"bad.yaml", "pose"}},
+    Hostile{"scene_duplicate_names",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, "tour:", kDuckTarget + "tour:"),
+            1,
+            {"bad.yaml", "duck"}},
+    Hostile{"scene_unknown_visit",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, "visits: [duck]", "visits: [duck, cat]"),
+            1,
+            {"bad.yaml", "cat"}},
+    Hostile{"scene_stop_outside_room",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, "stop: [3, 2, 90]", "stop: [30, 2, 90]"),
+            1,
+            {"bad.yaml", "duck", "stop"}},
+    Hostile{"scene_stop_in_obstacle",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, "stop: [3, 2, 90]", "stop: [0.5, 0.5, 90]"),
+            1,
+            {"bad.yaml", "duck", "obstacle"}},
+    Hostile{"scene_start_outside_room",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, "start: [2, 2, 0]", "start: [-2, 2, 0]"),
+            1,
+            {"bad.yaml", "start"}},
+    Hostile{"scene_start_in_obstacle",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, "start: [2, 2, 0]", "start: [0.5, 0.5, 0]"),
+            1,
+            {"bad.yaml", "start", "obstacle"}},
+    Hostile{"scene_model_is_folder",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            kProj + "targets:\n  - {name: a, model: {dir}/goodmap, pose: {translation: [0, 0, 1]}}\n",
+            1,
+            {"goodmap"}},
+    Hostile{"scene_deep_nesting",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            "a: " + std::string(20000, '['),
+            1,
+            {"bad.yaml"}},
+    Hostile{"scene_rpy_two_numbers",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            kProj + "targets:\n  - {name: a, model: {duck}, pose: {translation: [0, 0, 1], rpy_deg: [1, 2]}}\n",
+            1,
+            {"bad.yaml", "rpy_deg"}},
+    Hostile{"scene_translation_nan",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            kProj + "targets:\n  - {name: a, model: {duck}, pose: {translation: [0, .nan, 1]}}\n",
+            1,
+            {"bad.yaml", "translation"}},
+    Hostile{"scene_tab_indent",
+            "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+            kProj + "targets:\n\t- {name: a}\n",
+            1,
+            {"bad.yaml"}},
+    Hostile{"scene_room_negative",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, "room: {width: 6", "room: {width: -6"),
+            1,
+            {"bad.yaml", "room"}},
+    Hostile{"scene_target_without_stop",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            with(kTour, ", stop: [3, 2, 90]", ""),
+            1,
+            {"bad.yaml", "duck", "stop"}},
+    Hostile{"scene_folder", "render --scene {dir}/goodmap --out {dir}/prev.png", {}, 1, {"goodmap", "folder"}},
+    Hostile{"run_config_syntax", "run --headless --config {dir}/bad.yaml --profile {dir}/prev.csv", "tour: [\n", 1, {"bad.yaml"}},
+    Hostile{"rawlog_empty",
+            "slam --rawlog {dir}/e.rawlog --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"e.rawlog", ""}},
+            1,
+            {"e.rawlog"}},
+    Hostile{"rawlog_random",
+            "slam --rawlog {dir}/r.rawlog --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"r.rawlog", "@random:5000"}},
+            1,
+            {"r.rawlog", "rawlog"}},
+    Hostile{"rawlog_text",
+            "slam --rawlog {dir}/t.rawlog --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"t.rawlog", "scan 1 2 3\n"}},
+            1,
+            {"t.rawlog", "rawlog"}},
+    Hostile{"rawlog_reader_crash",
+            "slam --rawlog {src}/tests/hostile/mrpt_reader_crash.rawlog --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            {},
+            1,
+            {"mrpt_reader_crash.rawlog", "MRPT's reader crashed on it"}},
+    Hostile{"rawlog_endless",
+            "slam --rawlog {src}/tests/hostile/mrpt_endless_actions.rawlog --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            {},
+            1,
+            {"mrpt_endless_actions.rawlog", "corrupt MRPT rawlog?"}},
+    Hostile{"rawlog_truncated_gzip",
+            "slam --rawlog {dir}/cut.rawlog --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"cut.rawlog", "@head:11000:{rawlog}"}},
+            1,
+            {"cut.rawlog"}},
+    Hostile{"rawlog_folder", "slam --rawlog {dir}/goodmap --out-map {dir}/m --out-trajectory {dir}/prev.txt", {}, 1, {"goodmap"}},
+    Hostile{"rawlog_localize_random",
+            "localize --map {dir}/goodmap --rawlog {dir}/r.rawlog --out-trajectory {dir}/prev.txt",
+            Files{{"r.rawlog", "@random:5000"}},
+            1,
+            {"r.rawlog"}},
+    Hostile{"ini_non_numeric",
+            "slam --rawlog {rawlog} --config {dir}/c.ini --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"c.ini", with(kIni, "= 80", "= abc")}},
+            1,
+            {"c.ini:4", "maxIterations", "whole number"}},
+    Hostile{"ini_fraction",
+            "slam --rawlog {rawlog} --config {dir}/c.ini --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"c.ini", with(kIni, "= 80", "= 8.5")}},
+            1,
+            {"c.ini:4", "maxIterations"}},
+    Hostile{"ini_bad_number",
+            "slam --rawlog {rawlog} --config {dir}/c.ini --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"c.ini", with(kIni, "= 0.3", "= 0.3m")}},
+            1,
+            {"c.ini:5", "thresholdDist"}},
+    Hostile{"ini_bad_enum",
+            "slam --rawlog {rawlog} --config {dir}/c.ini --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"c.ini", kIni + "ICP_algorithm = icpMagic\n"}},
+            1,
+            {"c.ini:6", "ICP_algorithm", "icpClassic"}},
+    Hostile{"ini_no_sections",
+            "slam --rawlog {rawlog} --config {dir}/c.ini --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"c.ini", "maxIterations = 3\n"}},
+            1,
+            {"c.ini:1", "section"}},
+    Hostile{"ini_garbage_line",
+            "slam --rawlog {rawlog} --config {dir}/c.ini --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"c.ini", kIni + "this is not a setting\n"}},
+            1,
+            {"c.ini:6", "key = value"}},
+    Hostile{"ini_binary",
+            "slam --rawlog {rawlog} --config {dir}/c.ini --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            Files{{"c.ini", "@random:2000"}},
+            1,
+            {"c.ini"}},
+    Hostile{"ini_missing",
+            "slam --rawlog {rawlog} --config {dir}/none.ini --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            {},
+            1,
+            {"none.ini"}},
+    Hostile{"ini_folder",
+            "slam --rawlog {rawlog} --config {dir}/goodmap --out-map {dir}/m --out-trajectory {dir}/prev.txt",
+            {},
+            1,
+            {"goodmap"}},
+    Hostile{"map_folder_without_map",
+            "localize --map {dir}/m --rawlog {rawlog} --out-trajectory {dir}/prev.txt",
+            Files{{"m/readme.txt", "no map here\n"}},
+            1,
+            {"map.simplemap.gz", "no such map"}},
+    Hostile{"map_garbage",
+            "localize --map {dir}/m --rawlog {rawlog} --out-trajectory {dir}/prev.txt",
+            Files{{"m/map.simplemap.gz", "junk"}},
+            1,
+            {"map.simplemap.gz"}},
+    Hostile{"map_empty",
+            "localize --map {dir}/m --rawlog {rawlog} --out-trajectory {dir}/prev.txt",
+            Files{{"m/map.simplemap.gz", ""}},
+            1,
+            {"map.simplemap.gz"}},
+    Hostile{"map_truncated",
+            "localize --map {dir}/m --rawlog {rawlog} --out-trajectory {dir}/prev.txt",
+            Files{{"m/map.simplemap.gz", "@head:15000:{data}/mrpt/localization_demo.simplemap.gz"}},
+            1,
+            {"map.simplemap.gz"}},
+    Hostile{"map_random",
+            "localize --map {dir}/m --rawlog {rawlog} --out-trajectory {dir}/prev.txt",
+            Files{{"m/map.simplemap.gz", "@random:8000"}},
+            1,
+            {"map.simplemap.gz"}},
+    Hostile{"truth_bad_line",
+            "localize --map {dir}/goodmap --rawlog {rawlog} --out-trajectory {dir}/prev.txt --ground-truth {dir}/gt.txt",
+            Files{{"gt.txt", "1 2 3\n"}},
+            1,
+            {"gt.txt:1"}},
+    Hostile{"truth_nan",
+            "slam --rawlog {rawlog} --out-map {dir}/m --out-trajectory {dir}/prev.txt --ground-truth {dir}/gt.txt",
+            Files{{"gt.txt", "1 nan 0 0\n"}},
+            1,
+            {"gt.txt:1", "finite"}},
+    Hostile{"truth_empty",
+            "slam --rawlog {rawlog} --out-map {dir}/m --out-trajectory {dir}/prev.txt --ground-truth {dir}/gt.txt",
+            Files{{"gt.txt", ""}},
+            1,
+            {"gt.txt"}},
+    Hostile{"truth_missing",
+            "localize --map {dir}/goodmap --rawlog {rawlog} --out-trajectory {dir}/prev.txt --ground-truth {dir}/none.txt",
+            {},
+            1,
+            {"none.txt"}},
+    Hostile{"bench_localize_rawlog_random",
+            "bench localize --stops 3 --rawlog {dir}/r.rawlog --ground-truth {dir}/gt.txt",
+            Files{{"r.rawlog", "@random:3000"}, {"gt.txt", "1 0 0 0\n"}},
+            1,
+            {"r.rawlog"}},
+};
+
+// Arguments of every command.
+const std::vector<Hostile> kArgumentCases{
+    Hostile{"render_size_zero", "render --out {dir}/prev.png --size 0x0", {}, 2, {"--size"}},
+    Hostile{"render_size_huge", "render --out {dir}/prev.png --size 100000x100000", {}, 2, {"--size"}},
+    Hostile{"render_frames_nan", "render --out {dir}/prev.png --frames nan", {}, 2, {"--frames"}},
+    Hostile{"render_frames_huge", "render --out {dir}/prev.png --frames 1e12", {}, 2, {"--frames"}},
+    Hostile{"render_near_negative", "render --out {dir}/prev.png --near -1", {}, 1, {"near"}},
+    Hostile{"render_far_inf", "render --out {dir}/prev.png --far inf", {}, 2, {"--far"}},
+    Hostile{"render_intrinsics_nan", "render --out {dir}/prev.png --intrinsics nan,50,32,24", {}, 1, {"--intrinsics"}},
+    Hostile{"render_device_out_of_range", "render --out {dir}/prev.png --device 99", {}, 2, {"--device", "99"}},
+    Hostile{"render_device_missing", "render --out {dir}/prev.png --device 5", {}, 1, {"device", "5"}},
+    Hostile{"render_device_text", "render --out {dir}/prev.png --device gpu", {}, 2, {"--device"}},
+    Hostile{
+        "render_pose_short", "render --out {dir}/prev.png --model {duck} --pose-matrix 1,2,3", {}, 1, {"--pose-matrix", "16"}},
+    Hostile{"render_pose_nan",
+            "render --out {dir}/prev.png --model {duck} --pose-matrix nan,0,0,0,0,1,0,0,0,0,1,1,0,0,0,1",
+            {},
+            1,
+            {"--pose-matrix"}},
+    Hostile{"render_out_in_proc", "render --out /proc/projbot.png --size 64x48", {}, 2, {"/proc/projbot.png"}},
+    Hostile{"render_out_not_png", "render --out {dir}/prev.json --size 64x48", {}, 2, {"--out", ".png"}},
+    Hostile{"render_profile_is_folder", "render --out {dir}/a.png --profile {dir}/goodmap", {}, 2, {"--profile", "is a folder"}},
+    Hostile{"show_bad_present_mode", "show --present-mode bogus --frames 1", {}, 2, {"--present-mode", "bogus"}},
+    Hostile{"show_frames_negative", "show --frames -1", {}, 2, {"--frames"}},
+    Hostile{"show_monitor_negative", "show --fullscreen --monitor -2 --frames 1", {}, 2, {"--monitor"}},
+    Hostile{"run_monitor_text", "run --headless --monitor one", {}, 2, {"--monitor"}},
+    Hostile{"run_seed_text", "run --headless --seed abc", {}, 2, {"--seed"}},
+    Hostile{"run_visits_negative", "run --headless --visits -3", {}, 2, {"--visits"}},
+    Hostile{"run_seconds_nan", "run --headless --seconds nan", {}, 2, {"--seconds"}},
+    Hostile{"run_dwell_inf", "run --headless --dwell inf", {}, 2, {"--dwell"}},
+    Hostile{"run_profile_is_folder", "run --headless --profile {dir}/goodmap", {}, 2, {"--profile", "is a folder"}},
+    Hostile{"run_missing_config", "run --headless --config {dir}/none.yaml", {}, 1, {"none.yaml"}},
+    Hostile{"tour_seed_text", "tour --seed abc --report {dir}/prev.json", {}, 2, {"--seed"}},
+    Hostile{"tour_dwell_negative", "tour --dwell -1 --report {dir}/prev.json", {}, 2, {"--dwell"}},
+    Hostile{"tour_visits_huge", "tour --visits 1e12 --report {dir}/prev.json", {}, 2, {"--visits"}},
+    Hostile{"tour_frames_is_file", "tour --frames {dir}/prev.txt --report {dir}/prev.json", {}, 2, {"--frames", "prev.txt"}},
+    Hostile{"tour_report_is_folder", "tour --report {dir}/goodmap", {}, 2, {"--report", "is a folder"}},
+    Hostile{"tour_unknown_flag", "tour --fast", {}, 2, {"--fast"}},
+    Hostile{"align_voxel_zero", "align --model {duck} --scan {data}/bunny/bun4.pcd --voxel 0", {}, 2, {"--voxel"}},
+    Hostile{"align_voxel_nan", "align --model {duck} --scan {data}/bunny/bun4.pcd --voxel nan", {}, 2, {"--voxel"}},
+    Hostile{"align_depth_scale_zero", "align --model {duck} --scan " + kGood16 + " --depth-scale 0", {}, 2, {"--depth-scale"}},
+    Hostile{"align_intrinsics_three", "align --model {duck} --scan " + kGood16 + " --intrinsics 1,2,3", {}, 1, {"--intrinsics"}},
+    Hostile{"align_init_matrix_not_rigid",
+            "align --model {duck} --scan {data}/bunny/bun4.pcd --init-matrix 2,0,0,0,0,2,0,0,0,0,2,0,0,0,0,1",
+            {},
+            1,
+            {"--init-matrix"}},
+    Hostile{"align_init_three", "align --model {duck} --scan {data}/bunny/bun4.pcd --init \"1 2 3\"", {}, 1, {"--init"}},
+    Hostile{"slam_out_map_is_file",
+            "slam --rawlog {rawlog} --out-map {dir}/prev.txt --out-trajectory {dir}/t.txt",
+            {},
+            2,
+            {"--out-map", "prev.txt"}},
+    Hostile{"slam_out_trajectory_in_proc",
+            "slam --rawlog {rawlog} --out-map {dir}/m --out-trajectory /proc/t.txt",
+            {},
+            2,
+            {"--out-trajectory", "/proc/t.txt"}},
+    Hostile{"localize_initial_nan",
+            "localize --map {dir}/goodmap --rawlog {rawlog} --out-trajectory {dir}/prev.txt --initial \"nan 0 0\"",
+            {},
+            1,
+            {"--initial"}},
+    Hostile{"localize_no_out", "localize --map {dir}/goodmap --rawlog {rawlog}", {}, 2, {"--out-trajectory"}},
+    Hostile{"bench_render_frames_zero", "bench render --frames 0 --offscreen-only", {}, 2, {"--frames"}},
+    Hostile{"bench_render_sizes_bad", "bench render --sizes 64x,x48 --offscreen-only", {}, 2, {"--sizes"}},
+    Hostile{"bench_render_both_only",
+            "bench render --offscreen-only --windowed-only",
+            {},
+            2,
+            {"--offscreen-only", "--windowed-only"}},
+    Hostile{"bench_track_frames_negative", "bench track --frames -5", {}, 2, {"--frames"}},
+    Hostile{"bench_track_distance_nan", "bench track --distance nan", {}, 2, {"--distance"}},
+    Hostile{"bench_localize_seed_text", "bench localize --seed x", {}, 2, {"--seed"}},
+    Hostile{"bench_localize_truth_without_rawlog", "bench localize --stops 3 --ground-truth {dir}/prev.txt", {}, 2, {"--rawlog"}},
+    Hostile{"bench_unknown", "bench paint", {}, 2, {"paint"}},
+    Hostile{"version_extra", "--version now", {}, 2, {"now"}},
+};
+
+std::vector<Hostile> all_cases() {
+  std::vector<Hostile> cases{
+      Hostile{"no_command", "", "", 2, {"Usage"}},
+      Hostile{"unknown_command", "paint", "", 2, {"unknown command 'paint'"}},
+      Hostile{"unknown_flag", "render --out x.png --colour red", "", 2, {"unknown option --colour", "render --help"}},
+      Hostile{"missing_out", "render", "", 2, {"--out FILE is required"}},
+      Hostile{"missing_value", "render --out", "", 2, {"--out needs a value"}},
+      Hostile{"bad_frames", "render --out {dir}/a.png --frames -3", "", 2, {"--frames"}},
+      Hostile{"bad_size", "render --out {dir}/a.png --size 640by480", "", 2, {"--size", "1920x1080"}},
+      Hostile{"bad_intrinsics", "render --out {dir}/a.png --intrinsics 1,2,3", "", 1, {"--intrinsics", "4"}},
+      Hostile{"negative_fx", "render --out {dir}/a.png --intrinsics -1,2,3,4", "", 1, {"fx and fy"}},
+      Hostile{"near_far", "render --out {dir}/a.png --near 5 --far 1", "", 1, {"near < far"}},
+      Hostile{"pose_not_rigid",
+              "render --out {dir}/a.png --model {duck} --pose-matrix 2,0,0,0,0,2,0,0,0,0,2,1,0,0,0,1",
+              "",
+              1,
+              {"--pose-matrix", "rotation"}},
+      Hostile{"pose_with_two_targets",
+              "render --out {dir}/a.png --pose-matrix 1,0,0,0,0,1,0,0,0,0,1,1,0,0,0,1",
+              "",
+              2,
+              {"single target", "2"}},
+      Hostile{"missing_scene", "render --out {dir}/a.png --scene {dir}/none.yaml", "", 1, {"none.yaml", "cannot open"}},
+      Hostile{"scene_unknown_key",
+              "render --out {dir}/a.png --scene {dir}/bad.yaml",
+              kProj + "targets: []\nextra: 1\n",
+              1,
+              {"bad.yaml:3:", "extra", "unknown key"}},
+      Hostile{"scene_missing_model",
+              "render --out {dir}/a.png --scene {dir}/bad.yaml",
+              kProj + "targets:\n  - {name: a, model: nothere.glb, pose: {translation: [0, 0, 1]}}\n",
+              1,
+              {"nothere.glb", "no such model file"}},
+      Hostile{"scene_bad_model",
+              "render --out {dir}/a.png --scene {dir}/bad.yaml",
+              kProj + "targets:\n  - {name: a, model: bad.yaml, pose: {translation: [0, 0, 1]}}\n",
+              1,
+              {"bad.yaml"}},
+      Hostile{"unwritable_png",
+              "render --out /nonexistent-dir/a.png --size 64x48",
+              "",
+              2,
+              {"--out /nonexistent-dir/a.png", "does not exist"}},
+      Hostile{"render_out_is_a_folder", "render --out {dir} --size 64x48", "", 2, {"--out", "is a folder"}},
+      Hostile{"render_profile_missing_folder",
+              "render --out {dir}/a.png --profile {dir}/no/p.csv",
+              "",
+              2,
+              {"--profile", "no/p.csv", "does not exist"}},
+      Hostile{"tour_report_missing_folder", "tour --report {dir}/no/r.json", "", 2, {"--report", "does not exist"}},
+      Hostile{"tour_frames_parent_missing", "tour --frames {dir}/no/frames", "", 2, {"--frames", "parent folder"}},
+      Hostile{"run_profile_missing_folder", "run --headless --profile {dir}/no/p.csv", "", 2, {"--profile", "does not exist"}},
+      Hostile{"run_bad_present_mode_headless",
+              "run --headless --present-mode bogus",
+              "",
+              2,
+              {"--present-mode must be fifo, mailbox or immediate", "bogus"}},
+      Hostile{"run_bad_seconds", "run --headless --seconds -1", "", 2, {"--seconds"}},
+      Hostile{"slam_out_map_parent_missing",
+              "slam --rawlog {rawlog} --out-map {dir}/a/b/m --out-trajectory {dir}/t.txt",
+              "",
+              2,
+              {"--out-map", "parent folder", "does not exist"}},
+      Hostile{"slam_trajectory_missing_folder",
+              "slam --rawlog {rawlog} --out-map {dir}/m --out-trajectory {dir}/no/t.txt",
+              "",
+              2,
+              {"--out-trajectory", "does not exist"}},
+      Hostile{"localize_trajectory_is_a_folder",
+              "localize --map {dir} --rawlog {rawlog} --out-trajectory {dir}",
+              "",
+              2,
+              {"--out-trajectory", "is a folder"}},
+      Hostile{"bench_without_target", "bench", "", 2, {"bench render"}},
+      Hostile{"align_no_model", "align --scan x.pcd", "", 2, {"--model FILE is required"}},
+      Hostile{"align_missing_scan", "align --model {duck} --scan {dir}/none.pcd", "", 1, {"none.pcd", "no such point cloud"}},
+      Hostile{"align_bad_scan_type", "align --model {duck} --scan {dir}/bad.yaml", "a: 1\n", 2, {"--scan must be"}},
+      Hostile{"align_nan_init", "align --model {duck} --scan {dir}/a.pcd --init \"0 0 nan 0 0 0\"", "", 1, {"--init", "finite"}},
+      Hostile{"align_both_inits",
+              "align --model {duck} --scan {dir}/a.pcd --init \"0 0 1 0 0 0\" --init-matrix 1",
+              "",
+              2,
+              {"not both"}},
+      Hostile{"align_empty_cloud", "align --model {duck} --scan {dir}/bad.pcd", "", 1, {"bad.pcd"}},
+      Hostile{
+          "align_missing_model", "align --model {dir}/none.glb --scan {dir}/a.pcd", "", 1, {"none.glb", "no such model file"}},
+      Hostile{"slam_no_rawlog", "slam --out-map {dir}/m --out-trajectory {dir}/t.txt", "", 2, {"--rawlog is required"}},
+      Hostile{"slam_missing_rawlog",
+              "slam --rawlog {dir}/none.rawlog --out-map {dir}/m --out-trajectory {dir}/t.txt",
+              "",
+              1,
+              {"none.rawlog", "no such rawlog"}},
+      Hostile{"slam_corrupt_rawlog",
+              "slam --rawlog {dir}/bad.yaml --out-map {dir}/m --out-trajectory {dir}/t.txt",
+              "not: a rawlog\n",
+              1,
+              {"bad.yaml", "not a readable MRPT rawlog"}},
+      Hostile{"slam_bad_config",
+              "slam --rawlog {rawlog} --config {dir}/bad.yaml --out-map {dir}/m --out-trajectory {dir}/t.txt",
+              "a: 1\n",
+              1,
+              {"bad.yaml:1:", "expected 'key = value'"}},
+      Hostile{"localize_missing_map",
+              "localize --map {dir}/nomap --rawlog {rawlog} --out-trajectory {dir}/t.txt",
+              "",
+              1,
+              {"nomap", "no such map"}},
+      Hostile{"localize_bad_initial",
+              "localize --map {dir} --rawlog {rawlog} --out-trajectory {dir}/t.txt --initial \"1 2\"",
+              "",
+              1,
+              {"--initial"}},
+      Hostile{"bench_localize_bad_stops", "bench localize --stops 3,x", "", 2, {"--stops"}},
+      Hostile{"tour_bad_mode", "tour --mode paper", "", 2, {"--mode must be odometry, localized or tracking"}},
+      Hostile{"tour_missing_scene", "tour --scene {dir}/nope.yaml", "", 1, {"nope.yaml: cannot open scene file"}},
+      Hostile{"tour_without_tour_section", "tour --scene {dir}/bad.yaml", kProj + "targets: []\n", 1, {"needs a 'tour"}},
+      Hostile{"tour_bad_visits", "tour --visits 0", "", 2, {"--visits"}},
+      Hostile{"run_without_tour_section",
+              "run --headless --config {dir}/bad.yaml",
+              kProj + "targets: []\n",
+              1,
+              {"needs a 'tour: {visits: [...]}' section"}},
+      Hostile{"run_bad_dwell", "run --headless --dwell 0", "", 2, {"--dwell"}}};
+  const auto clouds = cloud_cases();
+  cases.insert(cases.end(), clouds.begin(), clouds.end());
+  cases.insert(cases.end(), kFileCases.begin(), kFileCases.end());
+  cases.insert(cases.end(), kArgumentCases.begin(), kArgumentCases.end());
+  return cases;
+}
+
+}  // namespace
+
+INSTANTIATE_TEST_SUITE_P(Cases, HostileTest, ::testing::ValuesIn(all_cases()),
+                         [](const ::testing::TestParamInfo<Hostile>& param_info) { return param_info.param.name; });
+
+TEST(HostileSuite, HasAtLeast120Cases) { EXPECT_GE(all_cases().size(), 120u); }
