@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <functional>
 
 #include "file_kind.hpp"
 #include "pcd_header.hpp"
@@ -15,15 +16,26 @@
 namespace projbot::alignment {
 namespace {
 
-// PCL's PLY parser asserts (abort) on a face list that names a missing vertex, and we read only the
-// vertices: it runs in a child process, whose cloud comes back as width, height and x y z floats.
-int load_ply_isolated(const std::filesystem::path& path, pcl::PointCloud<pcl::PointXYZ>& cloud) {
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+// PCL's readers are not safe on hostile files even after our header check: the PLY parser asserts
+// (abort) on a face list that names a missing vertex, the PCD reader read uninitialised memory on a
+// fuzzed binary file (a 94 TB string, or SIGSEGV). They run in a child process, whose cloud comes back
+// as PCL's return code, width, height and x y z floats.
+int load_isolated(const std::filesystem::path& path, const std::string& kind, const std::function<int(Cloud&)>& load,
+                  Cloud& cloud) {
   std::string bytes;
   try {
-    bytes = config::read_isolated(path, {"PLY file", "PCL's PLY reader"}, [&](config::ReadProgress&) {
-      pcl::PointCloud<pcl::PointXYZ> read;
+    bytes = config::read_isolated(path, {kind, "PCL's reader"}, [&](config::ReadProgress&) {
+      Cloud read;
       config::Bytes out;
-      out.put<std::int32_t>(pcl::io::loadPLYFile(path.string(), read));
+      try {
+        out.put<std::int32_t>(load(read));
+      } catch (const std::bad_alloc&) {
+        throw;
+      } catch (const std::exception& e) {  // PCLException, and std::stoi's from its header parser
+        throw AlignmentError(path.string() + ": malformed " + kind + " (PCL's reader failed on it: " + e.what() + ")");
+      }
       out.put<std::uint32_t>(read.width);
       out.put<std::uint32_t>(read.height);
       std::vector<float> xyz;
@@ -32,21 +44,21 @@ int load_ply_isolated(const std::filesystem::path& path, pcl::PointCloud<pcl::Po
       out.put_vector(xyz);
       return out.take();
     });
-    config::BytesReader in(bytes);
-    const auto rc = in.get<std::int32_t>();
-    const auto width = in.get<std::uint32_t>();
-    const auto height = in.get<std::uint32_t>();
-    const auto xyz = in.get_vector<float>();
-    cloud.clear();
-    for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) cloud.push_back({xyz[i], xyz[i + 1], xyz[i + 2]});
-    if (static_cast<std::size_t>(width) * height == cloud.size()) {
-      cloud.width = width;
-      cloud.height = height;
-    }
-    return rc;
   } catch (const config::IsolatedReadError& e) {
     throw AlignmentError(e.what());
   }
+  config::BytesReader in(bytes);
+  const auto rc = in.get<std::int32_t>();
+  const auto width = in.get<std::uint32_t>();
+  const auto height = in.get<std::uint32_t>();
+  const auto xyz = in.get_vector<float>();
+  cloud.clear();
+  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) cloud.push_back({xyz[i], xyz[i + 1], xyz[i + 2]});
+  if (static_cast<std::size_t>(width) * height == cloud.size()) {
+    cloud.width = width;
+    cloud.height = height;
+  }
+  return rc;
 }
 
 }  // namespace
@@ -56,19 +68,21 @@ PointCloud read_cloud(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(path, ec)) throw AlignmentError(path.string() + ": is a folder, not a point cloud file");
   if (!std::filesystem::is_regular_file(path, ec)) throw AlignmentError(path.string() + ": no such point cloud file");
   const std::string ext = detail::lower_extension(path);
-  pcl::PointCloud<pcl::PointXYZ> cloud;
+  Cloud cloud;
   int rc = -1;
   // PCL prints its own complaints to stderr; ours, below, names the file and what to do.
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   try {
     if (ext == ".pcd") {
       const detail::PcdHeader header = detail::check_pcd(path);  // PCL's reader crashes on what this refuses
-      rc = pcl::io::loadPCDFile(path.string(), cloud);
+      rc = load_isolated(
+          path, "PCD file", [&](Cloud& c) { return pcl::io::loadPCDFile(path.string(), c); }, cloud);
       if (rc >= 0 && cloud.size() != header.points)
         throw AlignmentError(path.string() + ": read " + std::to_string(cloud.size()) + " points, the header claims " +
                              std::to_string(header.points) + " (malformed data section?)");
     } else if (ext == ".ply") {
-      rc = load_ply_isolated(path, cloud);
+      rc = load_isolated(
+          path, "PLY file", [&](Cloud& c) { return pcl::io::loadPLYFile(path.string(), c); }, cloud);
     } else {
       throw AlignmentError(path.string() + ": unknown point cloud format (use .pcd or .ply)");
     }

@@ -75,6 +75,7 @@ class MapReader {
   // Call once every known key was read: any other key is a typo the user must hear about.
   void reject_unknown() const {
     for (const auto& kv : node_) {
+      if (!kv.first.IsScalar()) fail(kv.first, path_, "a key must be a plain name, not a list or map");
       const auto key = kv.first.as<std::string>();
       if (!used_.contains(key)) fail(kv.first, key_path(key), "unknown key");
     }
@@ -232,7 +233,9 @@ void validate_projector(const ProjectorConfig& p, std::string_view where) {
     fail("need 0 < near < far (near " + std::to_string(p.near_m) + ", far " + std::to_string(p.far_m) + ")");
 }
 
-Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& source) {
+namespace {
+
+Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path& source) {
   const std::string file = source.empty() ? std::string("<scene>") : source.string();
   YAML::Node root;
   try {
@@ -351,6 +354,8 @@ Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& sourc
   return scene;
 }
 
+}  // namespace
+
 int Scene::target_index(std::string_view name) const {
   for (std::size_t i = 0; i < targets.size(); ++i)
     if (targets[i].name == name) return static_cast<int>(i);
@@ -365,6 +370,15 @@ Scene load_scene(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   return parse_scene(text.str(), path);
+}
+
+Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& source) {
+  try {
+    return parse_scene_nodes(yaml_text, source);
+  } catch (const YAML::Exception& e) {  // what the readers above do not name themselves (a fuzzer found one)
+    const std::string file = source.empty() ? std::string("<scene>") : source.string();
+    throw ConfigError(file + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) : std::string()) + ": " + e.msg);
+  }
 }
 
 }  // namespace projbot::config
