@@ -126,14 +126,11 @@ KeyKind kind_of_default(const std::string& value) {
   return {Kind::Text, {}};
 }
 
+// MRPT's names of these enumerators (an out-of-range value cast to the enum would be undefined).
 template <typename Enum>
-std::vector<std::string> enum_names() {
+std::vector<std::string> enum_names(std::initializer_list<Enum> values) {
   std::vector<std::string> names;
-  for (int v = 0; v < 16; ++v) try {
-      names.push_back(mrpt::typemeta::TEnumType<Enum>::value2name(static_cast<Enum>(v)));
-    } catch (const std::exception&) {
-      break;
-    }
+  for (const Enum v : values) names.push_back(mrpt::typemeta::TEnumType<Enum>::value2name(v));
   return names;
 }
 
@@ -146,8 +143,9 @@ std::map<std::string, KeyKind> known_keys() {
   icp.getAllKeys("ICP", names);
   for (const auto& k : names) keys["icp/" + lower(k)] = kind_of_default(trim(icp.read_string("ICP", k, "")));
   keys["icp/thresholdang_deg"] = {Kind::Real, {}};  // read in degrees beside thresholdAng (radians)
-  keys["icp/icp_algorithm"] = {Kind::Choice, enum_names<mrpt::slam::TICPAlgorithm>()};
-  keys["icp/icp_covariance_method"] = {Kind::Choice, enum_names<mrpt::slam::TICPCovarianceMethod>()};
+  keys["icp/icp_algorithm"] = {Kind::Choice, enum_names({mrpt::slam::icpClassic, mrpt::slam::icpLevenbergMarquardt})};
+  keys["icp/icp_covariance_method"] = {Kind::Choice,
+                                       enum_names({mrpt::slam::icpCovLinealMSE, mrpt::slam::icpCovFiniteDifferences})};
   for (const auto& e : parse_ini(detail::kDefaultIcpSlamIni, "default"))
     keys.emplace(lower(e.section) + "/" + lower(e.key), kind_of_default(e.value));
   return keys;
