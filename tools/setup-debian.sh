@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build ccache pkg-config git clang-format
+  build-essential cmake ninja-build ccache pkg-config git clang clang-format
   libvulkan-dev vulkan-validationlayers mesa-vulkan-drivers glslang-tools vulkan-tools
   libglm-dev libeigen3-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
   libglfw3-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Quick start, command 2 (and CI): install what is missing, build everything with warnings as errors,
-# check formatting, check the align path for memory errors under AddressSanitizer + UBSan (on every
-# machine; valgrind's memcheck in the main suite is skipped where valgrind cannot run the executable,
-# see the README), then run the whole test suite (GPU tests on lavapipe, window tests under Xvfb).
+# check formatting, check the align path and the hostile-input suite for memory errors under
+# AddressSanitizer + UBSan (on every machine; valgrind's memcheck in the main suite is skipped where
+# valgrind cannot run the executable, see the README), run the whole test suite (GPU tests on lavapipe,
+# window tests under Xvfb), then every fuzz target for a short smoke run (its seeds include every
+# earlier finding).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # ccache keys without this checkout's absolute path, so a fresh clone (CI's) reuses earlier compiles.
@@ -12,10 +14,11 @@ bash tools/check-format.sh
 cmake --preset ci >/dev/null
 cmake --build --preset ci
 cmake --preset asan >/dev/null
-cmake --build --preset asan --target projbot
+cmake --build --preset asan --target projbot hostile_test
 ctest --preset asan-memory
 status=0
 ctest --preset ci || status=$?
 # ctest does not show a skipped test's output: say why each one was skipped.
 grep -h '^[a-z]*: SKIPPED:' build/ci/Testing/Temporary/LastTest.log 2>/dev/null || true
+bash tools/fuzz.sh all "${PROJBOT_FUZZ_SMOKE_SECONDS:-15}" || status=1
 exit "$status"
