@@ -252,6 +252,25 @@ TEST_F(CliTest, RunInterruptedKeepsTheProfile) {
   EXPECT_GT(rows, 100) << "about 5 s at 60 Hz";
 }
 
+// MRPT's own log lines only with --verbose, and then on stderr (stdout carries the results).
+TEST_F(CliTest, MrptLogsOnlyWithVerbose) {
+  const std::string base =
+      "slam --rawlog " + kRawlog + " --out-map " + (dir_ / "m").string() + " --out-trajectory " + (dir_ / "t.txt").string();
+  const CliRun quiet = run_projbot(base);
+  ASSERT_EQ(quiet.code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output.find("MRPT"), std::string::npos) << quiet.output;
+  const CliRun verbose = run_projbot(base + " --verbose");
+  ASSERT_EQ(verbose.code, 0) << verbose.output;
+  EXPECT_NE(verbose.output.find("[MRPT CMetricMapBuilderICP]"), std::string::npos) << verbose.output;
+  FILE* pipe = popen((std::string(PROJBOT_EXE) + " " + base + " --verbose 2>/dev/null").c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  for (std::array<char, 512> buf{}; fgets(buf.data(), buf.size(), pipe) != nullptr;) out += buf.data();
+  EXPECT_EQ(pclose(pipe), 0);
+  EXPECT_NE(out.find("ICP-SLAM: 37 scans"), std::string::npos) << out;
+  EXPECT_EQ(out.find("MRPT"), std::string::npos) << "MRPT lines on stdout: " << out;
+}
+
 // Ctrl-C and SIGTERM in the benchmarks: the rows measured are printed whole, the run under way is dropped
 // and named, exit 130 / 143 within a second.
 TEST_F(CliTest, BenchmarksInterruptedKeepTheRowsDone) {

@@ -26,6 +26,7 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <iostream>
 #include <sstream>
 
 #include "icp_slam_ini.hpp"
@@ -278,10 +279,16 @@ std::vector<TrajectoryPoint> read_trajectory(const std::filesystem::path& path) 
 }
 
 SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,
-                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested) {
+                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested, bool verbose) {
   const auto t0 = Clock::now();
   mrpt::slam::CMetricMapBuilderICP builder;
-  builder.setVerbosityLevel(mrpt::system::LVL_ERROR);
+  // MRPT logs to stdout, where our results go: its lines go to stderr, and only with --verbose.
+  builder.logging_enable_console_output = false;
+  builder.setVerbosityLevel(verbose ? mrpt::system::LVL_INFO : mrpt::system::LVL_ERROR);
+  if (verbose)
+    builder.logRegisterCallback([](std::string_view msg, mrpt::system::VerbosityLevel, std::string_view logger, auto) {
+      std::cerr << "[MRPT " << logger << "] " << msg << (msg.empty() || msg.back() != '\n' ? "\n" : "");
+    });
   try {
     if (ini) {
       check_icp_slam_config(*ini);

@@ -87,7 +87,8 @@ const Command kSlam{
      {"config", "FILE", "icp-slam .ini with [MappingApplication] and [ICP] sections"},
      {"out-map", "DIR", "directory for the map (created)"},
      {"out-trajectory", "FILE", "where to write the corrected trajectory"},
-     {"ground-truth", "FILE", "true trajectory to compare with (timestamp x y phi lines)"}},
+     {"ground-truth", "FILE", "true trajectory to compare with (timestamp x y phi lines)"},
+     {"verbose", "", "let MRPT's own log lines (its map builder's) through to stderr"}},
     [](const cli::Args& args) {
       for (const char* required : {"rawlog", "out-map", "out-trajectory"})
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
@@ -102,7 +103,8 @@ const Command kSlam{
       catch_interrupts();  // Ctrl-C: map and write the scans done so far, then exit 130
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
       std::cout << "mapping " << steps.size() << " scans (Ctrl-C stops and keeps the map of the scans done)..." << std::endl;
-      const robot::SlamResult r = robot::build_map(steps, ini, *args.get("out-map"), [] { return interrupted(); });
+      const robot::SlamResult r = robot::build_map(
+          steps, ini, *args.get("out-map"), [] { return interrupted(); }, args.flag("verbose"));
       robot::write_trajectory(*args.get("out-trajectory"), r.trajectory);
       if (r.interrupted) {
         std::cout << "ICP-SLAM interrupted after " << r.trajectory.size() << " of " << steps.size()

@@ -55,8 +55,10 @@ std::vector<std::string> check_icp_slam_config(const std::filesystem::path& ini)
 /// map.simplemap.gz (keyframes: poses and scans), grid.png and grid.yaml (ROS map_server form).
 /// `stop_requested`, asked before each step, ends the run there (Ctrl-C): the steps done are mapped and
 /// written as for a whole run.
+/// `verbose` lets MRPT's own log lines (its map builder's, at info level) through to stderr.
 SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,
-                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested = {});
+                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested = {},
+                     bool verbose = false);
 
 /// Localiser settings.
 struct LocalizerConfig {
