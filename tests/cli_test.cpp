@@ -338,6 +338,32 @@ TEST_F(CliTest, SlamInterruptedKeepsTheScansDone) {
   EXPECT_LT(lines, 1460);
 }
 
+// Ctrl-C in localize: the trajectory of the scans done is written, exit 130.
+TEST_F(CliTest, LocalizeInterruptedKeepsTheScansDone) {
+  const std::string rawlog = std::string(PROJBOT_SHARED_DATA) + "/mrpt/range_030_bearing_015.rawlog";  // 1460 scans
+  const CliRun slam = run_projbot("slam --rawlog " + rawlog + " --out-map " + (dir_ / "map").string() + " --out-trajectory " +
+                                  (dir_ / "slam.txt").string());
+  ASSERT_EQ(slam.code, 0) << slam.output;
+  const fs::path trajectory = dir_ / "loc.txt";
+  Background loc({"localize", "--map", (dir_ / "map").string(), "--rawlog", rawlog, "--out-trajectory", trajectory.string()},
+                 dir_ / "loc.log");
+  ASSERT_GT(loc.pid, 0);
+  ASSERT_TRUE(loc.wait_for_output("localising 1460 scans", std::chrono::seconds(60))) << loc.output();
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const auto [code, seconds] = loc.signal_and_wait(SIGINT, std::chrono::seconds(30));
+  if (code == 0) GTEST_SKIP() << "the run ended before the signal (a very fast machine): " << loc.output();
+  EXPECT_EQ(code, 130) << loc.output();
+  EXPECT_LT(seconds, 1.0);
+  EXPECT_NE(loc.output().find("localisation interrupted after"), std::string::npos) << loc.output();
+  std::ifstream in(trajectory);
+  int lines = 0;
+  for (std::string line; std::getline(in, line); ++lines) {
+    double ts, x, y, phi;
+    EXPECT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf %lf", &ts, &x, &y, &phi), 4) << line;
+  }
+  EXPECT_LT(lines, 1460);
+}
+
 // Hostile point clouds through the executable: one line naming the file, exit 1, never a signal; the
 // one claiming 2e9 points is refused within a second and in little memory.
 TEST_F(CliTest, HostilePcdFilesAreRefused) {

@@ -152,6 +152,8 @@ const Command kLocalize{
       catch_interrupts();  // Ctrl-C: write the trajectory of the scans done, then exit 130
       robot::Localizer loc = robot::Localizer::load(*args.get("map"));
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
+      std::cout << "localising " << steps.size() << " scans (Ctrl-C stops and keeps the trajectory of the scans done)..."
+                << std::endl;
       loc.reset(start);
       std::vector<robot::TrajectoryPoint> out;
       int accepted = 0;
