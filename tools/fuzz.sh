@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Fuzzes one reader of user files with libFuzzer (clang + AddressSanitizer):
-#   tools/fuzz.sh TARGET [SECONDS]     TARGET: gltf scene pcd ply depth_png depth_tiff rawlog ini, or all
+#   tools/fuzz.sh TARGET [SECONDS]     TARGET: gltf scene pcd ply depth_png depth_tiff oni rawlog ini, or all
 # Seeds: tests/fuzz/corpus/TARGET (committed) plus, for gltf, the shared models. The growing corpus is
 # build/fuzz/corpus/TARGET; a finding (crash, ASan report, allocation over 512 MB, 10 s on one input) is
 # saved under build/fuzz/findings/TARGET/ and the script exits 1: make it a regression test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-targets=(gltf scene pcd ply depth_png depth_tiff rawlog ini)
+targets=(gltf scene pcd ply depth_png depth_tiff oni rawlog ini)
 usage() { echo "usage: tools/fuzz.sh TARGET [SECONDS]   (TARGET: ${targets[*]} or all; SECONDS default 60)"; exit 2; }
 [[ $# -ge 1 ]] || usage
 target=$1
@@ -19,8 +19,12 @@ fi
 [[ " ${targets[*]} " == *" $target "* ]] || { echo "fuzz: unknown target '$target'"; usage; }
 command -v clang++ >/dev/null || { echo "fuzz: needs clang (apt-get install clang)"; exit 1; }
 export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
-cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz --target "fuzz_$target" | grep -v '^\[' || true
+mkdir -p build
+( # one build at a time: several fuzzers may start side by side
+  flock 9
+  cmake --preset fuzz >/dev/null
+  cmake --build --preset fuzz --target "fuzz_$target" | grep -v '^\[' || true
+) 9>build/.fuzz-build.lock
 [[ -x build/fuzz/tests/fuzz/fuzz_$target ]] || { echo "fuzz: fuzz_$target did not build"; exit 1; }
 
 corpus=build/fuzz/corpus/$target
@@ -36,12 +40,15 @@ malloc_limit=512
 [[ $target == rawlog ]] && malloc_limit=2048
 log=build/fuzz/$target.log
 set +e
+start=$(date +%s)
 "./build/fuzz/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=3072 \
   -malloc_limit_mb=$malloc_limit -artifact_prefix="$findings/" -print_final_stats=1 "$corpus" >"$log" 2>&1
 status=$?
+elapsed=$(($(date +%s) - start))
+((elapsed > 0)) || elapsed=1
 set -e
 runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1 || echo 0)
-echo "fuzz $target: $runs inputs in $seconds s ($((runs / seconds)) per second), corpus $(ls "$corpus" | wc -l) files, exit $status (log: $log)"
+echo "fuzz $target: $runs inputs in $elapsed s ($((runs / elapsed)) per second), corpus $(ls "$corpus" | wc -l) files, exit $status (log: $log)"
 if [[ $status -ne 0 ]]; then
   grep -E 'ERROR|SUMMARY|Test unit written' "$log" | head -5
   exit 1
