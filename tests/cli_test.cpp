@@ -106,6 +106,17 @@ class CliTest : public ::testing::Test {
   fs::path dir_;
 };
 
+// The lines of a trajectory file written by slam or localize; each must be `timestamp x y phi`.
+int trajectory_lines(const fs::path& file) {
+  std::ifstream in(file);
+  int lines = 0;
+  for (std::string line; std::getline(in, line); ++lines) {
+    double ts, x, y, phi;
+    EXPECT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf %lf", &ts, &x, &y, &phi), 4) << file << ": " << line;
+  }
+  return lines;
+}
+
 const std::string kDuck = std::string(PROJBOT_SHARED_DATA) + "/gltf/Duck/glTF-Binary/Duck.glb";
 const std::string kRawlog = std::string(PROJBOT_SHARED_DATA) + "/mrpt/localization_demo.rawlog";
 
@@ -166,15 +177,7 @@ TEST_F(CliTest, SlamThenLocalize) {
                                  (dir_ / "loc.txt").string() + " --ground-truth " + (dir_ / "slam.txt").string());
   ASSERT_EQ(loc.code, 0) << loc.output;
   EXPECT_NE(loc.output.find("localisation vs ground truth"), std::string::npos) << loc.output;
-  std::ifstream t(dir_ / "loc.txt");
-  std::string line;
-  int lines = 0;
-  while (std::getline(t, line)) {
-    double ts, x, y, phi;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf %lf", &ts, &x, &y, &phi), 4) << line;
-    ++lines;
-  }
-  EXPECT_EQ(lines, 225);
+  EXPECT_EQ(trajectory_lines(dir_ / "loc.txt"), 225);
 }
 
 TEST_F(CliTest, AlignPrintsJson) {
@@ -329,13 +332,7 @@ TEST_F(CliTest, SlamInterruptedKeepsTheScansDone) {
   EXPECT_EQ(code, 130) << slam.output();
   EXPECT_NE(slam.output().find("ICP-SLAM interrupted after"), std::string::npos) << slam.output();
   EXPECT_TRUE(fs::exists(dir_ / "map" / "map.simplemap.gz"));
-  std::ifstream in(trajectory);
-  int lines = 0;
-  for (std::string line; std::getline(in, line); ++lines) {
-    double ts, x, y, phi;
-    EXPECT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf %lf", &ts, &x, &y, &phi), 4) << line;
-  }
-  EXPECT_LT(lines, 1460);
+  EXPECT_LT(trajectory_lines(trajectory), 1460);
 }
 
 // Ctrl-C in localize: the trajectory of the scans done is written, exit 130.
@@ -355,13 +352,7 @@ TEST_F(CliTest, LocalizeInterruptedKeepsTheScansDone) {
   EXPECT_EQ(code, 130) << loc.output();
   EXPECT_LT(seconds, 1.0);
   EXPECT_NE(loc.output().find("localisation interrupted after"), std::string::npos) << loc.output();
-  std::ifstream in(trajectory);
-  int lines = 0;
-  for (std::string line; std::getline(in, line); ++lines) {
-    double ts, x, y, phi;
-    EXPECT_EQ(std::sscanf(line.c_str(), "%lf %lf %lf %lf", &ts, &x, &y, &phi), 4) << line;
-  }
-  EXPECT_LT(lines, 1460);
+  EXPECT_LT(trajectory_lines(trajectory), 1460);
 }
 
 // Hostile point clouds through the executable: one line naming the file, exit 1, never a signal; the
