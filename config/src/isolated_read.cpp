@@ -15,6 +15,8 @@
 #include <fstream>
 #include <new>
 
+#include "write_all.hpp"
+
 // A fuzzer's or sanitizer's report-and-exit hook, present only in such builds.
 extern "C" __attribute__((weak)) void __sanitizer_set_death_callback(void (*callback)());
 
@@ -32,17 +34,6 @@ constexpr bool kAddressSanitizer = false;
 #else
 constexpr bool kAddressSanitizer = false;
 #endif
-
-bool write_all(int fd, const char* data, std::size_t size) {
-  while (size > 0) {
-    const ssize_t n = ::write(fd, data, size);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    data += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
 
 // Everything the child writes, until it closes the pipe or `limit` passes (then: false).
 bool read_all(int fd, std::chrono::milliseconds limit, std::string& out) {
@@ -114,7 +105,7 @@ void default_action(int sig) {
   } catch (...) {
     reply = "Eunknown error";
   }
-  _exit(write_all(fd, reply.data(), reply.size()) ? 0 : 3);
+  _exit(detail::write_all(fd, reply.data(), reply.size()) == 0 ? 0 : 3);
 }
 
 // ", after N objects, at byte B", or "" where the reader kept no count.

@@ -8,26 +8,13 @@
 #include <cstring>
 #include <string>
 
+#include "write_all.hpp"
+
 namespace projbot::config {
 
 namespace {
 
 std::string reason(int err) { return std::strerror(err); }
-
-// Writes all bytes to fd; returns 0 or the errno of the first failure.
-int write_all(int fd, const void* data, std::size_t size) {
-  const auto* p = static_cast<const char*>(data);
-  while (size > 0) {
-    const ssize_t n = ::write(fd, p, size);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return errno;
-    }
-    p += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return 0;
-}
 
 std::filesystem::path temporary_beside(const std::filesystem::path& path) {
   static std::atomic<unsigned> counter{0};
@@ -47,7 +34,7 @@ void write_file_atomically(const std::filesystem::path& path, const void* data, 
     if (std::filesystem::is_directory(st)) throw OutputError(path.string() + ": cannot write: it is a folder");
     const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);  // a device or FIFO: in place
     if (fd < 0) throw OutputError(path.string() + ": cannot write: " + reason(errno));
-    const int err = write_all(fd, data, size);
+    const int err = detail::write_all(fd, data, size);
     const int close_err = ::close(fd) == 0 ? 0 : errno;
     if (err != 0 || close_err != 0) throw OutputError(path.string() + ": cannot write: " + reason(err != 0 ? err : close_err));
     return;
@@ -56,7 +43,7 @@ void write_file_atomically(const std::filesystem::path& path, const void* data, 
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0)
     throw OutputError(path.string() + ": cannot write: " + reason(errno) + " (does the folder exist and is it writable?)");
-  int err = write_all(fd, data, size);
+  int err = detail::write_all(fd, data, size);
   if (err == 0 && ::fsync(fd) != 0 && errno != EINVAL) err = errno;
   if (::close(fd) != 0 && err == 0) err = errno;
   if (err == 0 && std::rename(tmp.c_str(), path.c_str()) != 0) err = errno;
