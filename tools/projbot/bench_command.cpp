@@ -45,12 +45,6 @@ std::vector<std::pair<int, int>> parse_sizes(const std::string& text) {
   return out;
 }
 
-// Ctrl-C in a benchmark: the rows printed are whole measurements; the run under way is not one.
-int bench_interrupted(std::size_t measured, int planned) {
-  std::printf("interrupted after %zu of %d frames of this run (not reported); the rows above are complete\n", measured, planned);
-  return interrupt_exit_code();
-}
-
 }  // namespace
 
 const Command kBenchRender{
@@ -121,7 +115,9 @@ const Command kBenchRender{
             }
             renderer.finish(*target);
             const auto s = profiler.summary();
-            if (interrupted()) return bench_interrupted(s.frames, frames);
+            if (interrupted())
+              return benchmark_interrupted("after " + std::to_string(s.frames) + " of " + std::to_string(frames) +
+                                           " frames of this run (not reported)");
             char size[32];
             std::snprintf(size, sizeof size, "%dx%d", w, h);
             std::printf("%-11s %8zu %10s %-9s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f\n", m.name.c_str(), m.model.triangle_count(),

@@ -19,11 +19,6 @@
 namespace projbot::tools {
 namespace {
 
-int interrupted_at(const char* what, int frame, int frames) {
-  std::printf("interrupted while %s (frame %d of %d); the rows above are complete\n", what, frame, frames);
-  return interrupt_exit_code();
-}
-
 struct Stats {
   std::vector<double> ms, err_mm, err_deg;
   void print(const char* name) const {
@@ -73,9 +68,13 @@ const Command kBenchTrack{
       std::fflush(stdout);
       std::vector<Eigen::Matrix4d> truth;
       std::vector<alignment::DepthImage> depth;
+      const auto stopped = [&](const std::string& what, int frame) {
+        return benchmark_interrupted("while " + what + " (frame " + std::to_string(frame) + " of " + std::to_string(frames) +
+                                     ")");
+      };
       catch_interrupts();  // Ctrl-C: the methods measured are printed whole, the one under way is dropped; exit 130
       for (int f = 0; f < frames; ++f) {
-        if (interrupted()) return interrupted_at("rendering the depth sequence", f, frames);
+        if (interrupted()) return stopped("rendering the depth sequence", f);
         const double t = f / 30.0;  // a smooth path: up to 1 cm and 2 degrees per frame at 30 Hz
         const Eigen::Matrix4d T =
             config::pose_from_xyz_rpy({0.12 * std::sin(2.0 * t), 0.06 * std::sin(1.3 * t), distance + 0.1 * std::sin(0.9 * t)},
@@ -107,7 +106,7 @@ const Command kBenchTrack{
       const Stats ours = measure([&](int f, const Eigen::Matrix4d& prev) {
         return tracker.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target;
       });
-      if (interrupted()) return interrupted_at("measuring", static_cast<int>(ours.ms.size()) + 1, frames);
+      if (interrupted()) return stopped("measuring", static_cast<int>(ours.ms.size()) + 1);
       ours.print("projective (20k of 50k)");
       alignment::TrackerConfig all_points;
       all_points.model_points = {5000, 15000, 50000};
@@ -115,13 +114,13 @@ const Command kBenchTrack{
       const Stats ours_all = measure([&](int f, const Eigen::Matrix4d& prev) {
         return tracker_all.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target;
       });
-      if (interrupted()) return interrupted_at("measuring", static_cast<int>(ours_all.ms.size()) + 1, frames);
+      if (interrupted()) return stopped("measuring", static_cast<int>(ours_all.ms.size()) + 1);
       ours_all.print("projective (all 50k)");
       const alignment::PclIcpBaseline pcl_icp(model);
       const Stats base = measure([&](int f, const Eigen::Matrix4d& prev) {
         return pcl_icp.track(alignment::depth_to_cloud(depth[static_cast<std::size_t>(f)], k), prev);
       });
-      if (interrupted()) return interrupted_at("measuring", static_cast<int>(base.ms.size()) + 1, frames);
+      if (interrupted()) return stopped("measuring", static_cast<int>(base.ms.size()) + 1);
       base.print("pcl IterativeClosestPoint");
       const auto mean = [](const std::vector<double>& v) {
         return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());

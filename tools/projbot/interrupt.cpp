@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <iostream>
 
 namespace projbot::tools {
 namespace {
@@ -34,6 +35,11 @@ bool interrupted() { return g_signal.load() != 0; }
 int interrupt_exit_code() {
   const int sig = g_signal.load();
   return sig == 0 ? 0 : 128 + sig;
+}
+
+int benchmark_interrupted(const std::string& where) {
+  std::cout << "interrupted " << where << "; the rows above are complete" << std::endl;
+  return interrupt_exit_code();
 }
 
 }  // namespace projbot::tools

@@ -206,11 +206,6 @@ bool print_sim_tour_row(int n, robot::PoseSource source, int seed) {
   return true;
 }
 
-int bench_interrupted() {
-  std::cout << "interrupted: the rows above are complete; the rest was not measured\n";
-  return interrupt_exit_code();
-}
-
 const Command kBenchLocalize{
     "bench localize",
     "benchmark localisation at the stops of simulated tours, and ICP-SLAM vs ground truth",
@@ -255,7 +250,7 @@ const Command kBenchLocalize{
                 << "|---|---|---|---|---|---|---|---|\n";
       for (const int n : counts)
         for (const auto source : {robot::PoseSource::localized, robot::PoseSource::odometry}) {
-          if (!print_sim_tour_row(n, source, seed)) return bench_interrupted();
+          if (!print_sim_tour_row(n, source, seed)) return benchmark_interrupted("during the simulated tours");
         }
       if (!dataset) {
         std::cout << "\nICP-SLAM part skipped: " << rawlog << " or " << gt << " not found\n";
@@ -265,7 +260,7 @@ const Command kBenchLocalize{
       const fs::path dir = fs::temp_directory_path() / ("projbot_bench_slam_" + std::to_string(::getpid()));
       const auto r = robot::build_map(steps, std::nullopt, dir, [] { return interrupted(); });
       fs::remove_all(dir);
-      if (r.interrupted) return bench_interrupted();
+      if (r.interrupted) return benchmark_interrupted("during ICP-SLAM");
       std::cout << "\nICP-SLAM on " << rawlog.filename() << " (" << steps.size() << " scans, " << r.keyframes << " keyframes, "
                 << r.seconds * 1000 / static_cast<double>(steps.size()) << " ms per scan):\n";
       print_errors("ICP-SLAM vs ground truth", compare(r.trajectory, truth));
