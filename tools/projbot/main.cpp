@@ -112,9 +112,14 @@ int main(int argc, char** argv) {
   const int code = dispatch(argc, argv);
   // What went to standard output must have arrived: `align --json >/dev/full` once exited 0 with
   // nothing written. Every command and --help / --version end here.
-  if (std::cout.flush(), std::fflush(stdout) != 0 || !std::cout) {
+  errno = 0;
+  std::cout.flush();
+  const bool flushed = std::fflush(stdout) == 0;
+  const int err = errno;  // set only if these flushes failed: a write that failed during the run set it long ago
+  if (!flushed || !std::cout || std::ferror(stdout)) {
     std::cerr << "projbot" << (argc > 1 ? std::string(" ") + argv[1] : std::string())
-              << ": cannot write to standard output: " << std::strerror(errno) << '\n';
+              << ": cannot write to standard output: " << (err != 0 ? std::strerror(err) : "a write to it failed during the run")
+              << '\n';
     return 1;
   }
   return code;
