@@ -1,0 +1,96 @@
+#pragma once
+// Motion prediction (issue 14): a constant-velocity Kalman filter on SE(3) per target, fed by the
+// tracker's accepted poses and their capture times, and the bounded extrapolation that lets the renderer
+// draw a moving target where it will be when the projector's frame is displayed, not where it was
+// when the depth was captured. Eigen only.
+// The filter is not thread-safe (it lives in the tracker thread); MotionState is a plain value handed
+// to the render thread with each pose.
+
+#include <Eigen/Core>
+#include <deque>
+
+namespace projbot::alignment {
+
+struct MotionModelConfig {
+  /// Process noise: white acceleration, as the square root of its spectral density. How quickly the
+  /// filter lets a target change speed; tuned in the twin on scripted motions (`projbot bench motion`).
+  double accel_noise = 1.0;          ///< m s^-1.5
+  double angular_accel_noise = 3.0;  ///< rad s^-1.5
+  double position_noise_m = 0.0007;  ///< the tracker's pose noise per frame (1 sigma, each axis)
+  double rotation_noise_rad = 0.002;
+  /// A pose this far outside the prediction (normalised innovation squared, 3 degrees of freedom;
+  /// 16.3 is the 99.9 % point) means the target started or stopped: the velocity restarts from the
+  /// newest two poses instead of coasting on, so a sudden stop overshoots for two frames at most.
+  double maneuver_gate = 16.3;
+  /// Poses further apart than this restart the filter (dropped frames, a new stop).
+  double max_gap_s = 0.25;
+  double max_horizon_s = 0.1;     ///< predictions further ahead are held at this horizon
+  double max_speed_m_s = 2.0;     ///< faster estimates are clamped (a person walking with it)
+  double max_rate_deg_s = 360.0;  ///< likewise for turning
+  /// Still or moving, decided on the poses of the last stillness_window_s: the target moves when the
+  /// newest pose is farther from the oldest than still_sigmas times the noise of that difference (3-D;
+  /// 4 sigmas: 0.1 % of still frames at the noise above) and than the minimum speed over that time. A
+  /// still target, or a part of its motion that is still (turning in place), is drawn as measured,
+  /// never extrapolated.
+  double stillness_window_s = 0.2;
+  double still_sigmas = 4.0;
+  double min_speed_m_s = 0.02;
+  double min_rate_deg_s = 3.0;
+};
+
+/// What the renderer needs to extrapolate one target: the pose at `time_s` and its velocity (zero for
+/// the parts of the motion that are not significant). Frames as in T_camera_target.
+struct MotionState {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();                   ///< T_camera_target at time_s
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            ///< of the target's origin, camera frame
+  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  ///< camera frame, about the origin
+  double time_s = 0.0;                                               ///< capture time of the newest pose
+  double max_horizon_s = 0.1;
+  bool moving() const { return !velocity_m_s.isZero(0.0) || !angular_velocity_rad_s.isZero(0.0); }
+};
+
+/// The pose at `t_s`: T moved on at constant velocity for t_s - time_s, clamped to [0, max_horizon_s].
+/// A still state gives T itself, bit for bit.
+Eigen::Matrix4d predict_pose(const MotionState& state, double t_s);
+
+class MotionFilter {
+ public:
+  explicit MotionFilter(MotionModelConfig config = {});
+  /// Forget the motion (a new stop, a lost target).
+  void reset();
+  /// A measured pose (the tracker's) captured at t_s. A pose not newer than the last, or after a gap
+  /// longer than max_gap_s, restarts the filter from it.
+  void update(const Eigen::Matrix4d& T_camera_target, double t_s);
+  /// The state to extrapolate from: still (the newest measured pose, zero velocity) until two poses
+  /// are in and the target has moved more than noise over the stillness window.
+  MotionState state() const;
+  Eigen::Matrix4d predict(double t_s) const { return predict_pose(state(), t_s); }
+  /// Velocity restarts since the last reset (starts and stops detected), for tests and statistics.
+  int maneuvers() const { return maneuvers_; }
+  const MotionModelConfig& config() const { return cfg_; }
+
+ private:
+  // One group of three axes (translation, or rotation as a rotation vector) sharing a 2x2 covariance
+  // of (value, rate) per axis: the axes are independent and equally noisy.
+  struct Group {
+    Eigen::Vector3d rate = Eigen::Vector3d::Zero();
+    Eigen::Matrix2d P = Eigen::Matrix2d::Zero();
+  };
+  void restart_velocity(const Eigen::Matrix4d& T, double dt);
+  void predict_to(double dt);
+  struct Stamped {
+    double t_s;
+    Eigen::Matrix4d T;
+  };
+
+  MotionModelConfig cfg_;
+  int count_ = 0;  // poses since the last reset
+  double t_ = 0.0;
+  Eigen::Matrix4d measured_ = Eigen::Matrix4d::Identity();  // the newest measured pose
+  Eigen::Matrix4d filtered_ = Eigen::Matrix4d::Identity();  // the filter's pose at t_
+  Group translation_, rotation_;
+  int maneuvers_ = 0;
+  std::deque<Stamped> window_;  // the measured poses of the last stillness_window_s, oldest first
+};
+
+}  // namespace projbot::alignment

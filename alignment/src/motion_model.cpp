@@ -1,0 +1,141 @@
+#include "projbot/alignment/motion_model.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace projbot::alignment {
+namespace {
+
+Eigen::Matrix3d exp_so3(const Eigen::Vector3d& w) {
+  const double angle = w.norm();
+  if (angle < 1e-12) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+}
+
+Eigen::Vector3d log_so3(const Eigen::Matrix3d& R) {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+
+Eigen::Vector3d clamp_norm(const Eigen::Vector3d& v, double max_norm) {
+  const double n = v.norm();
+  return n > max_norm ? Eigen::Vector3d(v * (max_norm / n)) : v;
+}
+
+// The two-point start of a constant-velocity filter: value measured (variance r^2), rate from the
+// difference of two measurements dt apart (variance 2 r^2 / dt^2), correlated.
+Eigen::Matrix2d two_point_covariance(double r, double dt) {
+  const double r2 = r * r;
+  Eigen::Matrix2d P;
+  P << r2, r2 / dt, r2 / dt, 2.0 * r2 / (dt * dt);
+  return P;
+}
+
+// Kalman prediction of (value, rate) under white acceleration of spectral density q^2.
+Eigen::Matrix2d propagate(const Eigen::Matrix2d& P, double dt, double q) {
+  Eigen::Matrix2d F;
+  F << 1.0, dt, 0.0, 1.0;
+  Eigen::Matrix2d Q;
+  Q << dt * dt * dt / 3.0, dt * dt / 2.0, dt * dt / 2.0, dt;
+  return F * P * F.transpose() + q * q * Q;
+}
+
+}  // namespace
+
+Eigen::Matrix4d predict_pose(const MotionState& state, double t_s) {
+  if (!state.moving()) return state.T;
+  const double h = std::clamp(t_s - state.time_s, 0.0, state.max_horizon_s);
+  Eigen::Matrix4d T = state.T;
+  T.topLeftCorner<3, 3>() = exp_so3(state.angular_velocity_rad_s * h) * state.T.topLeftCorner<3, 3>();
+  T.topRightCorner<3, 1>() += state.velocity_m_s * h;
+  return T;
+}
+
+MotionFilter::MotionFilter(MotionModelConfig config) : cfg_(config) {}
+
+void MotionFilter::reset() {
+  count_ = 0;
+  measured_ = filtered_ = Eigen::Matrix4d::Identity();
+  window_.clear();
+  translation_ = {};
+  rotation_ = {};
+}
+
+void MotionFilter::restart_velocity(const Eigen::Matrix4d& T, double dt) {
+  translation_.rate = (T.topRightCorner<3, 1>() - measured_.topRightCorner<3, 1>()) / dt;
+  rotation_.rate = log_so3(T.topLeftCorner<3, 3>() * measured_.topLeftCorner<3, 3>().transpose()) / dt;
+  translation_.P = two_point_covariance(cfg_.position_noise_m, dt);
+  rotation_.P = two_point_covariance(cfg_.rotation_noise_rad, dt);
+  filtered_ = T;
+}
+
+void MotionFilter::predict_to(double dt) {
+  filtered_.topLeftCorner<3, 3>() = exp_so3(rotation_.rate * dt) * filtered_.topLeftCorner<3, 3>();
+  filtered_.topRightCorner<3, 1>() += translation_.rate * dt;
+  translation_.P = propagate(translation_.P, dt, cfg_.accel_noise);
+  rotation_.P = propagate(rotation_.P, dt, cfg_.angular_accel_noise);
+}
+
+void MotionFilter::update(const Eigen::Matrix4d& T, double t_s) {
+  const double dt = t_s - t_;
+  if (count_ > 0 && !(dt > 0.0 && dt <= cfg_.max_gap_s)) reset();
+  if (count_ == 0) {
+    filtered_ = T;
+  } else if (count_ == 1) {
+    restart_velocity(T, dt);
+  } else {
+    predict_to(dt);
+    // Innovations: the measured pose against the predicted one (rotation as a rotation vector).
+    const Eigen::Vector3d y_t = T.topRightCorner<3, 1>() - filtered_.topRightCorner<3, 1>();
+    const Eigen::Vector3d y_r = log_so3(T.topLeftCorner<3, 3>() * filtered_.topLeftCorner<3, 3>().transpose());
+    const double s_t = translation_.P(0, 0) + cfg_.position_noise_m * cfg_.position_noise_m;
+    const double s_r = rotation_.P(0, 0) + cfg_.rotation_noise_rad * cfg_.rotation_noise_rad;
+    if (y_t.squaredNorm() / s_t > cfg_.maneuver_gate || y_r.squaredNorm() / s_r > cfg_.maneuver_gate) {
+      ++maneuvers_;
+      restart_velocity(T, dt);  // a start or a stop: what the last frame interval says, nothing older
+    } else {
+      const Eigen::Vector2d k_t = translation_.P.col(0) / s_t, k_r = rotation_.P.col(0) / s_r;
+      filtered_.topRightCorner<3, 1>() += k_t(0) * y_t;
+      translation_.rate += k_t(1) * y_t;
+      filtered_.topLeftCorner<3, 3>() = exp_so3(k_r(0) * y_r) * filtered_.topLeftCorner<3, 3>();
+      rotation_.rate += k_r(1) * y_r;
+      translation_.P -= k_t * translation_.P.row(0);
+      rotation_.P -= k_r * rotation_.P.row(0);
+    }
+  }
+  measured_ = T;
+  t_ = t_s;
+  ++count_;
+  window_.push_back({t_s, T});
+  while (window_.size() > 2 && t_s - window_[1].t_s >= cfg_.stillness_window_s) window_.pop_front();
+}
+
+MotionState MotionFilter::state() const {
+  MotionState s;
+  s.T = measured_;
+  s.time_s = t_;
+  s.max_horizon_s = cfg_.max_horizon_s;
+  if (count_ < 2) return s;
+  // Each part of the motion is used only when it stands out of the measurement noise over the window;
+  // the other part stays as measured, so a target that only turns is not also slid by noise. The
+  // difference of two measured poses has sqrt(2) times their noise.
+  const Eigen::Matrix4d& oldest = window_.front().T;
+  const double span_s = t_ - window_.front().t_s;
+  const double moved_m = (measured_.topRightCorner<3, 1>() - oldest.topRightCorner<3, 1>()).norm();
+  const double turned_rad = log_so3(measured_.topLeftCorner<3, 3>() * oldest.topLeftCorner<3, 3>().transpose()).norm();
+  const bool translating = moved_m > std::max(cfg_.still_sigmas * M_SQRT2 * cfg_.position_noise_m, cfg_.min_speed_m_s * span_s);
+  const bool turning =
+      turned_rad > std::max(cfg_.still_sigmas * M_SQRT2 * cfg_.rotation_noise_rad, cfg_.min_rate_deg_s * M_PI / 180.0 * span_s);
+  if (translating) {
+    s.T.topRightCorner<3, 1>() = filtered_.topRightCorner<3, 1>();
+    s.velocity_m_s = clamp_norm(translation_.rate, cfg_.max_speed_m_s);
+  }
+  if (turning) {
+    s.T.topLeftCorner<3, 3>() = filtered_.topLeftCorner<3, 3>();
+    s.angular_velocity_rad_s = clamp_norm(rotation_.rate, cfg_.max_rate_deg_s * M_PI / 180.0);
+  }
+  return s;
+}
+
+}  // namespace projbot::alignment
