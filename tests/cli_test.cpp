@@ -437,3 +437,40 @@ TEST_F(CliTest, TourPrintsTheTableAndWritesReportAndFrames) {
   EXPECT_GT(share, 0.01);
   EXPECT_LT(share, 0.5);
 }
+
+namespace {
+
+// The figures in one table cell "a / b / c", as numbers.
+std::vector<double> numbers_in(const std::string& cell) {
+  std::vector<double> out;
+  std::istringstream in(cell);
+  std::string item;
+  while (std::getline(in, item, '/')) out.push_back(std::stod(item));
+  return out;
+}
+
+}  // namespace
+
+// bench motion through the executable: both runs, side by side, and prediction better on the box
+// carried at 0.5 m/s (visit 2 of the shipped motion scene).
+TEST_F(CliTest, BenchMotionComparesPredictionOffAndOn) {
+  const CliRun r = run_projbot("bench motion --visits 2 --dwell 2");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("prediction off: 1 2 visits done"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("prediction on: 1 2 visits done"), std::string::npos) << r.output;
+  const auto row = r.output.find("| 2 | box | moved | ");
+  ASSERT_NE(row, std::string::npos) << r.output;
+  std::vector<std::string> cells;
+  std::istringstream line(r.output.substr(row, r.output.find('\n', row) - row));
+  std::string cell;
+  while (std::getline(line, cell, '|')) cells.push_back(cell);
+  ASSERT_GE(cells.size(), 6U) << r.output;
+  const auto off = numbers_in(cells[4]), on = numbers_in(cells[5]);
+  ASSERT_EQ(off.size(), 3U);
+  ASSERT_EQ(on.size(), 3U);
+  EXPECT_GT(off[0], 8.0);  // 0.5 m/s and a pose about 50 ms old at display: about 25 mm behind
+  EXPECT_LT(on[0], 5.0);   // the goal for the mean while moving
+  EXPECT_LT(on[1], 10.0);  // and for its 95th percentile
+  EXPECT_NE(r.output.find("projector 60 Hz, input lag 0 ms; camera 30 Hz"), std::string::npos) << r.output;
+  EXPECT_EQ(run_projbot("bench motion --dwell 0").code, 2);
+}

@@ -48,7 +48,7 @@ TEST(RunWindowTest, FullscreenTwinRunLightsTheTargets) {
   }
   const auto [code, output] = run.get();
   ASSERT_EQ(code, 0) << output;
-  EXPECT_NE(output.find("pose age at present"), std::string::npos) << output;
+  EXPECT_NE(output.find("pose age at display"), std::string::npos) << output;
   EXPECT_NE(output.find("robot: 2 visit(s)"), std::string::npos) << output;
   // A lit target covers a few percent of the 1600x1200 screen, never all of it.
   EXPECT_GT(best, 0.005) << output;

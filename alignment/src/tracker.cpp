@@ -40,6 +40,9 @@ ProjectiveTracker::ProjectiveTracker(ModelCloud model, CameraIntrinsics intrinsi
   std::vector<std::size_t> order(model_.points.size());
   std::iota(order.begin(), order.end(), 0);
   std::shuffle(order.begin(), order.end(), std::mt19937(7));
+  double sq = 0.0;
+  for (const auto& p : model_.points) sq += p.cast<double>().squaredNorm();
+  model_radius_m_ = std::sqrt(sq / static_cast<double>(model_.points.size()));
   ModelCloud shuffled;
   for (auto i : order) {
     shuffled.points.push_back(model_.points[i]);
@@ -84,6 +87,32 @@ std::vector<ProjectiveTracker::Level> ProjectiveTracker::pyramid(const DepthImag
       }
   }
   return levels;
+}
+
+// A weak pull towards the start pose (the motion model's prediction, or the last pose): in the
+// directions the depth constrains, negligible beside the data; in those it does not (a box seen
+// face-on slides freely along its face), it keeps the start instead of whatever the solver's null
+// space gives. It weighs how far the model's points move from the start (at its origin c, and over
+// its radius for turns), times `weight` times the data's mean information per axis.
+void add_start_prior(Eigen::Matrix<double, 6, 6>& H, Eigen::Matrix<double, 6, 1>& g, const Eigen::Matrix4d& T,
+                     const Eigen::Matrix4d& T_start, double weight, double radius_m) {
+  if (!(weight > 0.0)) return;
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>() * T_start.topLeftCorner<3, 3>().transpose();
+  const Eigen::AngleAxisd aa(R);
+  Eigen::Matrix<double, 6, 1> xi;  // T = exp(xi) T_start to first order (turns about the camera's origin)
+  xi.head<3>() = T.topRightCorner<3, 1>() - R * T_start.topRightCorner<3, 1>();
+  xi.tail<3>() = aa.angle() * aa.axis();
+  // The displacement of the model's origin c is v + w x c = M xi; of its points, also rho w.
+  const Eigen::Vector3d c = T.topRightCorner<3, 1>();
+  Eigen::Matrix3d cx;
+  cx << 0.0, -c.z(), c.y(), c.z(), 0.0, -c.x(), -c.y(), c.x(), 0.0;
+  Eigen::Matrix<double, 3, 6> M;
+  M << Eigen::Matrix3d::Identity(), -cx;
+  Eigen::Matrix<double, 6, 6> Hp = M.transpose() * M;
+  Hp.bottomRightCorner<3, 3>() += radius_m * radius_m * Eigen::Matrix3d::Identity();
+  Hp *= weight * H.trace() / 6.0;
+  H += Hp;
+  g += Hp * xi;
 }
 
 TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matrix4d& T_prev) const {
@@ -144,6 +173,7 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       ++out.iterations;
       if (p.used < 6 * 3) break;
       p.H.triangularView<Eigen::Lower>() = p.H.transpose();
+      add_start_prior(p.H, p.g, T, T_prev, cfg_.start_prior, model_radius_m_);
       const Eigen::Matrix<double, 6, 1> xi = p.H.ldlt().solve(-p.g);
       if (!xi.allFinite()) break;
       T = twist_to_transform(xi) * T;

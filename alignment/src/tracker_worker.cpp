@@ -6,13 +6,28 @@
 #include "projbot/alignment/equations.hpp"
 
 namespace projbot::alignment {
+namespace {
+
+// A sample at rest: the motion to draw it with is the pose itself.
+PoseSample still_sample(const Eigen::Matrix4d& T, double capture_time_s, bool lost, double inlier_ratio, double rmse_mm) {
+  PoseSample s;
+  s.T_camera_target = s.motion.T = T;
+  s.capture_time_s = s.motion.time_s = capture_time_s;
+  s.lost = lost;
+  s.inlier_ratio = inlier_ratio;
+  s.rmse_mm = rmse_mm;
+  return s;
+}
+
+}  // namespace
 
 TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config)
     : model_(model),
       aligner_(model, config.acquisition),
       tracker_(std::move(model), intrinsics, config.tracking),
       k_(intrinsics),
-      cfg_(std::move(config)) {}
+      cfg_(std::move(config)),
+      filter_(cfg_.motion) {}
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target) {
   guess_ = T_camera_target;
@@ -23,6 +38,7 @@ void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target) {
   wait_ = 0;
   stats_ = {};
   last_attempt_.reset();
+  filter_.reset();
 }
 
 void TargetFollower::set_pose(const Eigen::Matrix4d& T_camera_target) {
@@ -43,7 +59,10 @@ PoseSample TargetFollower::found(const DepthImage& frame, const Eigen::Matrix4d&
   pose_ = T;
   rejected_ = 0;
   lost_reported_ = false;
-  return PoseSample{T, 0, frame.capture_time_s, false, inlier_ratio, rmse_mm};
+  PoseSample sample = still_sample(T, frame.capture_time_s, false, inlier_ratio, rmse_mm);
+  filter_.update(T, frame.capture_time_s);
+  if (cfg_.predict) sample.motion = filter_.state();
+  return sample;
 }
 
 std::optional<PoseSample> TargetFollower::step(const DepthImage& frame) {
@@ -59,19 +78,27 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
 }
 
 std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
-  const TrackResult r = tracker_.track(frame, *pose_);
+  // A moving target is looked for where its motion has taken it by this frame's capture: 1 m/s is
+  // 3.3 cm between 30 Hz frames, most of the tracker's reach from the last pose.
+  const Eigen::Matrix4d start = cfg_.predict ? filter_.predict(frame.capture_time_s) : *pose_;
+  const TrackResult r = tracker_.track(frame, start);
   if (r.accepted && verified(frame, r.T_camera_target)) return found(frame, r.T_camera_target, r.inlier_ratio, r.rmse_mm);
   // The target moved more than tracking follows (or frames were dropped): one ICP on this same frame
-  // from where it was last seen. Bounded: no restarts, no global search here.
-  const auto a = attempt(frame, *pose_, SearchStage::refine);
+  // from where it was last seen. Bounded: no restarts, no global search here. Not when almost nothing
+  // of the model met a surface or agreed with it: the target is gone from there (carried away), and the ICP
+  // (over a second on a full frame) would keep it lit that long after it left.
+  std::optional<AlignmentResult> a;
+  if (r.correspondences >= tracker_.config().min_correspondences && r.inlier_ratio >= 0.3)
+    a = attempt(frame, start, SearchStage::refine);
   if (a && a->converged && verified(frame, a->T_scan_model)) return found(frame, a->T_scan_model, a->inlier_ratio, a->rmse_mm);
   if (++rejected_ < cfg_.lost_after) return std::nullopt;  // one bad frame: keep showing the last pose
   // Lost: blank it now and search from where it was last seen.
   guess_ = *pose_;
   pose_.reset();
+  filter_.reset();
   wait_ = 0;
   lost_reported_ = true;
-  return PoseSample{guess_, 0, frame.capture_time_s, true, a ? a->inlier_ratio : 0.0, a ? a->rmse_mm : 0.0};
+  return still_sample(guess_, frame.capture_time_s, true, a ? a->inlier_ratio : 0.0, a ? a->rmse_mm : 0.0);
 }
 
 std::optional<PoseSample> TargetFollower::search(const DepthImage& frame) {
@@ -111,7 +138,7 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame) {
     wait_ = std::max(wait_, static_cast<int>(std::ceil(last_ms * (1.0 / cfg_.search_duty - 1.0) * cfg_.camera_hz / 1000.0)));
   if (lost_reported_) return std::nullopt;
   lost_reported_ = true;  // not found at this stop yet: say so once, so the renderer blanks it
-  return PoseSample{guess_, 0, frame.capture_time_s, true, a ? a->inlier_ratio : 0.0, a ? a->rmse_mm : 0.0};
+  return still_sample(guess_, frame.capture_time_s, true, a ? a->inlier_ratio : 0.0, a ? a->rmse_mm : 0.0);
 }
 
 TrackerWorker::TrackerWorker(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config)
@@ -167,7 +194,9 @@ void TrackerWorker::run(std::stop_token stop) {
       std::lock_guard lock(mutex_);
       error_ = std::current_exception();
     }
-    poses_.publish({follower_.last_pose(), ++sequence, 0.0, true, 0.0, 0.0});  // the renderer blanks the target
+    PoseSample lost = still_sample(follower_.last_pose(), 0.0, true, 0.0, 0.0);  // the renderer blanks the target
+    lost.sequence = ++sequence;
+    poses_.publish(lost);
   }
 }
 

@@ -117,6 +117,14 @@ ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std:
   p.cy_px = r.get<double>("cy", p.cy_px, required);
   p.near_m = r.get<double>("near", p.near_m);  // the aggregate above keeps near and far's defaults
   p.far_m = r.get<double>("far", p.far_m);
+  if (key == "projector") {
+    p.refresh_hz = r.get<double>("refresh_hz", p.refresh_hz);
+    p.input_lag_ms = r.get<double>("input_lag_ms", p.input_lag_ms);
+    if (!(p.refresh_hz >= 1.0 && p.refresh_hz <= 1000.0))
+      r.fail(node["refresh_hz"], r.key_path("refresh_hz"), "must be 1..1000 Hz");
+    if (!(p.input_lag_ms >= 0.0 && p.input_lag_ms <= 1000.0))
+      r.fail(node["input_lag_ms"], r.key_path("input_lag_ms"), "must be 0..1000 ms");
+  }
   r.reject_unknown();
   try {
     validate_projector(p, key);
@@ -124,6 +132,30 @@ ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std:
     r.fail(node, "", e.what());
   }
   return p;
+}
+
+TargetMotion read_motion(const YAML::Node& mo, const std::string& path, const std::string& file) {
+  MapReader m(mo, path, file);
+  TargetMotion motion;
+  motion.visit = m.get<int>("visit", motion.visit);
+  if (motion.visit < 1) m.fail(mo["visit"], m.key_path("visit"), "must be >= 1");
+  motion.start_s = m.get<double>("start_s", motion.start_s);
+  motion.duration_s = m.get<double>("duration_s", motion.duration_s);
+  if (motion.start_s < 0.0 || !(motion.duration_s > 0.0)) m.fail(mo, path, "need start_s >= 0 and duration_s > 0");
+  if (YAML::Node tr = m.child("translation", false)) motion.translation_m = m.vector3(tr, m.key_path("translation"));
+  if (YAML::Node rpy = m.child("rpy_deg", false)) motion.rpy_deg = m.vector3(rpy, m.key_path("rpy_deg"));
+  const std::string profile = m.get<std::string>("profile", "smooth");
+  if (profile == "constant")
+    motion.profile = MotionProfile::constant;
+  else if (profile == "accelerate")
+    motion.profile = MotionProfile::accelerate;
+  else if (profile != "smooth")
+    m.fail(mo["profile"], m.key_path("profile"), "must be smooth, constant or accelerate, not '" + profile + "'");
+  motion.stays = m.get<bool>("stays", false);
+  motion.removed = m.get<bool>("removed", false);
+  if (motion.removed && motion.stays) m.fail(mo, path, "a removed target cannot also stay: choose one");
+  m.reject_unknown();
+  return motion;
 }
 
 // Where the robot can stand: inside the room and outside every obstacle. Empty when it can.
@@ -310,22 +342,16 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
         target.markers_m.push_back(t.vector3(mk[k], path + ".markers[" + std::to_string(k) + "]"));
       }
     }
+    // `motion:` one scripted move, or a list of them (one per visit at most).
     if (YAML::Node mo = t.child("motion", false)) {
-      MapReader m(mo, path + ".motion", file);
-      TargetMotion motion;
-      motion.visit = m.get<int>("visit", motion.visit);
-      if (motion.visit < 1) m.fail(mo["visit"], m.key_path("visit"), "must be >= 1");
-      motion.start_s = m.get<double>("start_s", motion.start_s);
-      motion.duration_s = m.get<double>("duration_s", motion.duration_s);
-      if (motion.start_s < 0.0 || !(motion.duration_s > 0.0))
-        m.fail(mo, path + ".motion", "need start_s >= 0 and duration_s > 0");
-      if (YAML::Node tr = m.child("translation", false)) motion.translation_m = m.vector3(tr, m.key_path("translation"));
-      if (YAML::Node rpy = m.child("rpy_deg", false)) motion.rpy_deg = m.vector3(rpy, m.key_path("rpy_deg"));
-      motion.stays = m.get<bool>("stays", false);
-      motion.removed = m.get<bool>("removed", false);
-      if (motion.removed && motion.stays) m.fail(mo, path + ".motion", "a removed target cannot also stay: choose one");
-      m.reject_unknown();
-      target.motion = motion;
+      const bool list = mo.IsSequence();
+      for (std::size_t k = 0; k < (list ? mo.size() : 1); ++k) {
+        const std::string where = path + ".motion" + (list ? "[" + std::to_string(k) + "]" : "");
+        TargetMotion motion = read_motion(list ? mo[k] : mo, where, file);
+        if (target.motion_on(motion.visit))
+          t.fail(list ? mo[k] : mo, where, "visit " + std::to_string(motion.visit) + " already has a motion");
+        target.motions.push_back(motion);
+      }
     }
     t.reject_unknown();
     scene.targets.push_back(std::move(target));

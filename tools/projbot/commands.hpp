@@ -22,6 +22,7 @@ extern const Command kShow;
 extern const Command kBenchRender;
 extern const Command kAlign;
 extern const Command kBenchTrack;
+extern const Command kBenchMotion;
 extern const Command kSlam;
 extern const Command kLocalize;
 extern const Command kBenchLocalize;

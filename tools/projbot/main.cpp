@@ -16,9 +16,9 @@ using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
   static const std::vector<const Command*> all{
-      &projbot::tools::kRender,     &projbot::tools::kShow, &projbot::tools::kBenchRender, &projbot::tools::kAlign,
-      &projbot::tools::kBenchTrack, &projbot::tools::kSlam, &projbot::tools::kLocalize,    &projbot::tools::kBenchLocalize,
-      &projbot::tools::kTour,       &projbot::tools::kRun};
+      &projbot::tools::kRender,        &projbot::tools::kShow,        &projbot::tools::kBenchRender, &projbot::tools::kAlign,
+      &projbot::tools::kBenchTrack,    &projbot::tools::kBenchMotion, &projbot::tools::kSlam,        &projbot::tools::kLocalize,
+      &projbot::tools::kBenchLocalize, &projbot::tools::kTour,        &projbot::tools::kRun};
   return all;
 }
 
@@ -70,11 +70,12 @@ static int dispatch(int argc, char** argv) {
   }
   std::string name = argv[1];
   int first = 2;
-  if (name == "bench") {  // "bench render", "bench track", "bench localize": the benchmark of a subsystem
-    if (argc < 3 || (std::string(argv[2]) != "render" && std::string(argv[2]) != "track" && std::string(argv[2]) != "localize")) {
+  if (name == "bench") {  // "bench render", "bench track", "bench motion", "bench localize": the benchmark of a subsystem
+    const std::string what = argc < 3 ? std::string() : argv[2];
+    if (what != "render" && what != "track" && what != "motion" && what != "localize") {
       std::cerr << "projbot bench: "
                 << (argc < 3 ? std::string("say what to benchmark") : "no benchmark '" + std::string(argv[2]) + "'")
-                << ": projbot bench render | track | localize\n";
+                << ": projbot bench render | track | motion | localize\n";
       return 2;
     }
     name = std::string("bench ") + argv[2];

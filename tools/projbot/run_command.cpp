@@ -92,12 +92,16 @@ const Command kRun{
     "run",
     "the live engine: project onto the tracked targets while the robot tours (the twin with --sim)",
     "projbot run [--config C.yaml] [--sim] [--fullscreen] [--monitor N] [--headless] [--profile p.csv]\n"
-    "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n\n"
+    "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n"
+    "            [--no-predict]\n\n"
     "Opens the projector output and draws, every frame, each target the robot is projecting onto at the\n"
-    "newest pose its tracker worker accepted (Eq. 2, Eq. 3); targets not yet found or lost are blanked.\n"
+    "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
+    "expected display time (one refresh plus the projector's input_lag_ms); targets not yet found or lost\n"
+    "are blanked.\n"
     "The robot thread drives the tour of the config's `tour.visits`, aims the pan-tilt, gives the worker\n"
     "the initial guess (Eq. 1) and dwells while the camera streams depth. Per frame it records the pose's\n"
-    "age at present (depth capture to present) and the frame time, and prints percentiles at the end.\n"
+    "age at display (depth capture to the frame's expected display time) and the frame time, and prints\n"
+    "percentiles at the end.\n"
     "No robot or camera drivers are configured in a scene file yet, so it runs against the digital twin\n"
     "(--sim, the default). Without --config the shipped demo tour runs.\n",
     {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)"},
@@ -110,7 +114,8 @@ const Command kRun{
      {"seconds", "S", "stop after S seconds (default 0: when the tour ends, the window is closed or Ctrl-C)"},
      {"visits", "N", "visits, cycling through the tour (default: the list once)"},
      {"dwell", "S", "seconds the robot projects at each stop (default 4)"},
-     {"seed", "K", "seed of the twin's noise (default 1)"}},
+     {"seed", "K", "seed of the twin's noise (default 1)"},
+     {"no-predict", "", "draw the newest measured pose, not the one predicted for display time"}},
     [](const cli::Args& args) {
       catch_interrupts();  // Ctrl-C / SIGTERM: leave the frame loop at the next frame, then write what was measured
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
@@ -146,11 +151,15 @@ const Command kRun{
       // One tracker worker per target the tour visits.
       const alignment::CameraIntrinsics k = twin::depth_intrinsics(scene);
       std::vector<std::unique_ptr<alignment::TrackerWorker>> workers(scene.targets.size());
+      const bool predict = !args.flag("no-predict");
+      const double display_delay_s = 1.0 / scene.projector.refresh_hz + 1e-3 * scene.projector.input_lag_ms;
+      alignment::WorkerConfig worker_config;
+      worker_config.predict = predict;
       for (std::size_t i = 0; i < scene.targets.size(); ++i) {
         if (!scene.targets[i].T_world_target) continue;
         auto model = assets::load_gltf(scene.targets[i].model);
         assets::scale_and_recenter(model, scene.targets[i].scale, scene.targets[i].recenter);
-        workers[i] = std::make_unique<alignment::TrackerWorker>(alignment::model_cloud_from(model, 50000), k);
+        workers[i] = std::make_unique<alignment::TrackerWorker>(alignment::model_cloud_from(model, 50000), k, worker_config);
       }
 
       alignment::LatestValue<RobotState> state;
@@ -178,7 +187,7 @@ const Command kRun{
       std::size_t blank = 0;
       auto next_frame = Clock::now();
       while (!interrupted() && !target->poll_close() && !robot_done && (seconds == 0.0 || now_s() - t0 < seconds)) {
-        double used_capture = -1.0;
+        double used_capture = -1.0, used_display = 0.0;
         state.read(robot);
         const auto read_poses = [&](std::vector<engine::DrawItem>& out) {
           out.clear();
@@ -186,9 +195,15 @@ const Command kRun{
           alignment::PoseSample pose;
           auto& worker = *workers[static_cast<std::size_t>(robot.target)];
           if (!worker.latest(pose) || pose.lost || pose.capture_time_s < robot.since_s) return;
+          // Drawn where the target will be when this frame is lit: one refresh after it starts (FIFO
+          // presents at the next vblank) plus the projector's input lag (issue 14).
+          const double display_s = now_s() + display_delay_s;
+          const Eigen::Matrix4d T_camera_target =
+              predict ? alignment::predict_pose(pose.motion, display_s) : pose.T_camera_target;
           out.push_back({items[static_cast<std::size_t>(robot.target)].model,
-                         alignment::projector_from_target(scene.pan_tilt.T_projector_camera, pose.T_camera_target)});  // Eq. 2
+                         alignment::projector_from_target(scene.pan_tilt.T_projector_camera, T_camera_target)});  // Eq. 2
           used_capture = pose.capture_time_s;
+          used_display = display_s;
         };
         if (headless) {  // an offscreen target has no vsync: pace it like a 60 Hz projector
           next_frame += std::chrono::microseconds(16667);
@@ -197,7 +212,8 @@ const Command kRun{
         }
         const double start_ms = profiler.now_ms();
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
-        const double age_ms = used_capture >= 0.0 ? 1000.0 * (now_s() - used_capture) : -1.0;
+        // The pose's age when the frame is lit: capture to the expected display time.
+        const double age_ms = used_capture >= 0.0 ? 1000.0 * (std::max(now_s(), used_display) - used_capture) : -1.0;
         if (age_ms >= 0.0)
           ages_ms.push_back(age_ms);
         else
@@ -212,8 +228,8 @@ const Command kRun{
         if (w && w->error()) std::rethrow_exception(w->error());
 
       std::cout << engine::format_summary(profiler.summary()) << '\n';
-      std::cout << std::fixed << std::setprecision(1) << "pose age at present (depth capture to present), " << ages_ms.size()
-                << " frames with a target: p50 " << engine::percentile(ages_ms, 0.5) << " ms, p95 "
+      std::cout << std::fixed << std::setprecision(1) << "pose age at display (depth capture to expected display), "
+                << ages_ms.size() << " frames with a target: p50 " << engine::percentile(ages_ms, 0.5) << " ms, p95 "
                 << engine::percentile(ages_ms, 0.95) << " ms, p99 " << engine::percentile(ages_ms, 0.99) << " ms, max "
                 << engine::percentile(ages_ms, 1.0) << " ms; " << blank << " frames blank (driving, acquiring or lost)\n";
       std::size_t tracked = 0;

@@ -14,7 +14,7 @@ const Command kTour{
     "tour",
     "drive the stops in the digital twin and measure the projection error (the paper's Table 1)",
     "projbot tour [--scene S.yaml] [--visits N] [--seed K] [--mode odometry|localized|tracking] [--report R.json]\n"
-    "             [--frames DIR] [--dwell S] [--no-noise]\n\n"
+    "             [--frames DIR] [--dwell S] [--no-noise] [--no-predict]\n\n"
     "Runs the tour of the scene's `tour.visits` in the digital twin (simulated youBot with wheel drift, laser,\n"
     "MRPT localisation, pan-tilt, Kinect v1 depth camera, projector). At each stop the robot aims at the\n"
     "target's surveyed position, captures depth, takes the initial guess from its pose (Eq. 1), refines it by\n"
@@ -35,7 +35,8 @@ const Command kTour{
      {"report", "FILE", "write the per-visit report as JSON"},
      {"frames", "DIR", "write each visit's projector frame as DIR/visitNN_TARGET.png"},
      {"dwell", "S", "simulated seconds of projection per visit in tracking mode or while a target moves (default 3)"},
-     {"no-noise", "", "depth without the Kinect v1 noise model"}},
+     {"no-noise", "", "depth without the Kinect v1 noise model"},
+     {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"}},
     [](const cli::Args& args) {
       twin::TourOptions o;
       const std::string mode = args.get_or("mode", "localized");
@@ -53,6 +54,7 @@ const Command kTour{
       if (!(o.dwell_s >= 0.0 && o.dwell_s <= 600.0)) throw cli::UsageError("--dwell must be 0..600 seconds");
       o.frames_dir = args.get_or("frames", "");
       o.depth_noise = !args.flag("no-noise");
+      o.predict = !args.flag("no-predict");
       args.check_output_files({"report"});
       args.check_output_folders({"frames"});
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "tour.yaml").string()));

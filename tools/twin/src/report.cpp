@@ -28,6 +28,7 @@ nlohmann::json matrix_json(const Eigen::Matrix4d& T) {
 nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 std::string fixed(double v, int decimals) {
+  if (std::isnan(v)) return "-";  // nothing measured (no marker in the projector's light, no lit frame)
   std::ostringstream s;
   s << std::fixed << std::setprecision(decimals) << v;
   return s.str();
@@ -82,16 +83,21 @@ void print_table(const TourReport& report, std::ostream& out) {
   for (const auto& v : report.visits) any_timeline = any_timeline || !v.timeline.empty();
   if (any_timeline) {
     out << "\nWhile projecting (" << to_string(report.mode)
-        << "):\n\n| # | target | moved | worst mean mm while moving | "
-           "mean mm at the end | re-converged after the move, s | track ms/frame | lit frames | first light s (wall ms) | "
-           "search attempts, ms (longest) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+        << (report.predict ? ", drawn at the pose predicted for display time" : ", drawn at the newest measured pose")
+        << "; errors of each projector frame at its display time):\n\n| # | target | moved | while moving mean / p95 / worst mm "
+           "| "
+           "mean mm still | mean mm at the end | re-converged after the move, s | pose age at display p50 / p95 ms | "
+           "track ms/frame | lit frames | first light s (wall ms) | "
+           "search attempts, ms (longest) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& v : report.visits) {
       if (v.timeline.empty()) continue;
       out << "| " << v.visit << " | " << v.target << " | " << (v.moved ? "yes" : "no") << " | "
-          << (v.moved ? fixed(v.max_mm_moving, 1) : std::string("-")) << " | " << fixed(v.timeline.back().mean_mm, 2) << " | "
-          << (v.reconverge_s < 0 ? std::string("never") : fixed(v.reconverge_s, 2)) << " | "
-          << (v.track_ms_mean > 0 ? fixed(v.track_ms_mean, 1) : std::string("-")) << " | " << v.lit_frames << "/"
-          << v.timeline.size() + 1 << " | "
+          << (v.moved ? fixed(v.moving_mean_mm, 1) + " / " + fixed(v.moving_p95_mm, 1) + " / " + fixed(v.max_mm_moving, 1)
+                      : std::string("-"))
+          << " | " << fixed(v.still_mean_mm, 2) << " | " << fixed(v.timeline.back().mean_mm, 2) << " | "
+          << (v.reconverge_s < 0 ? std::string("never") : fixed(v.reconverge_s, 2)) << " | " << fixed(v.age_p50_ms, 0) << " / "
+          << fixed(v.age_p95_ms, 0) << " | " << (v.track_ms_mean > 0 ? fixed(v.track_ms_mean, 1) : std::string("-")) << " | "
+          << v.lit_frames << "/" << v.timeline.size() + 1 << " | "
           << (v.first_light_s < 0 ? std::string("never")
                                   : fixed(v.first_light_s, 2) + " (" + fixed(v.first_light_wall_ms, 0) + ")")
           << " | "
@@ -120,8 +126,12 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
                          {"error_mm", m.error_mm}});
     nlohmann::json timeline = nlohmann::json::array();
     for (const auto& s : v.timeline)
-      timeline.push_back(
-          {{"t_s", s.t_s}, {"mean_mm", s.mean_mm}, {"max_mm", s.max_mm}, {"moving", s.moving}, {"shown", s.shown}});
+      timeline.push_back({{"t_s", s.t_s},
+                          {"mean_mm", finite_or_null(s.mean_mm)},
+                          {"max_mm", finite_or_null(s.max_mm)},
+                          {"moving", s.moving},
+                          {"shown", s.shown},
+                          {"pose_age_ms", s.age_ms}});
     visits.push_back({{"visit", v.visit},
                       {"target", v.target},
                       {"target_visit", v.target_visit},
@@ -129,8 +139,8 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
                       {"T_projector_target_true", matrix_json(v.T_projector_target_true)},
                       {"T_projector_target_estimated", matrix_json(v.T_projector_target_estimated)},
                       {"markers", markers},
-                      {"mean_mm", v.mean_mm},
-                      {"max_mm", v.max_mm},
+                      {"mean_mm", finite_or_null(v.mean_mm)},
+                      {"max_mm", finite_or_null(v.max_mm)},
                       {"icp",
                        {{"converged", v.icp.converged},
                         {"inlier_ratio", v.icp.inlier_ratio},
@@ -156,6 +166,10 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
                         {"track_per_frame", v.track_ms_mean}}},
                       {"moved", v.moved},
                       {"max_mean_mm_while_moving", v.max_mm_moving},
+                      {"while_moving_mm", {{"mean", finite_or_null(v.moving_mean_mm)}, {"p95", finite_or_null(v.moving_p95_mm)}}},
+                      {"blank_frames_while_moving", v.moving_blank_frames},
+                      {"still_mean_mm", v.still_mean_mm},
+                      {"pose_age_at_display_ms", {{"p50", finite_or_null(v.age_p50_ms)}, {"p95", finite_or_null(v.age_p95_ms)}}},
                       {"reconverge_s", v.reconverge_s},
                       {"target_present", v.target_present},
                       {"lit_frames", v.lit_frames},
@@ -172,6 +186,7 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
   const auto& k = report.projector;
   const nlohmann::json out = {
       {"mode", to_string(report.mode)},
+      {"predict", report.predict},
       {"seed", report.seed},
       {"projector",
        {{"width", k.width_px}, {"height", k.height_px}, {"fx", k.fx_px}, {"fy", k.fy_px}, {"cx", k.cx_px}, {"cy", k.cy_px}}},

@@ -3,10 +3,13 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <deque>
+#include <optional>
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/image.hpp"
+#include "projbot/engine/frame_profiler.hpp"
 #include "projbot/twin/world.hpp"
 
 namespace projbot::twin {
@@ -23,6 +26,9 @@ struct Errors {
   double mean_mm = 0.0, max_mm = 0.0;
 };
 
+// The error at the target's markers. A marker the projector cannot light (turned away, or hidden by
+// the target itself or something in front) has no error to measure and is left out; mean and max are
+// NaN when no marker is visible (such frames are left out of the visit's statistics).
 Errors marker_errors(const Twin& twin, std::size_t target, const config::ProjectorConfig& projector,
                      const Eigen::Matrix4d& T_world_projector, const Eigen::Matrix4d& T_projector_target_estimated) {
   const Eigen::Matrix4d T_projector_world = alignment::rigid_inverse(T_world_projector);
@@ -30,11 +36,20 @@ Errors marker_errors(const Twin& twin, std::size_t target, const config::Project
   const TwinTarget& t = twin.targets()[target];
   const Eigen::Matrix4d T_true = T_projector_world * t.T_world_target_true;
   Errors e;
+  int visible = 0;
   for (const auto& m : t.config.markers_m) {
+    const Eigen::Vector3d truth = (T_true * m.homogeneous()).head<3>();
+    const auto first = cast_ray(scene, Eigen::Vector3d::Zero(), truth.normalized());
+    if (!first || (*first - truth).norm() > 0.002) continue;
     e.markers.push_back(measure_marker(projector, T_projector_target_estimated, T_true, m, scene));
-    e.mean_mm += e.markers.back().error_mm / static_cast<double>(t.config.markers_m.size());
+    e.mean_mm += e.markers.back().error_mm;
     e.max_mm = std::max(e.max_mm, e.markers.back().error_mm);
+    ++visible;
   }
+  if (visible == 0)
+    e.mean_mm = e.max_mm = std::nan("");
+  else
+    e.mean_mm /= visible;
   return e;
 }
 
@@ -85,68 +100,163 @@ struct DwellContext {
   std::uint32_t noise_seed;
 };
 
-// Projection while the robot dwells at the stop: the timeline of errors at camera rate, the target
-// moved or taken away by its script, and in tracking mode the follower stepped on each frame. Returns
-// false when the tour was asked to stop in the middle.
-bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitReport& r) {
+// A tracker result on the simulated clock: usable by projector frames that start at or after ready_s.
+struct InFlight {
+  std::optional<alignment::PoseSample> sample;
+  double ready_s = 0.0;
+};
+
+// The camera side of the dwell, on the simulated clock: frames captured at 30 Hz and handed to one
+// tracker worker, as in `projbot run`. A frame reaches the worker after its capture time (the twin's
+// rendering, standing in for the camera's readout); the worker takes it when it is free before the
+// next frame arrives, else the frame is dropped (the worker always takes the newest). Its result is
+// ready when the worker's step ends: measured wall time, or options.processing_ms for both together.
+class CameraSide {
+ public:
+  CameraSide(const DwellContext& c, alignment::TargetFollower& follower, VisitReport& r) : c_(c), follower_(follower), r_(r) {}
+  // Captures and tracks every frame taken up to t_s; returns the results ready by then, oldest first.
+  std::vector<alignment::PoseSample> ready_by(double t_s);
+  double track_ms = 0.0;
+  int frames = 0;        // captured
+  int tracked = 0;       // taken by the worker
+  double gone_s = -1.0;  // capture time of the first frame without the target (motion.removed)
+
+ private:
+  const DwellContext& c_;
+  alignment::TargetFollower& follower_;
+  VisitReport& r_;
+  std::deque<InFlight> in_flight_;
+  double worker_free_s_ = 0.0;
+};
+
+std::vector<alignment::PoseSample> CameraSide::ready_by(double t_s) {
+  TwinTarget& target = c_.twin.targets()[c_.target];
+  for (double t_k = (frames + 1) / kCameraHz; t_k <= t_s + 1e-9; t_k = (frames + 1) / kCameraHz) {
+    ++frames;
+    target.T_world_target_true = c_.twin.scripted_pose(c_.target, r_.target_visit, t_k);
+    target.in_world = c_.twin.scripted_presence(c_.target, r_.target_visit, t_k);
+    if (!target.in_world && r_.target_present && gone_s < 0.0) gone_s = t_k;
+    if (worker_free_s_ > t_k + 1.0 / kCameraHz) continue;  // still busy when the next frame comes: dropped
+    const auto t0 = Clock::now();
+    alignment::DepthImage frame =
+        c_.twin.capture(c_.truth.T_world_camera.matrix(), c_.noise_seed + static_cast<std::uint32_t>(frames));
+    frame.capture_time_s = t_k;  // the exposure, on the simulated clock
+    const double capture_ms = ms_since(t0);
+    const auto tt = Clock::now();
+    InFlight f{follower_.step(frame), 0.0};
+    const double step_ms = ms_since(tt);
+    track_ms += step_ms;
+    ++tracked;
+    const double start_s = std::max(worker_free_s_, t_k + (c_.options.processing_ms ? 0.0 : 1e-3 * capture_ms));
+    f.ready_s = worker_free_s_ = start_s + 1e-3 * c_.options.processing_ms.value_or(step_ms);
+    in_flight_.push_back(std::move(f));
+  }
+  std::vector<alignment::PoseSample> out;
+  while (!in_flight_.empty() && in_flight_.front().ready_s <= t_s + 1e-9) {
+    if (in_flight_.front().sample) out.push_back(*in_flight_.front().sample);
+    in_flight_.pop_front();
+  }
+  return out;
+}
+
+// The error of one projector frame, against the target's true pose at the frame's display time.
+TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double display_s, bool shown,
+                             const alignment::PoseSample& drawn, bool predict) {
   TwinTarget& target = c.twin.targets()[c.target];
+  target.T_world_target_true = c.twin.scripted_pose(c.target, r.target_visit, display_s);
+  target.in_world = c.twin.scripted_presence(c.target, r.target_visit, display_s);
+  const config::TargetMotion* motion = target.config.motion_on(r.target_visit);
+  TimelineSample s;
+  s.t_s = display_s;
+  s.shown = shown;
+  s.moving = motion && display_s > motion->start_s && display_s <= motion->start_s + motion->duration_s;
+  s.age_ms = 1000.0 * (display_s - drawn.capture_time_s);
+  const Eigen::Matrix4d T_camera_target = predict ? alignment::predict_pose(drawn.motion, display_s) : drawn.T_camera_target;
   const Eigen::Matrix4d& T_projector_camera = c.twin.scene().pan_tilt.T_projector_camera;
-  const Eigen::Matrix4d T_world_projector = c.truth.T_world_projector.matrix();
+  const Errors e = marker_errors(c.twin, c.target, c.projector, c.truth.T_world_projector.matrix(),
+                                 alignment::projector_from_target(T_projector_camera, T_camera_target));
+  s.mean_mm = e.mean_mm;
+  s.max_mm = e.max_mm;
+  return s;
+}
+
+void summarise_timeline(VisitReport& r) {
+  std::vector<double> moving, ages;
+  double still_sum = 0.0;
+  int still_n = 0;
+  for (const auto& s : r.timeline) {
+    if (s.moving && !s.shown) ++r.moving_blank_frames;
+    if (!s.shown || std::isnan(s.mean_mm)) continue;  // blank, or no marker in the projector's light
+    ages.push_back(s.age_ms);
+    if (s.moving) {
+      moving.push_back(s.mean_mm);
+    } else {
+      still_sum += s.mean_mm;
+      ++still_n;
+    }
+  }
+  for (const double m : moving) r.moving_mean_mm += m / static_cast<double>(moving.size());
+  r.moving_p95_mm = engine::percentile(moving, 0.95);
+  r.still_mean_mm = still_n > 0 ? still_sum / still_n : 0.0;
+  r.age_p50_ms = engine::percentile(ages, 0.5);
+  r.age_p95_ms = engine::percentile(ages, 0.95);
+}
+
+// Projection while the robot dwells at the stop, on a simulated clock: the camera at 30 Hz, its frames
+// tracked (tracking mode), and the projector at its refresh rate drawing the newest result ready when
+// its frame starts, predicted to the frame's display time (one refresh later, plus the projector's
+// input lag). Each projector frame's error is measured against the target's true pose at its display
+// time. Returns false when the tour was asked to stop in the middle.
+bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitReport& r) {
+  const TwinTarget& target = c.twin.targets()[c.target];
   const bool tracking = c.options.mode == TourMode::tracking;
-  Eigen::Matrix4d T_camera_target = r.icp.T_scan_model;  // the newest estimate
+  const double period_s = 1.0 / c.projector.refresh_hz;
+  const double display_delay_s = period_s + 1e-3 * c.projector.input_lag_ms;
+  alignment::PoseSample drawn;  // the newest result: at first the arrival's estimate
+  drawn.T_camera_target = drawn.motion.T = r.icp.T_scan_model;
   bool shown = r.projected;
-  double track_ms = 0.0, wall_to_light_ms = r.align_ms;
-  const int frames = static_cast<int>(std::lround(c.options.dwell_s * kCameraHz));
-  const auto& motion = target.config.motion;
-  const double motion_end_s = r.moved ? motion->start_s + motion->duration_s : 0.0;
+  CameraSide camera(c, follower, r);
+  double wall_to_light_ms = r.align_ms;
+  const config::TargetMotion* motion = target.config.motion_on(r.target_visit);
+  const double motion_end_s = motion ? motion->start_s + motion->duration_s : 0.0;
   double back_under = -1.0;  // when the error went back under the goal for good, -1 while it is not
   bool ever_over = false;
-  int gone_frame = -1;  // the first camera frame without the target (motion.removed)
-  for (int k = 1; k <= frames; ++k) {
+  const int frames = static_cast<int>(std::lround(c.options.dwell_s * c.projector.refresh_hz));
+  for (int j = 1; j <= frames; ++j) {
     if (c.options.stop_requested && c.options.stop_requested()) return false;
-    const double t_s = k / kCameraHz;
-    target.T_world_target_true = c.twin.scripted_pose(c.target, r.target_visit, t_s);
-    target.in_world = c.twin.scripted_presence(c.target, r.target_visit, t_s);
-    if (!target.in_world && r.target_present && gone_frame < 0) gone_frame = k;
-    // What the projector shows now was computed from the previous frame (one camera period of latency).
-    TimelineSample s;
-    s.t_s = t_s;
-    s.shown = shown;
-    s.moving = r.moved && t_s > motion->start_s && t_s <= motion_end_s;
-    const Errors now = marker_errors(c.twin, c.target, c.projector, T_world_projector,
-                                     alignment::projector_from_target(T_projector_camera, T_camera_target));
-    s.mean_mm = now.mean_mm;
-    s.max_mm = now.max_mm;
+    const double start_s = j * period_s;
+    if (tracking) {
+      const double before_ms = camera.track_ms;
+      for (const auto& sample : camera.ready_by(start_s)) {
+        shown = !sample.lost;
+        if (shown) drawn = sample;
+      }
+      if (r.first_light_s < 0.0) wall_to_light_ms += camera.track_ms - before_ms;
+    }
+    const TimelineSample s = measure_frame(c, r, start_s + display_delay_s, shown, drawn, c.options.predict);
     r.timeline.push_back(s);
     r.lit_frames += shown ? 1 : 0;
     if (shown && r.first_light_s < 0.0) {
-      r.first_light_s = t_s;
+      r.first_light_s = s.t_s;
       r.first_light_wall_ms = wall_to_light_ms;
     }
-    if (!shown && gone_frame > 0 && r.blank_after_removal_s < 0.0) r.blank_after_removal_s = (k - gone_frame) / kCameraHz;
+    if (!shown && camera.gone_s >= 0.0 && r.blank_after_removal_s < 0.0) r.blank_after_removal_s = s.t_s - camera.gone_s;
     if (s.moving) r.max_mm_moving = std::max(r.max_mm_moving, s.mean_mm);
+    if (std::isnan(s.mean_mm) && shown) continue;  // no marker in the projector's light: nothing measured
     const bool good = shown && s.mean_mm <= kConvergedMm;
-    if (!good && target.in_world) {
+    if (!good && c.twin.targets()[c.target].in_world) {
       ever_over = true;
       back_under = -1.0;
-    } else if (good && back_under < 0.0 && t_s >= motion_end_s) {
-      back_under = t_s;
+    } else if (good && back_under < 0.0 && s.t_s >= motion_end_s) {
+      back_under = s.t_s;
     }
-    if (!tracking) continue;
-    const alignment::DepthImage frame =
-        c.twin.capture(c.truth.T_world_camera.matrix(), c.noise_seed + static_cast<std::uint32_t>(k));
-    const auto tt = Clock::now();
-    if (const auto sample = follower.step(frame)) {
-      shown = !sample->lost;
-      if (shown) T_camera_target = sample->T_camera_target;
-    }
-    const double step_ms = ms_since(tt);
-    track_ms += step_ms;
-    if (r.first_light_s < 0.0) wall_to_light_ms += step_ms;
   }
-  r.track_ms_mean = tracking && frames > 0 ? track_ms / frames : 0.0;
+  r.track_ms_mean = tracking && camera.tracked > 0 ? camera.track_ms / camera.tracked : 0.0;
+  r.tracked_frames = camera.tracked;
+  r.dropped_frames = camera.frames - camera.tracked;
   if (tracking) r.search = follower.search_stats();
   r.reconverge_s = !ever_over ? 0.0 : back_under >= 0.0 ? std::max(0.0, back_under - motion_end_s) : -1.0;
+  summarise_timeline(r);
   return true;
 }
 
@@ -193,6 +303,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   // (the same one the live engine's TrackerWorker runs).
   alignment::WorkerConfig follow;
   follow.acquisition = acquisition;
+  follow.predict = options.predict;
   std::vector<alignment::TargetFollower> followers;
   for (const auto& t : targets) followers.emplace_back(t.cloud, twin.camera(), follow);
   std::unique_ptr<engine::RenderTarget> projector_frame;
@@ -204,6 +315,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   TourReport report;
   report.mode = options.mode;
   report.seed = options.seed;
+  report.predict = options.predict;
   report.projector = scene.projector;
   const int visits = options.visits > 0 ? options.visits : static_cast<int>(scene.visits.size());
   std::vector<int> visit_count(targets.size(), 0);
@@ -261,7 +373,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
 
     // Projecting: the target may be moved or taken away; the tracker (tracking mode) follows it at
     // camera rate, and a lost or missing target is searched for within the follower's budget.
-    r.moved = target.config.motion && target.config.motion->visit == r.target_visit;
+    r.moved = target.config.motion_on(r.target_visit) != nullptr;
     if (options.mode == TourMode::tracking || r.moved)
       report.interrupted = !dwell(DwellContext{twin, i, scene.projector, truth, options, noise_seed}, followers[i], r);
     twin.end_visit(i, r.target_visit);  // back home, or left where it was moved

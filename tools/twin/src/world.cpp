@@ -122,14 +122,26 @@ Arrival Twin::arrive(std::size_t target, int index) {
   return a;
 }
 
+double motion_fraction(config::MotionProfile profile, double x) {
+  switch (profile) {
+    case config::MotionProfile::smooth:
+      return x * x * (3.0 - 2.0 * x);  // smoothstep: no jump in speed at either end
+    case config::MotionProfile::constant:
+      return x;
+    case config::MotionProfile::accelerate:
+      return x * x;
+  }
+  return x;
+}
+
 Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double t_s) const {
   const TwinTarget& t = targets_.at(target);
   const Eigen::Matrix4d& home = home_.at(target);
-  if (!t.config.motion || t.config.motion->visit != target_visit) return home;
-  const config::TargetMotion& m = *t.config.motion;
-  // Smoothstep from 0 to 1 over the motion: no jump in speed at its ends.
+  const config::TargetMotion* motion = t.config.motion_on(target_visit);
+  if (!motion) return home;
+  const config::TargetMotion& m = *motion;
   const double x = std::clamp((t_s - m.start_s) / m.duration_s, 0.0, 1.0);
-  const double s = x * x * (3.0 - 2.0 * x);
+  const double s = motion_fraction(m.profile, x);
   const Eigen::Matrix4d delta = config::pose_from_xyz_rpy(Eigen::Vector3d::Zero(), s * m.rpy_deg);
   Eigen::Matrix4d T = home;
   // Turn about the target's own origin, then shift, both in the world frame.
@@ -141,15 +153,14 @@ Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double
 bool Twin::scripted_presence(std::size_t target, int target_visit, double t_s) const {
   const TwinTarget& t = targets_.at(target);
   if (!t.config.present || gone_.contains(target)) return false;
-  const auto& m = t.config.motion;
-  return !(m && m->removed && m->visit == target_visit && t_s >= m->start_s + m->duration_s);
+  const config::TargetMotion* m = t.config.motion_on(target_visit);
+  return !(m && m->removed && t_s >= m->start_s + m->duration_s);
 }
 
 void Twin::end_visit(std::size_t target, int target_visit) {
-  const auto& motion = targets_.at(target).config.motion;
-  if (motion && motion->stays && motion->visit == target_visit)
-    home_[target] = scripted_pose(target, target_visit, motion->start_s + motion->duration_s);
-  if (motion && motion->removed && motion->visit == target_visit) gone_.insert(target);
+  const config::TargetMotion* motion = targets_.at(target).config.motion_on(target_visit);
+  if (motion && motion->stays) home_[target] = scripted_pose(target, target_visit, motion->start_s + motion->duration_s);
+  if (motion && motion->removed) gone_.insert(target);
   targets_[target].T_world_target_true = home_[target];
   targets_[target].in_world = scripted_presence(target, 0, 0.0);
 }

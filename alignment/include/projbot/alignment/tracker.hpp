@@ -23,6 +23,9 @@ struct TrackerConfig {
   double min_inlier_ratio = 0.6;     ///< quality gate
   double max_rmse_mm = 6.0;
   std::size_t min_correspondences = 200;
+  /// Pull towards the start pose, relative to the depth's mean information per axis: holds the
+  /// directions the depth leaves free (a box seen face-on) at the start (the motion prediction).
+  double start_prior = 0.01;
 };
 
 /// One tracked frame.
@@ -56,6 +59,7 @@ class ProjectiveTracker {
   ModelCloud model_;  // shuffled once, so any prefix is a uniform subsample
   CameraIntrinsics k_;
   TrackerConfig cfg_;
+  double model_radius_m_ = 0.1;  // RMS distance of the model's points from its origin
 };
 
 }  // namespace projbot::alignment

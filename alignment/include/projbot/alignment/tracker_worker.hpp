@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "projbot/alignment/latest_value.hpp"
+#include "projbot/alignment/motion_model.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/tracker.hpp"
 #include "projbot/alignment/verification.hpp"
@@ -38,6 +39,11 @@ struct WorkerConfig {
   /// this share of the predicted silhouette seen through rejects it. A box fitted onto the bare pedestal
   /// it was taken from scores near 1; correct poses, partly occluded ones too, near 0.
   double max_behind_ratio = 0.2;
+  /// Motion prediction (issue 14): tracking starts each frame from the motion filter's prediction at
+  /// the frame's capture time, and each sample carries the motion the renderer extrapolates to its
+  /// display time. False: tracking starts from the last pose and every sample is still.
+  bool predict = true;
+  MotionModelConfig motion;
 };
 
 /// What searching for a target has cost since its stop began.
@@ -57,6 +63,9 @@ struct PoseSample {
   bool lost = true;             ///< true: blank the target, do not project
   double inlier_ratio = 0.0;
   double rmse_mm = 0.0;
+  /// The motion to draw it with: predict_pose(motion, display time). Still (motion.T is
+  /// T_camera_target) unless the target is seen moving and prediction is on.
+  MotionState motion;
 };
 
 /// The worker's policy for one frame, without the thread: track from the last pose; when tracking
@@ -87,6 +96,7 @@ class TargetFollower {
   /// The tracked pose, or the guess while acquiring.
   Eigen::Matrix4d last_pose() const { return pose_.value_or(guess_); }
   const Aligner& aligner() const { return aligner_; }
+  const MotionFilter& motion() const { return filter_; }
 
  private:
   ModelCloud model_;  // for the free-space check
@@ -103,6 +113,7 @@ class TargetFollower {
   SearchStats stats_;
   std::optional<AlignmentResult> last_attempt_;
   FreeSpaceCheck check_;
+  MotionFilter filter_;  // fed with every pose found, reset when the target is lost or a stop begins
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
   // The target is at T (tracked, refined or found): the sample to publish.
   PoseSample found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm);

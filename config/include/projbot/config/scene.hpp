@@ -32,17 +32,26 @@ struct ProjectorConfig {
   double cy_px = 399.5;   ///< principal point y, pixels
   double near_m = 0.1;    ///< near clipping distance along z, metres (> 0)
   double far_m = 20.0;    ///< far clipping distance along z, metres (> near_m)
+  // The projector only (`projector:`), for the time a frame reaches the object (issue 14):
+  double refresh_hz = 60.0;   ///< frames per second it shows (1..1000)
+  double input_lag_ms = 0.0;  ///< its own delay from a frame's arrival to light (0..1000 ms)
 };
+
+/// How a scripted move runs through its duration: `smooth` eases in and out (no jump in speed);
+/// `constant` starts and stops at full speed (a sudden start and a sudden stop); `accelerate` starts from
+/// rest at constant acceleration and stops suddenly at twice the mean speed.
+enum class MotionProfile { smooth, constant, accelerate };
 
 /// A scripted move of a target while the robot projects onto it (the twin): during visit `visit`
 /// (1-based, counted per target), from `start_s` after projection starts, the target turns and slides
-/// smoothly by `delta` (applied in the world frame about the target's origin) over `duration_s`.
+/// by `delta` (applied in the world frame about the target's origin) over `duration_s`, along `profile`.
 struct TargetMotion {
   int visit = 1;
   double start_s = 0.5;
   double duration_s = 2.0;
   Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();  ///< world-frame shift, metres
   Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();        ///< world-frame turn, degrees
+  MotionProfile profile = MotionProfile::smooth;
   bool stays = false;  ///< the target is left where it was moved: later visits find it away from its map pose
   /// Someone carries it away: at start_s + duration_s (after moving as above) it leaves the world for
   /// the rest of the tour.
@@ -72,7 +81,14 @@ struct TargetConfig {
   /// Marker points on the model (model frame after scale and recenter, metres): where the
   /// projection error is measured.
   std::vector<Eigen::Vector3d> markers_m;
-  std::optional<TargetMotion> motion;
+  /// Scripted moves in the twin (`motion:`, one or a list), at most one per visit of this target.
+  std::vector<TargetMotion> motions;
+  /// The move scripted for this target's `visit`-th visit, or nullptr.
+  const TargetMotion* motion_on(int visit) const {
+    for (const auto& m : motions)
+      if (m.visit == visit) return &m;
+    return nullptr;
+  }
 };
 
 /// The twin's room: an axis-aligned rectangle with box obstacles (metres, map frame).

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,12 @@ struct TourOptions {
   std::uint64_t seed = 1;            ///< drift, laser and depth noise
   std::filesystem::path frames_dir;  ///< when set, the projector frame of each visit as a PNG
   double dwell_s = 3.0;              ///< simulated projection time per visit (camera at 30 Hz), when tracking or moving
+  /// Motion prediction (issue 14): the tracker starts from it and each projector frame draws the pose
+  /// predicted for its display time. False: the newest measured pose, as before.
+  bool predict = true;
+  /// Time from a depth frame's capture to its pose being ready, on the simulated clock. Unset: the wall
+  /// time this machine took to render the frame (the twin's sensor) and track it, as `projbot run` sees.
+  std::optional<double> processing_ms;
   bool depth_noise = true;
   /// Asked between visits and between tracking frames: true ends the tour there, keeping the visits
   /// finished so far (the unfinished one is dropped) and marking the report interrupted.
@@ -41,13 +48,14 @@ struct TourOptions {
   std::function<void(const VisitReport&)> on_visit;
 };
 
-/// The projection error at one instant while projecting.
+/// The projection error of one projector frame while projecting, at its display time.
 struct TimelineSample {
-  double t_s = 0.0;      ///< since projection started
+  double t_s = 0.0;      ///< display time, since projection started
   double mean_mm = 0.0;  ///< over the markers
   double max_mm = 0.0;
   bool moving = false;  ///< the target is being moved
   bool shown = true;    ///< false while the target is blanked (lost)
+  double age_ms = 0.0;  ///< of the pose drawn: from its depth frame's capture to display
 };
 
 struct VisitReport {
@@ -69,12 +77,19 @@ struct VisitReport {
   std::vector<TimelineSample> timeline;                     ///< while projecting (empty when the visit projects one frame)
   bool moved = false;                                       ///< the target moved during this visit
   double max_mm_moving = 0.0;                               ///< worst mean error while it moved
+  /// Over the lit projector frames while it moved: mean and 95th percentile of their mean errors.
+  double moving_mean_mm = 0.0, moving_p95_mm = 0.0;
+  int moving_blank_frames = 0;                ///< projector frames blanked while it moved (lost)
+  double still_mean_mm = 0.0;                 ///< over the lit frames while it did not move
+  double age_p50_ms = 0.0, age_p95_ms = 0.0;  ///< pose age at display over the lit frames
   /// Seconds from the end of the motion until the mean error is back under 3 mm and stays there;
   /// 0 when it never left, -1 when it never came back within the dwell.
   double reconverge_s = 0.0;
   double track_ms_mean = 0.0;  ///< tracking mode: wall time per frame
+  /// Tracking mode: camera frames the worker took, and those it dropped because it was still busy.
+  int tracked_frames = 0, dropped_frames = 0;
   bool target_present = true;  ///< the target was in the world when the robot arrived
-  int lit_frames = 0;          ///< projector frames (camera rate) that showed the target, the first included
+  int lit_frames = 0;          ///< projector frames that showed the target, the arrival's included
   /// Simulated seconds from arrival to the first lit frame: 0 when the acquisition lit it at once, -1
   /// when it never did.
   double first_light_s = -1.0;
@@ -88,6 +103,7 @@ struct VisitReport {
 struct TourReport {
   TourMode mode = TourMode::localized;
   std::uint64_t seed = 1;
+  bool predict = true;  ///< TourOptions::predict
   config::ProjectorConfig projector;
   std::vector<VisitReport> visits;  ///< the finished visits
   double wall_s = 0.0;

@@ -115,6 +115,9 @@ class Twin {
   std::unique_ptr<engine::RenderTarget> depth_target_;
 };
 
+/// How far through a scripted motion (0..1) its profile is at the fraction x (0..1) of its duration.
+double motion_fraction(config::MotionProfile profile, double x);
+
 /// The scene's depth camera as the estimator's intrinsics.
 alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene);
 
