@@ -255,9 +255,23 @@ TEST_F(CliTest, RunInterruptedKeepsTheProfile) {
   std::ifstream in(csv);
   std::string line;
   ASSERT_TRUE(std::getline(in, line));
-  EXPECT_EQ(line, "frame,start_ms,pose_age_ms,target");
-  int rows = 0;
-  for (; std::getline(in, line); ++rows) EXPECT_EQ(std::count(line.begin(), line.end(), ','), 3) << line;
+  EXPECT_EQ(line, "frame,start_ms,pose_age_ms,target,capture_ms,display_ms");
+  int rows = 0, lit = 0;
+  for (; std::getline(in, line); ++rows) {
+    ASSERT_EQ(std::count(line.begin(), line.end(), ','), 5) << line;
+    std::vector<std::string> f;
+    std::istringstream cells(line);
+    for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
+    if (f.size() < 6 || f[2].empty()) continue;  // a blank frame
+    ++lit;
+    // Capture before the frame started, display one refresh (16.7 ms at 60 Hz) after, and the age at
+    // least the time between them (more when the frame took longer than a refresh).
+    const double start = std::stod(f[1]), age = std::stod(f[2]), capture = std::stod(f[4]), display = std::stod(f[5]);
+    EXPECT_LT(capture, start) << line;
+    EXPECT_NEAR(display - start, 16.7, 5.0) << line;
+    EXPECT_GE(age, display - capture - 0.01) << line;
+  }
+  EXPECT_GT(lit, 0);
   EXPECT_GT(rows, 100) << "about 5 s at 60 Hz";
 }
 

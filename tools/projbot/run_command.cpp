@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -177,8 +178,8 @@ const Command kRun{
 
       engine::FrameProfiler profiler;
       std::vector<double> ages_ms;
-      struct Row {
-        double start_ms, age_ms;
+      struct Row {  // times in ms on the profiler's clock; capture and display are NaN for a blank frame
+        double start_ms, age_ms, capture_ms, display_ms;
         int target;
       };
       std::vector<Row> rows;
@@ -210,7 +211,7 @@ const Command kRun{
           std::this_thread::sleep_until(next_frame);
           if (Clock::now() > next_frame + std::chrono::milliseconds(50)) next_frame = Clock::now();
         }
-        const double start_ms = profiler.now_ms();
+        const double start_ms = profiler.now_ms(), start_s = now_s();
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
         // The pose's age when the frame is lit: capture to the expected display time.
         const double age_ms = used_capture >= 0.0 ? 1000.0 * (std::max(now_s(), used_display) - used_capture) : -1.0;
@@ -218,7 +219,9 @@ const Command kRun{
           ages_ms.push_back(age_ms);
         else
           ++blank;
-        rows.push_back({start_ms, age_ms, age_ms >= 0.0 ? robot.target : -1});
+        const double nan = std::nan("");
+        rows.push_back({start_ms, age_ms, age_ms >= 0.0 ? start_ms + 1000.0 * (used_capture - start_s) : nan,
+                        age_ms >= 0.0 ? start_ms + 1000.0 * (used_display - start_s) : nan, age_ms >= 0.0 ? robot.target : -1});
       }
       renderer.finish(*target);
       robot_thread.request_stop();
@@ -240,11 +243,14 @@ const Command kRun{
                 << "\n";
       if (const auto csv = args.get("profile")) {
         std::ostringstream f;
-        f << "frame,start_ms,pose_age_ms,target\n";
+        // Per frame: when it started, the capture time of the depth its pose came from and its expected
+        // display time (empty for a blank frame), all on the frame profiler's clock.
+        f << "frame,start_ms,pose_age_ms,target,capture_ms,display_ms\n";
+        const auto opt = [](double v) { return std::isnan(v) ? std::string() : std::to_string(v); };
         for (std::size_t i = 0; i < rows.size(); ++i)
           f << i << ',' << rows[i].start_ms << ',' << (rows[i].age_ms >= 0 ? std::to_string(rows[i].age_ms) : std::string())
-            << ',' << (rows[i].target >= 0 ? scene.targets[static_cast<std::size_t>(rows[i].target)].name : std::string())
-            << '\n';
+            << ',' << (rows[i].target >= 0 ? scene.targets[static_cast<std::size_t>(rows[i].target)].name : std::string()) << ','
+            << opt(rows[i].capture_ms) << ',' << opt(rows[i].display_ms) << '\n';
         config::write_file_atomically(*csv, f.str());
         std::cout << "per-frame profile written to " << *csv << '\n';
       }
