@@ -264,11 +264,13 @@ TEST_F(CliTest, RunInterruptedKeepsTheProfile) {
     for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
     if (f.size() < 6 || f[2].empty()) continue;  // a blank frame
     ++lit;
-    // Capture before the frame started, display one refresh (16.7 ms at 60 Hz) after, and the age at
-    // least the time between them (more when the frame took longer than a refresh).
+    // Capture before the frame started; display one refresh (16.7 ms at 60 Hz) after the pose was read,
+    // which is at or after the frame's start (later when acquiring an image waited); the age at least
+    // the time between capture and display (more when the frame took longer than a refresh).
     const double start = std::stod(f[1]), age = std::stod(f[2]), capture = std::stod(f[4]), display = std::stod(f[5]);
     EXPECT_LT(capture, start) << line;
-    EXPECT_NEAR(display - start, 16.7, 5.0) << line;
+    EXPECT_GE(display - start, 16.6) << line;
+    EXPECT_LT(display - start, 16.7 + 100.0) << line;
     EXPECT_GE(age, display - capture - 0.01) << line;
   }
   EXPECT_GT(lit, 0);

@@ -9,6 +9,14 @@ namespace projbot::alignment {
 namespace {
 
 // A sample at rest: the motion to draw it with is the pose itself.
+// The tracker's second try on a frame where it lost the target: correspondences up to reach_m apart.
+TrackerConfig wide(const WorkerConfig& c) {
+  TrackerConfig t = c.tracking;
+  t.max_distance_m = std::max(t.max_distance_m, c.reach_m);
+  t.iterations = std::vector<int>(t.iterations.size(), 8);
+  return t;
+}
+
 PoseSample still_sample(const Eigen::Matrix4d& T, double capture_time_s, bool lost, double inlier_ratio, double rmse_mm) {
   PoseSample s;
   s.T_camera_target = s.motion.T = T;
@@ -24,7 +32,8 @@ PoseSample still_sample(const Eigen::Matrix4d& T, double capture_time_s, bool lo
 TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config)
     : model_(model),
       aligner_(model, config.acquisition),
-      tracker_(std::move(model), intrinsics, config.tracking),
+      tracker_(model, intrinsics, config.tracking),
+      wide_tracker_(std::move(model), intrinsics, wide(config)),
       k_(intrinsics),
       cfg_(std::move(config)),
       filter_(cfg_.motion) {}
@@ -83,22 +92,19 @@ std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
   const Eigen::Matrix4d start = cfg_.predict ? filter_.predict(frame.capture_time_s) : *pose_;
   const TrackResult r = tracker_.track(frame, start);
   if (r.accepted && verified(frame, r.T_camera_target)) return found(frame, r.T_camera_target, r.inlier_ratio, r.rmse_mm);
-  // The target moved more than tracking follows (or frames were dropped): one ICP on this same frame
-  // from where it was last seen. Bounded: no restarts, no global search here. Not when almost nothing
-  // of the model met a surface or agreed with it: the target is gone from there (carried away), and the ICP
-  // (over a second on a full frame) would keep it lit that long after it left.
-  std::optional<AlignmentResult> a;
-  if (r.correspondences >= tracker_.config().min_correspondences && r.inlier_ratio >= 0.3)
-    a = attempt(frame, start, SearchStage::refine);
-  if (a && a->converged && verified(frame, a->T_scan_model)) return found(frame, a->T_scan_model, a->inlier_ratio, a->rmse_mm);
+  // The target moved more than tracking follows (or frames were dropped): once more on this same frame
+  // with a wider reach (reach_m). A few milliseconds: the PCL ICP that did this before took over a
+  // second on a full frame, and the stale pose stayed lit all that time.
+  const TrackResult w = wide_tracker_.track(frame, start);
+  if (w.accepted && verified(frame, w.T_camera_target)) return found(frame, w.T_camera_target, w.inlier_ratio, w.rmse_mm);
   if (++rejected_ < cfg_.lost_after) return std::nullopt;  // one bad frame: keep showing the last pose
-  // Lost: blank it now and search from where it was last seen.
-  guess_ = *pose_;
+  // Lost: blank it now and search from where it was last seen, or where its motion was taking it.
+  guess_ = start;
   pose_.reset();
   filter_.reset();
   wait_ = 0;
   lost_reported_ = true;
-  return still_sample(guess_, frame.capture_time_s, true, a ? a->inlier_ratio : 0.0, a ? a->rmse_mm : 0.0);
+  return still_sample(guess_, frame.capture_time_s, true, w.inlier_ratio, w.rmse_mm);
 }
 
 std::optional<PoseSample> TargetFollower::search(const DepthImage& frame) {

@@ -22,10 +22,11 @@ namespace projbot::alignment {
 struct WorkerConfig {
   AcquisitionConfig acquisition;
   TrackerConfig tracking;
-  /// Consecutive frames in which neither tracking nor one ICP from the last pose (on the same frame)
-  /// found the target, after which it is reported lost and blanked: 2 frames at 30 Hz blank within
-  /// 100 ms of the first depth frame that shows it gone.
+  /// Consecutive frames in which neither tracking nor a second, wider tracking pass (on the same frame,
+  /// correspondences up to reach_m) found the target, after which it is reported lost and blanked:
+  /// 2 frames at 30 Hz blank within 100 ms of the first depth frame that shows it gone.
   int lost_after = 2;
+  double reach_m = 0.10;
   /// A lost or not-yet-found target is searched for by bounded attempts, escalating SearchStage::local ->
   /// global_near -> global_wide and round again, one attempt per frame at most. After the n-th failed
   /// attempt the next one waits search_spacing_frames[min(n - 1, size - 1)] frames, so an absent target
@@ -102,6 +103,7 @@ class TargetFollower {
   ModelCloud model_;  // for the free-space check
   Aligner aligner_;
   ProjectiveTracker tracker_;
+  ProjectiveTracker wide_tracker_;  // the same frame again, with a wider reach, when tracking failed
   CameraIntrinsics k_;
   WorkerConfig cfg_;
   std::optional<Eigen::Matrix4d> pose_;  // tracked pose; empty while acquiring
