@@ -36,7 +36,44 @@ struct RobotState {
   double since_s = 0.0;
   int visit = 0;
   bool done = false;
+  // The twin's truth for the stop, so the render thread can measure each frame at its display time:
+  int target_visit = 0;                                          // this target's n-th visit (its motion script)
+  Eigen::Matrix4d T_camera_world = Eigen::Matrix4d::Identity();  // the camera's true pose at the stop
+  Eigen::Matrix4d T_world_home = Eigen::Matrix4d::Identity();    // where the target stood when the stop began
 };
+
+// The error of the frames drawn, against the twin's truth at each frame's display time: the mean
+// distance between the markers as drawn and where they truly are then (mm, object space).
+struct DisplayErrors {
+  std::vector<double> moving_mm, still_mm;
+  void print(std::ostream& out) const {
+    double still = 0.0, moving = 0.0;
+    for (const double e : still_mm) still += e / static_cast<double>(still_mm.size());
+    for (const double e : moving_mm) moving += e / static_cast<double>(moving_mm.size());
+    out << "error at display (markers drawn vs true, twin): ";
+    if (moving_mm.empty())
+      out << "no frame while a target moved";
+    else
+      out << "while moving mean " << moving << " mm, p95 " << engine::percentile(moving_mm, 0.95) << " mm, max "
+          << engine::percentile(moving_mm, 1.0) << " mm over " << moving_mm.size() << " frames";
+    out << "; still mean " << (still_mm.empty() ? std::nan("") : still) << " mm over " << still_mm.size() << " frames\n";
+  }
+};
+
+// The mean marker error of a target drawn at T_camera_target, against the twin's truth at display_s.
+// Returns NaN for a target without markers; sets `moving` when its motion script runs at that instant.
+double marker_error_mm(const config::TargetConfig& target, const RobotState& robot, const Eigen::Matrix4d& T_camera_target,
+                       double display_s, bool& moving) {
+  const double t = display_s - robot.since_s;
+  const config::TargetMotion* m = target.motion_on(robot.target_visit);
+  moving = m && t > m->start_s && t <= m->start_s + m->duration_s;
+  if (target.markers_m.empty()) return std::nan("");
+  const Eigen::Matrix4d T_true = robot.T_camera_world * twin::scripted_pose(target, robot.T_world_home, robot.target_visit, t);
+  double sum = 0.0;
+  for (const auto& p : target.markers_m)
+    sum += ((T_camera_target * p.homogeneous()).head<3>() - (T_true * p.homogeneous()).head<3>()).norm();
+  return 1000.0 * sum / static_cast<double>(target.markers_m.size());
+}
 
 struct RunOptions {
   int visits = 0;
@@ -58,13 +95,14 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
     const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
     const std::size_t i = twin.target_index(name);
     const auto scene_index = static_cast<std::size_t>(scene.target_index(name));  // workers and draw items
-    state.publish({-1, now_s(), v + 1, false});
+    state.publish({-1, now_s(), v + 1, false, 0, Eigen::Matrix4d::Identity(), Eigen::Matrix4d::Identity()});
     const twin::Arrival arrival = twin.arrive(i, v);
     const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
     workers[scene_index]->set_initial_guess(arrival.T_camera_target_guess);  // Eq. 1
     const int target_visit = ++count[i];
     const double since = now_s();
-    state.publish({static_cast<int>(scene_index), since, v + 1, false});
+    state.publish({static_cast<int>(scene_index), since, v + 1, false, target_visit, alignment::rigid_inverse(T_world_camera),
+                   twin.home(i)});
     auto tick = Clock::now();
     for (std::uint32_t k = 0; !stop.stop_requested(); ++k) {
       const double t = now_s() - since;
@@ -84,7 +122,7 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
     }
     twin.end_visit(i, target_visit);
   }
-  state.publish({-1, now_s(), visits, true});
+  state.publish({-1, now_s(), visits, true, 0, Eigen::Matrix4d::Identity(), Eigen::Matrix4d::Identity()});
 }
 
 }  // namespace
@@ -101,8 +139,9 @@ const Command kRun{
     "are blanked.\n"
     "The robot thread drives the tour of the config's `tour.visits`, aims the pan-tilt, gives the worker\n"
     "the initial guess (Eq. 1) and dwells while the camera streams depth. Per frame it records the pose's\n"
-    "age at display (depth capture to the frame's expected display time) and the frame time, and prints\n"
-    "percentiles at the end.\n"
+    "age at display (depth capture to the frame's expected display time), the frame time and, in the twin,\n"
+    "the error of the markers as drawn against where they truly are at that display time; it prints\n"
+    "percentiles at the end (the error while a target moves and while it stands still, mm).\n"
     "No robot or camera drivers are configured in a scene file yet, so it runs against the digital twin\n"
     "(--sim, the default). Without --config the shipped demo tour runs.\n",
     {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)"},
@@ -111,7 +150,7 @@ const Command kRun{
      {"monitor", "N", "monitor index for --fullscreen (default 0)"},
      {"headless", "", "draw offscreen at 60 Hz instead of a window (profiling without a display)"},
      {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
-     {"profile", "FILE", "write one CSV row per frame: frame time and pose age"},
+     {"profile", "FILE", "write one CSV row per frame: start, pose age, capture and display time, error"},
      {"seconds", "S", "stop after S seconds (default 0: when the tour ends, the window is closed or Ctrl-C)"},
      {"visits", "N", "visits, cycling through the tour (default: the list once)"},
      {"dwell", "S", "seconds the robot projects at each stop (default 4)"},
@@ -178,8 +217,9 @@ const Command kRun{
 
       engine::FrameProfiler profiler;
       std::vector<double> ages_ms;
+      DisplayErrors errors;
       struct Row {  // times in ms on the profiler's clock; capture and display are NaN for a blank frame
-        double start_ms, age_ms, capture_ms, display_ms;
+        double start_ms, age_ms, capture_ms, display_ms, error_mm;
         int target;
       };
       std::vector<Row> rows;
@@ -189,6 +229,7 @@ const Command kRun{
       auto next_frame = Clock::now();
       while (!interrupted() && !target->poll_close() && !robot_done && (seconds == 0.0 || now_s() - t0 < seconds)) {
         double used_capture = -1.0, used_display = 0.0;
+        Eigen::Matrix4d used_pose = Eigen::Matrix4d::Identity();
         state.read(robot);
         const auto read_poses = [&](std::vector<engine::DrawItem>& out) {
           out.clear();
@@ -205,6 +246,7 @@ const Command kRun{
                          alignment::projector_from_target(scene.pan_tilt.T_projector_camera, T_camera_target)});  // Eq. 2
           used_capture = pose.capture_time_s;
           used_display = display_s;
+          used_pose = T_camera_target;
         };
         if (headless) {  // an offscreen target has no vsync: pace it like a 60 Hz projector
           next_frame += std::chrono::microseconds(16667);
@@ -215,13 +257,20 @@ const Command kRun{
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
         // The pose's age when the frame is lit: capture to the expected display time.
         const double age_ms = used_capture >= 0.0 ? 1000.0 * (std::max(now_s(), used_display) - used_capture) : -1.0;
-        if (age_ms >= 0.0)
+        double error_mm = std::nan("");
+        if (age_ms >= 0.0) {
           ages_ms.push_back(age_ms);
-        else
+          bool moving = false;
+          error_mm =
+              marker_error_mm(scene.targets[static_cast<std::size_t>(robot.target)], robot, used_pose, used_display, moving);
+          if (!std::isnan(error_mm)) (moving ? errors.moving_mm : errors.still_mm).push_back(error_mm);
+        } else {
           ++blank;
+        }
         const double nan = std::nan("");
         rows.push_back({start_ms, age_ms, age_ms >= 0.0 ? start_ms + 1000.0 * (used_capture - start_s) : nan,
-                        age_ms >= 0.0 ? start_ms + 1000.0 * (used_display - start_s) : nan, age_ms >= 0.0 ? robot.target : -1});
+                        age_ms >= 0.0 ? start_ms + 1000.0 * (used_display - start_s) : nan, error_mm,
+                        age_ms >= 0.0 ? robot.target : -1});
       }
       renderer.finish(*target);
       robot_thread.request_stop();
@@ -235,6 +284,7 @@ const Command kRun{
                 << ages_ms.size() << " frames with a target: p50 " << engine::percentile(ages_ms, 0.5) << " ms, p95 "
                 << engine::percentile(ages_ms, 0.95) << " ms, p99 " << engine::percentile(ages_ms, 0.99) << " ms, max "
                 << engine::percentile(ages_ms, 1.0) << " ms; " << blank << " frames blank (driving, acquiring or lost)\n";
+      errors.print(std::cout);
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
       std::cout << "robot: " << robot.visit << " visit(s); the twin's depth camera delivered " << capture_ms.size()
@@ -245,12 +295,12 @@ const Command kRun{
         std::ostringstream f;
         // Per frame: when it started, the capture time of the depth its pose came from and its expected
         // display time (empty for a blank frame), all on the frame profiler's clock.
-        f << "frame,start_ms,pose_age_ms,target,capture_ms,display_ms\n";
+        f << "frame,start_ms,pose_age_ms,target,capture_ms,display_ms,error_mm\n";
         const auto opt = [](double v) { return std::isnan(v) ? std::string() : std::to_string(v); };
         for (std::size_t i = 0; i < rows.size(); ++i)
           f << i << ',' << rows[i].start_ms << ',' << (rows[i].age_ms >= 0 ? std::to_string(rows[i].age_ms) : std::string())
             << ',' << (rows[i].target >= 0 ? scene.targets[static_cast<std::size_t>(rows[i].target)].name : std::string()) << ','
-            << opt(rows[i].capture_ms) << ',' << opt(rows[i].display_ms) << '\n';
+            << opt(rows[i].capture_ms) << ',' << opt(rows[i].display_ms) << ',' << opt(rows[i].error_mm) << '\n';
         config::write_file_atomically(*csv, f.str());
         std::cout << "per-frame profile written to " << *csv << '\n';
       }

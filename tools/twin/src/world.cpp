@@ -134,10 +134,8 @@ double motion_fraction(config::MotionProfile profile, double x) {
   return x;
 }
 
-Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double t_s) const {
-  const TwinTarget& t = targets_.at(target);
-  const Eigen::Matrix4d& home = home_.at(target);
-  const config::TargetMotion* motion = t.config.motion_on(target_visit);
+Eigen::Matrix4d scripted_pose(const config::TargetConfig& target, const Eigen::Matrix4d& home, int target_visit, double t_s) {
+  const config::TargetMotion* motion = target.motion_on(target_visit);
   if (!motion) return home;
   const config::TargetMotion& m = *motion;
   const double x = std::clamp((t_s - m.start_s) / m.duration_s, 0.0, 1.0);
@@ -148,6 +146,10 @@ Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double
   T.topLeftCorner<3, 3>() = delta.topLeftCorner<3, 3>() * home.topLeftCorner<3, 3>();
   T.topRightCorner<3, 1>() += s * m.translation_m;
   return T;
+}
+
+Eigen::Matrix4d Twin::scripted_pose(std::size_t target, int target_visit, double t_s) const {
+  return twin::scripted_pose(targets_.at(target).config, home_.at(target), target_visit, t_s);
 }
 
 bool Twin::scripted_presence(std::size_t target, int target_visit, double t_s) const {

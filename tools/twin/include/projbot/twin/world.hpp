@@ -85,6 +85,8 @@ class Twin {
   /// The target's pose `t_s` into a projection during its `target_visit`-th visit (motion script);
   /// visit 0 is where it stands between visits.
   Eigen::Matrix4d scripted_pose(std::size_t target, int target_visit, double t_s) const;
+  /// Where the target stands between visits (its world pose, or where a `stays` motion left it).
+  const Eigen::Matrix4d& home(std::size_t target) const { return home_.at(target); }
   /// Whether the target is in the world `t_s` into its `target_visit`-th visit (a `removed` motion
   /// takes it away at its end).
   bool scripted_presence(std::size_t target, int target_visit, double t_s) const;
@@ -114,6 +116,9 @@ class Twin {
   alignment::CameraIntrinsics camera_;
   std::unique_ptr<engine::RenderTarget> depth_target_;
 };
+
+/// The pose of `target` standing at `home`, `t_s` into its `target_visit`-th visit (its motion script).
+Eigen::Matrix4d scripted_pose(const config::TargetConfig& target, const Eigen::Matrix4d& home, int target_visit, double t_s);
 
 /// How far through a scripted motion (0..1) its profile is at the fraction x (0..1) of its duration.
 double motion_fraction(config::MotionProfile profile, double x);
