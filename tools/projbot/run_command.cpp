@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -40,6 +41,25 @@ struct RobotState {
   int target_visit = 0;                                          // this target's n-th visit (its motion script)
   Eigen::Matrix4d T_camera_world = Eigen::Matrix4d::Identity();  // the camera's true pose at the stop
   Eigen::Matrix4d T_world_home = Eigen::Matrix4d::Identity();    // where the target stood when the stop began
+};
+
+// The projector's frame period as the render loop sees it: the median interval between the last frame
+// starts (vsync paces them in FIFO mode), the configured refresh until enough frames have run.
+class PresentCadence {
+ public:
+  void frame_started(double t_s) {
+    if (last_s_ > 0.0) intervals_.push_back(t_s - last_s_);
+    if (intervals_.size() > 31) intervals_.pop_front();
+    last_s_ = t_s;
+  }
+  double period_s(double configured_s) const {
+    if (intervals_.size() < 10) return configured_s;
+    return engine::percentile(std::vector<double>(intervals_.begin(), intervals_.end()), 0.5);
+  }
+
+ private:
+  std::deque<double> intervals_;
+  double last_s_ = 0.0;
 };
 
 // The error of the frames drawn, against the twin's truth at each frame's display time: the mean
@@ -135,8 +155,9 @@ const Command kRun{
     "            [--no-predict]\n\n"
     "Opens the projector output and draws, every frame, each target the robot is projecting onto at the\n"
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
-    "expected display time (one refresh plus the projector's input_lag_ms); targets not yet found or lost\n"
-    "are blanked.\n"
+    "expected display time (one frame period as measured, plus the projector's input_lag_ms); targets not\n"
+    "yet found or lost"
+    " are blanked.\n"
     "The robot thread drives the tour of the config's `tour.visits`, aims the pan-tilt, gives the worker\n"
     "the initial guess (Eq. 1) and dwells while the camera streams depth. Per frame it records the pose's\n"
     "age at display (depth capture to the frame's expected display time), the frame time and, in the twin,\n"
@@ -192,7 +213,7 @@ const Command kRun{
       const alignment::CameraIntrinsics k = twin::depth_intrinsics(scene);
       std::vector<std::unique_ptr<alignment::TrackerWorker>> workers(scene.targets.size());
       const bool predict = !args.flag("no-predict");
-      const double display_delay_s = 1.0 / scene.projector.refresh_hz + 1e-3 * scene.projector.input_lag_ms;
+      PresentCadence cadence;
       alignment::WorkerConfig worker_config;
       worker_config.predict = predict;
       for (std::size_t i = 0; i < scene.targets.size(); ++i) {
@@ -237,9 +258,10 @@ const Command kRun{
           alignment::PoseSample pose;
           auto& worker = *workers[static_cast<std::size_t>(robot.target)];
           if (!worker.latest(pose) || pose.lost || pose.capture_time_s < robot.since_s) return;
-          // Drawn where the target will be when this frame is lit: one refresh after it starts (FIFO
-          // presents at the next vblank) plus the projector's input lag (issue 14).
-          const double display_s = now_s() + display_delay_s;
+          // Drawn where the target will be when this frame is lit: one frame period after it starts (FIFO
+          // presents at the next vblank; the period as measured) plus the projector's input lag (issue 14).
+          const double display_s =
+              now_s() + cadence.period_s(1.0 / scene.projector.refresh_hz) + 1e-3 * scene.projector.input_lag_ms;
           const Eigen::Matrix4d T_camera_target =
               predict ? alignment::predict_pose(pose.motion, display_s) : pose.T_camera_target;
           out.push_back({items[static_cast<std::size_t>(robot.target)].model,
@@ -254,6 +276,7 @@ const Command kRun{
           if (Clock::now() > next_frame + std::chrono::milliseconds(50)) next_frame = Clock::now();
         }
         const double start_ms = profiler.now_ms(), start_s = now_s();
+        cadence.frame_started(start_s);
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
         // The pose's age when the frame is lit: capture to the expected display time.
         const double age_ms = used_capture >= 0.0 ? 1000.0 * (std::max(now_s(), used_display) - used_capture) : -1.0;
