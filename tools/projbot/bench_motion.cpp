@@ -42,7 +42,7 @@ void print_side_by_side(const twin::TourReport& off, const twin::TourReport& on)
 const Command kBenchMotion{
     "bench motion",
     "benchmark tracking of moving targets with motion prediction off and on (the twin)",
-    "projbot bench motion [--scene S.yaml] [--visits N] [--seed K] [--dwell S]\n\n"
+    "projbot bench motion [--scene S.yaml] [--visits N] [--seed K] [--dwell S] [--process-noise Q]\n\n"
     "Runs the scene's tour twice in the digital twin in tracking mode, the same seed and motions each time:\n"
     "first drawing the newest measured pose, then the pose predicted for each projector frame's display time\n"
     "(a constant-velocity filter per target; the tracker also starts from it). The camera runs at 30 Hz,\n"
@@ -54,7 +54,8 @@ const Command kBenchMotion{
     {{"scene", "FILE", "scene with scripted motions (default: assets/scenes/motion.yaml)"},
      {"visits", "N", "visits, cycling through the scene's list (default: the list once)"},
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
-     {"dwell", "S", "simulated seconds of projection per visit (default 3)"}},
+     {"dwell", "S", "simulated seconds of projection per visit (default 3)"},
+     {"process-noise", "Q", "the motion filter's acceleration noise, m s^-1.5 (turning: 3 Q rad s^-1.5; default 1)"}},
     [](const cli::Args& args) {
       twin::TourOptions o;
       o.mode = twin::TourMode::tracking;
@@ -62,6 +63,10 @@ const Command kBenchMotion{
       o.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
       o.dwell_s = args.get_double("dwell", 3.0);
       if (!(o.dwell_s >= 0.1 && o.dwell_s <= 600.0)) throw cli::UsageError("--dwell must be 0.1..600 seconds");
+      const double q = args.get_double("process-noise", alignment::MotionModelConfig{}.accel_noise);
+      if (!(q > 0.0 && q <= 100.0)) throw cli::UsageError("--process-noise must be in (0, 100]");
+      o.motion.accel_noise = q;
+      o.motion.angular_accel_noise = 3.0 * q;
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "motion.yaml").string()));
       catch_interrupts();
       o.stop_requested = [] { return interrupted(); };

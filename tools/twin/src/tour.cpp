@@ -304,6 +304,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   alignment::WorkerConfig follow;
   follow.acquisition = acquisition;
   follow.predict = options.predict;
+  follow.motion = options.motion;
   std::vector<alignment::TargetFollower> followers;
   for (const auto& t : targets) followers.emplace_back(t.cloud, twin.camera(), follow);
   std::unique_ptr<engine::RenderTarget> projector_frame;

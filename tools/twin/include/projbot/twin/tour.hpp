@@ -37,6 +37,7 @@ struct TourOptions {
   /// Motion prediction (issue 14): the tracker starts from it and each projector frame draws the pose
   /// predicted for its display time. False: the newest measured pose, as before.
   bool predict = true;
+  alignment::MotionModelConfig motion;  ///< the motion filter's tuning
   /// Time from a depth frame's capture to its pose being ready, on the simulated clock. Unset: the wall
   /// time this machine took to render the frame (the twin's sensor) and track it, as `projbot run` sees.
   std::optional<double> processing_ms;
