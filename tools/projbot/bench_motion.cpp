@@ -23,17 +23,21 @@ std::string cell(double v, int decimals = 1) {
 void print_side_by_side(const twin::TourReport& off, const twin::TourReport& on) {
   std::printf(
       "\n| # | target | motion | while moving mean / p95 / worst mm, off | on | blank frames while moving, off / on | "
-      "still mean mm, off / on | pose age at display p50 / p95 ms (on) |\n|---|---|---|---|---|---|---|---|\n");
+      "lost, lit again after s, off / on | still mean mm, off / on | pose age at display p50 / p95 ms (on) |\n"
+      "|---|---|---|---|---|---|---|---|---|\n");
+  const auto moving = [](const twin::VisitReport& v) {
+    return v.moved ? cell(v.moving_mean_mm) + " / " + cell(v.moving_p95_mm) + " / " + cell(v.max_mm_moving) : std::string("-");
+  };
+  const auto recovery = [](const twin::VisitReport& v) {
+    return v.recovery_s == 0.0 ? std::string("-") : v.recovery_s < 0.0 ? std::string("never") : cell(v.recovery_s, 2);
+  };
   for (std::size_t i = 0; i < std::min(off.visits.size(), on.visits.size()); ++i) {
     const auto& a = off.visits[i];
     const auto& b = on.visits[i];
-    const auto moving = [](const twin::VisitReport& v) {
-      return v.moved ? cell(v.moving_mean_mm) + " / " + cell(v.moving_p95_mm) + " / " + cell(v.max_mm_moving) : std::string("-");
-    };
-    std::printf("| %d | %s | %s | %s | %s | %d / %d | %s / %s | %s / %s |\n", a.visit, a.target.c_str(),
+    std::printf("| %d | %s | %s | %s | %s | %d / %d | %s / %s | %s / %s | %s / %s |\n", a.visit, a.target.c_str(),
                 a.moved ? "moved" : "still", moving(a).c_str(), moving(b).c_str(), a.moving_blank_frames, b.moving_blank_frames,
-                cell(a.still_mean_mm, 2).c_str(), cell(b.still_mean_mm, 2).c_str(), cell(b.age_p50_ms, 0).c_str(),
-                cell(b.age_p95_ms, 0).c_str());
+                recovery(a).c_str(), recovery(b).c_str(), cell(a.still_mean_mm, 2).c_str(), cell(b.still_mean_mm, 2).c_str(),
+                cell(b.age_p50_ms, 0).c_str(), cell(b.age_p95_ms, 0).c_str());
   }
 }
 

@@ -168,6 +168,7 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
                       {"max_mean_mm_while_moving", v.max_mm_moving},
                       {"while_moving_mm", {{"mean", finite_or_null(v.moving_mean_mm)}, {"p95", finite_or_null(v.moving_p95_mm)}}},
                       {"blank_frames_while_moving", v.moving_blank_frames},
+                      {"recovery_s", v.recovery_s},
                       {"still_mean_mm", v.still_mean_mm},
                       {"pose_age_at_display_ms", {{"p50", finite_or_null(v.age_p50_ms)}, {"p95", finite_or_null(v.age_p95_ms)}}},
                       {"reconverge_s", v.reconverge_s},

@@ -171,6 +171,7 @@ TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double
   s.shown = shown;
   s.moving = motion && display_s > motion->start_s && display_s <= motion->start_s + motion->duration_s;
   s.age_ms = 1000.0 * (display_s - drawn.capture_time_s);
+  s.in_world = target.in_world;
   const Eigen::Matrix4d T_camera_target = predict ? alignment::predict_pose(drawn.motion, display_s) : drawn.T_camera_target;
   const Eigen::Matrix4d& T_projector_camera = c.twin.scene().pan_tilt.T_projector_camera;
   const Errors e = marker_errors(c.twin, c.target, c.projector, c.truth.T_world_projector.matrix(),
@@ -198,6 +199,19 @@ void summarise_timeline(VisitReport& r) {
   for (const double m : moving) r.moving_mean_mm += m / static_cast<double>(moving.size());
   r.moving_p95_mm = engine::percentile(moving, 0.95);
   r.still_mean_mm = still_n > 0 ? still_sum / still_n : 0.0;
+  double lost_at = -1.0;  // when the current blank episode began, -1 while lit
+  bool was_lit = false;
+  for (const auto& s : r.timeline) {
+    if (s.shown && lost_at >= 0.0) {
+      r.recovery_s = std::max(r.recovery_s, s.t_s - lost_at);
+      lost_at = -1.0;
+    } else if (!s.shown && was_lit && s.in_world && lost_at < 0.0) {
+      lost_at = s.t_s;
+    }
+    was_lit = was_lit || s.shown;
+    if (!s.in_world) lost_at = -1.0;  // carried away: blank is right, nothing to recover
+  }
+  if (lost_at >= 0.0) r.recovery_s = -1.0;
   r.age_p50_ms = engine::percentile(ages, 0.5);
   r.age_p95_ms = engine::percentile(ages, 0.95);
 }

@@ -54,9 +54,10 @@ struct TimelineSample {
   double t_s = 0.0;      ///< display time, since projection started
   double mean_mm = 0.0;  ///< over the markers
   double max_mm = 0.0;
-  bool moving = false;  ///< the target is being moved
-  bool shown = true;    ///< false while the target is blanked (lost)
-  double age_ms = 0.0;  ///< of the pose drawn: from its depth frame's capture to display
+  bool moving = false;   ///< the target is being moved
+  bool shown = true;     ///< false while the target is blanked (lost)
+  double age_ms = 0.0;   ///< of the pose drawn: from its depth frame's capture to display
+  bool in_world = true;  ///< the target was there (not carried away)
 };
 
 struct VisitReport {
@@ -83,6 +84,9 @@ struct VisitReport {
   int moving_blank_frames = 0;                ///< projector frames blanked while it moved (lost)
   double still_mean_mm = 0.0;                 ///< over the lit frames while it did not move
   double age_p50_ms = 0.0, age_p95_ms = 0.0;  ///< pose age at display over the lit frames
+  /// After the target was lost (blanked while it was there and had been lit): the longest time until
+  /// it was lit again, s; 0 when it was never lost, -1 when it was not lit again within the dwell.
+  double recovery_s = 0.0;
   /// Seconds from the end of the motion until the mean error is back under 3 mm and stays there;
   /// 0 when it never left, -1 when it never came back within the dwell.
   double reconverge_s = 0.0;
