@@ -393,3 +393,111 @@ TEST(TourTest, EachProjectorFrameIsMeasuredAtItsDisplayTime) {
 }
 
 }  // namespace
+
+namespace {
+
+// The depth camera's reading at the image centre, looking from `eye` towards `at` (world frame).
+double centre_depth_m(projbot::twin::Twin& twin, const Eigen::Vector3d& eye, const Eigen::Vector3d& at) {
+  // Camera frame: z forward, x right, y down.
+  const Eigen::Vector3d z = (at - eye).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix4d T_world_camera = Eigen::Matrix4d::Identity();
+  T_world_camera.block<3, 1>(0, 0) = x;
+  T_world_camera.block<3, 1>(0, 1) = y;
+  T_world_camera.block<3, 1>(0, 2) = z;
+  T_world_camera.topRightCorner<3, 1>() = eye;
+  const auto depth = twin.capture(T_world_camera, 1);
+  return depth.at(depth.width / 2, depth.height / 2);
+}
+
+}  // namespace
+
+// The room stands in the depth images: walls room.wall_height high, obstacles as blocks, box props,
+// supports as given.
+TEST(TwinRoomTest, WallsPropsAndSupportsAreSolid) {
+  std::ifstream in(kAssets + "/scenes/tour.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("  obstacles:"), 12, "  wall_height: 2.0\n  obstacles:");
+  yaml.replace(yaml.find("    stop: [5.2, 2.2, 80]"), 24, "    stop: [5.2, 2.2, 80]\n    support: {width: 0.6, depth: 0.5}");
+  yaml +=
+      "props:\n  - {name: pillar, box: {min: [3.8, 4.3, 0.0], max: [4.0, 4.5, 2.0]}, colour: [0.2, 0.3, 0.9]}\n"
+      "  - {name: toy, model: ../models/Duck/Duck.glb, scale: 0.25, recenter: true, world_pose: {translation: [6.5, 1.5, "
+      "0.3]}}\n";
+  const auto scene = projbot::config::parse_scene(yaml, kAssets + "/scenes/tour.yaml");
+  ASSERT_EQ(scene.props.size(), 2U);
+  EXPECT_DOUBLE_EQ(scene.room.wall_height_m, 2.0);
+  projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
+  projbot::twin::TwinOptions o;
+  o.depth_noise = false;
+  projbot::twin::Twin twin(scene, o, renderer);
+  // The east wall (x = 8) from 3 m away at 1.5 m height, and nothing above it.
+  EXPECT_NEAR(centre_depth_m(twin, {5.0, 1.5, 1.5}, {8.0, 1.5, 1.5}), 3.0, 0.01);
+  EXPECT_EQ(centre_depth_m(twin, {5.0, 1.5, 2.3}, {8.0, 1.5, 2.3}), 0.0);  // over a 2 m wall: no return
+  // The obstacle [0.0, 2.4, 0.5, 3.6] is a block: seen from x = 2 at 1 m height, 1.5 m away.
+  EXPECT_NEAR(centre_depth_m(twin, {2.0, 3.0, 1.0}, {0.0, 3.0, 1.0}), 1.5, 0.01);
+  // The pillar prop, 1 m in front of a camera at x = 2.8.
+  EXPECT_NEAR(centre_depth_m(twin, {2.8, 4.4, 1.0}, {4.0, 4.4, 1.0}), 1.0, 0.01);
+  // The box's support is 60 x 50 cm: its face at y = 3.6 - 0.25, seen from y = 2.35 at 0.3 m height.
+  EXPECT_NEAR(centre_depth_m(twin, {5.75, 2.35, 0.3}, {5.75, 4.0, 0.3}), 1.0, 0.01);
+  // The toy duck (a glTF prop, up to 40 cm long, centred 1 m away) in front of the east wall (2.5 m).
+  const double toy_m = centre_depth_m(twin, {5.5, 1.5, 0.3}, {8.0, 1.5, 0.3});
+  EXPECT_GT(toy_m, 0.75);
+  EXPECT_LT(toy_m, 1.0);
+  // The pillar catches the projector's light too.
+  const auto hit = projbot::twin::cast_ray(twin.true_scene(Eigen::Matrix4d::Identity()), {2.8, 4.4, 1.0}, {1.0, 0.0, 0.0});
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->x(), 3.8, 1e-6);
+  // Bad props are named.
+  const auto prop_error = [&](const std::string& prop) {
+    try {
+      projbot::config::parse_scene(text.str() + "props:\n  - " + prop + "\n", kAssets + "/scenes/tour.yaml");
+    } catch (const projbot::config::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(prop_error("{name: p, box: {min: [1, 1, 0], max: [1, 2, 1]}}").find("props[0].box: need min < max"),
+            std::string::npos);
+  EXPECT_NE(prop_error("{name: duck, box: {min: [1, 1, 0], max: [2, 2, 1]}}").find("already the name of a target"),
+            std::string::npos);
+  EXPECT_NE(prop_error("{name: p, model: x.glb}").find("props[0]: a model prop needs a world_pose"), std::string::npos);
+  EXPECT_NE(prop_error("{name: p}").find("props[0]: give either a 'model'"), std::string::npos);
+  EXPECT_NE(prop_error("{name: p, box: {min: [1, 1, 0], max: [2, 2, 1]}, colour: [2, 0, 0]}").find("props[0].colour"),
+            std::string::npos);
+}
+
+TEST(TwinRoomTest, AFigureStandsOnTheFloor) {
+  // The duck's lowest point is above the floor in the demo (its pedestal's height): on the floor it
+  // must come down to z = 0, else the twin says so.
+  double lowest_m = 0.0;
+  {
+    projbot::engine::Renderer probe(projbot::engine::RendererOptions{});
+    projbot::twin::Twin t(demo_with("x", "x"), {}, probe);
+    lowest_m = t.targets()[0].pedestal_raycaster->closest_point({0.0, 0.0, 10.0}).z();  // the pedestal's top
+  }
+  ASSERT_GT(lowest_m, 0.5);
+  auto scene = demo_with("    stop: [3.0, 1.8, 90]\n", "    stop: [3.0, 1.8, 90]\n    support: floor\n");
+  EXPECT_TRUE(scene.targets[0].support.floor);
+  const std::string error = twin_error(scene);
+  char expected[96];
+  std::snprintf(expected, sizeof expected, "its lowest point is at z = %.3f m", lowest_m);
+  EXPECT_NE(error.find("target 'duck' stands on the floor (support: floor) but"), std::string::npos) << error;
+  EXPECT_NE(error.find(expected), std::string::npos) << error;
+  // Lowered by that much, it stands: no pedestal under it, the box's still there.
+  (*scene.targets[0].T_world_target)(2, 3) -= lowest_m;
+  projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
+  projbot::twin::Twin twin(scene, {}, renderer);
+  EXPECT_EQ(twin.targets()[0].pedestal_raycaster, nullptr);
+  EXPECT_NE(twin.targets()[1].pedestal_raycaster, nullptr);
+  for (const char* bad : {"support: table", "support: {width: 0.5}", "support: {width: 0, depth: 0.5}"}) {
+    try {
+      demo_with("    stop: [3.0, 1.8, 90]\n", std::string("    stop: [3.0, 1.8, 90]\n    ") + bad + "\n");
+      ADD_FAILURE() << bad;
+    } catch (const projbot::config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("targets[0].support"), std::string::npos) << e.what();
+    }
+  }
+}

@@ -201,6 +201,58 @@ Eigen::Matrix4d read_pose(MapReader& target, const std::string& path, const std:
   return T;
 }
 
+TargetSupport read_support(MapReader& t, const std::string& path) {
+  TargetSupport support;
+  YAML::Node node = t.child("support", false);
+  if (!node) return support;
+  if (node.IsScalar()) {
+    if (node.Scalar() != "floor") t.fail(node, path, "expected 'floor' or {width: W, depth: D}, not '" + node.Scalar() + "'");
+    support.floor = true;
+    return support;
+  }
+  MapReader m(node, path, t.file());
+  support.width_m = m.get<double>("width", 0.0, true);
+  support.depth_m = m.get<double>("depth", 0.0, true);
+  if (!(support.width_m >= 0.01 && support.width_m <= 20.0) || !(support.depth_m >= 0.01 && support.depth_m <= 20.0))
+    m.fail(node, path, "width and depth must be 0.01..20 m");
+  m.reject_unknown();
+  return support;
+}
+
+PropConfig read_prop(const YAML::Node& node, const std::string& path, const std::string& file,
+                     const std::filesystem::path& base) {
+  MapReader p(node, path, file);
+  PropConfig prop;
+  prop.name = p.get<std::string>("name", "", true);
+  if (prop.name.empty()) p.fail(node, path + ".name", "must not be empty");
+  if (p.has("box") == p.has("model")) p.fail(node, path, "give either a 'model' (glTF) or a 'box: {min, max}', not both");
+  if (p.has("model")) {
+    const auto model = p.get<std::string>("model", "", true);
+    if (model.empty()) p.fail(node, path + ".model", "must not be empty");
+    prop.model = std::filesystem::path(model).is_absolute() ? std::filesystem::path(model) : base / model;
+    prop.scale = p.get<double>("scale", 1.0);
+    if (!(prop.scale >= 1e-4 && prop.scale <= 1e4)) p.fail(node["scale"], path + ".scale", "must be 0.0001..10000");
+    prop.recenter = p.get<bool>("recenter", false);
+    if (!p.has("world_pose")) p.fail(node, path, "a model prop needs a world_pose");
+    prop.T_world_prop = read_pose(p, path + ".world_pose", "world_pose");
+  } else {
+    MapReader b(p.child("box", true), path + ".box", file);
+    prop.box_min_m = b.vector3(b.child("min", true), path + ".box.min");
+    prop.box_max_m = b.vector3(b.child("max", true), path + ".box.max");
+    if (!(prop.box_min_m.array() < prop.box_max_m.array()).all())
+      p.fail(node["box"], path + ".box", "need min < max on every axis");
+    b.reject_unknown();
+    if (YAML::Node c = p.child("colour", false)) {
+      const Eigen::Vector3d rgb = p.vector3(c, path + ".colour");
+      if (!((rgb.array() >= 0.0).all() && (rgb.array() <= 1.0).all()))
+        p.fail(c, path + ".colour", "each of r, g, b must be 0..1");
+      prop.colour = {static_cast<float>(rgb.x()), static_cast<float>(rgb.y()), static_cast<float>(rgb.z())};
+    }
+  }
+  p.reject_unknown();
+  return prop;
+}
+
 // The optional robot section: the pan-tilt rig's calibration, each key defaulting to the simulated rig.
 PanTiltConfig read_robot(MapReader& root, Scene& scene) {
   PanTiltConfig c = default_pan_tilt();
@@ -289,6 +341,9 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
     scene.room.depth_m = m.get<double>("depth", 0.0, true);
     if (!(scene.room.width_m > 0.5) || !(scene.room.depth_m > 0.5) || scene.room.width_m > 200 || scene.room.depth_m > 200)
       m.fail(room, "room", "width and depth must be 0.5..200 m");
+    scene.room.wall_height_m = m.get<double>("wall_height", scene.room.wall_height_m);
+    if (!(scene.room.wall_height_m >= 0.1 && scene.room.wall_height_m <= 50.0))
+      m.fail(room["wall_height"], "room.wall_height", "must be 0.1..50 m");
     if (YAML::Node obs = m.child("obstacles", false)) {
       if (!obs.IsSequence()) m.fail(obs, "room.obstacles", "expected a list of [x0, y0, x1, y1]");
       for (std::size_t i = 0; i < obs.size(); ++i) {
@@ -324,6 +379,7 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
       t.fail(targets[i]["scale"], path + ".scale", "must be 0.0001..10000 (a uniform factor on the model's metres)");
     target.recenter = t.get<bool>("recenter", false);
     target.present = t.get<bool>("present", true);
+    target.support = read_support(t, path + ".support");
     target.T_projector_target = read_pose(t, path + ".pose");
     if (t.has("world_pose")) target.T_world_target = read_pose(t, path + ".world_pose", "world_pose");
     if (t.has("map_pose")) {
@@ -360,6 +416,16 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
     if (!targets[i]["pose"] && !scene.targets[i].T_world_target)
       r.fail(targets[i], "targets[" + std::to_string(i) + "]",
              "needs a pose (where it stands in the projector frame) or a world_pose (a tour's map frame)");
+  if (YAML::Node props = r.child("props", false)) {
+    if (!props.IsSequence()) r.fail(props, "props", "expected a list of props");
+    std::set<std::string> prop_names;
+    for (std::size_t i = 0; i < props.size(); ++i) {
+      const std::string path = "props[" + std::to_string(i) + "]";
+      scene.props.push_back(read_prop(props[i], path, file, base));
+      if (!prop_names.insert(scene.props.back().name).second || scene.target_index(scene.props.back().name) >= 0)
+        r.fail(props[i], path + ".name", "'" + scene.props.back().name + "' is already the name of a target or prop");
+    }
+  }
   if (YAML::Node tour = r.child("tour", false)) {
     MapReader m(tour, "tour", file);
     YAML::Node visits = m.child("visits", true);

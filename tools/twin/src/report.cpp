@@ -83,7 +83,9 @@ void print_table(const TourReport& report, std::ostream& out) {
   for (const auto& v : report.visits) any_timeline = any_timeline || !v.timeline.empty();
   if (any_timeline) {
     out << "\nWhile projecting (" << to_string(report.mode)
-        << (report.predict ? ", drawn at the pose predicted for display time" : ", drawn at the newest measured pose")
+        << (report.mode != TourMode::tracking ? ", drawn at the arrival's estimate, not tracked"
+            : report.predict                  ? ", drawn at the pose predicted for display time"
+                                              : ", drawn at the newest measured pose")
         << "; errors of each projector frame at its display time):\n\n| # | target | moved | while moving mean / p95 / worst mm "
            "| "
            "mean mm still | mean mm at the end | re-converged after the move, s | pose age at display p50 / p95 ms | "

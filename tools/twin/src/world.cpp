@@ -12,15 +12,42 @@
 namespace projbot::twin {
 namespace {
 
-constexpr double kPedestalHalfWidthM = 0.12;  // 24 cm square pedestals: narrower than the targets
-
-// The pedestal's top is the target's lowest point, so the target stands on it: its height, metres.
-double pedestal_height(const assets::Model& model, const Eigen::Matrix4d& T_world_target) {
-  double z_min = std::numeric_limits<double>::infinity();
+// The model's bounds in the world frame (its vertices placed by T_world_model).
+Eigen::AlignedBox3d world_bounds(const assets::Model& model, const Eigen::Matrix4d& T_world_model) {
+  Eigen::AlignedBox3d box;
   for (const auto& p : model.primitives)
     for (const auto& v : p.vertices)
-      z_min = std::min(z_min, (T_world_target * Eigen::Vector4d(v.position[0], v.position[1], v.position[2], 1.0)).z());
-  return std::max(z_min, 0.01);
+      box.extend((T_world_model * Eigen::Vector4d(v.position[0], v.position[1], v.position[2], 1.0)).head<3>());
+  return box;
+}
+
+std::array<double, 4> footprint(const Eigen::AlignedBox3d& b) { return {b.min().x(), b.min().y(), b.max().x(), b.max().y()}; }
+
+// Appends `part`'s primitives and materials to `into` (one mesh for the room's static surfaces).
+void append(assets::Model& into, const assets::Model& part) {
+  const int offset = static_cast<int>(into.materials.size());
+  for (auto p : part.primitives) {
+    p.material += offset;
+    into.primitives.push_back(std::move(p));
+  }
+  into.materials.insert(into.materials.end(), part.materials.begin(), part.materials.end());
+}
+
+// The room's static surfaces: the floor, the outline's walls, the obstacles as blocks (all
+// room.wall_height high) and the box props.
+assets::Model room_model(const config::Scene& scene) {
+  const double w = scene.room.width_m, d = scene.room.depth_m, h = scene.room.wall_height_m, t = 0.05;
+  assets::Model room = assets::make_box({-2.0, -2.0, -0.05}, {w + 2.0, d + 2.0, 0.0}, {0.45F, 0.45F, 0.45F, 1.0F});
+  const std::array<float, 4> wall{0.8F, 0.8F, 0.78F, 1.0F};
+  append(room, assets::make_box({-t, -t, 0.0}, {w + t, 0.0, h}, wall));
+  append(room, assets::make_box({-t, d, 0.0}, {w + t, d + t, h}, wall));
+  append(room, assets::make_box({-t, 0.0, 0.0}, {0.0, d, h}, wall));
+  append(room, assets::make_box({w, 0.0, 0.0}, {w + t, d, h}, wall));
+  for (const auto& o : scene.room.obstacles) append(room, assets::make_box({o[0], o[1], 0.0}, {o[2], o[3], h}, wall));
+  for (const auto& p : scene.props)
+    if (p.is_box()) append(room, assets::make_box(p.box_min_m, p.box_max_m, {p.colour[0], p.colour[1], p.colour[2], 1.0F}));
+  room.source = "room";
+  return room;
 }
 
 }  // namespace
@@ -30,17 +57,13 @@ alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene) {
   return {k.width_px, k.height_px, k.fx_px, k.fy_px, k.cx_px, k.cy_px};
 }
 
-robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed) {
+robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed,
+                                  const std::vector<std::array<double, 4>>& footprints) {
   robot::SimTourConfig c;
   c.room.width_m = scene.room.width_m;
   c.room.depth_m = scene.room.depth_m;
   for (const auto& o : scene.room.obstacles) c.room.obstacles.push_back({o[0], o[1], o[2], o[3]});
-  for (const auto& t : scene.targets)
-    if (t.T_world_target) {
-      const double x = (*t.T_world_target)(0, 3), y = (*t.T_world_target)(1, 3);
-      c.room.obstacles.push_back(
-          {x - kPedestalHalfWidthM, y - kPedestalHalfWidthM, x + kPedestalHalfWidthM, y + kPedestalHalfWidthM});
-    }
+  for (const auto& f : footprints) c.room.obstacles.push_back({f[0], f[1], f[2], f[3]});
   c.start = {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()};
   c.errors.seed = seed;
   c.errors.wheel_scale_sigma = scene.drift.wheel_scale_sigma;
@@ -57,10 +80,20 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     : scene_(scene), options_(options), renderer_(renderer), pan_tilt_(scene.pan_tilt), camera_(depth_intrinsics(scene)) {
   const std::string where = scene.source.empty() ? std::string("<scene>") : scene.source.string();
   if (scene.visits.empty()) throw TwinError(where + ": the twin needs a 'tour: {visits: [...]}' section");
-  const auto floor = assets::make_box({-2.0, -2.0, -0.05}, {scene.room.width_m + 2.0, scene.room.depth_m + 2.0, 0.0},
-                                      {0.45F, 0.45F, 0.45F, 1.0F});
-  floor_ray_ = std::make_unique<MeshRaycaster>(floor);
-  floor_id_ = renderer_.add_model(floor);
+  const assets::Model room = room_model(scene);
+  room_ray_ = std::make_unique<MeshRaycaster>(room);
+  room_id_ = renderer_.add_model(room);
+  std::vector<std::array<double, 4>> footprints;  // for the laser: what stands on the floor
+  for (const auto& p : scene.props) {
+    if (p.is_box()) {
+      footprints.push_back({p.box_min_m.x(), p.box_min_m.y(), p.box_max_m.x(), p.box_max_m.y()});
+      continue;
+    }
+    assets::Model model = assets::load_gltf(p.model);
+    assets::scale_and_recenter(model, p.scale, p.recenter);
+    footprints.push_back(footprint(world_bounds(model, p.T_world_prop)));
+    props_.push_back({std::make_unique<MeshRaycaster>(model), renderer_.add_model(model), p.T_world_prop});
+  }
   for (const auto& t : scene.targets) {
     if (!t.T_world_target) continue;
     if (!t.stop) throw TwinError(where + ": target '" + t.name + "' has a world_pose but no stop");
@@ -84,20 +117,39 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     }
     tt.cloud = alignment::model_cloud_from(tt.model, 50000);
     tt.T_world_target_true = *t.T_world_target;
-    const auto pedestal = assets::make_box(
-        {-kPedestalHalfWidthM, -kPedestalHalfWidthM, 0.0},
-        {kPedestalHalfWidthM, kPedestalHalfWidthM, pedestal_height(tt.model, tt.T_world_target_true)}, {0.7F, 0.7F, 0.7F, 1.0F});
-    tt.T_world_pedestal = Eigen::Matrix4d::Identity();
-    tt.T_world_pedestal.topRightCorner<2, 1>() = tt.T_world_target_true.topRightCorner<2, 1>();
-    tt.pedestal_raycaster = std::make_unique<MeshRaycaster>(pedestal);
-    tt.pedestal_id = renderer_.add_model(pedestal);
+    place_support(tt, where, footprints);
     target_ids_.push_back(renderer_.add_model(tt.model));
     tt.in_world = t.present;
     home_.push_back(tt.T_world_target_true);
     targets_.push_back(std::move(tt));
   }
-  robot_ = std::make_unique<robot::SimRobot>(robot_config(scene, options.pose_source, options.seed));
+  robot_ = std::make_unique<robot::SimRobot>(robot_config(scene, options.pose_source, options.seed, footprints));
   depth_target_ = renderer_.make_depth_camera(camera_.width_px, camera_.height_px);
+}
+
+void Twin::place_support(TwinTarget& t, const std::string& where, std::vector<std::array<double, 4>>& footprints) {
+  const Eigen::AlignedBox3d bounds = world_bounds(t.model, t.T_world_target_true);
+  const config::TargetSupport& support = t.config.support;
+  if (support.floor) {
+    if (std::abs(bounds.min().z()) > 0.01) {
+      char msg[160];
+      std::snprintf(msg, sizeof msg, "stands on the floor (support: floor) but its lowest point is at z = %.3f m",
+                    bounds.min().z());
+      throw TwinError(where + ": target '" + t.config.name + "' " + msg +
+                      ": move its world_pose so that it is at 0 (within 1 cm), or give it a support");
+    }
+    footprints.push_back(footprint(bounds));
+    return;
+  }
+  // A box from the floor up to the target's lowest point, centred under it: the target stands on it.
+  const double hx = support.width_m / 2.0, hy = support.depth_m / 2.0;
+  const auto box = assets::make_box({-hx, -hy, 0.0}, {hx, hy, std::max(bounds.min().z(), 0.01)}, {0.7F, 0.7F, 0.7F, 1.0F});
+  t.T_world_pedestal = Eigen::Matrix4d::Identity();
+  t.T_world_pedestal.topRightCorner<2, 1>() = t.T_world_target_true.topRightCorner<2, 1>();
+  t.pedestal_raycaster = std::make_unique<MeshRaycaster>(box);
+  t.pedestal_id = renderer_.add_model(box);
+  const double x = t.T_world_pedestal(0, 3), y = t.T_world_pedestal(1, 3);
+  footprints.push_back({x - hx, y - hy, x + hx, y + hy});
 }
 
 std::size_t Twin::target_index(const std::string& name) const {
@@ -169,10 +221,11 @@ void Twin::end_visit(std::size_t target, int target_visit) {
 
 alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
   const Eigen::Matrix4d T_camera_world = alignment::rigid_inverse(T_world_camera);
-  std::vector<engine::DrawItem> items{{floor_id_, T_camera_world}};
+  std::vector<engine::DrawItem> items{{room_id_, T_camera_world}};
+  for (const auto& p : props_) items.push_back({p.id, T_camera_world * p.T_world});
   for (std::size_t i = 0; i < targets_.size(); ++i) {
     if (targets_[i].in_world) items.push_back({target_ids_[i], T_camera_world * targets_[i].T_world_target_true});
-    items.push_back({targets_[i].pedestal_id, T_camera_world * targets_[i].T_world_pedestal});
+    if (targets_[i].pedestal_raycaster) items.push_back({targets_[i].pedestal_id, T_camera_world * targets_[i].T_world_pedestal});
   }
   // Rendered from 0.3 to 8 m: the noise model, not the clip planes, drops what the Kinect cannot see.
   config::ProjectorConfig pinhole = scene_.depth_camera;
@@ -186,10 +239,11 @@ alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::
 }
 
 std::vector<PlacedMesh> Twin::true_scene(const Eigen::Matrix4d& T_frame_world) const {
-  std::vector<PlacedMesh> out{{floor_ray_.get(), T_frame_world}};
+  std::vector<PlacedMesh> out{{room_ray_.get(), T_frame_world}};
+  for (const auto& p : props_) out.push_back({p.raycaster.get(), T_frame_world * p.T_world});
   for (const auto& t : targets_) {
     if (t.in_world) out.push_back({t.raycaster.get(), T_frame_world * t.T_world_target_true});
-    out.push_back({t.pedestal_raycaster.get(), T_frame_world * t.T_world_pedestal});
+    if (t.pedestal_raycaster) out.push_back({t.pedestal_raycaster.get(), T_frame_world * t.T_world_pedestal});
   }
   return out;
 }

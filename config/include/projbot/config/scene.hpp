@@ -58,6 +58,30 @@ struct TargetMotion {
   bool removed = false;
 };
 
+/// What a target stands on in the twin (`support:`): the floor itself (`support: floor`: its lowest
+/// point must be at z = 0), or a box from the floor up to its lowest point, centred under it
+/// (`support: {width: W, depth: D}`, metres along the world's x and y; may be wider than the target, a
+/// table). Default: a 24 x 24 cm pedestal.
+struct TargetSupport {
+  bool floor = false;
+  double width_m = 0.24;
+  double depth_m = 0.24;
+};
+
+/// A static thing in the twin's room that is not a target (`props:`): a neighbour, a distractor, a
+/// pillar that hides part of a target. A glTF model placed like a target, or a plain coloured box.
+struct PropConfig {
+  std::string name;
+  std::filesystem::path model;  ///< glTF; empty for a box
+  double scale = 1.0;
+  bool recenter = false;
+  Eigen::Matrix4d T_world_prop = Eigen::Matrix4d::Identity();  ///< the model's pose (`world_pose`)
+  Eigen::Vector3d box_min_m = Eigen::Vector3d::Zero();         ///< a box's corners, world frame
+  Eigen::Vector3d box_max_m = Eigen::Vector3d::Zero();
+  std::array<float, 3> colour{0.6F, 0.6F, 0.6F};  ///< a box's colour, 0..1
+  bool is_box() const { return model.empty(); }
+};
+
 /// One target object: its textured model and its pose in the projector frame.
 struct TargetConfig {
   std::string name;             ///< unique within the scene
@@ -81,6 +105,7 @@ struct TargetConfig {
   /// Marker points on the model (model frame after scale and recenter, metres): where the
   /// projection error is measured.
   std::vector<Eigen::Vector3d> markers_m;
+  TargetSupport support;  ///< the twin only
   /// Scripted moves in the twin (`motion:`, one or a list), at most one per visit of this target.
   std::vector<TargetMotion> motions;
   /// The move scripted for this target's `visit`-th visit, or nullptr.
@@ -96,6 +121,8 @@ struct RoomSpec {
   double width_m = 8.0;
   double depth_m = 6.0;
   std::vector<std::array<double, 4>> obstacles;  ///< x0, y0, x1, y1
+  /// The outline and the obstacles stand this high (metres) in the twin's depth and projector light.
+  double wall_height_m = 2.5;
 };
 
 /// Wheel-odometry error of the simulated base (see robot::BaseErrorModel for the meaning of each).
@@ -123,6 +150,7 @@ struct Scene {
   DriftSpec drift;                                          ///< `robot.drift:`
   ProjectorConfig depth_camera = kinect_v1_depth_camera();  ///< `camera:`, the RGB-D camera's depth intrinsics
   std::vector<std::string> visits;                          ///< `tour.visits:` target names in order
+  std::vector<PropConfig> props;                            ///< `props:` the twin's static non-targets
 
   /// Kinect v1 depth: 640x480, fx = fy = 525 px, 0.5-4.5 m.
   static ProjectorConfig kinect_v1_depth_camera() { return {640, 480, 525.0, 525.0, 319.5, 239.5, 0.5, 4.5}; }

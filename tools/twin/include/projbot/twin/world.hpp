@@ -46,9 +46,10 @@ struct TwinTarget {
   /// (`motion.removed`). An absent target is neither seen by the camera nor catches the projector's
   /// light; its pedestal stays.
   bool in_world = true;
-  Eigen::Matrix4d T_world_pedestal;  ///< the pedestal under it (a translation)
-  std::unique_ptr<MeshRaycaster> pedestal_raycaster;
-  std::size_t pedestal_id = 0;  ///< renderer model id
+  /// What it stands on (config.support): a box from the floor (a translation), none for the floor.
+  Eigen::Matrix4d T_world_pedestal = Eigen::Matrix4d::Identity();
+  std::unique_ptr<MeshRaycaster> pedestal_raycaster;  ///< null when it stands on the floor
+  std::size_t pedestal_id = 0;                        ///< renderer model id
 };
 
 /// Where the robot stands after driving to a target's stop and aiming at it.
@@ -106,11 +107,19 @@ class Twin {
   TwinOptions options_;
   engine::Renderer& renderer_;
   std::vector<TwinTarget> targets_;
-  std::vector<Eigen::Matrix4d> home_;  // where each target stands between visits
-  std::set<std::size_t> gone_;         // targets carried away (motion.removed) on an earlier visit
-  std::unique_ptr<MeshRaycaster> floor_ray_;
+  std::vector<Eigen::Matrix4d> home_;        // where each target stands between visits
+  std::set<std::size_t> gone_;               // targets carried away (motion.removed) on an earlier visit
+  std::unique_ptr<MeshRaycaster> room_ray_;  // floor, walls, obstacle blocks and box props
+  std::size_t room_id_ = 0;
+  struct PlacedProp {
+    std::unique_ptr<MeshRaycaster> raycaster;
+    std::size_t id = 0;  // renderer model id
+    Eigen::Matrix4d T_world = Eigen::Matrix4d::Identity();
+  };
+  std::vector<PlacedProp> props_;  // the glTF props
   std::vector<std::size_t> target_ids_;
-  std::size_t floor_id_ = 0;
+  // Checks and builds a target's support; adds what stands on the floor to `footprints` (the laser's).
+  void place_support(TwinTarget& t, const std::string& where, std::vector<std::array<double, 4>>& footprints);
   std::unique_ptr<robot::SimRobot> robot_;
   robot::SimulatedPanTilt pan_tilt_;
   alignment::CameraIntrinsics camera_;
@@ -126,8 +135,9 @@ double motion_fraction(config::MotionProfile profile, double x);
 /// The scene's depth camera as the estimator's intrinsics.
 alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene);
 
-/// The twin's robot set-up for a scene: its room (with a pedestal under each target), start pose and
-/// drift, closing the loop on `source`.
-robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed);
+/// The twin's robot set-up for a scene: its room (with `footprints`, x0 y0 x1 y1, of what stands on the
+/// floor: supports, floor-standing targets, props), start pose and drift, closing the loop on `source`.
+robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed,
+                                  const std::vector<std::array<double, 4>>& footprints);
 
 }  // namespace projbot::twin
