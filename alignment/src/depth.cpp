@@ -87,6 +87,27 @@ GrabberCalibration read_pcl_grabber_xml(const std::filesystem::path& path, int w
   }
 }
 
+Plane floor_in_camera(const Eigen::Matrix4d& T_world_camera) {
+  // World z of a camera-frame point p: row 3 of R p + t_z.
+  Plane p;
+  p.normal = T_world_camera.block<1, 3>(2, 0).transpose();
+  p.d = T_world_camera(2, 3);
+  return p;
+}
+
+DepthImage without_plane(const DepthImage& depth, const CameraIntrinsics& k, const Plane& plane, double margin_m) {
+  if (depth.width != k.width_px || depth.height != k.height_px) throw AlignmentError("depth image and intrinsics differ in size");
+  DepthImage out = depth;
+  for (int y = 0; y < depth.height; ++y)
+    for (int x = 0; x < depth.width; ++x) {
+      float& z = out.depth_m[static_cast<std::size_t>(y) * depth.width + x];
+      if (!(z > 0.0F)) continue;
+      const Eigen::Vector3d p((x - k.cx_px) * z / k.fx_px, (y - k.cy_px) * z / k.fy_px, z);
+      if (plane.height_of(p) < margin_m) z = 0.0F;
+    }
+  return out;
+}
+
 PointCloud depth_to_cloud(const DepthImage& depth, const CameraIntrinsics& k, double min_m, double max_m) {
   if (depth.width != k.width_px || depth.height != k.height_px)
     throw AlignmentError("depth image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) +

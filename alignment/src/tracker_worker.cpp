@@ -38,8 +38,9 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
       cfg_(std::move(config)),
       filter_(cfg_.motion) {}
 
-void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target) {
+void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor) {
   guess_ = T_camera_target;
+  floor_ = floor;
   have_guess_ = true;
   pose_.reset();
   rejected_ = 0;
@@ -80,7 +81,14 @@ std::optional<PoseSample> TargetFollower::step(const DepthImage& frame) {
 }
 
 std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage) {
-  const PointCloud scan = depth_to_cloud(frame, k_);
+  // The floor is known (map and camera pose): left out, so a figure standing on it is aligned to and
+  // judged on its own points.
+  DepthImage known = floor_ ? without_plane(frame, k_, *floor_, cfg_.floor_margin_m) : frame;
+  // Local stages look near the guess: only at what lies inside its silhouette, grown by its uncertainty
+  // (a wall behind, a neighbour beside drop out). Global ones search wider on purpose.
+  if (stage == SearchStage::local || stage == SearchStage::refine)
+    known = crop_to_silhouette(known, k_, model_, from, cfg_.silhouette_margin_m);
+  const PointCloud scan = depth_to_cloud(known, k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
   last_attempt_ = aligner_.align(scan, from, stage);
   return last_attempt_;

@@ -1,5 +1,6 @@
 #include "projbot/alignment/verification.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -30,6 +31,37 @@ std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4
 }
 
 }  // namespace
+
+DepthImage crop_to_silhouette(const DepthImage& depth, const CameraIntrinsics& k, const ModelCloud& model,
+                              const Eigen::Matrix4d& T_camera_model, double grow_m) {
+  DepthImage out = depth;
+  if (depth.width != k.width_px || depth.height != k.height_px || !T_camera_model.allFinite()) return out;
+  std::array<int, 4> box{};
+  const std::vector<float> predicted = predicted_depth(model, T_camera_model, k, box);
+  if (box[2] < 0) {  // nothing of the model in view: nothing to keep
+    std::fill(out.depth_m.begin(), out.depth_m.end(), 0.0F);
+    return out;
+  }
+  float z_near = std::numeric_limits<float>::infinity(), z_far = 0.0F;
+  for (const float z : predicted)
+    if (std::isfinite(z)) z_near = std::min(z_near, z), z_far = std::max(z_far, z);
+  // Grown by grow_m at the model's nearest depth, in pixels; then a box dilation, rows then columns.
+  const int r = static_cast<int>(std::ceil(grow_m * std::max(k.fx_px, k.fy_px) / std::max(z_near, 0.1F))) + 1;
+  const int w = k.width_px, h = k.height_px;
+  std::vector<unsigned char> rows(predicted.size(), 0), mask(predicted.size(), 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (std::isfinite(predicted[static_cast<std::size_t>(y) * w + x]))
+        for (int dx = std::max(0, x - r); dx <= std::min(w - 1, x + r); ++dx) rows[static_cast<std::size_t>(y) * w + dx] = 1;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (rows[static_cast<std::size_t>(y) * w + x])
+        for (int dy = std::max(0, y - r); dy <= std::min(h - 1, y + r); ++dy) mask[static_cast<std::size_t>(dy) * w + x] = 1;
+  const auto lo = static_cast<float>(z_near - grow_m), hi = static_cast<float>(z_far + grow_m);
+  for (std::size_t i = 0; i < out.depth_m.size(); ++i)
+    if (!mask[i] || !(out.depth_m[i] >= lo && out.depth_m[i] <= hi)) out.depth_m[i] = 0.0F;
+  return out;
+}
 
 FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
                                 const CameraIntrinsics& k) {

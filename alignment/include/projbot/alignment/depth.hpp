@@ -78,6 +78,21 @@ GrabberCalibration read_pcl_grabber_xml(const std::filesystem::path& path, int w
 /// result is organised.
 PointCloud depth_to_cloud(const DepthImage& depth, const CameraIntrinsics& k, double min_m = 0.3, double max_m = 8.0);
 
+/// A known plane in the camera frame, n . p + d = 0 with |n| = 1 and n pointing up (away from what lies
+/// under it): the floor, from the map and the camera's pose.
+struct Plane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double d = 0.0;
+  double height_of(const Eigen::Vector3d& p) const { return normal.dot(p) + d; }
+};
+
+/// The floor (z = 0 in the map) in the frame of a camera at T_world_camera.
+Plane floor_in_camera(const Eigen::Matrix4d& T_world_camera);
+
+/// The depth image without the pixels whose points lie within margin_m above `plane`, or below it
+/// (set to 0, missing): the floor a figure stands on, which would otherwise count against its gate.
+DepthImage without_plane(const DepthImage& depth, const CameraIntrinsics& k, const Plane& plane, double margin_m);
+
 /// Reads a PCD or PLY file (by extension) as x, y, z; keeps the organisation of organised PCDs.
 PointCloud read_cloud(const std::filesystem::path& path);
 

@@ -45,6 +45,12 @@ struct WorkerConfig {
   /// display time. False: tracking starts from the last pose and every sample is still.
   bool predict = true;
   MotionModelConfig motion;
+  /// Acquisition leaves out the scan points this close to a known floor (or under it): 2 cm is well
+  /// outside a localised camera's plane error (a 0.1 degree tilt is 3.5 mm at 2 m).
+  double floor_margin_m = 0.02;
+  /// Local acquisition keeps the depth inside the guess's predicted silhouette grown by this much (the
+  /// guess's uncertainty: a localised robot's Eq. 1 guess is within a few cm).
+  double silhouette_margin_m = 0.10;
 };
 
 /// What searching for a target has cost since its stop began.
@@ -78,8 +84,9 @@ class TargetFollower {
  public:
   /// Throws AlignmentError for a bad model or intrinsics.
   TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config = {});
-  /// A new stop: the next frame acquires from this guess (Eq. 1).
-  void set_initial_guess(const Eigen::Matrix4d& T_camera_target);
+  /// A new stop: the next frame acquires from this guess (Eq. 1). With `floor` (from the map and the
+  /// camera's pose), acquisition leaves out what lies on it (floor_margin_m).
+  void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor = std::nullopt);
   /// The target was already acquired at T_camera_target: the next frame tracks from there.
   void set_pose(const Eigen::Matrix4d& T_camera_target);
   /// One frame: the sample to publish (sequence left 0), or nothing when there is no guess yet, the
@@ -115,7 +122,8 @@ class TargetFollower {
   SearchStats stats_;
   std::optional<AlignmentResult> last_attempt_;
   FreeSpaceCheck check_;
-  MotionFilter filter_;  // fed with every pose found, reset when the target is lost or a stop begins
+  std::optional<Plane> floor_;  // this stop's floor, camera frame
+  MotionFilter filter_;         // fed with every pose found, reset when the target is lost or a stop begins
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
   // The target is at T (tracked, refined or found): the sample to publish.
   PoseSample found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm);

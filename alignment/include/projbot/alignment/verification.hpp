@@ -21,6 +21,12 @@ struct FreeSpaceCheck {
   double behind_ratio() const { return predicted == 0 ? 0.0 : static_cast<double>(behind) / static_cast<double>(predicted); }
 };
 
+/// The depth inside the model's silhouette at T_camera_model, grown by grow_m (the guess's
+/// uncertainty) in the image and in depth; the rest set to 0 (missing). What acquisition aligns to:
+/// the wall behind a target and a neighbour beside it drop out before ICP sees them.
+DepthImage crop_to_silhouette(const DepthImage& depth, const CameraIntrinsics& k, const ModelCloud& model,
+                              const Eigen::Matrix4d& T_camera_model, double grow_m);
+
 /// The model's visible surface (samples whose normals face the camera, nearest per pixel) under
 /// T_camera_model compared with `depth`. The tolerance grows with range like the Kinect v1's error:
 /// 15 mm + 5 mm per square metre of depth (35 mm at 2 m).
