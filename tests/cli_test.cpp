@@ -507,3 +507,16 @@ TEST_F(CliTest, RunMeasuresTheErrorAtDisplayTime) {
   ASSERT_NE(still, std::string::npos);
   EXPECT_LT(std::stod(r.output.substr(still + 11)), 2.0) << r.output;
 }
+
+// bench acquire through the executable, one trial per target on the demo tour: a row per target, kind
+// of guess and method, and the duck acquired from a 5 cm / 10 degree guess without a false accept.
+TEST_F(CliTest, BenchAcquireReportsEveryTargetAndMethod) {
+  const CliRun r = run_projbot("bench acquire --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml --trials 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* row : {"| duck | 5 cm, 10 deg | ours | 1 |", "| duck | 5 cm, 10 deg | PCL | 1 |",
+                          "| duck | 30 cm, 40 deg | ours | 1 |", "| box | 30 cm, 40 deg | PCL | 1 |"})
+    EXPECT_NE(r.output.find(row), std::string::npos) << row << '\n' << r.output;
+  EXPECT_NE(r.output.find("| duck | 5 cm, 10 deg | ours | 1 | 100.0 % | 0 | 0 |"), std::string::npos) << r.output;
+  EXPECT_EQ(run_projbot("bench acquire --guess-error 5").code, 2);
+  EXPECT_EQ(run_projbot("bench acquire --trials 0").code, 2);
+}

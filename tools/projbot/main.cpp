@@ -16,9 +16,9 @@ using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
   static const std::vector<const Command*> all{
-      &projbot::tools::kRender,        &projbot::tools::kShow,        &projbot::tools::kBenchRender, &projbot::tools::kAlign,
-      &projbot::tools::kBenchTrack,    &projbot::tools::kBenchMotion, &projbot::tools::kSlam,        &projbot::tools::kLocalize,
-      &projbot::tools::kBenchLocalize, &projbot::tools::kTour,        &projbot::tools::kRun};
+      &projbot::tools::kRender,     &projbot::tools::kShow,          &projbot::tools::kBenchRender,  &projbot::tools::kAlign,
+      &projbot::tools::kBenchTrack, &projbot::tools::kBenchMotion,   &projbot::tools::kBenchAcquire, &projbot::tools::kSlam,
+      &projbot::tools::kLocalize,   &projbot::tools::kBenchLocalize, &projbot::tools::kTour,         &projbot::tools::kRun};
   return all;
 }
 
@@ -70,12 +70,13 @@ static int dispatch(int argc, char** argv) {
   }
   std::string name = argv[1];
   int first = 2;
-  if (name == "bench") {  // "bench render", "bench track", "bench motion", "bench localize": the benchmark of a subsystem
+  if (name == "bench") {  // "bench render", "bench track", "bench motion", "bench acquire", "bench localize": the benchmark of a
+                          // subsystem
     const std::string what = argc < 3 ? std::string() : argv[2];
-    if (what != "render" && what != "track" && what != "motion" && what != "localize") {
+    if (what != "render" && what != "track" && what != "motion" && what != "acquire" && what != "localize") {
       std::cerr << "projbot bench: "
                 << (argc < 3 ? std::string("say what to benchmark") : "no benchmark '" + std::string(argv[2]) + "'")
-                << ": projbot bench render | track | motion | localize\n";
+                << ": projbot bench render | track | motion | acquire | localize\n";
       return 2;
     }
     name = std::string("bench ") + argv[2];

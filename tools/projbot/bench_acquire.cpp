@@ -1,0 +1,168 @@
+// projbot bench acquire: acquisition from perturbed initial guesses in the twin (issue 11): success rate,
+// false accepts, false blanks and time, ours beside PCL's own pipeline on the same captures.
+
+#include <Eigen/Geometry>
+#include <cstdio>
+#include <random>
+
+#include "commands.hpp"
+#include "interrupt.hpp"
+#include "projbot/alignment/equations.hpp"
+#include "projbot/alignment/tracker_worker.hpp"
+#include "projbot/alignment/verification.hpp"
+#include "projbot/engine/frame_profiler.hpp"
+#include "projbot/twin/world.hpp"
+#include "scene_setup.hpp"
+
+namespace projbot::tools {
+namespace {
+
+// One acquisition: lit or blanked, how far its pose is from the truth, how long it took.
+struct Outcome {
+  bool lit = false;
+  double error_mm = 0.0, error_deg = 0.0, ms = 0.0;
+};
+
+struct Tally {
+  int trials = 0, success = 0, false_accepts = 0, false_blanks = 0;
+  std::vector<double> ms;
+  void add(const Outcome& o) {
+    ++trials;
+    const bool close = o.error_mm <= 3.0 && o.error_deg <= 0.5;
+    success += o.lit && close ? 1 : 0;
+    false_accepts += o.lit && o.error_mm > 10.0 ? 1 : 0;
+    false_blanks += !o.lit && close ? 1 : 0;
+    ms.push_back(o.ms);
+  }
+  void print(const std::string& target, const char* guesses, const char* method) const {
+    std::printf("| %s | %s | %s | %d | %.1f %% | %d | %d | %.0f / %.0f / %.0f |\n", target.c_str(), guesses, method, trials,
+                trials > 0 ? 100.0 * success / trials : 0.0, false_accepts, false_blanks, engine::percentile(ms, 0.5),
+                engine::percentile(ms, 0.95), engine::percentile(ms, 1.0));
+  }
+};
+
+// The truth moved by `cm` and turned by `deg` about its own origin, each in a random direction.
+Eigen::Matrix4d perturbed(const Eigen::Matrix4d& T, double cm, double deg, std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  const Eigen::Vector3d axis = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+  const Eigen::Vector3d shift = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized() * cm / 100.0;
+  Eigen::Matrix4d out = T;
+  out.topLeftCorner<3, 3>() = Eigen::AngleAxisd(deg * M_PI / 180.0, axis).toRotationMatrix() * T.topLeftCorner<3, 3>();
+  out.topRightCorner<3, 1>() += shift;
+  return out;
+}
+
+Outcome judged(const Eigen::Matrix4d& T_true, const Eigen::Matrix4d& T_est, bool lit, double ms) {
+  const Eigen::Matrix4d d = alignment::rigid_inverse(T_true) * T_est;
+  return {lit, 1000.0 * alignment::translation_norm_m(d), alignment::rotation_angle_deg(d), ms};
+}
+
+// Ours, as the tour's localized mode runs it: the floor left out, the silhouette crop, ICP with restarts
+// and global re-initialisation, the quality gate and the free-space check.
+Outcome ours(const alignment::TargetFollower& follower, const twin::Twin& twin, const twin::TwinTarget& target,
+             const alignment::DepthImage& depth, const alignment::Plane& floor, const Eigen::Matrix4d& guess,
+             const Eigen::Matrix4d& T_true) {
+  const alignment::WorkerConfig w;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto scan = alignment::crop_to_silhouette(alignment::without_plane(depth, twin.camera(), floor, w.floor_margin_m),
+                                                  twin.camera(), target.cloud, guess, w.silhouette_margin_m);
+  alignment::AlignmentResult r;
+  try {
+    r = follower.aligner().align(alignment::depth_to_cloud(scan, twin.camera()), guess);
+  } catch (const alignment::AlignmentError&) {  // too little left to align: blank
+  }
+  const bool lit = r.converged && follower.passes(follower.verify(depth, r.T_scan_model));
+  return judged(T_true, r.T_scan_model, lit,
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+}
+
+// PCL's own pipeline: crop around the guess, normals, point-to-plane ICP; lit whenever ICP converges.
+Outcome pcl_pipeline(const alignment::Aligner& aligner, const twin::Twin& twin, const alignment::DepthImage& depth,
+                     const Eigen::Matrix4d& guess, const Eigen::Matrix4d& T_true) {
+  const auto t0 = std::chrono::steady_clock::now();
+  alignment::AlignmentResult r;
+  try {
+    r = aligner.align(alignment::depth_to_cloud(depth, twin.camera()), guess, alignment::SearchStage::refine);
+  } catch (const alignment::AlignmentError&) {
+  }
+  return judged(T_true, r.T_scan_model, r.converged,
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+}
+
+alignment::AcquisitionConfig pcl_config() {
+  alignment::AcquisitionConfig c;
+  c.restart_angle_deg = 0.0;
+  c.reinitialise = false;
+  c.min_inlier_ratio = 0.0;  // no gate: PCL reports convergence, not whether the pose is right
+  c.max_rmse_mm = 1e9;
+  return c;
+}
+
+}  // namespace
+
+const Command kBenchAcquire{
+    "bench acquire",
+    "benchmark acquisition from perturbed guesses in the twin, ours beside PCL's pipeline",
+    "projbot bench acquire [--scene S.yaml] [--trials N] [--guess-error CM,DEG] [--seed K]\n\n"
+    "For every target of the scene the robot drives to its stop and aims (the twin), then N depth captures\n"
+    "(Kinect v1 noise, a seed each) are acquired from the true pose moved by CM and turned by DEG in random\n"
+    "directions, and N more from a gross guess (30 cm, 40 degrees), where the target must be re-found or\n"
+    "blanked. Ours: the floor left out, the scan cropped to the guess's silhouette, ICP with restarts and\n"
+    "global re-initialisation, the quality gate and the free-space check. PCL's pipeline: crop around the\n"
+    "guess, normals, point-to-plane ICP, lit whenever it converges. Success: lit within 3 mm and 0.5 degrees\n"
+    "of the truth; false accept: lit more than 10 mm off; false blank: blanked within 3 mm and 0.5 degrees.\n"
+    "Without --scene, assets/scenes/shop.yaml runs. Ctrl-C prints the rows finished.\n",
+    {{"scene", "FILE", "scene with a tour (default: assets/scenes/shop.yaml)"},
+     {"trials", "N", "acquisitions per target and kind of guess (default 20)"},
+     {"guess-error", "CM,DEG", "the guess's error (default 5,10)"},
+     {"seed", "K", "seed of the guesses and the depth noise (default 1)"}},
+    [](const cli::Args& args) {
+      const int trials = args.get_int("trials", 20, 1, 10000);
+      double cm = 5.0, deg = 10.0;
+      const std::string ge = args.get_or("guess-error", "5,10");
+      char extra = 0;
+      if (std::sscanf(ge.c_str(), "%lf,%lf%c", &cm, &deg, &extra) != 2 || !(cm >= 0.0 && cm <= 100.0) ||
+          !(deg >= 0.0 && deg <= 180.0))
+        throw cli::UsageError("--guess-error must be CM,DEG with 0..100 cm and 0..180 degrees, not '" + ge + "'");
+      const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
+      const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
+      catch_interrupts();
+      engine::Renderer renderer(engine::RendererOptions{});
+      twin::TwinOptions to;
+      to.seed = seed;
+      twin::Twin twin(scene, to, renderer);
+      std::mt19937 rng(static_cast<std::uint32_t>(seed));
+      std::printf(
+          "| target | guesses | method | trials | success | false accepts | false blanks | time median / p95 / max ms |\n"
+          "|---|---|---|---|---|---|---|---|\n");
+      char small[48];
+      std::snprintf(small, sizeof small, "%.0f cm, %.0f deg", cm, deg);
+      for (std::size_t i = 0; i < twin.targets().size(); ++i) {
+        const twin::TwinTarget& target = twin.targets()[i];
+        const twin::Arrival arrival = twin.arrive(i, static_cast<int>(i));
+        const Eigen::Matrix4d T_true =
+            alignment::rigid_inverse(arrival.truth.T_world_camera.matrix()) * target.T_world_target_true;
+        const alignment::Plane floor = alignment::floor_in_camera(arrival.believed.T_world_camera.matrix());
+        const alignment::TargetFollower follower(target.cloud, twin.camera());
+        const alignment::Aligner pcl(target.cloud, pcl_config());
+        Tally tallies[4];  // ours, PCL: small guesses; ours, PCL: gross guesses
+        for (int k = 0; k < trials; ++k) {
+          if (interrupted()) return benchmark_interrupted("at " + target.config.name + ", trial " + std::to_string(k + 1));
+          const auto depth =
+              twin.capture(arrival.truth.T_world_camera.matrix(), static_cast<std::uint32_t>(seed * 7919 + i * 1000 + k));
+          for (const int gross : {0, 1}) {
+            const Eigen::Matrix4d guess = perturbed(T_true, gross ? 30.0 : cm, gross ? 40.0 : deg, rng);
+            tallies[2 * gross].add(ours(follower, twin, target, depth, floor, guess, T_true));
+            tallies[2 * gross + 1].add(pcl_pipeline(pcl, twin, depth, guess, T_true));
+          }
+        }
+        tallies[0].print(target.config.name, small, "ours");
+        tallies[1].print(target.config.name, small, "PCL");
+        tallies[2].print(target.config.name, "30 cm, 40 deg", "ours");
+        tallies[3].print(target.config.name, "30 cm, 40 deg", "PCL");
+        std::fflush(stdout);
+      }
+      return 0;
+    }};
+
+}  // namespace projbot::tools
