@@ -36,7 +36,8 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
       wide_tracker_(std::move(model), intrinsics, wide(config)),
       k_(intrinsics),
       cfg_(std::move(config)),
-      filter_(cfg_.motion) {}
+      filter_(cfg_.motion),
+      reach_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)) {}
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor) {
   guess_ = T_camera_target;
@@ -86,8 +87,7 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   DepthImage known = floor_ ? without_plane(frame, k_, *floor_, cfg_.floor_margin_m) : frame;
   // Local stages look near the guess: only at what lies inside its silhouette, grown by its uncertainty
   // (a wall behind, a neighbour beside drop out). Global ones search wider on purpose.
-  if (stage == SearchStage::local || stage == SearchStage::refine)
-    known = crop_to_silhouette(known, k_, model_, from, cfg_.silhouette_margin_m);
+  if (stage == SearchStage::local || stage == SearchStage::refine) known = crop_to_silhouette(known, k_, model_, from, reach_m_);
   const PointCloud scan = depth_to_cloud(known, k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
   last_attempt_ = aligner_.align(scan, from, stage);

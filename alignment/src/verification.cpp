@@ -63,6 +63,12 @@ DepthImage crop_to_silhouette(const DepthImage& depth, const CameraIntrinsics& k
   return out;
 }
 
+double guess_reach_m(const ModelCloud& model, double translation_m, double rotation_deg) {
+  double radius = 0.0;
+  for (const auto& p : model.points) radius = std::max(radius, static_cast<double>(p.norm()));
+  return translation_m + 2.0 * std::sin(std::min(rotation_deg, 180.0) * M_PI / 360.0) * radius;
+}
+
 FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
                                 const CameraIntrinsics& k) {
   FreeSpaceCheck c;

@@ -57,15 +57,16 @@ Outcome judged(const Eigen::Matrix4d& T_true, const Eigen::Matrix4d& T_est, bool
   return {lit, 1000.0 * alignment::translation_norm_m(d), alignment::rotation_angle_deg(d), ms};
 }
 
-// Ours, as the tour's localized mode runs it: the floor left out, the silhouette crop, ICP with restarts
-// and global re-initialisation, the quality gate and the free-space check.
+// Ours, as the tour's localized mode runs it: the floor left out, the silhouette crop (grown by how far
+// the guess's error, known here, reaches), ICP with restarts and global re-initialisation, the quality
+// gate and the free-space check.
 Outcome ours(const alignment::TargetFollower& follower, const twin::Twin& twin, const twin::TwinTarget& target,
-             const alignment::DepthImage& depth, const alignment::Plane& floor, const Eigen::Matrix4d& guess,
+             const alignment::DepthImage& depth, const alignment::Plane& floor, const Eigen::Matrix4d& guess, double reach_m,
              const Eigen::Matrix4d& T_true) {
   const alignment::WorkerConfig w;
   const auto t0 = std::chrono::steady_clock::now();
   const auto scan = alignment::crop_to_silhouette(alignment::without_plane(depth, twin.camera(), floor, w.floor_margin_m),
-                                                  twin.camera(), target.cloud, guess, w.silhouette_margin_m);
+                                                  twin.camera(), target.cloud, guess, reach_m);
   alignment::AlignmentResult r;
   try {
     r = follower.aligner().align(alignment::depth_to_cloud(scan, twin.camera()), guess);
@@ -107,10 +108,11 @@ const Command kBenchAcquire{
     "For every target of the scene the robot drives to its stop and aims (the twin), then N depth captures\n"
     "(Kinect v1 noise, a seed each) are acquired from the true pose moved by CM and turned by DEG in random\n"
     "directions, and N more from a gross guess (30 cm, 40 degrees), where the target must be re-found or\n"
-    "blanked. Ours: the floor left out, the scan cropped to the guess's silhouette, ICP with restarts and\n"
-    "global re-initialisation, the quality gate and the free-space check. PCL's pipeline: crop around the\n"
-    "guess, normals, point-to-plane ICP, lit whenever it converges. Success: lit within 3 mm and 0.5 degrees\n"
-    "of the truth; false accept: lit more than 10 mm off; false blank: blanked within 3 mm and 0.5 degrees.\n"
+    "blanked. Ours: the floor left out, the scan cropped to the guess's silhouette grown by how far its\n"
+    "error reaches, ICP with restarts and global re-initialisation, the quality gate and the free-space\n"
+    "check. PCL's pipeline: crop around the guess, normals, point-to-plane ICP, lit whenever it converges.\n"
+    "Success: lit within 3 mm and 0.5 degrees of the truth; false accept: lit more than 10 mm off; false\n"
+    "blank: blanked within 3 mm and 0.5 degrees.\n"
     "Without --scene, assets/scenes/shop.yaml runs. Ctrl-C prints the rows finished.\n",
     {{"scene", "FILE", "scene with a tour (default: assets/scenes/shop.yaml)"},
      {"trials", "N", "acquisitions per target and kind of guess (default 20)"},
@@ -152,7 +154,8 @@ const Command kBenchAcquire{
               twin.capture(arrival.truth.T_world_camera.matrix(), static_cast<std::uint32_t>(seed * 7919 + i * 1000 + k));
           for (const int gross : {0, 1}) {
             const Eigen::Matrix4d guess = perturbed(T_true, gross ? 30.0 : cm, gross ? 40.0 : deg, rng);
-            tallies[2 * gross].add(ours(follower, twin, target, depth, floor, guess, T_true));
+            const double reach = alignment::guess_reach_m(target.cloud, (gross ? 30.0 : cm) / 100.0, gross ? 40.0 : deg);
+            tallies[2 * gross].add(ours(follower, twin, target, depth, floor, guess, reach, T_true));
             tallies[2 * gross + 1].add(pcl_pipeline(pcl, twin, depth, guess, T_true));
           }
         }

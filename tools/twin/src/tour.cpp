@@ -80,8 +80,10 @@ void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twi
       alignment::DepthImage scan = depth;
       if (mode == TourMode::localized) {
         const alignment::WorkerConfig w;
+        const auto& cloud = twin.targets()[target].cloud;
         scan = alignment::crop_to_silhouette(alignment::without_plane(depth, twin.camera(), floor, w.floor_margin_m),
-                                             twin.camera(), twin.targets()[target].cloud, T_init, w.silhouette_margin_m);
+                                             twin.camera(), cloud, T_init,
+                                             alignment::guess_reach_m(cloud, w.guess_uncertainty_m, w.guess_uncertainty_deg));
       }
       r.icp = follower.aligner().align(alignment::depth_to_cloud(scan, twin.camera()), T_init);
     } catch (const alignment::AlignmentError&) {

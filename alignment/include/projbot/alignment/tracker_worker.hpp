@@ -48,9 +48,12 @@ struct WorkerConfig {
   /// Acquisition leaves out the scan points this close to a known floor (or under it): 2 cm is well
   /// outside a localised camera's plane error (a 0.1 degree tilt is 3.5 mm at 2 m).
   double floor_margin_m = 0.02;
-  /// Local acquisition keeps the depth inside the guess's predicted silhouette grown by this much (the
-  /// guess's uncertainty: a localised robot's Eq. 1 guess is within a few cm).
-  double silhouette_margin_m = 0.10;
+  /// Local acquisition keeps the depth inside the guess's predicted silhouette grown by the guess's
+  /// uncertainty: this far, plus guess_uncertainty_deg turning the model's farthest point about its
+  /// origin (a tall figure turned 3 degrees about its feet moves its head 8 cm). A localised robot's
+  /// Eq. 1 guess is within about 1 cm and 0.2 degrees (the tour's table).
+  double guess_uncertainty_m = 0.05;
+  double guess_uncertainty_deg = 3.0;
 };
 
 /// What searching for a target has cost since its stop began.
@@ -124,6 +127,7 @@ class TargetFollower {
   FreeSpaceCheck check_;
   std::optional<Plane> floor_;  // this stop's floor, camera frame
   MotionFilter filter_;         // fed with every pose found, reset when the target is lost or a stop begins
+  double reach_m_;              // the silhouette crop's growth: how far the guess's uncertainty reaches
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
   // The target is at T (tracked, refined or found): the sample to publish.
   PoseSample found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm);

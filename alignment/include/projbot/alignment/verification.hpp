@@ -27,6 +27,10 @@ struct FreeSpaceCheck {
 DepthImage crop_to_silhouette(const DepthImage& depth, const CameraIntrinsics& k, const ModelCloud& model,
                               const Eigen::Matrix4d& T_camera_model, double grow_m);
 
+/// How far a guess off by translation_m and rotation_deg (about the model's origin) can put a model
+/// point: the silhouette crop's growth.
+double guess_reach_m(const ModelCloud& model, double translation_m, double rotation_deg);
+
 /// The model's visible surface (samples whose normals face the camera, nearest per pixel) under
 /// T_camera_model compared with `depth`. The tolerance grows with range like the Kinect v1's error:
 /// 15 mm + 5 mm per square metre of depth (35 mm at 2 m).
