@@ -70,6 +70,7 @@ PoseSample TargetFollower::found(const DepthImage& frame, const Eigen::Matrix4d&
   pose_ = T;
   rejected_ = 0;
   lost_reported_ = false;
+  last_found_s_ = frame.capture_time_s;
   PoseSample sample = still_sample(T, frame.capture_time_s, false, inlier_ratio, rmse_mm);
   filter_.update(T, frame.capture_time_s);
   if (cfg_.predict) sample.motion = filter_.state();
@@ -85,9 +86,10 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   // The floor is known (map and camera pose): left out, so a figure standing on it is aligned to and
   // judged on its own points.
   DepthImage known = floor_ ? without_plane(frame, k_, *floor_, cfg_.floor_margin_m) : frame;
-  // Local stages look near the guess: only at what lies inside its silhouette, grown by its uncertainty
-  // (a wall behind, a neighbour beside drop out). Global ones search wider on purpose.
-  if (stage == SearchStage::local || stage == SearchStage::refine) known = crop_to_silhouette(known, k_, model_, from, reach_m_);
+  // Acquisition from a guess looks near it: only at what lies inside its silhouette, grown by its
+  // uncertainty (a wall behind, a neighbour beside drop out). Global stages search wider on purpose, and
+  // a refine after dropped frames starts from a pose the target may have left by more than that.
+  if (stage == SearchStage::local) known = crop_to_silhouette(known, k_, model_, from, reach_m_);
   const PointCloud scan = depth_to_cloud(known, k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
   last_attempt_ = aligner_.align(scan, from, stage);
@@ -100,11 +102,16 @@ std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
   const Eigen::Matrix4d start = cfg_.predict ? filter_.predict(frame.capture_time_s) : *pose_;
   const TrackResult r = tracker_.track(frame, start);
   if (r.accepted && verified(frame, r.T_camera_target)) return found(frame, r.T_camera_target, r.inlier_ratio, r.rmse_mm);
-  // The target moved more than tracking follows (or frames were dropped): once more on this same frame
-  // with a wider reach (reach_m). A few milliseconds: the PCL ICP that did this before took over a
-  // second on a full frame, and the stale pose stayed lit all that time.
+  // The target moved more than tracking follows: once more on this same frame with a wider reach
+  // (reach_m), a few milliseconds. Only when frames were dropped since the last pose (the worker was
+  // busy, the target may be far from it) one ICP from there as well: on consecutive frames that ICP
+  // (over a second on a full frame) kept a target that had been carried away lit all that time.
   const TrackResult w = wide_tracker_.track(frame, start);
   if (w.accepted && verified(frame, w.T_camera_target)) return found(frame, w.T_camera_target, w.inlier_ratio, w.rmse_mm);
+  if (frame.capture_time_s - last_found_s_ > 2.5 / cfg_.camera_hz) {
+    const auto a = attempt(frame, start, SearchStage::refine);
+    if (a && a->converged && verified(frame, a->T_scan_model)) return found(frame, a->T_scan_model, a->inlier_ratio, a->rmse_mm);
+  }
   if (++rejected_ < cfg_.lost_after) return std::nullopt;  // one bad frame: keep showing the last pose
   // Lost: blank it now and search from where it was last seen, or where its motion was taking it.
   guess_ = start;

@@ -23,8 +23,9 @@ struct WorkerConfig {
   AcquisitionConfig acquisition;
   TrackerConfig tracking;
   /// Consecutive frames in which neither tracking nor a second, wider tracking pass (on the same frame,
-  /// correspondences up to reach_m) found the target, after which it is reported lost and blanked:
-  /// 2 frames at 30 Hz blank within 100 ms of the first depth frame that shows it gone.
+  /// correspondences up to reach_m; and one ICP when frames were dropped since the last pose) found the
+  /// target, after which it is reported lost and blanked: 2 frames at 30 Hz blank within 100 ms of the
+  /// first depth frame that shows it gone.
   int lost_after = 2;
   double reach_m = 0.10;
   /// A lost or not-yet-found target is searched for by bounded attempts, escalating SearchStage::local ->
@@ -128,6 +129,7 @@ class TargetFollower {
   std::optional<Plane> floor_;  // this stop's floor, camera frame
   MotionFilter filter_;         // fed with every pose found, reset when the target is lost or a stop begins
   double reach_m_;              // the silhouette crop's growth: how far the guess's uncertainty reaches
+  double last_found_s_ = 0.0;   // capture time of the newest pose found
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
   // The target is at T (tracked, refined or found): the sample to publish.
   PoseSample found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm);
