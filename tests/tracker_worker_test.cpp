@@ -236,6 +236,7 @@ TEST(TargetFollowerTest, FindsTheTargetAgainAfterDroppedFrames) {
   };
   WorkerConfig cfg;
   cfg.acquisition.reinitialise = false;
+  cfg.acquisition.attempt_budget_ms = 1e9;  // under ThreadSanitizer the ICP's stages run many times slower
   TargetFollower follower(cube_model(), k, cfg);
   follower.set_initial_guess(projbot::config::pose_from_xyz_rpy({0.06, -0.02, 1.0}, {23, 30, 10}));
   const auto found = follower.step(*cube_depth(truth(0), k, 0.0));
