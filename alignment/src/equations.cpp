@@ -39,4 +39,15 @@ double rotation_angle_deg(const Eigen::Matrix4d& T) {
 
 double translation_norm_m(const Eigen::Matrix4d& T) { return T.topRightCorner<3, 1>().norm(); }
 
+Eigen::Matrix3d exp_so3(const Eigen::Vector3d& w) {
+  const double angle = w.norm();
+  if (!(angle > 1e-12)) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+}
+
+Eigen::Vector3d log_so3(const Eigen::Matrix3d& R) {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+
 }  // namespace projbot::alignment

@@ -4,19 +4,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "projbot/alignment/equations.hpp"
+
 namespace projbot::alignment {
 namespace {
-
-Eigen::Matrix3d exp_so3(const Eigen::Vector3d& w) {
-  const double angle = w.norm();
-  if (angle < 1e-12) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
-}
-
-Eigen::Vector3d log_so3(const Eigen::Matrix3d& R) {
-  const Eigen::AngleAxisd aa(R);
-  return aa.angle() * aa.axis();
-}
 
 Eigen::Vector3d clamp_norm(const Eigen::Vector3d& v, double max_norm) {
   const double n = v.norm();

@@ -8,6 +8,7 @@
 #include <numeric>
 #include <random>
 
+#include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
 
 namespace projbot::alignment {
@@ -16,9 +17,7 @@ namespace {
 // exp of a twist (v, w) as a rigid transform (first order in the rotation's axis-angle, exact rotation).
 Eigen::Matrix4d twist_to_transform(const Eigen::Matrix<double, 6, 1>& xi) {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  const Eigen::Vector3d w = xi.tail<3>();
-  const double angle = w.norm();
-  if (angle > 1e-12) T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+  T.topLeftCorner<3, 3>() = exp_so3(xi.tail<3>());
   T.topRightCorner<3, 1>() = xi.head<3>();
   return T;
 }
@@ -98,10 +97,9 @@ void add_start_prior(Eigen::Matrix<double, 6, 6>& H, Eigen::Matrix<double, 6, 1>
                      const Eigen::Matrix4d& T_start, double weight, double radius_m) {
   if (!(weight > 0.0)) return;
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>() * T_start.topLeftCorner<3, 3>().transpose();
-  const Eigen::AngleAxisd aa(R);
   Eigen::Matrix<double, 6, 1> xi;  // T = exp(xi) T_start to first order (turns about the camera's origin)
   xi.head<3>() = T.topRightCorner<3, 1>() - R * T_start.topRightCorner<3, 1>();
-  xi.tail<3>() = aa.angle() * aa.axis();
+  xi.tail<3>() = log_so3(R);
   // The displacement of the model's origin c is v + w x c = M xi; of its points, also rho w.
   const Eigen::Vector3d c = T.topRightCorner<3, 1>();
   Eigen::Matrix3d cx;

@@ -21,4 +21,9 @@ Eigen::Matrix4d rigid_inverse(const Eigen::Matrix4d& T);
 double rotation_angle_deg(const Eigen::Matrix4d& T);
 double translation_norm_m(const Eigen::Matrix4d& T);
 
+/// The rotation by |w| radians about w (the exponential map of SO(3)); the identity for w = 0.
+Eigen::Matrix3d exp_so3(const Eigen::Vector3d& w);
+/// Its inverse: the rotation vector (axis times angle, radians, angle in [0, pi]) of R.
+Eigen::Vector3d log_so3(const Eigen::Matrix3d& R);
+
 }  // namespace projbot::alignment
