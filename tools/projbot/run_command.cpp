@@ -86,7 +86,7 @@ double marker_error_mm(const config::TargetConfig& target, const RobotState& rob
                        double display_s, bool& moving) {
   const double t = display_s - robot.since_s;
   const config::TargetMotion* m = target.motion_on(robot.target_visit);
-  moving = m && t > m->start_s && t <= m->start_s + m->duration_s;
+  moving = m && m->moving_at(t);
   if (target.markers_m.empty()) return std::nan("");
   const Eigen::Matrix4d T_true = robot.T_camera_world * twin::scripted_pose(target, robot.T_world_home, robot.target_visit, t);
   double sum = 0.0;

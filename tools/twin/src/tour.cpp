@@ -179,7 +179,7 @@ TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double
   TimelineSample s;
   s.t_s = display_s;
   s.shown = shown;
-  s.moving = motion && display_s > motion->start_s && display_s <= motion->start_s + motion->duration_s;
+  s.moving = motion && motion->moving_at(display_s);
   s.age_ms = 1000.0 * (display_s - drawn.capture_time_s);
   s.in_world = target.in_world;
   const Eigen::Matrix4d T_camera_target = predict ? alignment::predict_pose(drawn.motion, display_s) : drawn.T_camera_target;
@@ -242,7 +242,7 @@ bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitRepo
   CameraSide camera(c, follower, r);
   double wall_to_light_ms = r.align_ms;
   const config::TargetMotion* motion = target.config.motion_on(r.target_visit);
-  const double motion_end_s = motion ? motion->start_s + motion->duration_s : 0.0;
+  const double motion_end_s = motion ? motion->end_s() : 0.0;
   double back_under = -1.0;  // when the error went back under the goal for good, -1 while it is not
   bool ever_over = false;
   const int frames = static_cast<int>(std::lround(c.options.dwell_s * c.projector.refresh_hz));

@@ -208,12 +208,12 @@ bool Twin::scripted_presence(std::size_t target, int target_visit, double t_s) c
   const TwinTarget& t = targets_.at(target);
   if (!t.config.present || gone_.contains(target)) return false;
   const config::TargetMotion* m = t.config.motion_on(target_visit);
-  return !(m && m->removed && t_s >= m->start_s + m->duration_s);
+  return !(m && m->removed && t_s >= m->end_s());
 }
 
 void Twin::end_visit(std::size_t target, int target_visit) {
   const config::TargetMotion* motion = targets_.at(target).config.motion_on(target_visit);
-  if (motion && motion->stays) home_[target] = scripted_pose(target, target_visit, motion->start_s + motion->duration_s);
+  if (motion && motion->stays) home_[target] = scripted_pose(target, target_visit, motion->end_s());
   if (motion && motion->removed) gone_.insert(target);
   targets_[target].T_world_target_true = home_[target];
   targets_[target].in_world = scripted_presence(target, 0, 0.0);

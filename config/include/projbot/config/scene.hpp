@@ -56,6 +56,9 @@ struct TargetMotion {
   /// Someone carries it away: at start_s + duration_s (after moving as above) it leaves the world for
   /// the rest of the tour.
   bool removed = false;
+  double end_s() const { return start_s + duration_s; }
+  /// Whether the target is moving `t_s` into the visit: after start_s, up to and including end_s().
+  bool moving_at(double t_s) const { return t_s > start_s && t_s <= end_s(); }
 };
 
 /// What a target stands on in the twin (`support:`): the floor itself (`support: floor`: its lowest
