@@ -201,6 +201,19 @@ Eigen::Matrix4d read_pose(MapReader& target, const std::string& path, const std:
   return T;
 }
 
+// A glTF reference, for targets and props alike: `model` (resolved against the scene's folder), `scale`
+// and `recenter`.
+void read_model_ref(MapReader& m, const YAML::Node& node, const std::string& path, const std::filesystem::path& base,
+                    std::filesystem::path& model, double& scale, bool& recenter) {
+  const auto file = m.get<std::string>("model", "", true);
+  if (file.empty()) m.fail(node, path + ".model", "must not be empty");
+  model = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : base / file;
+  scale = m.get<double>("scale", 1.0);
+  if (!(scale >= 1e-4 && scale <= 1e4))
+    m.fail(node["scale"], path + ".scale", "must be 0.0001..10000 (a uniform factor on the model's metres)");
+  recenter = m.get<bool>("recenter", false);
+}
+
 TargetSupport read_support(MapReader& t, const std::string& path) {
   TargetSupport support;
   YAML::Node node = t.child("support", false);
@@ -227,12 +240,7 @@ PropConfig read_prop(const YAML::Node& node, const std::string& path, const std:
   if (prop.name.empty()) p.fail(node, path + ".name", "must not be empty");
   if (p.has("box") == p.has("model")) p.fail(node, path, "give either a 'model' (glTF) or a 'box: {min, max}', not both");
   if (p.has("model")) {
-    const auto model = p.get<std::string>("model", "", true);
-    if (model.empty()) p.fail(node, path + ".model", "must not be empty");
-    prop.model = std::filesystem::path(model).is_absolute() ? std::filesystem::path(model) : base / model;
-    prop.scale = p.get<double>("scale", 1.0);
-    if (!(prop.scale >= 1e-4 && prop.scale <= 1e4)) p.fail(node["scale"], path + ".scale", "must be 0.0001..10000");
-    prop.recenter = p.get<bool>("recenter", false);
+    read_model_ref(p, node, path, base, prop.model, prop.scale, prop.recenter);
     if (!p.has("world_pose")) p.fail(node, path, "a model prop needs a world_pose");
     prop.T_world_prop = read_pose(p, path + ".world_pose", "world_pose");
   } else {
@@ -371,13 +379,7 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
     target.name = t.get<std::string>("name", "", true);
     if (target.name.empty()) t.fail(targets[i], path + ".name", "must not be empty");
     if (!names.insert(target.name).second) t.fail(targets[i], path + ".name", "duplicate target name '" + target.name + "'");
-    const auto model = t.get<std::string>("model", "", true);
-    if (model.empty()) t.fail(targets[i], path + ".model", "must not be empty");
-    target.model = std::filesystem::path(model).is_absolute() ? std::filesystem::path(model) : base / model;
-    target.scale = t.get<double>("scale", 1.0);
-    if (!(target.scale >= 1e-4 && target.scale <= 1e4))
-      t.fail(targets[i]["scale"], path + ".scale", "must be 0.0001..10000 (a uniform factor on the model's metres)");
-    target.recenter = t.get<bool>("recenter", false);
+    read_model_ref(t, targets[i], path, base, target.model, target.scale, target.recenter);
     target.present = t.get<bool>("present", true);
     target.support = read_support(t, path + ".support");
     target.T_projector_target = read_pose(t, path + ".pose");
