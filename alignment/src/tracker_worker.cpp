@@ -8,7 +8,6 @@
 namespace projbot::alignment {
 namespace {
 
-// A sample at rest: the motion to draw it with is the pose itself.
 // The tracker's second try on a frame where it lost the target: correspondences up to reach_m apart.
 TrackerConfig wide(const WorkerConfig& c) {
   TrackerConfig t = c.tracking;
@@ -17,6 +16,7 @@ TrackerConfig wide(const WorkerConfig& c) {
   return t;
 }
 
+// A sample at rest: the motion to draw it with is the pose itself.
 PoseSample still_sample(const Eigen::Matrix4d& T, double capture_time_s, bool lost, double inlier_ratio, double rmse_mm) {
   PoseSample s;
   s.T_camera_target = s.motion.T = T;
@@ -37,7 +37,7 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
       k_(intrinsics),
       cfg_(std::move(config)),
       filter_(cfg_.motion),
-      reach_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)) {}
+      silhouette_grow_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)) {}
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor) {
   guess_ = T_camera_target;
@@ -82,15 +82,26 @@ std::optional<PoseSample> TargetFollower::step(const DepthImage& frame) {
   return pose_ ? track(frame) : search(frame);
 }
 
-std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage) {
+DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matrix4d& from, const std::optional<Plane>& floor,
+                                      std::optional<double> grow_m) const {
   // The floor is known (map and camera pose): left out, so a figure standing on it is aligned to and
   // judged on its own points.
-  DepthImage known = floor_ ? without_plane(frame, k_, *floor_, cfg_.floor_margin_m) : frame;
+  DepthImage known = floor ? without_plane(frame, k_, *floor, cfg_.floor_margin_m) : frame;
+  if (grow_m) known = crop_to_silhouette(known, k_, model_, from, *grow_m);
+  return known;
+}
+
+AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Plane& floor,
+                                        double grow_m) const {
+  return aligner_.align(depth_to_cloud(near_guess(frame, guess, floor, grow_m), k_), guess);
+}
+
+std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage) {
   // Acquisition from a guess looks near it: only at what lies inside its silhouette, grown by its
   // uncertainty (a wall behind, a neighbour beside drop out). Global stages search wider on purpose, and
   // a refine after dropped frames starts from a pose the target may have left by more than that.
-  if (stage == SearchStage::local) known = crop_to_silhouette(known, k_, model_, from, reach_m_);
-  const PointCloud scan = depth_to_cloud(known, k_);
+  const auto grow_m = stage == SearchStage::local ? std::optional<double>(silhouette_grow_m_) : std::nullopt;
+  const PointCloud scan = depth_to_cloud(near_guess(frame, from, floor_, grow_m), k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
   last_attempt_ = aligner_.align(scan, from, stage);
   return last_attempt_;

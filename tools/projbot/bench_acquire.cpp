@@ -57,19 +57,15 @@ Outcome judged(const Eigen::Matrix4d& T_true, const Eigen::Matrix4d& T_est, bool
   return {lit, 1000.0 * alignment::translation_norm_m(d), alignment::rotation_angle_deg(d), ms};
 }
 
-// Ours, as the tour's localized mode runs it: the floor left out, the silhouette crop (grown by how far
-// the guess's error, known here, reaches), ICP with restarts and global re-initialisation, the quality
-// gate and the free-space check.
-Outcome ours(const alignment::TargetFollower& follower, const twin::Twin& twin, const twin::TwinTarget& target,
-             const alignment::DepthImage& depth, const alignment::Plane& floor, const Eigen::Matrix4d& guess, double reach_m,
-             const Eigen::Matrix4d& T_true) {
-  const alignment::WorkerConfig w;
+// Ours, as the tour's localized mode runs it (TargetFollower::acquire: the floor left out, the silhouette
+// crop grown by `grow_m`, ICP with restarts and global re-initialisation), then the quality gate and
+// the free-space check.
+Outcome ours(const alignment::TargetFollower& follower, const alignment::DepthImage& depth, const alignment::Plane& floor,
+             const Eigen::Matrix4d& guess, double grow_m, const Eigen::Matrix4d& T_true) {
   const auto t0 = std::chrono::steady_clock::now();
-  const auto scan = alignment::crop_to_silhouette(alignment::without_plane(depth, twin.camera(), floor, w.floor_margin_m),
-                                                  twin.camera(), target.cloud, guess, reach_m);
   alignment::AlignmentResult r;
   try {
-    r = follower.aligner().align(alignment::depth_to_cloud(scan, twin.camera()), guess);
+    r = follower.acquire(depth, guess, floor, grow_m);
   } catch (const alignment::AlignmentError&) {  // too little left to align: blank
   }
   const bool lit = r.converged && follower.passes(follower.verify(depth, r.T_scan_model));
@@ -146,6 +142,9 @@ const Command kBenchAcquire{
             alignment::rigid_inverse(arrival.truth.T_world_camera.matrix()) * target.T_world_target_true;
         const alignment::Plane floor = alignment::floor_in_camera(arrival.believed.T_world_camera.matrix());
         const alignment::TargetFollower follower(target.cloud, twin.camera());
+        // The crop grows by how far each kind of guess's error (known here) can reach.
+        const double grow_m[2] = {alignment::guess_reach_m(target.cloud, cm / 100.0, deg),
+                                  alignment::guess_reach_m(target.cloud, 0.30, 40.0)};
         const alignment::Aligner pcl(target.cloud, pcl_config());
         Tally tallies[4];  // ours, PCL: small guesses; ours, PCL: gross guesses
         for (int k = 0; k < trials; ++k) {
@@ -154,8 +153,7 @@ const Command kBenchAcquire{
               twin.capture(arrival.truth.T_world_camera.matrix(), static_cast<std::uint32_t>(seed * 7919 + i * 1000 + k));
           for (const int gross : {0, 1}) {
             const Eigen::Matrix4d guess = perturbed(T_true, gross ? 30.0 : cm, gross ? 40.0 : deg, rng);
-            const double reach = alignment::guess_reach_m(target.cloud, (gross ? 30.0 : cm) / 100.0, gross ? 40.0 : deg);
-            tallies[2 * gross].add(ours(follower, twin, target, depth, floor, guess, reach, T_true));
+            tallies[2 * gross].add(ours(follower, depth, floor, guess, grow_m[gross], T_true));
             tallies[2 * gross + 1].add(pcl_pipeline(pcl, twin, depth, guess, T_true));
           }
         }

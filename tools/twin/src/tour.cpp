@@ -56,8 +56,8 @@ Errors marker_errors(const Twin& twin, std::size_t target, const config::Project
 // One acquisition at arrival. Odometry and localized modes: the whole acquisition once (the paper's
 // one alignment per stop; odometry projects whatever it gives). Tracking mode: the follower's first
 // step, the bounded start of its search, as the live engine's worker does it.
-void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, std::size_t target,
-             const alignment::DepthImage& depth, const Eigen::Matrix4d& T_init, const alignment::Plane& floor, VisitReport& r) {
+void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const alignment::DepthImage& depth,
+             const Eigen::Matrix4d& T_init, const alignment::Plane& floor, VisitReport& r) {
   const auto t0 = Clock::now();
   r.icp.T_scan_model = T_init;  // too little in view: nothing to align
   r.icp.converged = false;
@@ -77,15 +77,8 @@ void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twi
     try {
       // Ours leaves out the floor (known from the map and where the robot believes its camera is) and
       // what lies outside the guess's silhouette; the paper's set-up aligns to everything near the guess.
-      alignment::DepthImage scan = depth;
-      if (mode == TourMode::localized) {
-        const alignment::WorkerConfig w;
-        const auto& cloud = twin.targets()[target].cloud;
-        scan = alignment::crop_to_silhouette(alignment::without_plane(depth, twin.camera(), floor, w.floor_margin_m),
-                                             twin.camera(), cloud, T_init,
-                                             alignment::guess_reach_m(cloud, w.guess_uncertainty_m, w.guess_uncertainty_deg));
-      }
-      r.icp = follower.aligner().align(alignment::depth_to_cloud(scan, twin.camera()), T_init);
+      r.icp = mode == TourMode::localized ? follower.acquire(depth, T_init, floor, follower.silhouette_grow_m())
+                                          : follower.aligner().align(alignment::depth_to_cloud(depth, twin.camera()), T_init);
     } catch (const alignment::AlignmentError&) {
     }
     // Ours also checks the estimate against free space; the paper's set-up projects whatever ICP gives.
@@ -375,8 +368,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     const Eigen::Matrix4d guess_error = alignment::rigid_inverse(T_camera_true) * T_init;
     r.guess_error_cm = 100.0 * alignment::translation_norm_m(guess_error);
     r.guess_error_deg = alignment::rotation_angle_deg(guess_error);
-    acquire(options.mode, followers[i], twin, i, depth, T_init,
-            alignment::floor_in_camera(arrival.believed.T_world_camera.matrix()), r);
+    acquire(options.mode, followers[i], twin, depth, T_init, alignment::floor_in_camera(arrival.believed.T_world_camera.matrix()),
+            r);
     const Eigen::Matrix4d T_world_projector = truth.T_world_projector.matrix();
     r.T_projector_target_estimated = alignment::projector_from_target(rig.T_projector_camera, r.icp.T_scan_model);
     r.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;

@@ -27,7 +27,7 @@ struct WorkerConfig {
   /// target, after which it is reported lost and blanked: 2 frames at 30 Hz blank within 100 ms of the
   /// first depth frame that shows it gone.
   int lost_after = 2;
-  double reach_m = 0.10;
+  double reach_m = 0.10;  ///< the second tracking pass's correspondence distance, metres
   /// A lost or not-yet-found target is searched for by bounded attempts, escalating SearchStage::local ->
   /// global_near -> global_wide and round again, one attempt per frame at most. After the n-th failed
   /// attempt the next one waits search_spacing_frames[min(n - 1, size - 1)] frames, so an absent target
@@ -109,6 +109,11 @@ class TargetFollower {
   Eigen::Matrix4d last_pose() const { return pose_.value_or(guess_); }
   const Aligner& aligner() const { return aligner_; }
   const MotionFilter& motion() const { return filter_; }
+  /// One whole acquisition (SearchStage::full) from `guess`, as the tour's localized mode runs it: the
+  /// floor left out, the depth cropped to the guess's silhouette grown by grow_m (silhouette_grow_m():
+  /// how far the configured uncertainty reaches). Throws AlignmentError when too little depth is left.
+  AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Plane& floor, double grow_m) const;
+  double silhouette_grow_m() const { return silhouette_grow_m_; }
 
  private:
   ModelCloud model_;  // for the free-space check
@@ -128,9 +133,12 @@ class TargetFollower {
   FreeSpaceCheck check_;
   std::optional<Plane> floor_;  // this stop's floor, camera frame
   MotionFilter filter_;         // fed with every pose found, reset when the target is lost or a stop begins
-  double reach_m_;              // the silhouette crop's growth: how far the guess's uncertainty reaches
+  double silhouette_grow_m_;    // how far the guess's configured uncertainty reaches
   double last_found_s_ = 0.0;   // capture time of the newest pose found
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
+  // The frame without the known floor and, with grow_m, cropped to the silhouette at `from` grown by it.
+  DepthImage near_guess(const DepthImage& frame, const Eigen::Matrix4d& from, const std::optional<Plane>& floor,
+                        std::optional<double> grow_m) const;
   // The target is at T (tracked, refined or found): the sample to publish.
   PoseSample found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm);
 
