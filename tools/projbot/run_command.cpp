@@ -115,7 +115,7 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
     const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
     const std::size_t i = twin.target_index(name);
     const auto scene_index = static_cast<std::size_t>(scene.target_index(name));  // workers and draw items
-    state.publish({-1, now_s(), v + 1, false, 0, Eigen::Matrix4d::Identity(), Eigen::Matrix4d::Identity()});
+    state.publish({.target = -1, .since_s = now_s(), .visit = v + 1});
     const twin::Arrival arrival = twin.arrive(i, v);
     const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
     workers[scene_index]->set_initial_guess(arrival.T_camera_target_guess);  // Eq. 1
@@ -142,7 +142,7 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
     }
     twin.end_visit(i, target_visit);
   }
-  state.publish({-1, now_s(), visits, true, 0, Eigen::Matrix4d::Identity(), Eigen::Matrix4d::Identity()});
+  state.publish({.target = -1, .since_s = now_s(), .visit = visits, .done = true});
 }
 
 }  // namespace
@@ -156,8 +156,7 @@ const Command kRun{
     "Opens the projector output and draws, every frame, each target the robot is projecting onto at the\n"
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
     "expected display time (one frame period as measured, plus the projector's input_lag_ms); targets not\n"
-    "yet found or lost"
-    " are blanked.\n"
+    "yet found or lost are blanked.\n"
     "The robot thread drives the tour of the config's `tour.visits`, aims the pan-tilt, gives the worker\n"
     "the initial guess (Eq. 1) and dwells while the camera streams depth. Per frame it records the pose's\n"
     "age at display (depth capture to the frame's expected display time), the frame time and, in the twin,\n"
