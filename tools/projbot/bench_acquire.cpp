@@ -147,8 +147,8 @@ const Command kBenchAcquire{
                                   alignment::guess_reach_m(target.cloud, 0.30, 40.0)};
         const alignment::Aligner pcl(target.cloud, pcl_config());
         Tally tallies[4];  // ours, PCL: small guesses; ours, PCL: gross guesses
-        for (int k = 0; k < trials; ++k) {
-          if (interrupted()) return benchmark_interrupted("at " + target.config.name + ", trial " + std::to_string(k + 1));
+        int k = 0;
+        for (; k < trials && !interrupted(); ++k) {
           const auto depth =
               twin.capture(arrival.truth.T_world_camera.matrix(), static_cast<std::uint32_t>(seed * 7919 + i * 1000 + k));
           for (const int gross : {0, 1}) {
@@ -157,11 +157,14 @@ const Command kBenchAcquire{
             tallies[2 * gross + 1].add(pcl_pipeline(pcl, twin, depth, guess, T_true));
           }
         }
-        tallies[0].print(target.config.name, small, "ours");
-        tallies[1].print(target.config.name, small, "PCL");
-        tallies[2].print(target.config.name, "30 cm, 40 deg", "ours");
-        tallies[3].print(target.config.name, "30 cm, 40 deg", "PCL");
-        std::fflush(stdout);
+        if (k > 0) {  // Ctrl-C: the trials finished for this target are printed too (their count says how many)
+          tallies[0].print(target.config.name, small, "ours");
+          tallies[1].print(target.config.name, small, "PCL");
+          tallies[2].print(target.config.name, "30 cm, 40 deg", "ours");
+          tallies[3].print(target.config.name, "30 cm, 40 deg", "PCL");
+          std::fflush(stdout);
+        }
+        if (k < trials) return benchmark_interrupted("at " + target.config.name + ", trial " + std::to_string(k + 1));
       }
       return 0;
     }};

@@ -31,13 +31,17 @@ void print_side_by_side(const twin::TourReport& off, const twin::TourReport& on)
   const auto recovery = [](const twin::VisitReport& v) {
     return v.recovery_s == 0.0 ? std::string("-") : v.recovery_s < 0.0 ? std::string("never") : cell(v.recovery_s, 2);
   };
-  for (std::size_t i = 0; i < std::min(off.visits.size(), on.visits.size()); ++i) {
+  // After Ctrl-C in the first run, its finished visits are printed with the second run's cells "-".
+  for (std::size_t i = 0; i < off.visits.size(); ++i) {
     const auto& a = off.visits[i];
-    const auto& b = on.visits[i];
-    std::printf("| %d | %s | %s | %s | %s | %d / %d | %s / %s | %s / %s | %s / %s |\n", a.visit, a.target.c_str(),
-                a.moved ? "moved" : "still", moving(a).c_str(), moving(b).c_str(), a.moving_blank_frames, b.moving_blank_frames,
-                recovery(a).c_str(), recovery(b).c_str(), cell(a.still_mean_mm, 2).c_str(), cell(b.still_mean_mm, 2).c_str(),
-                cell(b.age_p50_ms, 0).c_str(), cell(b.age_p95_ms, 0).c_str());
+    const bool ran = i < on.visits.size();
+    const auto& b = ran ? on.visits[i] : a;
+    const auto second = [ran](const std::string& text) { return ran ? text : std::string("-"); };
+    std::printf("| %d | %s | %s | %s | %s | %d / %s | %s / %s | %s / %s | %s / %s |\n", a.visit, a.target.c_str(),
+                a.moved ? "moved" : "still", moving(a).c_str(), second(moving(b)).c_str(), a.moving_blank_frames,
+                second(std::to_string(b.moving_blank_frames)).c_str(), recovery(a).c_str(), second(recovery(b)).c_str(),
+                cell(a.still_mean_mm, 2).c_str(), second(cell(b.still_mean_mm, 2)).c_str(), second(cell(b.age_p50_ms, 0)).c_str(),
+                second(cell(b.age_p95_ms, 0)).c_str());
   }
 }
 
@@ -87,7 +91,10 @@ const Command kBenchMotion{
       const auto& p = scene.projector;
       std::printf("\nprojector %.0f Hz, input lag %.0f ms; camera 30 Hz; seed %llu\n", p.refresh_hz, p.input_lag_ms,
                   static_cast<unsigned long long>(o.seed));
-      if (interrupted()) return benchmark_interrupted("during the tours (the visits above finished in both runs)");
+      if (interrupted())
+        return benchmark_interrupted(
+            "during the tours (the visits above are those finished; '-' where the run with "
+            "prediction did not reach them)");
       return 0;
     }};
 
