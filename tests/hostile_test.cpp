@@ -225,6 +225,12 @@ const std::vector<Hostile> kFileCases{
         "png_too_small_for_intrinsics", "align --model {duck} --scan " + kGood16, {}, 1, {"gray16_4x3.png", "4x3", "640x480"}},
     Hostile{"tiff_random", "align --model {duck} --scan {dir}/r.tiff", Files{{"r.tiff", "@random:5000"}}, 1, {"r.tiff"}},
     Hostile{"tiff_empty", "align --model {duck} --scan {dir}/e.tiff", Files{{"e.tiff", ""}}, 1, {"e.tiff"}},
+    // A 145-byte file whose header claims 11012 x 15352 pixels: it was a 676 MB allocation (a fuzzer's find).
+    Hostile{"tiff_claims_more_than_it_holds",
+            "align --model {duck} --scan {src}/tests/hostile/tiff_claims_169M_pixels.tiff",
+            {},
+            1,
+            {"tiff_claims_169M_pixels.tiff", "11012x15352", "145 bytes"}},
     Hostile{"tiff_truncated",
             "align --model {duck} --scan {dir}/cut.tiff",
             Files{{"cut.tiff", "@head:30:{src}/tests/fuzz/corpus/depth_tiff/gray16_4x3.tiff"}},
