@@ -313,7 +313,7 @@ TEST_F(CliTest, BenchmarksInterruptedKeepTheRowsDone) {
       {{"bench", "localize", "--stops", "3,3,3,3,3,3,3,3"}, "| 3 | odometry alone |", SIGTERM, "the rows above are complete"},
       {{"bench", "track", "--frames", "2000"}, "rendering 2000 frames", SIGINT, "interrupted while rendering"},
       // In the first of its two runs: the visits it finished, the second run's cells "-".
-      {{"bench", "motion"}, "prediction off: 1 ", SIGINT, "| 1 | duck | still | - | - | 0 / - | - / - | 0.2"}};
+      {{"bench", "motion"}, "prediction off: 1 ", SIGINT, "| 1 | duck | still | - | - | 0 / - | - / - | 0."}};
   for (const auto& c : cases) {
     Background run(c.args, dir_ / "bench.log");
     ASSERT_GT(run.pid, 0);

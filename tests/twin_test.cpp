@@ -515,6 +515,10 @@ TEST(TourTest, TheShopFigureOnTheFloorIsLit) {
   EXPECT_TRUE(localized.visits[0].projected);
   EXPECT_FALSE(localized.visits[0].icp.reinitialised);  // found from the guess, no global search
   EXPECT_LT(localized.visits[0].mean_mm, 5.0);          // the shelf touching its hand still pulls (3.7 mm)
+  // The pan-tilt aims at the model's middle, not its origin at the feet: every marker, the chest's too,
+  // is in the projector's image and lit (aimed at the feet, the chest was above the image).
+  ASSERT_EQ(localized.visits[0].markers.size(), 5U);
+  for (const auto& m : localized.visits[0].markers) EXPECT_TRUE(m.in_image && m.landed) << m.marker_m.transpose();
   const auto tracked = tracking_tour(scene, 1, 1.0);
   ASSERT_EQ(tracked.visits.size(), 1U);
   EXPECT_EQ(tracked.visits[0].lit_frames, 61);

@@ -26,8 +26,15 @@ struct Errors {
   double mean_mm = 0.0, max_mm = 0.0;
 };
 
-// The error at the target's markers. A marker the projector cannot light (turned away, or hidden by
-// the target itself or something in front) has no error to measure and is left out; mean and max are
+// Whether a point in the projector frame falls inside the projector's image (Eq. 3).
+bool lit_by(const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
+  if (p.z() <= 0.0) return false;
+  const double u = k.fx_px * p.x() / p.z() + k.cx_px, v = k.fy_px * p.y() / p.z() + k.cy_px;
+  return u >= 0.0 && v >= 0.0 && u < k.width_px && v < k.height_px;
+}
+
+// The error at the target's markers. A marker the projector cannot light (outside its image, turned
+// away, or hidden by the target itself or something in front) has no error to measure and is left out; mean and max are
 // NaN when no marker is visible (such frames are left out of the visit's statistics).
 Errors marker_errors(const Twin& twin, std::size_t target, const config::ProjectorConfig& projector,
                      const Eigen::Matrix4d& T_world_projector, const Eigen::Matrix4d& T_projector_target_estimated) {
@@ -39,6 +46,7 @@ Errors marker_errors(const Twin& twin, std::size_t target, const config::Project
   int visible = 0;
   for (const auto& m : t.config.markers_m) {
     const Eigen::Vector3d truth = (T_true * m.homogeneous()).head<3>();
+    if (!lit_by(projector, truth)) continue;  // outside the projector's image: it cannot be lit
     const auto first = cast_ray(scene, Eigen::Vector3d::Zero(), truth.normalized());
     if (!first || (*first - truth).norm() > 0.002) continue;
     e.markers.push_back(measure_marker(projector, T_projector_target_estimated, T_true, m, scene));

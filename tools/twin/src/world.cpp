@@ -164,7 +164,10 @@ Arrival Twin::arrive(std::size_t target, int index) {
   const Eigen::Vector3d& stop = *t.config.stop;
   a.drive = robot_->drive_to({stop.x(), stop.y(), stop.z()}, index);
   a.T_map_target = t.config.T_map_target.value_or(*t.config.T_world_target);
-  const auto aim = robot::aim_at(robot_->believed_pose(), a.T_map_target.topRightCorner<3, 1>(), scene_.pan_tilt);
+  // Aim at the middle of the model, not its origin: a standing figure's origin is at its feet, and
+  // aiming there left its chest above the projector's image.
+  const Eigen::Vector3d middle = (a.T_map_target * t.model.bounds().center().homogeneous()).head<3>();
+  const auto aim = robot::aim_at(robot_->believed_pose(), middle, scene_.pan_tilt);
   if (const auto s = pan_tilt_.move_to(aim.angles); !s.ok) throw TwinError("pan-tilt: " + s.error);
   robot::PanTiltAngles reported;
   if (const auto s = pan_tilt_.position(reported); !s.ok) throw TwinError("pan-tilt: " + s.error);
