@@ -454,6 +454,19 @@ TEST_F(CliTest, TourPrintsTheTableAndWritesReportAndFrames) {
   const double share = static_cast<double>(lit) / (image.width * image.height);
   EXPECT_GT(share, 0.01);
   EXPECT_LT(share, 0.5);
+  // Beside it, the RGB-D camera's colour view at 640 x 480: the yellow Duck in the middle of a lit room.
+  const auto camera = projbot::assets::read_image(dir_ / "frames" / "visit01_duck_camera.png");
+  ASSERT_EQ(camera.width, 640);
+  ASSERT_EQ(camera.height, 480);
+  std::size_t yellow = 0, dark = 0;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const auto* p = camera.pixel(x, y);
+      yellow += p[0] > 180 && p[1] > 150 && p[2] < 90 ? 1 : 0;
+      dark += p[0] + p[1] + p[2] < 30 ? 1 : 0;
+    }
+  EXPECT_GT(static_cast<double>(yellow) / (640 * 480), 0.02);
+  EXPECT_LT(static_cast<double>(dark) / (640 * 480), 0.05);  // walls and floor everywhere else
 }
 
 namespace {

@@ -524,3 +524,60 @@ TEST(TourTest, TheShopFigureOnTheFloorIsLit) {
   EXPECT_EQ(tracked.visits[0].lit_frames, 61);
   EXPECT_LT(tracked.visits[0].still_mean_mm, 2.0);
 }
+
+// The twin's colour camera (issue 11): registered to its depth, the textured model as it is, and the
+// colour sensor's noise. Checked against the Duck drawn alone from the same viewpoint, noiseless.
+TEST(TwinColourTest, ColourIsRegisteredToDepthWithTheModelsTextureAndNoise) {
+  const auto scene = projbot::config::load_scene(kAssets + "/scenes/shop.yaml");
+  projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
+  projbot::twin::Twin twin(scene, {}, renderer);
+  const std::size_t duck = twin.target_index("duck");
+  const auto arrival = twin.arrive(duck, 0);
+  const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
+  const auto colour = twin.capture_colour(T_world_camera, 7);
+  const auto depth = twin.capture(T_world_camera, 7);
+  ASSERT_EQ(colour.width, depth.width);
+  ASSERT_EQ(colour.height, depth.height);
+  EXPECT_EQ(twin.capture_colour(T_world_camera, 7).rgba, colour.rgba);  // seeded
+  // The Duck alone, noiseless, in colour and depth.
+  projbot::config::ProjectorConfig pinhole = scene.depth_camera;
+  pinhole.near_m = 0.3;
+  pinhole.far_m = 8.0;
+  const std::vector<projbot::engine::DrawItem> duck_only{
+      {twin.target_model_ids()[duck],
+       projbot::alignment::rigid_inverse(T_world_camera) * twin.targets()[duck].T_world_target_true}};
+  auto offscreen = renderer.make_offscreen(colour.width, colour.height);
+  renderer.draw_frame(*offscreen, pinhole, duck_only);
+  const auto alone = offscreen->read_back();
+  auto depth_camera = renderer.make_depth_camera(colour.width, colour.height);
+  renderer.draw_frame(*depth_camera, pinhole, duck_only);
+  const auto alone_depth = depth_camera->read_back_depth();
+  // Where the Duck is (nothing stands in front of it at its stop): the scene's colour is the texture's
+  // plus zero-mean noise of the sensor's sigma, and the scene's depth is the Duck's.
+  double sum = 0.0, sum2 = 0.0, depth_off = 0.0;
+  std::size_t n = 0, yellow = 0, depth_n = 0;
+  for (int i = 0; i < colour.width * colour.height; ++i) {
+    const float z = alone_depth.z_m[static_cast<std::size_t>(i)];
+    if (z <= 0.0F) continue;
+    const std::uint8_t* a = &alone.rgba[static_cast<std::size_t>(i) * 4];
+    const std::uint8_t* c = &colour.rgba[static_cast<std::size_t>(i) * 4];
+    for (int ch = 0; ch < 3; ++ch) {
+      if (a[ch] < 10 || a[ch] > 245) continue;  // no clipping at 0 or 255
+      const double d = static_cast<double>(c[ch]) - a[ch];
+      sum += d, sum2 += d * d, ++n;
+    }
+    yellow += a[0] > 180 && a[1] > 150 && a[2] < 90 ? 1 : 0;
+    if (depth.depth_m[static_cast<std::size_t>(i)] > 0.0F) {
+      depth_off += std::abs(depth.depth_m[static_cast<std::size_t>(i)] - z);
+      ++depth_n;
+    }
+  }
+  ASSERT_GT(n, 20000U);
+  const double count = static_cast<double>(n);
+  const double mean = sum / count, sigma = std::sqrt(sum2 / count - mean * mean);
+  EXPECT_LT(std::abs(mean), 0.2);
+  EXPECT_NEAR(sigma, projbot::twin::Twin::kColourNoiseSigma, 0.3);
+  EXPECT_GT(static_cast<double>(yellow) / static_cast<double>(depth_n), 0.8);  // the Duck's texture is mostly yellow
+  ASSERT_GT(depth_n, 5000U);
+  EXPECT_LT(depth_off / static_cast<double>(depth_n), 0.01);  // registered: the depth there is the Duck's (Kinect noise aside)
+}

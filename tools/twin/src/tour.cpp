@@ -396,6 +396,9 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
       char file[64];
       std::snprintf(file, sizeof file, "visit%02d_%s.png", r.visit, name.c_str());
       assets::write_png(options.frames_dir / file, image);
+      // What the RGB-D camera saw at the capture: its colour, registered to the depth that was used.
+      std::snprintf(file, sizeof file, "visit%02d_%s_camera.png", r.visit, name.c_str());
+      assets::write_png(options.frames_dir / file, twin.capture_colour(truth.T_world_camera.matrix(), noise_seed));
     }
 
     // Projecting: the target may be moved or taken away; the tracker (tracking mode) follows it at

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <random>
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
@@ -222,7 +223,7 @@ void Twin::end_visit(std::size_t target, int target_visit) {
   targets_[target].in_world = scripted_presence(target, 0, 0.0);
 }
 
-alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
+std::vector<engine::DrawItem> Twin::camera_items(const Eigen::Matrix4d& T_world_camera) const {
   const Eigen::Matrix4d T_camera_world = alignment::rigid_inverse(T_world_camera);
   std::vector<engine::DrawItem> items{{room_id_, T_camera_world}};
   for (const auto& p : props_) items.push_back({p.id, T_camera_world * p.T_world});
@@ -230,6 +231,28 @@ alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::
     if (targets_[i].in_world) items.push_back({target_ids_[i], T_camera_world * targets_[i].T_world_target_true});
     if (targets_[i].pedestal_raycaster) items.push_back({targets_[i].pedestal_id, T_camera_world * targets_[i].T_world_pedestal});
   }
+  return items;
+}
+
+assets::Image Twin::capture_colour(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
+  if (!colour_target_) colour_target_ = renderer_.make_offscreen(camera_.width_px, camera_.height_px);
+  config::ProjectorConfig pinhole = scene_.depth_camera;
+  pinhole.near_m = 0.3;
+  pinhole.far_m = 8.0;
+  renderer_.draw_frame(*colour_target_, pinhole, camera_items(T_world_camera));
+  assets::Image image = colour_target_->read_back();
+  if (!options_.depth_noise) return image;
+  std::mt19937 rng(noise_seed ^ 0x9e3779b9U);
+  std::normal_distribution<double> noise(0.0, kColourNoiseSigma);
+  for (std::size_t i = 0; i < image.rgba.size(); ++i) {
+    if (i % 4 == 3) continue;  // alpha
+    image.rgba[i] = static_cast<std::uint8_t>(std::clamp(std::lround(image.rgba[i] + noise(rng)), 0L, 255L));
+  }
+  return image;
+}
+
+alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
+  const std::vector<engine::DrawItem> items = camera_items(T_world_camera);
   // Rendered from 0.3 to 8 m: the noise model, not the clip planes, drops what the Kinect cannot see.
   config::ProjectorConfig pinhole = scene_.depth_camera;
   pinhole.near_m = 0.3;

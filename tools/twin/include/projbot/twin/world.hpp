@@ -96,6 +96,12 @@ class Twin {
 
   /// Renders the true scene's depth from T_world_camera (Kinect v1 noise when enabled, seeded).
   alignment::DepthImage capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed);
+  /// Renders the true scene's colour from T_world_camera, registered to capture()'s depth (the same
+  /// pinhole and viewpoint, as a Kinect v1 registers its RGB to depth): textured models under plain,
+  /// even room light, with the colour sensor's noise (Gaussian, kColourNoiseSigma levels per channel,
+  /// seeded) when depth noise is on. RGBA8, alpha 255.
+  assets::Image capture_colour(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed);
+  static constexpr double kColourNoiseSigma = 2.5;
   /// The true surfaces placed in a frame (T_frame_world): for the projector's rays.
   std::vector<PlacedMesh> true_scene(const Eigen::Matrix4d& T_frame_world) const;
 
@@ -124,6 +130,9 @@ class Twin {
   robot::SimulatedPanTilt pan_tilt_;
   alignment::CameraIntrinsics camera_;
   std::unique_ptr<engine::RenderTarget> depth_target_;
+  std::unique_ptr<engine::RenderTarget> colour_target_;
+  // What the camera sees: the room, props, pedestals and the targets in the world, in the camera frame.
+  std::vector<engine::DrawItem> camera_items(const Eigen::Matrix4d& T_world_camera) const;
 };
 
 /// The pose of `target` standing at `home`, `t_s` into its `target_visit`-th visit (its motion script).
