@@ -467,6 +467,10 @@ TEST_F(CliTest, TourPrintsTheTableAndWritesReportAndFrames) {
     }
   EXPECT_GT(static_cast<double>(yellow) / (640 * 480), 0.02);
   EXPECT_LT(static_cast<double>(dark) / (640 * 480), 0.05);  // walls and floor everywhere else
+  // And a visitor's view of the room with the projector's light on it.
+  const auto spectator = projbot::assets::read_image(dir_ / "frames" / "visit01_duck_spectator.png");
+  EXPECT_EQ(spectator.width, 960);
+  EXPECT_EQ(spectator.height, 720);
 }
 
 namespace {

@@ -11,6 +11,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/twin/raycast.hpp"
+#include "projbot/twin/spectator.hpp"
 #include "projbot/twin/tour.hpp"
 #include "projbot/twin/world.hpp"
 
@@ -580,4 +581,56 @@ TEST(TwinColourTest, ColourIsRegisteredToDepthWithTheModelsTextureAndNoise) {
   EXPECT_GT(static_cast<double>(yellow) / static_cast<double>(depth_n), 0.8);  // the Duck's texture is mostly yellow
   ASSERT_GT(depth_n, 5000U);
   EXPECT_LT(depth_off / static_cast<double>(depth_n), 0.01);  // registered: the depth there is the Duck's (Kinect noise aside)
+}
+
+// The spectator's view (issue 11): the projector's light falls on the true surfaces. The Duck's own
+// frame drawn at its true pose lights the Duck and almost nothing else; drawn 5 cm to the side, much of
+// its light spills past it onto the table and the wall.
+TEST(SpectatorViewTest, LightFallsOnTheTargetOrSpillsPastIt) {
+  const auto scene = projbot::config::load_scene(kAssets + "/scenes/shop.yaml");
+  projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
+  projbot::twin::Twin twin(scene, {}, renderer);
+  const std::size_t duck = twin.target_index("duck");
+  const auto arrival = twin.arrive(duck, 0);
+  const Eigen::Matrix4d T_world_projector = arrival.truth.T_world_projector.matrix();
+  const Eigen::Matrix4d T_world_duck = twin.targets()[duck].T_world_target_true;
+  projbot::twin::SpectatorView view(renderer, scene.projector);
+  const Eigen::Matrix4d T_world_spectator =
+      projbot::twin::spectator_pose(arrival.truth.T_world_camera.translation(), T_world_duck.topRightCorner<3, 1>());
+  // Where the spectator sees the Duck.
+  auto depth_camera = renderer.make_depth_camera(view.pinhole().width_px, view.pinhole().height_px);
+  const std::size_t duck_id = twin.target_model_ids()[duck];
+  const std::vector<projbot::engine::DrawItem> seen{
+      {duck_id, projbot::alignment::rigid_inverse(T_world_spectator) * T_world_duck}};
+  renderer.draw_frame(*depth_camera, view.pinhole(), seen);
+  const auto duck_depth = depth_camera->read_back_depth();
+  auto frame_target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+  projbot::assets::Image black;
+  black.width = scene.projector.width_px, black.height = scene.projector.height_px;
+  black.rgba.assign(static_cast<std::size_t>(black.width) * black.height * 4, 0);
+  const auto unlit = view.draw(twin, T_world_spectator, T_world_projector, black);
+  // Lit pixels on the Duck and off it, for the Duck's frame drawn at T_projector_duck.
+  const auto lit = [&](const Eigen::Matrix4d& T_projector_duck) {
+    const std::vector<projbot::engine::DrawItem> drawn{{duck_id, T_projector_duck}};
+    renderer.draw_frame(*frame_target, scene.projector, drawn);
+    const auto picture = view.draw(twin, T_world_spectator, T_world_projector, frame_target->read_back());
+    std::array<std::size_t, 2> on_off{0, 0};
+    for (std::size_t i = 0; i < duck_depth.z_m.size(); ++i) {
+      const int gain = picture.rgba[i * 4] + picture.rgba[i * 4 + 1] - unlit.rgba[i * 4] - unlit.rgba[i * 4 + 1];
+      if (gain > 20) ++on_off[duck_depth.z_m[i] > 0.0F ? 0 : 1];
+    }
+    return on_off;
+  };
+  const Eigen::Matrix4d T_projector_duck = projbot::alignment::rigid_inverse(T_world_projector) * T_world_duck;
+  const auto right = lit(T_projector_duck);
+  EXPECT_GT(right[0], 5000U);                                                      // the Duck is lit
+  EXPECT_LT(static_cast<double>(right[1]), 0.03 * static_cast<double>(right[0]));  // edges only
+  Eigen::Matrix4d shifted = T_projector_duck;
+  shifted(0, 3) += 0.05;
+  const auto off = lit(shifted);
+  EXPECT_GT(static_cast<double>(off[1]), 0.2 * static_cast<double>(off[0] + off[1]));  // spilled past it (32 %)
+  // Without light the room is dimmed to its room light: a mid-grey wall of 200 shows about 60.
+  std::size_t dim = 0;
+  for (std::size_t i = 0; i < unlit.rgba.size(); i += 4) dim += unlit.rgba[i] < 0.35 * 255 ? 1 : 0;
+  EXPECT_EQ(dim, unlit.rgba.size() / 4);
 }

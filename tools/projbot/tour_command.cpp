@@ -34,8 +34,8 @@ const Command kTour{
      {"mode", "M", "odometry | localized | tracking (default localized)"},
      {"report", "FILE", "write the per-visit report as JSON"},
      {"frames", "DIR",
-      "write each visit's projector frame as DIR/visitNN_TARGET.png and the RGB-D camera's colour view as "
-      "visitNN_TARGET_camera.png"},
+      "write each visit's projector frame (DIR/visitNN_TARGET.png), the RGB-D camera's colour view "
+      "(_camera.png) and a visitor's view of the projector's light on the room (_spectator.png)"},
      {"dwell", "S", "simulated seconds of projection per visit in tracking mode or while a target moves (default 3)"},
      {"no-noise", "", "depth without the Kinect v1 noise model"},
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"}},

@@ -10,6 +10,7 @@
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/image.hpp"
 #include "projbot/engine/frame_profiler.hpp"
+#include "projbot/twin/spectator.hpp"
 #include "projbot/twin/world.hpp"
 
 namespace projbot::twin {
@@ -333,9 +334,11 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   std::vector<alignment::TargetFollower> followers;
   for (const auto& t : targets) followers.emplace_back(t.cloud, twin.camera(), follow);
   std::unique_ptr<engine::RenderTarget> projector_frame;
+  std::unique_ptr<SpectatorView> spectator;
   if (!options.frames_dir.empty()) {
     std::filesystem::create_directories(options.frames_dir);
     projector_frame = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+    spectator = std::make_unique<SpectatorView>(renderer, scene.projector);
   }
 
   TourReport report;
@@ -399,6 +402,11 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
       // What the RGB-D camera saw at the capture: its colour, registered to the depth that was used.
       std::snprintf(file, sizeof file, "visit%02d_%s_camera.png", r.visit, name.c_str());
       assets::write_png(options.frames_dir / file, twin.capture_colour(truth.T_world_camera.matrix(), noise_seed));
+      // What a visitor beside the robot sees: the frame's light on the true surfaces.
+      const Eigen::Vector3d middle = (target.T_world_target_true * target.model.bounds().center().homogeneous()).head<3>();
+      const Eigen::Matrix4d T_world_spectator = spectator_pose(truth.T_world_camera.translation(), middle);
+      std::snprintf(file, sizeof file, "visit%02d_%s_spectator.png", r.visit, name.c_str());
+      assets::write_png(options.frames_dir / file, spectator->draw(twin, T_world_spectator, T_world_projector, image));
     }
 
     // Projecting: the target may be moved or taken away; the tracker (tracking mode) follows it at

@@ -159,6 +159,12 @@ std::size_t Twin::target_index(const std::string& name) const {
   throw TwinError("the twin has no target named '" + name + "'");
 }
 
+Eigen::Vector3d Twin::surveyed_middle(std::size_t target) const {
+  const TwinTarget& t = targets_.at(target);
+  const Eigen::Matrix4d T_map_target = t.config.T_map_target.value_or(*t.config.T_world_target);
+  return (T_map_target * t.model.bounds().center().homogeneous()).head<3>();
+}
+
 Arrival Twin::arrive(std::size_t target, int index) {
   const TwinTarget& t = targets_.at(target);
   Arrival a;
@@ -167,8 +173,7 @@ Arrival Twin::arrive(std::size_t target, int index) {
   a.T_map_target = t.config.T_map_target.value_or(*t.config.T_world_target);
   // Aim at the middle of the model, not its origin: a standing figure's origin is at its feet, and
   // aiming there left its chest above the projector's image.
-  const Eigen::Vector3d middle = (a.T_map_target * t.model.bounds().center().homogeneous()).head<3>();
-  const auto aim = robot::aim_at(robot_->believed_pose(), middle, scene_.pan_tilt);
+  const auto aim = robot::aim_at(robot_->believed_pose(), surveyed_middle(target), scene_.pan_tilt);
   if (const auto s = pan_tilt_.move_to(aim.angles); !s.ok) throw TwinError("pan-tilt: " + s.error);
   robot::PanTiltAngles reported;
   if (const auto s = pan_tilt_.position(reported); !s.ok) throw TwinError("pan-tilt: " + s.error);
@@ -223,7 +228,7 @@ void Twin::end_visit(std::size_t target, int target_visit) {
   targets_[target].in_world = scripted_presence(target, 0, 0.0);
 }
 
-std::vector<engine::DrawItem> Twin::camera_items(const Eigen::Matrix4d& T_world_camera) const {
+std::vector<engine::DrawItem> Twin::draw_items(const Eigen::Matrix4d& T_world_camera) const {
   const Eigen::Matrix4d T_camera_world = alignment::rigid_inverse(T_world_camera);
   std::vector<engine::DrawItem> items{{room_id_, T_camera_world}};
   for (const auto& p : props_) items.push_back({p.id, T_camera_world * p.T_world});
@@ -239,7 +244,7 @@ assets::Image Twin::capture_colour(const Eigen::Matrix4d& T_world_camera, std::u
   config::ProjectorConfig pinhole = scene_.depth_camera;
   pinhole.near_m = 0.3;
   pinhole.far_m = 8.0;
-  renderer_.draw_frame(*colour_target_, pinhole, camera_items(T_world_camera));
+  renderer_.draw_frame(*colour_target_, pinhole, draw_items(T_world_camera));
   assets::Image image = colour_target_->read_back();
   if (!options_.depth_noise) return image;
   std::mt19937 rng(noise_seed ^ 0x9e3779b9U);
@@ -252,7 +257,7 @@ assets::Image Twin::capture_colour(const Eigen::Matrix4d& T_world_camera, std::u
 }
 
 alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
-  const std::vector<engine::DrawItem> items = camera_items(T_world_camera);
+  const std::vector<engine::DrawItem> items = draw_items(T_world_camera);
   // Rendered from 0.3 to 8 m: the noise model, not the clip planes, drops what the Kinect cannot see.
   config::ProjectorConfig pinhole = scene_.depth_camera;
   pinhole.near_m = 0.3;

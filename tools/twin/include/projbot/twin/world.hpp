@@ -105,6 +105,12 @@ class Twin {
   /// The true surfaces placed in a frame (T_frame_world): for the projector's rays.
   std::vector<PlacedMesh> true_scene(const Eigen::Matrix4d& T_frame_world) const;
 
+  /// What a camera at T_world_camera sees: the room, props, supports and the targets in the world, each
+  /// placed in the camera frame (for the renderer's draw_frame).
+  std::vector<engine::DrawItem> draw_items(const Eigen::Matrix4d& T_world_camera) const;
+  /// The middle of a target's model (its bounding box's centre) where the map says it stands.
+  Eigen::Vector3d surveyed_middle(std::size_t target) const;
+
   /// Renderer model ids of the targets (same order as targets()).
   const std::vector<std::size_t>& target_model_ids() const { return target_ids_; }
 
@@ -131,8 +137,6 @@ class Twin {
   alignment::CameraIntrinsics camera_;
   std::unique_ptr<engine::RenderTarget> depth_target_;
   std::unique_ptr<engine::RenderTarget> colour_target_;
-  // What the camera sees: the room, props, pedestals and the targets in the world, in the camera frame.
-  std::vector<engine::DrawItem> camera_items(const Eigen::Matrix4d& T_world_camera) const;
 };
 
 /// The pose of `target` standing at `home`, `t_s` into its `target_visit`-th visit (its motion script).

@@ -1,0 +1,83 @@
+#include "projbot/twin/spectator.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "projbot/alignment/equations.hpp"
+
+namespace projbot::twin {
+
+Eigen::Matrix4d look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& at) {
+  const Eigen::Vector3d z = (at - eye).normalized();
+  Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ());
+  if (x.norm() < 1e-9) x = Eigen::Vector3d::UnitX();  // looking straight up or down
+  x.normalize();
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.block<3, 1>(0, 0) = x;
+  T.block<3, 1>(0, 1) = z.cross(x);
+  T.block<3, 1>(0, 2) = z;
+  T.topRightCorner<3, 1>() = eye;
+  return T;
+}
+
+Eigen::Matrix4d spectator_pose(const Eigen::Vector3d& head, const Eigen::Vector3d& target_middle) {
+  Eigen::Vector3d forward = target_middle - head;
+  forward.z() = 0.0;
+  forward = forward.norm() > 1e-9 ? forward.normalized() : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ());
+  Eigen::Vector3d eye = head + 1.0 * right - 0.6 * forward;
+  eye.z() = 1.6;
+  return look_at(eye, target_middle);
+}
+
+SpectatorView::SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector)
+    : renderer_(renderer), projector_(projector) {
+  pinhole_.width_px = kWidth;
+  pinhole_.height_px = kHeight;
+  pinhole_.fx_px = pinhole_.fy_px = 660.0;
+  pinhole_.cx_px = (kWidth - 1) / 2.0;
+  pinhole_.cy_px = (kHeight - 1) / 2.0;
+  pinhole_.near_m = 0.1;
+  pinhole_.far_m = 20.0;
+  colour_ = renderer_.make_offscreen(kWidth, kHeight);
+  depth_ = renderer_.make_depth_camera(kWidth, kHeight);
+  projector_depth_ = renderer_.make_depth_camera(projector_.width_px, projector_.height_px);
+}
+
+assets::Image SpectatorView::draw(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const Eigen::Matrix4d& T_world_projector,
+                                  const assets::Image& projector_frame) {
+  renderer_.draw_frame(*colour_, pinhole_, twin.draw_items(T_world_spectator));
+  assets::Image out = colour_->read_back();  // the albedo: the twin's colours as they are
+  renderer_.draw_frame(*depth_, pinhole_, twin.draw_items(T_world_spectator));
+  const engine::DepthMap depth = depth_->read_back_depth();
+  renderer_.draw_frame(*projector_depth_, projector_, twin.draw_items(T_world_projector));
+  const engine::DepthMap lit_depth = projector_depth_->read_back_depth();
+  const Eigen::Matrix4d T_projector_spectator = alignment::rigid_inverse(T_world_projector) * T_world_spectator;
+  const config::ProjectorConfig& k = projector_;
+  for (int v = 0; v < kHeight; ++v)
+    for (int u = 0; u < kWidth; ++u) {
+      std::uint8_t* px = out.pixel(u, v);
+      const float z = depth.z_m[static_cast<std::size_t>(v) * kWidth + u];
+      double light[3] = {kRoomLight, kRoomLight, kRoomLight};
+      if (z > 0.0F) {
+        const Eigen::Vector4d p(z * (u - pinhole_.cx_px) / pinhole_.fx_px, z * (v - pinhole_.cy_px) / pinhole_.fy_px, z, 1.0);
+        const Eigen::Vector3d q = (T_projector_spectator * p).head<3>();
+        // Eq. 3: the projector pixel that reaches this point, if nothing nearer the projector blocks it.
+        const long pu = q.z() > k.near_m ? std::lround(k.fx_px * q.x() / q.z() + k.cx_px) : -1;
+        const long pv = q.z() > k.near_m ? std::lround(k.fy_px * q.y() / q.z() + k.cy_px) : -1;
+        if (pu >= 0 && pv >= 0 && pu < k.width_px && pv < k.height_px) {
+          const float seen = lit_depth.z_m[static_cast<std::size_t>(pv) * k.width_px + pu];
+          if (seen > 0.0F && std::abs(seen - q.z()) < 0.01 + 0.01 * q.z()) {
+            const std::uint8_t* c = projector_frame.pixel(static_cast<int>(pu), static_cast<int>(pv));
+            for (int ch = 0; ch < 3; ++ch) light[ch] += c[ch] / 255.0;
+          }
+        }
+      }
+      for (int ch = 0; ch < 3; ++ch) px[ch] = static_cast<std::uint8_t>(std::clamp(std::lround(px[ch] * light[ch]), 0L, 255L));
+      px[3] = 255;
+    }
+  return out;
+}
+
+}  // namespace projbot::twin
