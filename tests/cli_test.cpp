@@ -187,7 +187,8 @@ TEST_F(CliTest, AlignPrintsJson) {
   ASSERT_EQ(r.code, 0) << r.output;
   // One JSON object: T row-major with the reference's -34 degree turn about y, and the gate's numbers.
   EXPECT_EQ(r.output.rfind("{\"T\":[[", 0), 0U) << r.output;
-  for (const char* key : {"\"converged\":true", "\"inlier_ratio\"", "\"rmse_mm\"", "\"iterations\"", "\"time_ms\""})
+  for (const char* key : {"\"converged\":true", "\"inlier_ratio\"", "\"rmse_mm\"", "\"iterations\"", "\"time_ms\"",
+                          "\"accepted\":true", "\"free_space\":null"})  // a cloud has no viewpoint to check from
     EXPECT_NE(r.output.find(key), std::string::npos) << key;
   const double m00 = std::stod(r.output.substr(8));
   EXPECT_NEAR(m00, 0.825, 0.02);  // cos(34.4 degrees)
@@ -236,6 +237,11 @@ TEST_F(CliTest, AlignReadsA16BitDepthPng) {
   const auto at = r.output.find("\"scan_valid_points\":");
   ASSERT_NE(at, std::string::npos) << r.output;
   EXPECT_EQ(std::stoul(r.output.substr(at + 20)), expected) << r.output;
+  // A depth image is checked for free space too; at the identity the model is out of view: nothing to
+  // check, not accepted.
+  EXPECT_NE(r.output.find("\"accepted\":false"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\"free_space\":{\"behind_px\":0,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\"passed\":false,\"predicted_px\":0}"), std::string::npos) << r.output;
 }
 
 // Ctrl-C in the live engine: it stops at the next frame, prints its summary, writes the whole profile

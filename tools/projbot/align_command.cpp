@@ -3,10 +3,13 @@
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "commands.hpp"
 #include "projbot/alignment/depth.hpp"
 #include "projbot/alignment/registration.hpp"
+#include "projbot/alignment/tracker_worker.hpp"
+#include "projbot/alignment/verification.hpp"
 #include "projbot/config/scene.hpp"
 
 namespace projbot::tools {
@@ -18,13 +21,20 @@ std::string lower_extension(const std::filesystem::path& p) {
   return ext;
 }
 
-alignment::PointCloud load_scan(const cli::Args& args) {
+// The scan as a cloud, and for a depth image the image and its camera too (for the free-space check).
+struct Scan {
+  alignment::PointCloud cloud;
+  std::optional<alignment::DepthImage> depth;
+  alignment::CameraIntrinsics k;
+};
+
+Scan load_scan(const cli::Args& args) {
   const std::filesystem::path scan = *args.get("scan");
   const std::string ext = lower_extension(scan);
   if (ext == ".pcd" || ext == ".ply") {
     if (args.get("intrinsics") || args.get("depth-scale"))
       throw cli::UsageError("--intrinsics and --depth-scale apply to depth images, not to " + ext + " clouds");
-    return alignment::read_cloud(scan);
+    return {alignment::read_cloud(scan), std::nullopt, {}};
   }
   if (ext != ".png" && ext != ".tif" && ext != ".tiff")
     throw cli::UsageError("--scan must be a .pcd or .ply cloud or a 16-bit .png / .tiff depth image, got '" + scan.string() +
@@ -54,7 +64,21 @@ alignment::PointCloud load_scan(const cli::Args& args) {
                                     std::to_string(k.cx_px) + ", " + std::to_string(k.cy_px) + ")");
   k.width_px = depth.width;
   k.height_px = depth.height;
-  return alignment::depth_to_cloud(depth, k);
+  return {alignment::depth_to_cloud(depth, k), depth, k};
+}
+
+// Fewer interior silhouette pixels than this and the check cannot speak for the estimate: the model is
+// out of view or nearly so there, and the estimate is not accepted.
+constexpr std::size_t kMinCheckedPixels = 50;
+
+bool free_space_passes(const alignment::FreeSpaceCheck& c, double limit) {
+  return c.predicted >= kMinCheckedPixels && c.behind_ratio() <= limit;
+}
+
+nlohmann::json free_space_json(const std::optional<alignment::FreeSpaceCheck>& c, double limit) {
+  if (!c) return nullptr;
+  return {{"predicted_px", c->predicted},      {"behind_px", c->behind},    {"in_front_px", c->in_front},
+          {"behind_ratio", c->behind_ratio()}, {"max_behind_ratio", limit}, {"passed", free_space_passes(*c, limit)}};
 }
 
 Eigen::Matrix4d initial_guess(const cli::Args& args) {
@@ -92,6 +116,9 @@ const Command kAlign{
     "guess turned +-25 degrees about each axis, then re-initialises globally (FPFH features,\n"
     "SampleConsensusPrerejective) and tries again. M is a glTF model or a PCD / PLY\n"
     "cloud; S is a PCD / PLY cloud or a 16-bit PNG / TIFF depth image (then --intrinsics and --depth-scale).\n"
+    "A depth image is also checked for free space: the depth the model would give at the estimate against\n"
+    "the depth measured inside its silhouette; where the camera sees through the model (more than 20 % of\n"
+    "the silhouette), the pose is rejected however well it fits.\n"
     "Exit status: 0 when the pose passed the quality gate, 3 when it did not, 1 or 2 on bad input.\n",
     {{"model", "FILE", "target model: .gltf / .glb (surface-sampled) or .pcd / .ply"},
      {"scan", "FILE", "scan: .pcd / .ply cloud, or .png / .tiff 16-bit depth image"},
@@ -110,12 +137,20 @@ const Command kAlign{
       cfg.crop = !args.flag("no-crop");
       cfg.voxel_m = args.get_double("voxel", cfg.voxel_m);
       if (!(cfg.voxel_m > 0.0) || cfg.voxel_m > 0.1) throw cli::UsageError("--voxel must be in (0, 0.1] metres");
-      const alignment::Aligner aligner(alignment::load_model_cloud(*args.get("model")), cfg);
-      const alignment::PointCloud scan = load_scan(args);
+      const alignment::ModelCloud model = alignment::load_model_cloud(*args.get("model"));
+      const alignment::Aligner aligner(model, cfg);
+      const Scan loaded = load_scan(args);
+      const alignment::PointCloud& scan = loaded.cloud;
       if (const std::size_t valid = scan.finite_count(); valid < cfg.min_points)
         throw alignment::AlignmentError(*args.get("scan") + ": " + std::to_string(valid) + " valid points; at least " +
                                         std::to_string(cfg.min_points) + " are needed");
       const alignment::AlignmentResult r = aligner.align(scan, T_init);
+      // A depth image can say more than the fit: where the camera looks through the model at the
+      // estimate, it is in the wrong place, however well it fits.
+      std::optional<alignment::FreeSpaceCheck> free_space;
+      const double limit = alignment::WorkerConfig{}.max_behind_ratio;
+      if (loaded.depth) free_space = alignment::check_free_space(model, r.T_scan_model, *loaded.depth, loaded.k);
+      const bool accepted = r.converged && (!free_space || free_space_passes(*free_space, limit));
       if (args.flag("json")) {
         nlohmann::json T = nlohmann::json::array();
         for (int i = 0; i < 4; ++i)
@@ -128,7 +163,9 @@ const Command kAlign{
                                     {"time_ms", r.time_ms},
                                     {"reinitialised", r.reinitialised},
                                     {"scan_valid_points", scan.finite_count()},
-                                    {"scan_points_used", r.scan_points}};
+                                    {"scan_points_used", r.scan_points},
+                                    {"free_space", free_space_json(free_space, limit)},
+                                    {"accepted", accepted}};
         std::cout << out.dump() << '\n';
       } else {
         std::cout << "T_scan_model (row-major, metres):\n";
@@ -138,8 +175,15 @@ const Command kAlign{
         std::printf("%s: inlier ratio %.3f, rmse %.2f mm, %d iterations, %.1f ms%s\n",
                     r.converged ? "converged" : "NOT converged", r.inlier_ratio, r.rmse_mm, r.iterations, r.time_ms,
                     r.reinitialised ? " (after global re-initialisation)" : "");
+        if (free_space && free_space->predicted < kMinCheckedPixels)
+          std::printf("free space: the model at the estimate covers %zu pixels of the image, too few to check: REJECTED\n",
+                      free_space->predicted);
+        else if (free_space)
+          std::printf("free space: the camera sees through the model at %zu of %zu silhouette pixels (%.3f, limit %.2f): %s\n",
+                      free_space->behind, free_space->predicted, free_space->behind_ratio(), limit,
+                      free_space->behind_ratio() <= limit ? "passed" : "REJECTED, the model is not where it fits");
       }
-      return r.converged ? 0 : 3;
+      return accepted ? 0 : 3;
     }};
 
 }  // namespace projbot::tools
