@@ -194,6 +194,16 @@ TEST(FreeSpaceTest, SeesThroughAWrongPoseNotThroughAnOccludedOne) {
   const FreeSpaceCheck occluded = check_free_space(model, truth, *depth, k);
   EXPECT_GT(occluded.in_front, occluded.predicted / 4);
   EXPECT_LT(occluded.behind_ratio(), 0.02);
+  EXPECT_TRUE(right.passes(0.2));
+  EXPECT_TRUE(occluded.passes(0.2));
+  EXPECT_FALSE(check_free_space(model, nearer, *depth, k).passes(0.2));
+  // Out of view (behind the camera): nothing sees through it, and nothing vouches for it either.
+  Eigen::Matrix4d behind_camera = truth;
+  behind_camera(2, 3) = -1.2;
+  const FreeSpaceCheck unseen = check_free_space(model, behind_camera, *depth, k);
+  EXPECT_EQ(unseen.predicted, 0U);
+  EXPECT_EQ(unseen.behind_ratio(), 0.0);
+  EXPECT_FALSE(unseen.passes(0.2));
 }
 
 // Searching for a target that is not there: one attempt per due frame, escalating and spaced out, the

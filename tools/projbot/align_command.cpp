@@ -67,18 +67,10 @@ Scan load_scan(const cli::Args& args) {
   return {alignment::depth_to_cloud(depth, k), depth, k};
 }
 
-// Fewer interior silhouette pixels than this and the check cannot speak for the estimate: the model is
-// out of view or nearly so there, and the estimate is not accepted.
-constexpr std::size_t kMinCheckedPixels = 50;
-
-bool free_space_passes(const alignment::FreeSpaceCheck& c, double limit) {
-  return c.predicted >= kMinCheckedPixels && c.behind_ratio() <= limit;
-}
-
 nlohmann::json free_space_json(const std::optional<alignment::FreeSpaceCheck>& c, double limit) {
   if (!c) return nullptr;
   return {{"predicted_px", c->predicted},      {"behind_px", c->behind},    {"in_front_px", c->in_front},
-          {"behind_ratio", c->behind_ratio()}, {"max_behind_ratio", limit}, {"passed", free_space_passes(*c, limit)}};
+          {"behind_ratio", c->behind_ratio()}, {"max_behind_ratio", limit}, {"passed", c->passes(limit)}};
 }
 
 Eigen::Matrix4d initial_guess(const cli::Args& args) {
@@ -150,7 +142,7 @@ const Command kAlign{
       std::optional<alignment::FreeSpaceCheck> free_space;
       const double limit = alignment::WorkerConfig{}.max_behind_ratio;
       if (loaded.depth) free_space = alignment::check_free_space(model, r.T_scan_model, *loaded.depth, loaded.k);
-      const bool accepted = r.converged && (!free_space || free_space_passes(*free_space, limit));
+      const bool accepted = r.converged && (!free_space || free_space->passes(limit));
       if (args.flag("json")) {
         nlohmann::json T = nlohmann::json::array();
         for (int i = 0; i < 4; ++i)
@@ -175,7 +167,7 @@ const Command kAlign{
         std::printf("%s: inlier ratio %.3f, rmse %.2f mm, %d iterations, %.1f ms%s\n",
                     r.converged ? "converged" : "NOT converged", r.inlier_ratio, r.rmse_mm, r.iterations, r.time_ms,
                     r.reinitialised ? " (after global re-initialisation)" : "");
-        if (free_space && free_space->predicted < kMinCheckedPixels)
+        if (free_space && free_space->predicted < alignment::FreeSpaceCheck::kMinPredicted)
           std::printf("free space: the model at the estimate covers %zu pixels of the image, too few to check: REJECTED\n",
                       free_space->predicted);
         else if (free_space)

@@ -102,7 +102,7 @@ class TargetFollower {
   const std::optional<AlignmentResult>& last_attempt() const { return last_attempt_; }
   /// The free-space check of a pose on a frame, and whether it passes (see max_behind_ratio).
   FreeSpaceCheck verify(const DepthImage& frame, const Eigen::Matrix4d& T_camera_target) const;
-  bool passes(const FreeSpaceCheck& check) const { return check.behind_ratio() <= cfg_.max_behind_ratio; }
+  bool passes(const FreeSpaceCheck& check) const { return check.passes(cfg_.max_behind_ratio); }
   /// The newest free-space check (of the last pose accepted or refused).
   const FreeSpaceCheck& last_check() const { return check_; }
   /// The tracked pose, or the guess while acquiring.

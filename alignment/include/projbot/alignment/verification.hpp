@@ -19,6 +19,12 @@ struct FreeSpaceCheck {
   std::size_t in_front = 0;   ///< measured nearer: occluded, neutral
   /// Share of the predicted pixels where the camera looks through the model; 0 with nothing predicted.
   double behind_ratio() const { return predicted == 0 ? 0.0 : static_cast<double>(behind) / static_cast<double>(predicted); }
+  /// Fewer predicted pixels than this and the check cannot vouch for an estimate (the model is out of
+  /// view, or nearly so, there).
+  static constexpr std::size_t kMinPredicted = 50;
+  /// Whether the estimate passes: enough of its silhouette measured, and the camera seeing through the
+  /// model in at most `max_behind_ratio` of it.
+  bool passes(double max_behind_ratio) const { return predicted >= kMinPredicted && behind_ratio() <= max_behind_ratio; }
 };
 
 /// The depth inside the model's silhouette at T_camera_model, grown by grow_m (the guess's
