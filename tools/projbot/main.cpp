@@ -2,6 +2,7 @@
 
 #include <malloc.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -119,7 +120,11 @@ int main(int argc, char** argv) {
   const bool flushed = std::fflush(stdout) == 0;
   const int err = errno;  // set only if these flushes failed: a write that failed during the run set it long ago
   if (!flushed || !std::cout || std::ferror(stdout)) {
-    std::cerr << "projbot" << (argc > 1 ? std::string(" ") + argv[1] : std::string())
+    // The command as typed: "bench motion", not "bench".
+    std::string what;
+    for (int i = 1; i < std::min(argc, 3) && argv[i][0] != '-'; ++i) what += std::string(" ") + argv[i];
+    if (argc > 1 && std::string(argv[1]) != "bench") what = what.substr(0, what.find(' ', 1));
+    std::cerr << "projbot" << what
               << ": cannot write to standard output: " << (err != 0 ? std::strerror(err) : "a write to it failed during the run")
               << '\n';
     return 1;
