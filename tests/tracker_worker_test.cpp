@@ -206,6 +206,34 @@ TEST(FreeSpaceTest, SeesThroughAWrongPoseNotThroughAnOccludedOne) {
   EXPECT_FALSE(unseen.passes(0.2));
 }
 
+// Weak directions of a view: a cube face-on leaves its face's plane free (two slides and the turn about
+// its normal); a cube seen on its corner, three faces at once, leaves none.
+TEST(ViewConstraintsTest, AFaceOnBoxSlidesAlongItsFaceACornerViewHoldsEverything) {
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  const ModelCloud model = cube_model();
+  const ViewConstraints face_on = view_constraints(model, projbot::config::pose_from_xyz_rpy({0, 0, 1.2}, {0, 0, 0}), k);
+  EXPECT_GT(face_on.points, 1000U);
+  ASSERT_EQ(face_on.weak.size(), 3U);
+  int slides = 0;
+  for (const auto& w : face_on.weak) {
+    if (w.is_slide()) {
+      ++slides;
+      EXPECT_LT(std::abs(w.translation.z()), 0.05);  // in the face's plane
+    } else {
+      EXPECT_GT(std::abs(w.rotation.z()) / w.rotation.norm(), 0.95);  // about the face's normal
+    }
+    EXPECT_LT(w.strength, 1e-6);
+  }
+  EXPECT_EQ(slides, 2);
+  const ViewConstraints corner = view_constraints(model, projbot::config::pose_from_xyz_rpy({0, 0, 1.2}, {35, 45, 0}), k);
+  EXPECT_TRUE(corner.weak.empty());
+  EXPECT_GT(corner.strength[0], 0.1);
+  // Out of view: nothing seen, nothing claimed.
+  const ViewConstraints unseen = view_constraints(model, projbot::config::pose_from_xyz_rpy({0, 0, -1.2}, {0, 0, 0}), k);
+  EXPECT_EQ(unseen.points, 0U);
+  EXPECT_TRUE(unseen.weak.empty());
+}
+
 // Searching for a target that is not there: one attempt per due frame, escalating and spaced out, the
 // model's features computed once however often the global search runs.
 TEST(TargetFollowerTest, AnAbsentTargetCostsABoundedNumberOfAttempts) {

@@ -1,5 +1,6 @@
 #include "projbot/alignment/verification.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -98,6 +99,51 @@ FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& 
       else if (measured < z - tolerance)
         ++c.in_front;
     }
+  return c;
+}
+
+ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k) {
+  ViewConstraints c;
+  if (!T_camera_model.allFinite() || model.normals.size() != model.points.size()) return c;
+  // The nearest front-facing sample per pixel: what one scan can measure, one point per pixel (a face
+  // seen at a grazing angle has many samples but few pixels).
+  const Eigen::Matrix3d R = T_camera_model.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T_camera_model.topRightCorner<3, 1>();
+  std::vector<std::pair<float, std::size_t>> nearest(static_cast<std::size_t>(k.width_px) * k.height_px,
+                                                     {std::numeric_limits<float>::infinity(), 0});
+  for (std::size_t i = 0; i < model.points.size(); ++i) {
+    const Eigen::Vector3d p = R * model.points[i].cast<double>() + t;
+    int u = 0, v = 0;
+    if (!(p.z() > 0.05) || (R * model.normals[i].cast<double>()).dot(p) >= 0.0 || !k.nearest_pixel(p, u, v)) continue;
+    auto& best = nearest[static_cast<std::size_t>(v) * k.width_px + u];
+    if (p.z() < best.first) best = {static_cast<float>(p.z()), i};
+  }
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> seen;  // point, normal (camera frame)
+  for (const auto& [z, i] : nearest)
+    if (std::isfinite(z))
+      seen.emplace_back(R * model.points[i].cast<double>() + t, (R * model.normals[i].cast<double>()).normalized());
+  c.points = seen.size();
+  if (seen.size() < 6) return c;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& [p, n] : seen) centre += p;
+  centre /= static_cast<double>(seen.size());
+  double r2 = 0.0;
+  for (const auto& [p, n] : seen) r2 += (p - centre).squaredNorm();
+  const double radius = std::max(std::sqrt(r2 / static_cast<double>(seen.size())), 1e-3);
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  for (const auto& [p, n] : seen) {
+    Eigen::Matrix<double, 6, 1> J;
+    J << n, (p - centre).cross(n) / radius;
+    H += J * J.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(H);
+  const double largest = std::max(eig.eigenvalues()(5), 1e-12);
+  for (int i = 0; i < 6; ++i) {
+    c.strength[static_cast<std::size_t>(i)] = eig.eigenvalues()(i) / largest;
+    if (c.strength[static_cast<std::size_t>(i)] >= ViewConstraints::kWeak) continue;
+    const Eigen::Matrix<double, 6, 1> d = eig.eigenvectors().col(i);
+    c.weak.push_back({d.head<3>(), d.tail<3>(), c.strength[static_cast<std::size_t>(i)]});
+  }
   return c;
 }
 

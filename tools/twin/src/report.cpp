@@ -16,6 +16,17 @@
 namespace projbot::twin {
 namespace {
 
+// The view's weak directions: what depth alone could not pin down at arrival (camera frame).
+nlohmann::json view_json(const alignment::ViewConstraints& c) {
+  nlohmann::json weak = nlohmann::json::array();
+  for (const auto& w : c.weak)
+    weak.push_back({{"kind", w.is_slide() ? "slide" : "turn"},
+                    {"translation", {w.translation.x(), w.translation.y(), w.translation.z()}},
+                    {"rotation", {w.rotation.x(), w.rotation.y(), w.rotation.z()}},
+                    {"strength", w.strength}});
+  return {{"points", c.points}, {"strength", c.strength}, {"weak_threshold", alignment::ViewConstraints::kWeak}, {"weak", weak}};
+}
+
 // Table 1 of the paper: projection error at markers, mm, per visit of each target (odometry only).
 constexpr double kPaperMm[2][3] = {{4.0, 6.0, 12.0}, {6.0, 6.0, 19.0}};
 
@@ -154,6 +165,7 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
                         {"behind_px", v.free_space.behind},
                         {"in_front_px", v.free_space.in_front},
                         {"behind_ratio", v.free_space.behind_ratio()}}},
+                      {"view", view_json(v.view)},
                       {"robot",
                        {{"base_error_cm", v.base_error_cm},
                         {"base_error_deg", v.base_error_deg},

@@ -382,6 +382,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     acquire(options.mode, followers[i], twin, depth, T_init, alignment::floor_in_camera(arrival.believed.T_world_camera.matrix()),
             r);
     const Eigen::Matrix4d T_world_projector = truth.T_world_projector.matrix();
+    r.view = alignment::view_constraints(target.cloud, r.icp.T_scan_model, twin.camera());
     r.T_projector_target_estimated = alignment::projector_from_target(rig.T_projector_camera, r.icp.T_scan_model);
     r.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;
     Errors e = marker_errors(twin, i, scene.projector, T_world_projector, r.T_projector_target_estimated);

@@ -5,7 +5,9 @@
 // evidence against. Measured in front is occlusion (a visitor, a pillar): neutral. Agreement supports.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
+#include <vector>
 
 #include "projbot/alignment/depth.hpp"
 #include "projbot/alignment/registration.hpp"
@@ -42,5 +44,31 @@ double guess_reach_m(const ModelCloud& model, double translation_m, double rotat
 /// 15 mm + 5 mm per square metre of depth (35 mm at 2 m).
 FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
                                 const CameraIntrinsics& k);
+
+/// A direction of rigid motion the view hardly constrains: moving the model along it changes the
+/// point-to-plane distances of its visible surface least (a box seen face-on slides along its face).
+struct WeakDirection {
+  /// The motion as a unit 6-vector split in two: translation (camera frame, metres) and rotation (axis
+  /// times angle about the visible surface's centre, radians scaled by its radius), so that both parts
+  /// move surface points by comparable amounts.
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
+  /// Its eigenvalue of the point-to-plane normal equations over the largest one (0..1).
+  double strength = 0.0;
+  bool is_slide() const { return translation.norm() >= rotation.norm(); }
+};
+
+/// How well the model's visible surface at T_camera_model pins each direction of motion down.
+struct ViewConstraints {
+  std::size_t points = 0;            ///< visible model samples used
+  std::array<double, 6> strength{};  ///< eigenvalues over the largest, ascending
+  std::vector<WeakDirection> weak;   ///< those with strength below kWeak, weakest first
+  static constexpr double kWeak = 0.02;
+};
+
+/// The eigen-decomposition of the point-to-plane normal equations (sum of J^T J, J = [n, (q x n) / r])
+/// over the model samples the camera sees at T_camera_model (front-facing, nearest per pixel). Depends
+/// on the model, the pose and the camera only: what any scan of this view can and cannot fix.
+ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k);
 
 }  // namespace projbot::alignment

@@ -70,11 +70,12 @@ struct VisitReport {
   std::vector<MarkerError> markers;
   double mean_mm = 0.0, max_mm = 0.0;  ///< at acquisition (the paper's Table 1 figure)
   alignment::AlignmentResult icp;
-  alignment::FreeSpaceCheck free_space;                     ///< the estimate at arrival against the measured depth
-  double base_error_cm = 0.0, base_error_deg = 0.0;         ///< believed vs true base pose at the stop
-  double odometry_error_cm = 0.0;                           ///< raw wheel odometry vs truth
-  double guess_error_cm = 0.0, guess_error_deg = 0.0;       ///< Eq. 1's initial guess vs the true T_camera_target
-  double drive_s = 0.0;                                     ///< simulated driving time to the stop
+  alignment::FreeSpaceCheck free_space;                ///< the estimate at arrival against the measured depth
+  alignment::ViewConstraints view;                     ///< how well the view at arrival pins the estimate down (weak directions)
+  double base_error_cm = 0.0, base_error_deg = 0.0;    ///< believed vs true base pose at the stop
+  double odometry_error_cm = 0.0;                      ///< raw wheel odometry vs truth
+  double guess_error_cm = 0.0, guess_error_deg = 0.0;  ///< Eq. 1's initial guess vs the true T_camera_target
+  double drive_s = 0.0;                                ///< simulated driving time to the stop
   double capture_ms = 0.0, align_ms = 0.0, frame_ms = 0.0;  ///< wall time: depth render, acquisition, projector frame
   std::vector<TimelineSample> timeline;                     ///< while projecting (empty when the visit projects one frame)
   bool moved = false;                                       ///< the target moved during this visit
