@@ -515,7 +515,8 @@ TEST(TourTest, TheShopFigureOnTheFloorIsLit) {
   EXPECT_EQ(localized.visits[0].target, "figure");
   EXPECT_TRUE(localized.visits[0].projected);
   EXPECT_FALSE(localized.visits[0].icp.reinitialised);  // found from the guess, no global search
-  EXPECT_LT(localized.visits[0].mean_mm, 5.0);          // the shelf touching its hand still pulls (3.7 mm)
+  // The shelf touching its hand pulled ICP to 3.7 mm; the projective polish after it does not follow it.
+  EXPECT_LT(localized.visits[0].mean_mm, 2.0);
   // The pan-tilt aims at the model's middle, not its origin at the feet: every marker, the chest's too,
   // is in the projector's image and lit (aimed at the feet, the chest was above the image).
   ASSERT_EQ(localized.visits[0].markers.size(), 5U);

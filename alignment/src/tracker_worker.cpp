@@ -93,7 +93,14 @@ DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matr
 
 AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Plane& floor,
                                         double grow_m) const {
-  return aligner_.align(depth_to_cloud(near_guess(frame, guess, floor, grow_m), k_), guess);
+  AlignmentResult r = aligner_.align(depth_to_cloud(near_guess(frame, guess, floor, grow_m), k_), guess);
+  if (!r.converged) return r;
+  for (int i = 0; i < 3; ++i) {  // the polish: projective association, which a touching neighbour pulls less
+    const TrackResult t = tracker_.track(frame, r.T_scan_model);
+    if (!t.accepted) break;
+    r.T_scan_model = t.T_camera_target;
+  }
+  return r;
 }
 
 std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage) {

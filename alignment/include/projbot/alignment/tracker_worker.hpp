@@ -111,7 +111,11 @@ class TargetFollower {
   const MotionFilter& motion() const { return filter_; }
   /// One whole acquisition (SearchStage::full) from `guess`, as the tour's localized mode runs it: the
   /// floor left out, the depth cropped to the guess's silhouette grown by grow_m (silhouette_grow_m():
-  /// how far the configured uncertainty reaches). Throws AlignmentError when too little depth is left.
+  /// how far the configured uncertainty reaches). A converged pose is then polished by up to three
+  /// projective tracking passes on the whole frame (model points against the pixels they fall on: a
+  /// neighbour touching the target pulls less than in ICP's nearest neighbours; the shop's figure, its
+  /// hand at a shelf, went from 2.7-3.6 mm to about 1 mm). The ICP's inlier ratio and rmse are of the
+  /// pose before the polish. Throws AlignmentError when too little depth is left.
   AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Plane& floor, double grow_m) const;
   double silhouette_grow_m() const { return silhouette_grow_m_; }
 
