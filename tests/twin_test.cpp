@@ -630,6 +630,16 @@ TEST(SpectatorViewTest, LightFallsOnTheTargetOrSpillsPastIt) {
   shifted(0, 3) += 0.05;
   const auto off = lit(shifted);
   EXPECT_GT(static_cast<double>(off[1]), 0.2 * static_cast<double>(off[0] + off[1]));  // spilled past it (32 %)
+  // A frame of another size than the projector's is refused, naming both.
+  projbot::assets::Image small = black;
+  small.width = 64, small.height = 40;
+  small.rgba.assign(64 * 40 * 4, 0);
+  try {
+    view.draw(twin, T_world_spectator, T_world_projector, small);
+    ADD_FAILURE() << "a 64x40 frame was drawn";
+  } catch (const projbot::twin::TwinError& e) {
+    EXPECT_NE(std::string(e.what()).find("64x40, the projector 1280x800"), std::string::npos) << e.what();
+  }
   // Without light the room is dimmed to its room light: a mid-grey wall of 200 shows about 60.
   std::size_t dim = 0;
   for (std::size_t i = 0; i < unlit.rgba.size(); i += 4) dim += unlit.rgba[i] < 0.35 * 255 ? 1 : 0;

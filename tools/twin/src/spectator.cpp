@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "projbot/alignment/equations.hpp"
 
@@ -47,6 +48,11 @@ SpectatorView::SpectatorView(engine::Renderer& renderer, const config::Projector
 
 assets::Image SpectatorView::draw(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const Eigen::Matrix4d& T_world_projector,
                                   const assets::Image& projector_frame) {
+  if (projector_frame.width != projector_.width_px || projector_frame.height != projector_.height_px ||
+      projector_frame.rgba.size() != static_cast<std::size_t>(projector_frame.width) * projector_frame.height * 4)
+    throw TwinError("spectator view: the projector frame is " + std::to_string(projector_frame.width) + "x" +
+                    std::to_string(projector_frame.height) + ", the projector " + std::to_string(projector_.width_px) + "x" +
+                    std::to_string(projector_.height_px));
   renderer_.draw_frame(*colour_, pinhole_, twin.draw_items(T_world_spectator));
   assets::Image out = colour_->read_back();  // the albedo: the twin's colours as they are
   renderer_.draw_frame(*depth_, pinhole_, twin.draw_items(T_world_spectator));

@@ -30,7 +30,8 @@ class SpectatorView {
 
   /// The spectator's picture at T_world_spectator: each visible surface point's albedo (the twin's
   /// colour) lit by the room light plus the projector's pixel that reaches it (Eq. 3 from
-  /// T_world_projector, blocked by whatever stands nearer the projector).
+  /// T_world_projector, blocked by whatever stands nearer the projector). Throws TwinError when the
+  /// frame is not the projector's size.
   assets::Image draw(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const Eigen::Matrix4d& T_world_projector,
                      const assets::Image& projector_frame);
 
