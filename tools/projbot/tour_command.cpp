@@ -17,10 +17,11 @@ const Command kTour{
     "             [--frames DIR] [--dwell S] [--no-noise] [--no-predict]\n\n"
     "Runs the tour of the scene's `tour.visits` in the digital twin (simulated youBot with wheel drift, laser,\n"
     "MRPT localisation, pan-tilt, Kinect v1 depth camera, projector). At each stop the robot aims at the\n"
-    "target's surveyed position, captures depth, takes the initial guess from its pose (Eq. 1), refines it by\n"
+    "middle of the target as surveyed, captures depth, takes the initial guess from its pose (Eq. 1), refines it by\n"
     "ICP, moves it to the projector (Eq. 2) and projects (Eq. 3). The projection error is measured at the\n"
-    "target's markers: the projector pixel carrying each marker is cast into the true scene and the distance\n"
-    "to the true marker is reported, in mm, with the paper's Table 1 beside it. Without --scene the shipped\n"
+    "target's markers the projector can light: the projector pixel carrying each marker is cast into the\n"
+    "true scene and the distance to the true marker is reported, in mm, with the paper's Table 1 beside it\n"
+    "(a marker outside the projector's image, turned away or hidden is left out). Without --scene the shipped\n"
     "demo tour runs (two targets, three visits each; the box is moved on its second visit).\n\n"
     "Modes: odometry = the paper's set-up (odometry only, one plain point-to-point ICP per stop, always\n"
     "projected; assets/scenes/paper.yaml is the paper's experiment, nothing moved); localized = MRPT\n"
@@ -34,8 +35,7 @@ const Command kTour{
      {"mode", "M", "odometry | localized | tracking (default localized)"},
      {"report", "FILE", "write the per-visit report as JSON"},
      {"frames", "DIR",
-      "write each visit's projector frame (DIR/visitNN_TARGET.png), the RGB-D camera's colour view "
-      "(_camera.png) and a visitor's view of the projector's light on the room (_spectator.png)"},
+      "write per visit DIR/visitNN_TARGET.png (projector), _camera.png (RGB-D colour), _spectator.png (a visitor's view)"},
      {"dwell", "S", "simulated seconds of projection per visit in tracking mode or while a target moves (default 3)"},
      {"no-noise", "", "depth without the Kinect v1 noise model"},
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"}},
