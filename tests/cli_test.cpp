@@ -391,6 +391,23 @@ TEST_F(CliTest, LocalizeInterruptedKeepsTheScansDone) {
   EXPECT_LT(trajectory_lines(trajectory), 1460);
 }
 
+// A moved target gets a spectator's picture at the end of its visit too: the demo's box, moved on its
+// second visit (the tour's fourth), is seen elsewhere with the light left where it stood.
+TEST_F(CliTest, TourShowsAMovedTargetAtTheEndOfItsVisit) {
+  const fs::path frames = dir_ / "frames";
+  const CliRun r = run_projbot("tour --visits 4 --frames " + frames.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(frames / "visit02_box_spectator_end.png"));  // not moved on its first visit
+  const auto arrival = projbot::assets::read_image(frames / "visit04_box_spectator.png");
+  const auto end = projbot::assets::read_image(frames / "visit04_box_spectator_end.png");
+  ASSERT_EQ(end.width, arrival.width);
+  ASSERT_EQ(end.height, arrival.height);
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < end.rgba.size(); i += 4)
+    changed += std::abs(end.rgba[i] - arrival.rgba[i]) + std::abs(end.rgba[i + 1] - arrival.rgba[i + 1]) > 30 ? 1 : 0;
+  EXPECT_GT(changed, end.rgba.size() / 4 / 200) << "the box moved 17 cm: more than 0.5 % of the picture changes";
+}
+
 namespace {
 
 // The peak resident KiB of one projbot run, its own (RUSAGE_CHILDREN would give the largest of every

@@ -35,7 +35,8 @@ const Command kTour{
      {"mode", "M", "odometry | localized | tracking (default localized)"},
      {"report", "FILE", "write the per-visit report as JSON"},
      {"frames", "DIR",
-      "write per visit DIR/visitNN_TARGET.png (projector), _camera.png (RGB-D colour), _spectator.png (a visitor's view)"},
+      "write per visit DIR/visitNN_TARGET.png (projector), _camera.png (RGB-D colour), _spectator.png (a visitor's view; "
+      "_spectator_end.png after a move)"},
      {"dwell", "S", "simulated seconds of projection per visit in tracking mode or while a target moves (default 3)"},
      {"no-noise", "", "depth without the Kinect v1 noise model"},
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"}},

@@ -277,6 +277,8 @@ bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitRepo
       back_under = s.t_s;
     }
   }
+  r.shown_at_end = shown;
+  r.T_camera_target_at_end = drawn.T_camera_target;
   r.track_ms_mean = tracking && camera.tracked > 0 ? camera.track_ms / camera.tracked : 0.0;
   r.tracked_frames = camera.tracked;
   r.dropped_frames = camera.frames - camera.tracked;
@@ -366,6 +368,11 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     r.base_error_deg = arrival.drive.error_rad * 180.0 / M_PI;
     r.odometry_error_cm = 100.0 * arrival.drive.odometry_error_m;
     const robot::HeadPoses& truth = arrival.truth;
+    // A visitor beside the robot, looking at the target where it truly stands now.
+    const auto spectator_at = [&](const TwinTarget& t) {
+      const Eigen::Vector3d middle = (t.T_world_target_true * t.model.bounds().center().homogeneous()).head<3>();
+      return spectator_pose(truth.T_world_camera.translation(), middle);
+    };
     target.in_world = twin.scripted_presence(i, r.target_visit, 0.0);
     r.target_present = target.in_world;
 
@@ -404,10 +411,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
       std::snprintf(file, sizeof file, "visit%02d_%s_camera.png", r.visit, name.c_str());
       assets::write_png(options.frames_dir / file, twin.capture_colour(truth.T_world_camera.matrix(), noise_seed));
       // What a visitor beside the robot sees: the frame's light on the true surfaces.
-      const Eigen::Vector3d middle = (target.T_world_target_true * target.model.bounds().center().homogeneous()).head<3>();
-      const Eigen::Matrix4d T_world_spectator = spectator_pose(truth.T_world_camera.translation(), middle);
       std::snprintf(file, sizeof file, "visit%02d_%s_spectator.png", r.visit, name.c_str());
-      assets::write_png(options.frames_dir / file, spectator->draw(twin, T_world_spectator, T_world_projector, image));
+      assets::write_png(options.frames_dir / file, spectator->draw(twin, spectator_at(target), T_world_projector, image));
     }
 
     // Projecting: the target may be moved or taken away; the tracker (tracking mode) follows it at
@@ -415,6 +420,19 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     r.moved = target.config.motion_on(r.target_visit) != nullptr;
     if (options.mode == TourMode::tracking || r.moved)
       report.interrupted = !dwell(DwellContext{twin, i, scene.projector, truth, options, noise_seed}, followers[i], r);
+    if (spectator && r.moved && !report.interrupted) {
+      // A moved target: what the visitor sees at the end of the dwell, where the target went and where
+      // the light went (followed, or left where the target was).
+      std::vector<engine::DrawItem> items;
+      if (r.shown_at_end)
+        items.push_back(
+            {twin.target_model_ids()[i], alignment::projector_from_target(rig.T_projector_camera, r.T_camera_target_at_end)});
+      renderer.draw_frame(*projector_frame, scene.projector, items);
+      char file[64];
+      std::snprintf(file, sizeof file, "visit%02d_%s_spectator_end.png", r.visit, name.c_str());
+      assets::write_png(options.frames_dir / file,
+                        spectator->draw(twin, spectator_at(target), T_world_projector, projector_frame->read_back()));
+    }
     twin.end_visit(i, r.target_visit);  // back home, or left where it was moved
     if (report.interrupted) break;      // this visit did not finish: keep the finished ones only
     if (options.on_visit) options.on_visit(r);

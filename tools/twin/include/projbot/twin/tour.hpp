@@ -67,6 +67,9 @@ struct VisitReport {
   Eigen::Matrix4d T_projector_target_true = Eigen::Matrix4d::Identity();
   Eigen::Matrix4d T_projector_target_estimated = Eigen::Matrix4d::Identity();
   bool projected = false;  ///< the estimate passed the gate (the paper's set-up always projects)
+  /// The last projector frame of the dwell: whether it was lit, and the pose it drew (camera frame).
+  bool shown_at_end = false;
+  Eigen::Matrix4d T_camera_target_at_end = Eigen::Matrix4d::Identity();
   std::vector<MarkerError> markers;
   double mean_mm = 0.0, max_mm = 0.0;  ///< at acquisition (the paper's Table 1 figure)
   alignment::AlignmentResult icp;
