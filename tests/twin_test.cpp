@@ -527,14 +527,23 @@ TEST(TourTest, TheShopFigureOnTheFloorIsLit) {
   EXPECT_LT(tracked.visits[0].still_mean_mm, 2.0);
 }
 
+namespace {
+
+// The shop's twin with the robot arrived at the Duck's stop (its first visit).
+class ShopDuckStop : public ::testing::Test {
+ protected:
+  const projbot::config::Scene scene = projbot::config::load_scene(kAssets + "/scenes/shop.yaml");
+  projbot::engine::Renderer renderer{projbot::engine::RendererOptions{}};
+  projbot::twin::Twin twin{scene, {}, renderer};
+  const std::size_t duck = twin.target_index("duck");
+  const projbot::twin::Arrival arrival = twin.arrive(duck, 0);
+};
+
+}  // namespace
+
 // The twin's colour camera (issue 11): registered to its depth, the textured model as it is, and the
 // colour sensor's noise. Checked against the Duck drawn alone from the same viewpoint, noiseless.
-TEST(TwinColourTest, ColourIsRegisteredToDepthWithTheModelsTextureAndNoise) {
-  const auto scene = projbot::config::load_scene(kAssets + "/scenes/shop.yaml");
-  projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
-  projbot::twin::Twin twin(scene, {}, renderer);
-  const std::size_t duck = twin.target_index("duck");
-  const auto arrival = twin.arrive(duck, 0);
+TEST_F(ShopDuckStop, ColourIsRegisteredToDepthWithTheModelsTextureAndNoise) {
   const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
   const auto colour = twin.capture_colour(T_world_camera, 7);
   const auto depth = twin.capture(T_world_camera, 7);
@@ -542,9 +551,7 @@ TEST(TwinColourTest, ColourIsRegisteredToDepthWithTheModelsTextureAndNoise) {
   ASSERT_EQ(colour.height, depth.height);
   EXPECT_EQ(twin.capture_colour(T_world_camera, 7).rgba, colour.rgba);  // seeded
   // The Duck alone, noiseless, in colour and depth.
-  projbot::config::ProjectorConfig pinhole = scene.depth_camera;
-  pinhole.near_m = 0.3;
-  pinhole.far_m = 8.0;
+  const projbot::config::ProjectorConfig pinhole = twin.camera_pinhole();
   const std::vector<projbot::engine::DrawItem> duck_only{
       {twin.target_model_ids()[duck],
        projbot::alignment::rigid_inverse(T_world_camera) * twin.targets()[duck].T_world_target_true}};
@@ -587,12 +594,7 @@ TEST(TwinColourTest, ColourIsRegisteredToDepthWithTheModelsTextureAndNoise) {
 // The spectator's view (issue 11): the projector's light falls on the true surfaces. The Duck's own
 // frame drawn at its true pose lights the Duck and almost nothing else; drawn 5 cm to the side, much of
 // its light spills past it onto the table and the wall.
-TEST(SpectatorViewTest, LightFallsOnTheTargetOrSpillsPastIt) {
-  const auto scene = projbot::config::load_scene(kAssets + "/scenes/shop.yaml");
-  projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
-  projbot::twin::Twin twin(scene, {}, renderer);
-  const std::size_t duck = twin.target_index("duck");
-  const auto arrival = twin.arrive(duck, 0);
+TEST_F(ShopDuckStop, SpectatorSeesLightFallOnTheTargetOrSpillPastIt) {
   const Eigen::Matrix4d T_world_projector = arrival.truth.T_world_projector.matrix();
   const Eigen::Matrix4d T_world_duck = twin.targets()[duck].T_world_target_true;
   projbot::twin::SpectatorView view(renderer, scene.projector);

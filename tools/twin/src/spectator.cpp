@@ -6,6 +6,7 @@
 #include <string>
 
 #include "projbot/alignment/equations.hpp"
+#include "projbot/engine/projection.hpp"
 
 namespace projbot::twin {
 
@@ -53,9 +54,10 @@ assets::Image SpectatorView::draw(Twin& twin, const Eigen::Matrix4d& T_world_spe
     throw TwinError("spectator view: the projector frame is " + std::to_string(projector_frame.width) + "x" +
                     std::to_string(projector_frame.height) + ", the projector " + std::to_string(projector_.width_px) + "x" +
                     std::to_string(projector_.height_px));
-  renderer_.draw_frame(*colour_, pinhole_, twin.draw_items(T_world_spectator));
+  const std::vector<engine::DrawItem> room = twin.draw_items(T_world_spectator);
+  renderer_.draw_frame(*colour_, pinhole_, room);
   assets::Image out = colour_->read_back();  // the albedo: the twin's colours as they are
-  renderer_.draw_frame(*depth_, pinhole_, twin.draw_items(T_world_spectator));
+  renderer_.draw_frame(*depth_, pinhole_, room);
   const engine::DepthMap depth = depth_->read_back_depth();
   renderer_.draw_frame(*projector_depth_, projector_, twin.draw_items(T_world_projector));
   const engine::DepthMap lit_depth = projector_depth_->read_back_depth();
@@ -70,8 +72,8 @@ assets::Image SpectatorView::draw(Twin& twin, const Eigen::Matrix4d& T_world_spe
         const Eigen::Vector4d p(z * (u - pinhole_.cx_px) / pinhole_.fx_px, z * (v - pinhole_.cy_px) / pinhole_.fy_px, z, 1.0);
         const Eigen::Vector3d q = (T_projector_spectator * p).head<3>();
         // Eq. 3: the projector pixel that reaches this point, if nothing nearer the projector blocks it.
-        const long pu = q.z() > k.near_m ? std::lround(k.fx_px * q.x() / q.z() + k.cx_px) : -1;
-        const long pv = q.z() > k.near_m ? std::lround(k.fy_px * q.y() / q.z() + k.cy_px) : -1;
+        const Eigen::Vector2d x = q.z() > k.near_m ? engine::project_to_pixel(k, q) : Eigen::Vector2d(-1.0, -1.0);
+        const long pu = std::lround(x.x()), pv = std::lround(x.y());
         if (pu >= 0 && pv >= 0 && pu < k.width_px && pv < k.height_px) {
           const float seen = lit_depth.z_m[static_cast<std::size_t>(pv) * k.width_px + pu];
           if (seen > 0.0F && std::abs(seen - q.z()) < 0.01 + 0.01 * q.z()) {

@@ -10,6 +10,7 @@
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/image.hpp"
 #include "projbot/engine/frame_profiler.hpp"
+#include "projbot/engine/projection.hpp"
 #include "projbot/twin/spectator.hpp"
 #include "projbot/twin/world.hpp"
 
@@ -30,8 +31,8 @@ struct Errors {
 // Whether a point in the projector frame falls inside the projector's image (Eq. 3).
 bool lit_by(const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
   if (p.z() <= 0.0) return false;
-  const double u = k.fx_px * p.x() / p.z() + k.cx_px, v = k.fy_px * p.y() / p.z() + k.cy_px;
-  return u >= 0.0 && v >= 0.0 && u < k.width_px && v < k.height_px;
+  const Eigen::Vector2d x = engine::project_to_pixel(k, p);
+  return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < k.width_px && x.y() < k.height_px;
 }
 
 // The error at the target's markers. A marker the projector cannot light (outside its image, turned
@@ -288,6 +289,13 @@ bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitRepo
   return true;
 }
 
+// Where --frames writes one of a visit's pictures: DIR/visitNN_TARGET<suffix>.png.
+std::filesystem::path frame_path(const TourOptions& options, const VisitReport& r, const char* suffix) {
+  char file[96];
+  std::snprintf(file, sizeof file, "visit%02d_%s%s.png", r.visit, r.target.c_str(), suffix);
+  return options.frames_dir / file;
+}
+
 }  // namespace
 
 const char* to_string(TourMode mode) {
@@ -369,9 +377,15 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     r.odometry_error_cm = 100.0 * arrival.drive.odometry_error_m;
     const robot::HeadPoses& truth = arrival.truth;
     // A visitor beside the robot, looking at the target where it truly stands now.
+    // The projector's frame: the target drawn at T_projector_target when lit, else all black.
+    const auto projector_image = [&](bool lit, const Eigen::Matrix4d& T_projector_target) {
+      std::vector<engine::DrawItem> items;
+      if (lit) items.push_back({twin.target_model_ids()[i], T_projector_target});
+      renderer.draw_frame(*projector_frame, scene.projector, items);
+      return projector_frame->read_back();
+    };
     const auto spectator_at = [&](const TwinTarget& t) {
-      const Eigen::Vector3d middle = (t.T_world_target_true * t.model.bounds().center().homogeneous()).head<3>();
-      return spectator_pose(truth.T_world_camera.translation(), middle);
+      return spectator_pose(truth.T_world_camera.translation(), model_middle(t, t.T_world_target_true));
     };
     target.in_world = twin.scripted_presence(i, r.target_visit, 0.0);
     r.target_present = target.in_world;
@@ -399,20 +413,14 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
 
     if (projector_frame) {
       t0 = Clock::now();
-      std::vector<engine::DrawItem> items;
-      if (r.projected) items.push_back({twin.target_model_ids()[i], r.T_projector_target_estimated});
-      renderer.draw_frame(*projector_frame, scene.projector, items);
-      const auto image = projector_frame->read_back();
+      const auto image = projector_image(r.projected, r.T_projector_target_estimated);
       r.frame_ms = ms_since(t0);
-      char file[64];
-      std::snprintf(file, sizeof file, "visit%02d_%s.png", r.visit, name.c_str());
-      assets::write_png(options.frames_dir / file, image);
+      assets::write_png(frame_path(options, r, ""), image);
       // What the RGB-D camera saw at the capture: its colour, registered to the depth that was used.
-      std::snprintf(file, sizeof file, "visit%02d_%s_camera.png", r.visit, name.c_str());
-      assets::write_png(options.frames_dir / file, twin.capture_colour(truth.T_world_camera.matrix(), noise_seed));
+      assets::write_png(frame_path(options, r, "_camera"), twin.capture_colour(truth.T_world_camera.matrix(), noise_seed));
       // What a visitor beside the robot sees: the frame's light on the true surfaces.
-      std::snprintf(file, sizeof file, "visit%02d_%s_spectator.png", r.visit, name.c_str());
-      assets::write_png(options.frames_dir / file, spectator->draw(twin, spectator_at(target), T_world_projector, image));
+      assets::write_png(frame_path(options, r, "_spectator"),
+                        spectator->draw(twin, spectator_at(target), T_world_projector, image));
     }
 
     // Projecting: the target may be moved or taken away; the tracker (tracking mode) follows it at
@@ -423,15 +431,10 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     if (spectator && r.moved && !report.interrupted) {
       // A moved target: what the visitor sees at the end of the dwell, where the target went and where
       // the light went (followed, or left where the target was).
-      std::vector<engine::DrawItem> items;
-      if (r.shown_at_end)
-        items.push_back(
-            {twin.target_model_ids()[i], alignment::projector_from_target(rig.T_projector_camera, r.T_camera_target_at_end)});
-      renderer.draw_frame(*projector_frame, scene.projector, items);
-      char file[64];
-      std::snprintf(file, sizeof file, "visit%02d_%s_spectator_end.png", r.visit, name.c_str());
-      assets::write_png(options.frames_dir / file,
-                        spectator->draw(twin, spectator_at(target), T_world_projector, projector_frame->read_back()));
+      const auto image =
+          projector_image(r.shown_at_end, alignment::projector_from_target(rig.T_projector_camera, r.T_camera_target_at_end));
+      assets::write_png(frame_path(options, r, "_spectator_end"),
+                        spectator->draw(twin, spectator_at(target), T_world_projector, image));
     }
     twin.end_visit(i, r.target_visit);  // back home, or left where it was moved
     if (report.interrupted) break;      // this visit did not finish: keep the finished ones only

@@ -159,10 +159,13 @@ std::size_t Twin::target_index(const std::string& name) const {
   throw TwinError("the twin has no target named '" + name + "'");
 }
 
+Eigen::Vector3d model_middle(const TwinTarget& t, const Eigen::Matrix4d& T_world_target) {
+  return (T_world_target * t.model.bounds().center().homogeneous()).head<3>();
+}
+
 Eigen::Vector3d Twin::surveyed_middle(std::size_t target) const {
   const TwinTarget& t = targets_.at(target);
-  const Eigen::Matrix4d T_map_target = t.config.T_map_target.value_or(*t.config.T_world_target);
-  return (T_map_target * t.model.bounds().center().homogeneous()).head<3>();
+  return model_middle(t, t.config.T_map_target.value_or(*t.config.T_world_target));
 }
 
 Arrival Twin::arrive(std::size_t target, int index) {
@@ -239,12 +242,17 @@ std::vector<engine::DrawItem> Twin::draw_items(const Eigen::Matrix4d& T_world_ca
   return items;
 }
 
-assets::Image Twin::capture_colour(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
-  if (!colour_target_) colour_target_ = renderer_.make_offscreen(camera_.width_px, camera_.height_px);
+config::ProjectorConfig Twin::camera_pinhole() const {
+  // Rendered from 0.3 to 8 m: the noise model, not the clip planes, drops what the Kinect cannot see.
   config::ProjectorConfig pinhole = scene_.depth_camera;
   pinhole.near_m = 0.3;
   pinhole.far_m = 8.0;
-  renderer_.draw_frame(*colour_target_, pinhole, draw_items(T_world_camera));
+  return pinhole;
+}
+
+assets::Image Twin::capture_colour(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
+  if (!colour_target_) colour_target_ = renderer_.make_offscreen(camera_.width_px, camera_.height_px);
+  renderer_.draw_frame(*colour_target_, camera_pinhole(), draw_items(T_world_camera));
   assets::Image image = colour_target_->read_back();
   if (!options_.depth_noise) return image;
   std::mt19937 rng(noise_seed ^ 0x9e3779b9U);
@@ -257,12 +265,7 @@ assets::Image Twin::capture_colour(const Eigen::Matrix4d& T_world_camera, std::u
 }
 
 alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
-  const std::vector<engine::DrawItem> items = draw_items(T_world_camera);
-  // Rendered from 0.3 to 8 m: the noise model, not the clip planes, drops what the Kinect cannot see.
-  config::ProjectorConfig pinhole = scene_.depth_camera;
-  pinhole.near_m = 0.3;
-  pinhole.far_m = 8.0;
-  renderer_.draw_frame(*depth_target_, pinhole, items);
+  renderer_.draw_frame(*depth_target_, camera_pinhole(), draw_items(T_world_camera));
   const engine::DepthMap map = depth_target_->read_back_depth();
   alignment::DepthImage clean{map.width, map.height, map.z_m, 0.0};
   if (!options_.depth_noise) return clean;

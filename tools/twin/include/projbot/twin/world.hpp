@@ -102,6 +102,8 @@ class Twin {
   /// seeded) when depth noise is on. RGBA8, alpha 255.
   assets::Image capture_colour(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed);
   static constexpr double kColourNoiseSigma = 2.5;
+  /// The camera's pinhole as capture() and capture_colour() render it (clipped at 0.3 and 8 m).
+  config::ProjectorConfig camera_pinhole() const;
   /// The true surfaces placed in a frame (T_frame_world): for the projector's rays.
   std::vector<PlacedMesh> true_scene(const Eigen::Matrix4d& T_frame_world) const;
 
@@ -138,6 +140,9 @@ class Twin {
   std::unique_ptr<engine::RenderTarget> depth_target_;
   std::unique_ptr<engine::RenderTarget> colour_target_;
 };
+
+/// The middle of a target's model (its bounding box's centre) placed by T_world_target.
+Eigen::Vector3d model_middle(const TwinTarget& t, const Eigen::Matrix4d& T_world_target);
 
 /// The pose of `target` standing at `home`, `t_s` into its `target_visit`-th visit (its motion script).
 Eigen::Matrix4d scripted_pose(const config::TargetConfig& target, const Eigen::Matrix4d& home, int target_visit, double t_s);
