@@ -11,12 +11,12 @@ namespace projbot::alignment {
 
 namespace {
 
-// The predicted depth image: nearest front-facing model sample per pixel, +inf where none lands; `box`
-// gets the pixel bounds of what landed (x0, y0, x1, y1, inclusive).
-std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k,
-                                   std::array<int, 4>& box) {
-  box = {k.width_px, k.height_px, -1, -1};
-  std::vector<float> z_buffer(static_cast<std::size_t>(k.width_px) * k.height_px, std::numeric_limits<float>::infinity());
+// The nearest front-facing model sample per pixel under T_camera_model: (depth, sample index), +inf
+// where none lands.
+std::vector<std::pair<float, std::size_t>> nearest_samples(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model,
+                                                           const CameraIntrinsics& k) {
+  std::vector<std::pair<float, std::size_t>> nearest(static_cast<std::size_t>(k.width_px) * k.height_px,
+                                                     {std::numeric_limits<float>::infinity(), 0});
   const Eigen::Matrix3d R = T_camera_model.topLeftCorner<3, 3>();
   const Eigen::Vector3d t = T_camera_model.topRightCorner<3, 1>();
   for (std::size_t i = 0; i < model.points.size(); ++i) {
@@ -24,8 +24,23 @@ std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4
     if (!(p.z() > 0.05) || (R * model.normals[i].cast<double>()).dot(p) >= 0.0) continue;  // behind the camera, or a back face
     int u = 0, v = 0;
     if (!k.nearest_pixel(p, u, v)) continue;
-    float& z = z_buffer[static_cast<std::size_t>(v) * k.width_px + u];
-    z = std::min(z, static_cast<float>(p.z()));
+    auto& best = nearest[static_cast<std::size_t>(v) * k.width_px + u];
+    if (p.z() < best.first) best = {static_cast<float>(p.z()), i};
+  }
+  return nearest;
+}
+
+// The predicted depth image: nearest front-facing model sample per pixel, +inf where none lands; `box`
+// gets the pixel bounds of what landed (x0, y0, x1, y1, inclusive).
+std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k,
+                                   std::array<int, 4>& box) {
+  box = {k.width_px, k.height_px, -1, -1};
+  const auto nearest = nearest_samples(model, T_camera_model, k);
+  std::vector<float> z_buffer(nearest.size());
+  for (std::size_t i = 0; i < nearest.size(); ++i) {
+    z_buffer[i] = nearest[i].first;
+    if (!std::isfinite(z_buffer[i])) continue;
+    const int u = static_cast<int>(i % k.width_px), v = static_cast<int>(i / k.width_px);
     box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v)};
   }
   return z_buffer;
@@ -109,17 +124,8 @@ ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d&
   // seen at a grazing angle has many samples but few pixels).
   const Eigen::Matrix3d R = T_camera_model.topLeftCorner<3, 3>();
   const Eigen::Vector3d t = T_camera_model.topRightCorner<3, 1>();
-  std::vector<std::pair<float, std::size_t>> nearest(static_cast<std::size_t>(k.width_px) * k.height_px,
-                                                     {std::numeric_limits<float>::infinity(), 0});
-  for (std::size_t i = 0; i < model.points.size(); ++i) {
-    const Eigen::Vector3d p = R * model.points[i].cast<double>() + t;
-    int u = 0, v = 0;
-    if (!(p.z() > 0.05) || (R * model.normals[i].cast<double>()).dot(p) >= 0.0 || !k.nearest_pixel(p, u, v)) continue;
-    auto& best = nearest[static_cast<std::size_t>(v) * k.width_px + u];
-    if (p.z() < best.first) best = {static_cast<float>(p.z()), i};
-  }
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> seen;  // point, normal (camera frame)
-  for (const auto& [z, i] : nearest)
+  for (const auto& [z, i] : nearest_samples(model, T_camera_model, k))
     if (std::isfinite(z))
       seen.emplace_back(R * model.points[i].cast<double>() + t, (R * model.normals[i].cast<double>()).normalized());
   c.points = seen.size();
