@@ -2,7 +2,6 @@
 
 #include <malloc.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -50,7 +49,9 @@ void print_help() {
 }  // namespace
 
 // Runs the command argv names; its exit status.
-static int dispatch(int argc, char** argv) {
+// Runs the command argv names; `name` gets it as typed ("align", "bench motion"), empty for --help
+// and --version.
+static int dispatch(int argc, char** argv, std::string& name) {
   // Lavapipe allocates its per-frame binning memory anew each frame. By default glibc returns such large
   // blocks to the kernel on free and the next frame faults them in again, zeroed; keeping them in the
   // heap took the 100k-triangle 1080p benchmark from p99 23 ms to 18 ms (tools/bench-vs-vkcube.sh,
@@ -69,7 +70,7 @@ static int dispatch(int argc, char** argv) {
     std::cout << "projbot " << PROJBOT_VERSION << '\n';
     return 0;
   }
-  std::string name = argv[1];
+  name = argv[1];
   int first = 2;
   if (name == "bench") {  // "bench render", "bench track", "bench motion", "bench acquire", "bench localize": the benchmark of a
                           // subsystem
@@ -112,7 +113,8 @@ static int dispatch(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  const int code = dispatch(argc, argv);
+  std::string name;
+  const int code = dispatch(argc, argv, name);
   // What went to standard output must have arrived: `align --json >/dev/full` once exited 0 with
   // nothing written. Every command and --help / --version end here.
   errno = 0;
@@ -120,11 +122,7 @@ int main(int argc, char** argv) {
   const bool flushed = std::fflush(stdout) == 0;
   const int err = errno;  // set only if these flushes failed: a write that failed during the run set it long ago
   if (!flushed || !std::cout || std::ferror(stdout)) {
-    // The command as typed: "bench motion", not "bench".
-    std::string what;
-    for (int i = 1; i < std::min(argc, 3) && argv[i][0] != '-'; ++i) what += std::string(" ") + argv[i];
-    if (argc > 1 && std::string(argv[1]) != "bench") what = what.substr(0, what.find(' ', 1));
-    std::cerr << "projbot" << what
+    std::cerr << "projbot" << (name.empty() ? "" : " " + name)
               << ": cannot write to standard output: " << (err != 0 ? std::strerror(err) : "a write to it failed during the run")
               << '\n';
     return 1;
