@@ -89,6 +89,47 @@ TEST_F(SyntheticDepthTest, DepthCameraMatchesTheModelSurface) {
   EXPECT_LT(at_truth.rmse_mm, 0.3);
 }
 
+TEST_F(SyntheticDepthTest, TheGateAllowsForTheSensorNoiseAtItsRange) {
+  // Kinect v1 at 2 m: sigma 5.7 mm plus 11.5 mm disparity steps. A fixed 6 mm inlier distance leaves
+  // part of a scan at its true pose unexplained; within two sigma of the noise at each point's range
+  // nearly all of it is explained, and a pose 3 cm nearer still is not. At 0.8 m the tolerance stays the fixed 6 mm.
+  const Eigen::Matrix4d far = poses()[3], near = poses()[0];
+  const DepthImage noisy = apply_kinect_v1_noise(render(far), k_, KinectNoiseConfig{}, 77);
+  const PointCloud scan = depth_to_cloud(noisy, k_);
+  AcquisitionConfig fixed;
+  fixed.depth_sigma_coeff = 0.0;
+  const AlignmentResult by_fixed = Aligner(*model_, fixed).score(scan, far);
+  const Aligner aligner(*model_);
+  const AlignmentResult by_noise = aligner.score(scan, far);
+  EXPECT_GT(by_noise.inlier_ratio, 0.95);
+  EXPECT_GT(by_noise.inlier_ratio, by_fixed.inlier_ratio + 0.08);
+  EXPECT_TRUE(by_noise.converged) << "rmse " << by_noise.rmse_mm << " scale " << by_noise.tolerance_scale;
+  EXPECT_NEAR(by_noise.tolerance_scale, 2.0 * 1.65e-3 * 4.0 / 0.006, 0.3);  // about 2.2 at 2 m
+  Eigen::Matrix4d nearer = far;
+  nearer(2, 3) -= 0.03;
+  EXPECT_FALSE(aligner.score(scan, nearer).converged);
+  const PointCloud close = depth_to_cloud(apply_kinect_v1_noise(render(near), k_, KinectNoiseConfig{}, 78), k_);
+  EXPECT_DOUBLE_EQ(aligner.score(close, near).tolerance_scale, 1.0);
+}
+
+TEST_F(SyntheticDepthTest, ABigScanIsThinnedToTheCapAndStaysAccurate) {
+  // The duck at 0.8 m fills 20000 pixels; with a cap of 2000 points ICP and the gate work on a coarser
+  // grid, and the pose stays within a millimetre.
+  const Eigen::Matrix4d T = poses()[0];
+  const PointCloud scan = depth_to_cloud(render(T), k_);
+  ASSERT_GT(scan.finite_count(), 15000U);
+  AcquisitionConfig capped;
+  capped.max_scan_points = 2000;
+  std::mt19937 rng(4);
+  const AlignmentResult r = Aligner(*model_, capped).align(scan, perturb(T, 5.0, 0.02, rng));
+  EXPECT_TRUE(r.converged);
+  EXPECT_LE(r.scan_points, 2600U);
+  EXPECT_GT(r.scan_points, 1000U);
+  const Eigen::Matrix4d err = rigid_inverse(T) * r.T_scan_model;
+  EXPECT_LT(translation_norm_m(err), 0.001);
+  EXPECT_LT(rotation_angle_deg(err), 0.3);
+}
+
 TEST_F(SyntheticDepthTest, AccurateWithoutNoise) {
   Aligner aligner(*model_);
   std::mt19937 rng(1);

@@ -198,6 +198,12 @@ struct Aligner::Impl {
     grid.setInputCloud(raw);
     grid.setLeafSize(static_cast<float>(leaf), static_cast<float>(leaf), static_cast<float>(leaf));
     grid.filter(*down);
+    if (cfg.max_scan_points > 0 && down->size() > cfg.max_scan_points) {
+      // A surface's points fall with the square of the leaf: one coarser grid brings them near the cap.
+      leaf *= std::sqrt(static_cast<double>(down->size()) / static_cast<double>(cfg.max_scan_points));
+      grid.setLeafSize(static_cast<float>(leaf), static_cast<float>(leaf), static_cast<float>(leaf));
+      grid.filter(*down);
+    }
     if (down->size() > static_cast<std::size_t>(cfg.outlier_neighbours) * 2) {
       auto kept = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
       pcl::StatisticalOutlierRemoval<pcl::PointXYZ> sor;
@@ -277,8 +283,15 @@ struct Aligner::Impl {
     return rigid_inverse(T_model_scan.cast<double>());
   }
 
+  // A scan point at range z is explained within this of the model: the fixed inlier distance, or the
+  // sensor's noise there when that is more.
+  double tolerance_m(float z) const {
+    const double zz = static_cast<double>(z) * z;
+    return std::max(cfg.inlier_distance_m, cfg.inlier_sigmas * cfg.depth_sigma_coeff * zz);
+  }
+
   // Quality of a pose: scan points near the posed model are inliers when their point-to-plane distance
-  // to the nearest model sample is under inlier_distance_m.
+  // to the nearest model sample is within their tolerance (tolerance_m).
   void evaluate(const pcl::PointCloud<pcl::PointXYZ>& near, const Eigen::Matrix4d& T, AlignmentResult& r) const {
     r.scan_points = near.size();
     if (near.empty()) {
@@ -288,26 +301,31 @@ struct Aligner::Impl {
     }
     const Eigen::Matrix4f inv = rigid_inverse(T).cast<float>();
     std::size_t inliers = 0;
-    double sum2 = 0.0;
+    double sum2 = 0.0, scale_sum = 0.0;
     pcl::Indices index(1);
     std::vector<float> dist2(1);
     for (const auto& p : near) {
       PointN q;
       q.getVector3fMap() = (inv * Eigen::Vector4f(p.x, p.y, p.z, 1.0F)).head<3>();
       if (!q.getVector3fMap().allFinite()) continue;
+      const double tolerance = tolerance_m(p.z);
+      scale_sum += tolerance / cfg.inlier_distance_m;
       if (model_tree.nearestKSearch(q, 1, index, dist2) < 1) continue;
-      if (dist2[0] > 4.0F * static_cast<float>(cfg.inlier_distance_m * cfg.inlier_distance_m)) continue;
+      if (dist2[0] > static_cast<float>(4.0 * tolerance * tolerance)) continue;
       const PointN& m = (*model)[static_cast<std::size_t>(index[0])];
       const double d = std::abs((q.getVector3fMap() - m.getVector3fMap()).dot(m.getNormalVector3fMap()));
-      if (d > cfg.inlier_distance_m) continue;
+      if (d > tolerance) continue;
       ++inliers;
       sum2 += d * d;
     }
     r.inlier_ratio = static_cast<double>(inliers) / static_cast<double>(near.size());
     r.rmse_mm = inliers > 0 ? 1000.0 * std::sqrt(sum2 / static_cast<double>(inliers)) : std::numeric_limits<double>::infinity();
+    r.tolerance_scale = std::max(1.0, scale_sum / static_cast<double>(near.size()));
   }
 
-  bool passes(const AlignmentResult& r) const { return r.inlier_ratio >= cfg.min_inlier_ratio && r.rmse_mm <= cfg.max_rmse_mm; }
+  bool passes(const AlignmentResult& r) const {
+    return r.inlier_ratio >= cfg.min_inlier_ratio && r.rmse_mm <= cfg.max_rmse_mm * r.tolerance_scale;
+  }
 
   // The scan within `margin` of the model's sphere under T_init, on the coarse grid, thinned by a coarser
   // grid until at most max_global_points remain: what a bounded global search works on.

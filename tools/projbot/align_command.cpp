@@ -130,8 +130,10 @@ const Command kAlign{
       cfg.voxel_m = args.get_double("voxel", cfg.voxel_m);
       if (!(cfg.voxel_m > 0.0) || cfg.voxel_m > 0.1) throw cli::UsageError("--voxel must be in (0, 0.1] metres");
       const alignment::ModelCloud model = alignment::load_model_cloud(*args.get("model"));
-      const alignment::Aligner aligner(model, cfg);
       const Scan loaded = load_scan(args);
+      // A cloud's frame is unknown: its z is no range, and the depth camera's noise at a range says nothing.
+      if (!loaded.depth) cfg.depth_sigma_coeff = 0.0;
+      const alignment::Aligner aligner(model, cfg);
       const alignment::PointCloud& scan = loaded.cloud;
       if (const std::size_t valid = scan.finite_count(); valid < cfg.min_points)
         throw alignment::AlignmentError(*args.get("scan") + ": " + std::to_string(valid) + " valid points; at least " +
