@@ -198,8 +198,9 @@ struct Aligner::Impl {
     grid.setInputCloud(raw);
     grid.setLeafSize(static_cast<float>(leaf), static_cast<float>(leaf), static_cast<float>(leaf));
     grid.filter(*down);
-    if (cfg.max_scan_points > 0 && down->size() > cfg.max_scan_points) {
-      // A surface's points fall with the square of the leaf: one coarser grid brings them near the cap.
+    // A surface's points fall with the square of the leaf, a noisy one's more slowly: up to three
+    // coarser grids bring them within a quarter over the cap.
+    for (int i = 0; i < 3 && cfg.max_scan_points > 0 && down->size() > cfg.max_scan_points * 5 / 4; ++i) {
       leaf *= std::sqrt(static_cast<double>(down->size()) / static_cast<double>(cfg.max_scan_points));
       grid.setLeafSize(static_cast<float>(leaf), static_cast<float>(leaf), static_cast<float>(leaf));
       grid.filter(*down);
@@ -520,7 +521,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
 
   // A bounded stage stops starting new work once attempt_budget_ms has passed; `full` runs to the end.
   const auto out_of_time = [&] {
-    return stage != SearchStage::full &&
+    return stage != SearchStage::full && stage != SearchStage::icp_only &&
            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() > m.cfg.attempt_budget_ms;
   };
   AlignmentResult best;
@@ -537,7 +538,8 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     r.iterations = best.iterations;
     if (better_than(r, best)) best = r;
   };
-  const bool local = stage == SearchStage::full || stage == SearchStage::refine || stage == SearchStage::local;
+  const bool local =
+      stage == SearchStage::full || stage == SearchStage::refine || stage == SearchStage::icp_only || stage == SearchStage::local;
   if (local) attempt(T_init, false);
   if (!best.converged && m.cfg.restart_angle_deg > 0.0 && (stage == SearchStage::full || stage == SearchStage::local)) {
     // Local restarts: the guess turned about the target's centre, which ICP alone cannot leave.

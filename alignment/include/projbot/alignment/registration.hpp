@@ -93,6 +93,7 @@ struct AlignmentResult {
 enum class SearchStage {
   full,         ///< ICP from the guess, the local restarts, then the global search near the guess
   refine,       ///< ICP from the guess only (a track lost on this frame)
+  icp_only,     ///< ICP from the guess only, not bounded: the first pass of a whole acquisition
   local,        ///< ICP from the guess and from the guess turned +-restart_angle_deg about each axis
   global_near,  ///< FPFH + SampleConsensusPrerejective within model radius + reinit_crop_margin_m, then ICP
   global_wide,  ///< the same within model radius + wide_crop_margin_m

@@ -55,6 +55,9 @@ struct WorkerConfig {
   /// Eq. 1 guess is within about 1 cm and 0.2 degrees (the tour's table).
   double guess_uncertainty_m = 0.05;
   double guess_uncertainty_deg = 3.0;
+  /// ...and once ICP has an estimate, the depth is cropped again at it, grown by this, and ICP refines
+  /// from there on what is left (what stood beside the target inside the first crop drops out).
+  double recrop_m = 0.03;
 };
 
 /// What searching for a target has cost since its stop began.
@@ -111,7 +114,8 @@ class TargetFollower {
   const MotionFilter& motion() const { return filter_; }
   /// One whole acquisition (SearchStage::full) from `guess`, as the tour's localized mode runs it: the
   /// floor left out, the depth cropped to the guess's silhouette grown by grow_m (silhouette_grow_m():
-  /// how far the configured uncertainty reaches). A converged pose is then polished by up to three
+  /// how far the configured uncertainty reaches), then refined on the depth cropped again at the
+  /// estimate (recrop_m). A converged pose is then polished by up to three
   /// projective tracking passes on the whole frame (model points against the pixels they fall on: a
   /// neighbour touching the target pulls less than in ICP's nearest neighbours; the shop's figure, its
   /// hand at a shelf, went from 2.7-3.6 mm to about 1 mm). The ICP's inlier ratio and rmse are of the
@@ -120,6 +124,14 @@ class TargetFollower {
   double silhouette_grow_m() const { return silhouette_grow_m_; }
 
  private:
+  /// ICP on the depth near `guess` (near_guess, grown by grow_m), refined on the depth near its
+  /// estimate (recropped); when that fails the gate, the same with `stage`'s restarts and global search.
+  AlignmentResult align_near(const DepthImage& frame, const Eigen::Matrix4d& guess, const std::optional<Plane>& floor,
+                             double grow_m, SearchStage stage) const;
+  /// r refined by ICP (`stage`: refine or icp_only) on the depth near its estimate, grown by recrop_m;
+  /// r itself when only it passes the gate.
+  AlignmentResult recropped(const DepthImage& frame, const AlignmentResult& r, const std::optional<Plane>& floor,
+                            SearchStage stage) const;
   ModelCloud model_;  // for the free-space check
   Aligner aligner_;
   ProjectiveTracker tracker_;
