@@ -220,7 +220,7 @@ const std::vector<Hostile> kFileCases{
             Files{{"r.png", "@random:5000"}},
             1,
             {"r.png", "cannot read PNG"}},
-    Hostile{"png_empty", "align --model {duck} --scan {dir}/e.png", Files{{"e.png", ""}}, 1, {"e.png"}},
+    Hostile{"png_empty", "align --model {duck} --scan {dir}/e.png", Files{{"e.png", ""}}, 1, {"e.png", "empty"}},
     Hostile{
         "png_too_small_for_intrinsics", "align --model {duck} --scan " + kGood16, {}, 1, {"gray16_4x3.png", "4x3", "640x480"}},
     Hostile{"tiff_random", "align --model {duck} --scan {dir}/r.tiff", Files{{"r.tiff", "@random:5000"}}, 1, {"r.tiff"}},
@@ -551,7 +551,8 @@ const std::vector<Hostile> kArgumentCases{
             {},
             1,
             {"--pose-matrix"}},
-    Hostile{"render_out_in_proc", "render --out /proc/projbot.png --size 64x48", {}, 2, {"/proc/projbot.png"}},
+    Hostile{
+        "render_out_in_proc", "render --out /proc/projbot.png --size 64x48", {}, 2, {"/proc/projbot.png", "takes no new files"}},
     Hostile{"render_out_not_png", "render --out {dir}/prev.json --size 64x48", {}, 2, {"--out", ".png"}},
     Hostile{"render_profile_is_folder", "render --out {dir}/a.png --profile {dir}/goodmap", {}, 2, {"--profile", "is a folder"}},
     Hostile{"show_bad_present_mode", "show --present-mode bogus --frames 1", {}, 2, {"--present-mode", "bogus"}},

@@ -74,11 +74,12 @@ void check_claimed_size(const std::filesystem::path& path, int w, int h, int byt
 // stb allocates what a PNG chunk's length claims before reading it (a 73-byte file claiming a 553 MB
 // IDAT): every chunk must fit in the file. Files that are not PNG are left to stb.
 void check_png_chunks(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::uint64_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size == 0) throw AssetError(path.string() + ": the file is empty (0 bytes), not an image");
   std::ifstream in(path, std::ios::binary);
   unsigned char sig[8] = {};
   if (!in.read(reinterpret_cast<char*>(sig), 8) || sig[0] != 0x89 || sig[1] != 'P' || sig[2] != 'N' || sig[3] != 'G') return;
-  std::error_code ec;
-  const std::uint64_t size = std::filesystem::file_size(path, ec);
   for (std::uint64_t at = 8; !ec && at < size;) {
     unsigned char head[8] = {};
     in.seekg(static_cast<std::streamoff>(at));

@@ -57,7 +57,13 @@ void check_folder_writable(const std::filesystem::path& folder) {
   // access(W_OK) says yes to root everywhere, /proc included: only creating a file there tells.
   const std::filesystem::path probe = folder / (".projbot-probe-" + std::to_string(::getpid()));
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) throw OutputError("the folder " + folder.string() + " is not writable (" + reason(errno) + ")");
+  if (fd < 0) {
+    // /proc and /sys answer "No such file or directory" for a new name in a folder that exists.
+    const int err = errno;
+    std::error_code ec;
+    const std::string why = err == ENOENT && std::filesystem::is_directory(folder, ec) ? "it takes no new files" : reason(err);
+    throw OutputError("the folder " + folder.string() + " is not writable (" + why + ")");
+  }
   ::close(fd);
   ::unlink(probe.c_str());
 }
