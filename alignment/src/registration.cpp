@@ -556,7 +556,8 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
       }
   }
   // Global re-initialisation: in `full` after the local attempts failed (as many points as the region
-  // holds); as a stage of its own, bounded by max_global_points.
+  // holds on the coarse grid, up to about max_scan_points); as a stage of its own, bounded by
+  // max_global_points.
   const bool global = m.cfg.reinitialise && ((stage == SearchStage::full && !best.converged) ||
                                              stage == SearchStage::global_near || stage == SearchStage::global_wide);
   if (global) {

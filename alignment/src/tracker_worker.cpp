@@ -105,9 +105,8 @@ AlignmentResult TargetFollower::recropped(const DepthImage& frame, const Alignme
   return again.converged || !r.converged ? again : r;
 }
 
-AlignmentResult TargetFollower::align_near(const DepthImage& frame, const Eigen::Matrix4d& guess,
+AlignmentResult TargetFollower::align_near(const DepthImage& frame, const PointCloud& near, const Eigen::Matrix4d& guess,
                                            const std::optional<Plane>& floor, double grow_m, SearchStage stage) const {
-  const PointCloud near = depth_to_cloud(near_guess(frame, guess, floor, grow_m), k_);
   if (!(grow_m > cfg_.recrop_m)) return aligner_.align(near, guess, stage);
   // ICP from the guess and the refine on the tighter crop first: the restarts and the global search
   // of `stage` only when that fails.
@@ -123,7 +122,8 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const Eigen:
 
 AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Plane& floor,
                                         double grow_m) const {
-  AlignmentResult r = align_near(frame, guess, floor, grow_m, SearchStage::full);
+  AlignmentResult r =
+      align_near(frame, depth_to_cloud(near_guess(frame, guess, floor, grow_m), k_), guess, floor, grow_m, SearchStage::full);
   if (!r.converged) return r;
   for (int i = 0; i < 3; ++i) {  // the polish: projective association, which a touching neighbour pulls less
     const TrackResult t = tracker_.track(frame, r.T_scan_model);
@@ -137,15 +137,10 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   // Acquisition from a guess looks near it: only at what lies inside its silhouette, grown by its
   // uncertainty (a wall behind, a neighbour beside drop out). Global stages search wider on purpose, and
   // a refine after dropped frames starts from a pose the target may have left by more than that.
-  if (stage == SearchStage::local) {
-    if (depth_to_cloud(near_guess(frame, from, floor_, silhouette_grow_m_), k_).finite_count() < aligner_.config().min_points)
-      return std::nullopt;
-    last_attempt_ = align_near(frame, from, floor_, silhouette_grow_m_, stage);
-    return last_attempt_;
-  }
-  const PointCloud scan = depth_to_cloud(near_guess(frame, from, floor_, std::nullopt), k_);
+  const auto grow_m = stage == SearchStage::local ? std::optional<double>(silhouette_grow_m_) : std::nullopt;
+  const PointCloud scan = depth_to_cloud(near_guess(frame, from, floor_, grow_m), k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
-  last_attempt_ = aligner_.align(scan, from, stage);
+  last_attempt_ = grow_m ? align_near(frame, scan, from, floor_, *grow_m, stage) : aligner_.align(scan, from, stage);
   return last_attempt_;
 }
 

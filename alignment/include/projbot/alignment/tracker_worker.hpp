@@ -124,10 +124,11 @@ class TargetFollower {
   double silhouette_grow_m() const { return silhouette_grow_m_; }
 
  private:
-  /// ICP on the depth near `guess` (near_guess, grown by grow_m), refined on the depth near its
-  /// estimate (recropped); when that fails the gate, the same with `stage`'s restarts and global search.
-  AlignmentResult align_near(const DepthImage& frame, const Eigen::Matrix4d& guess, const std::optional<Plane>& floor,
-                             double grow_m, SearchStage stage) const;
+  /// ICP on `near` (the frame's depth near `guess`: near_guess, grown by grow_m), refined on the depth
+  /// near its estimate (recropped); when that fails the gate, the same with `stage`'s restarts and
+  /// global search.
+  AlignmentResult align_near(const DepthImage& frame, const PointCloud& near, const Eigen::Matrix4d& guess,
+                             const std::optional<Plane>& floor, double grow_m, SearchStage stage) const;
   /// r refined by ICP (`stage`: refine or icp_only) on the depth near its estimate, grown by recrop_m;
   /// r itself when only it passes the gate.
   AlignmentResult recropped(const DepthImage& frame, const AlignmentResult& r, const std::optional<Plane>& floor,
