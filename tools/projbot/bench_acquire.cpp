@@ -105,8 +105,9 @@ const Command kBenchAcquire{
     "(Kinect v1 noise, a seed each) are acquired from the true pose moved by CM and turned by DEG in random\n"
     "directions, and N more from a gross guess (30 cm, 40 degrees), where the target must be re-found or\n"
     "blanked. Ours: the floor left out, the scan cropped to the guess's silhouette grown by how far its\n"
-    "error reaches, ICP with restarts and global re-initialisation, the quality gate and the free-space\n"
-    "check. PCL's pipeline: crop around the guess, normals, point-to-plane ICP, lit whenever it converges.\n"
+    "error reaches, ICP, refined on the scan cropped again at its estimate (3 cm), restarts and global\n"
+    "re-initialisation when that fails, the quality gate and the free-space check. PCL's pipeline: crop around the guess, "
+    "normals, point-to-plane ICP, lit whenever it converges.\n"
     "Success: lit within 3 mm and 0.5 degrees of the truth; false accept: lit more than 10 mm off; false\n"
     "blank: blanked within 3 mm and 0.5 degrees.\n"
     "Without --scene, assets/scenes/shop.yaml runs. Ctrl-C prints the rows finished.\n",
