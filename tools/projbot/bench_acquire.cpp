@@ -106,8 +106,8 @@ const Command kBenchAcquire{
     "directions, and N more from a gross guess (30 cm, 40 degrees), where the target must be re-found or\n"
     "blanked. Ours: the floor left out, the scan cropped to the guess's silhouette grown by how far its\n"
     "error reaches, ICP, refined on the scan cropped again at its estimate (3 cm), restarts and global\n"
-    "re-initialisation when that fails, the quality gate and the free-space check. PCL's pipeline: crop around the guess, "
-    "normals, point-to-plane ICP, lit whenever it converges.\n"
+    "re-initialisation when that fails, the quality gate and the free-space check. PCL's pipeline: crop\n"
+    "around the guess, normals, point-to-plane ICP, lit whenever it converges.\n"
     "Success: lit within 3 mm and 0.5 degrees of the truth; false accept: lit more than 10 mm off; false\n"
     "blank: blanked within 3 mm and 0.5 degrees.\n"
     "Without --scene, assets/scenes/shop.yaml runs. Ctrl-C prints the rows finished.\n",
