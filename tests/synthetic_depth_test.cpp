@@ -130,6 +130,59 @@ TEST_F(SyntheticDepthTest, ABigScanIsThinnedToTheCapAndStaysAccurate) {
   EXPECT_LT(rotation_angle_deg(err), 0.3);
 }
 
+TEST_F(SyntheticDepthTest, AFootingFromTheMapHoldsThePoseUprightAtItsHeight) {
+  // A camera 1.1 m up, looking along the world's y and 20 degrees down, at the duck standing at 0.8 m
+  // (a table's height). The footing is where the map says it stands: upright, its lowest point 0.8 m
+  // up. A pose lifted 3 cm or tipped fails it; a guess tipped 35 degrees and 4 cm too high is stood
+  // upright at the surveyed height before ICP and found.
+  const double s = std::sin(20.0 * M_PI / 180.0), c = std::cos(20.0 * M_PI / 180.0);
+  Eigen::Matrix4d T_world_camera = Eigen::Matrix4d::Identity();
+  T_world_camera.topLeftCorner<3, 3>().col(0) = Eigen::Vector3d(1, 0, 0);
+  T_world_camera.topLeftCorner<3, 3>().col(1) = Eigen::Vector3d(0, -s, -c);
+  T_world_camera.topLeftCorner<3, 3>().col(2) = Eigen::Vector3d(0, c, -s);
+  T_world_camera.topRightCorner<3, 1>() = Eigen::Vector3d(0.0, 0.0, 1.1);
+  Eigen::Matrix4d T_world_target = projbot::config::pose_from_xyz_rpy({0.05, 1.4, 0.0}, {90, 0, 30});
+  double lowest = 1e9;
+  for (const auto& p : model_->points) lowest = std::min(lowest, (T_world_target.topLeftCorner<3, 3>() * p.cast<double>()).z());
+  T_world_target(2, 3) = 0.8 - lowest;
+  const Footing footing = footing_in_camera(*model_, T_world_target, T_world_camera);
+  EXPECT_NEAR(footing.height_m, 0.8, 1e-9);
+  EXPECT_NEAR(footing.floor.d, 1.1, 1e-9);  // the camera is 1.1 m above the floor
+  EXPECT_NEAR(footing.floor.normal.dot(Eigen::Vector3d(0, -c, -s)), 1.0, 1e-9);
+  const Eigen::Matrix4d T = rigid_inverse(T_world_camera) * T_world_target;
+  const PointCloud scan = depth_to_cloud(render(T), k_);
+  const Aligner aligner(*model_);
+  const AlignmentResult truth = aligner.score(scan, T, footing);
+  EXPECT_TRUE(truth.converged && truth.stands);
+  EXPECT_NEAR(truth.footing_height_error_mm, 0.0, 0.5);
+  EXPECT_LT(truth.footing_tilt_deg, 0.01);
+  const auto moved = [&](const Eigen::Matrix4d& T_world_delta) {
+    return Eigen::Matrix4d(rigid_inverse(T_world_camera) * T_world_delta * T_world_target);
+  };
+  const AlignmentResult lifted = aligner.score(scan, moved(projbot::config::pose_from_xyz_rpy({0, 0, 0.03}, {0, 0, 0})), footing);
+  EXPECT_FALSE(lifted.stands || lifted.converged);
+  EXPECT_NEAR(lifted.footing_height_error_mm, 30.0, 0.5);
+  Eigen::Matrix4d tipped = Eigen::Matrix4d::Identity();  // 120 degrees about the world's x through the duck
+  tipped.topLeftCorner<3, 3>() = Eigen::AngleAxisd(120.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Vector3d middle = T_world_target.topRightCorner<3, 1>();
+  tipped.topRightCorner<3, 1>() = middle - tipped.topLeftCorner<3, 3>() * middle + Eigen::Vector3d(0.0, 0.0, 0.04);
+  const AlignmentResult tipped_score = aligner.score(scan, moved(tipped), footing);
+  EXPECT_NEAR(tipped_score.footing_tilt_deg, 120.0, 0.01);
+  EXPECT_FALSE(tipped_score.stands);
+  AcquisitionConfig one_icp;  // ICP from the guess alone: no restarts, no global search
+  one_icp.reinitialise = false;
+  one_icp.restart_angle_deg = 0.0;
+  const Aligner icp_only(*model_, one_icp);
+  const AlignmentResult r = icp_only.align(scan, moved(tipped), SearchStage::full, footing);
+  EXPECT_TRUE(r.converged && r.stands);
+  const Eigen::Matrix4d err = rigid_inverse(T) * r.T_scan_model;
+  EXPECT_LT(translation_norm_m(err), 0.002);
+  EXPECT_LT(rotation_angle_deg(err), 0.5);
+  const AlignmentResult without = icp_only.align(scan, moved(tipped), SearchStage::full);
+  EXPECT_GT(rotation_angle_deg(rigid_inverse(T) * without.T_scan_model), 30.0);  // ICP alone cannot turn it back
+  EXPECT_THROW(footing_in_camera(ModelCloud{}, T_world_target, T_world_camera), AlignmentError);
+}
+
 TEST_F(SyntheticDepthTest, AccurateWithoutNoise) {
   Aligner aligner(*model_);
   std::mt19937 rng(1);

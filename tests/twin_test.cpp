@@ -550,10 +550,11 @@ TEST(TourTest, TheShopFigureIsFoundFromATenDegreeGuessBesideItsShelf) {
   const Eigen::Matrix4d guess = turn * T_true;
   const auto& cloud = twin.targets()[figure].cloud;
   const double grow_m = projbot::alignment::guess_reach_m(cloud, 0.05, 10.0);
-  const auto floor = projbot::alignment::floor_in_camera(arrival.believed.T_world_camera.matrix());
+  const auto footing =
+      projbot::alignment::footing_in_camera(cloud, arrival.T_map_target, arrival.believed.T_world_camera.matrix());
   const auto error = [&](const Eigen::Matrix4d& T) { return rigid_inverse(T_true) * T; };
   const projbot::alignment::TargetFollower follower(cloud, twin.camera());
-  const auto r = follower.acquire(depth, guess, floor, grow_m);
+  const auto r = follower.acquire(depth, guess, footing, grow_m);
   EXPECT_TRUE(r.converged) << "inliers " << r.inlier_ratio;
   EXPECT_TRUE(follower.passes(follower.verify(depth, r.T_scan_model)));
   EXPECT_LT(projbot::alignment::translation_norm_m(error(r.T_scan_model)), 0.003);
@@ -561,7 +562,7 @@ TEST(TourTest, TheShopFigureIsFoundFromATenDegreeGuessBesideItsShelf) {
   // Without the second crop (recrop_m as wide as the first), the same guess is not found.
   projbot::alignment::WorkerConfig once;
   once.recrop_m = 10.0;
-  const auto r1 = projbot::alignment::TargetFollower(cloud, twin.camera(), once).acquire(depth, guess, floor, grow_m);
+  const auto r1 = projbot::alignment::TargetFollower(cloud, twin.camera(), once).acquire(depth, guess, footing, grow_m);
   EXPECT_TRUE(!r1.converged || projbot::alignment::translation_norm_m(error(r1.T_scan_model)) > 0.005)
       << "found without the second crop: " << 1000.0 * projbot::alignment::translation_norm_m(error(r1.T_scan_model)) << " mm";
 }

@@ -328,6 +328,46 @@ struct Aligner::Impl {
     return r.inlier_ratio >= cfg.min_inlier_ratio && r.rmse_mm <= cfg.max_rmse_mm * r.tolerance_scale;
   }
 
+  // The model's lowest point (over all its samples, as footing_in_camera measures it) above the
+  // footing's floor under T.
+  double lowest(const Footing& footing, const Eigen::Matrix4d& T) const {
+    const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+    const Eigen::Vector3d t = T.topRightCorner<3, 1>();
+    double h = std::numeric_limits<double>::infinity();
+    for (const auto& p : *model) h = std::min(h, footing.floor.height_of(R * p.getVector3fMap().cast<double>() + t));
+    return h;
+  }
+
+  // T stood on its footing: turned about the model's centre (the least turn) until upright, then moved
+  // along the floor's normal to the surveyed height. What remains for ICP is where on the floor and
+  // which way round: a gross guess tilted 40 degrees loses most of its error here.
+  Eigen::Matrix4d stood(const Footing& footing, const Eigen::Matrix4d& T) const {
+    const Eigen::Vector3d up = (T.topLeftCorner<3, 3>() * footing.up_model).normalized();
+    const Eigen::Vector3d c = extent.centre_in(T);
+    Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
+    // (Eigen's Quaternion::FromTwoVectors would do; its SVD trips GCC 12's use-after-free warning here.)
+    const Eigen::Vector3d axis = up.cross(footing.floor.normal);
+    const double angle = std::atan2(axis.norm(), up.dot(footing.floor.normal));
+    const Eigen::Vector3d about = axis.norm() > 1e-9 ? axis.normalized() : up.unitOrthogonal();
+    turn.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle, about).toRotationMatrix();
+    turn.topRightCorner<3, 1>() = c - turn.topLeftCorner<3, 3>() * c;
+    Eigen::Matrix4d out = turn * T;
+    out.topRightCorner<3, 1>() += footing.floor.normal * (footing.height_m - lowest(footing, out));
+    return out;
+  }
+
+  // Whether the model under r.T_scan_model stands as `footing` says: its lowest point at the surveyed
+  // height, upright. Fills r's footing numbers.
+  bool stands(const Footing& footing, AlignmentResult& r) const {
+    const double h = lowest(footing, r.T_scan_model);
+    const Eigen::Vector3d up = r.T_scan_model.topLeftCorner<3, 3>() * footing.up_model;
+    const double cosine = std::clamp(up.normalized().dot(footing.floor.normal), -1.0, 1.0);
+    r.footing_height_error_mm = 1000.0 * (h - footing.height_m);
+    r.footing_tilt_deg = std::acos(cosine) * 180.0 / M_PI;
+    r.stands = std::abs(h - footing.height_m) <= cfg.footing_height_m && r.footing_tilt_deg <= cfg.footing_tilt_deg;
+    return r.stands;
+  }
+
   // The scan within `margin` of the model's sphere under T_init, on the coarse grid, thinned by a coarser
   // grid until at most max_global_points remain: what a bounded global search works on.
   pcl::PointCloud<pcl::PointXYZ>::Ptr global_points(const PointCloud& scan, const Eigen::Matrix4d& T_init, double margin,
@@ -489,12 +529,26 @@ Aligner::Aligner(Aligner&&) noexcept = default;
 Aligner& Aligner::operator=(Aligner&&) noexcept = default;
 const AcquisitionConfig& Aligner::config() const { return impl_->cfg; }
 
-AlignmentResult Aligner::score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const {
+AlignmentResult Aligner::score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model,
+                               const std::optional<Footing>& footing) const {
   AlignmentResult r;
   r.T_scan_model = T_scan_model;
   impl_->evaluate(*impl_->near_scan(scan, T_scan_model, impl_->gate_margin()), T_scan_model, r);
-  r.converged = impl_->passes(r);
+  const bool stands = !footing || impl_->stands(*footing, r);  // its numbers are wanted whether the gate passes or not
+  r.converged = impl_->passes(r) && stands;
   return r;
+}
+
+Footing footing_in_camera(const ModelCloud& model, const Eigen::Matrix4d& T_world_target, const Eigen::Matrix4d& T_world_camera) {
+  if (model.points.empty()) throw AlignmentError("the model has no points to find its lowest point from");
+  if (!T_world_target.allFinite() || !T_world_camera.allFinite()) throw AlignmentError("the surveyed pose is not finite");
+  Footing f;
+  f.floor = floor_in_camera(T_world_camera);
+  const Eigen::Matrix3d R = T_world_target.topLeftCorner<3, 3>();
+  f.up_model = R.transpose() * Eigen::Vector3d::UnitZ();
+  f.height_m = std::numeric_limits<double>::infinity();
+  for (const auto& p : model.points) f.height_m = std::min(f.height_m, (R * p.cast<double>()).z() + T_world_target(2, 3));
+  return f;
 }
 
 int Aligner::model_feature_computations() const { return impl_->feature_computations; }
@@ -510,7 +564,8 @@ bool better_than(const AlignmentResult& r, const AlignmentResult& best) {
 
 }  // namespace
 
-AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage) const {
+AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage,
+                               const std::optional<Footing>& footing) const {
   const auto t0 = std::chrono::steady_clock::now();
   const Impl& m = *impl_;
   if (!T_init.allFinite()) throw AlignmentError("initial guess is not finite");
@@ -528,13 +583,15 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   best.T_scan_model = T_init;
   best.inlier_ratio = 0.0;
   best.rmse_mm = std::numeric_limits<double>::infinity();
+  // With a footing every start is stood on it first: ICP then has only its place and heading to find.
   const auto attempt = [&](const Eigen::Matrix4d& start, bool reinitialised) {
     AlignmentResult r;
     bool icp_converged = false;
-    r.T_scan_model = m.icp(scan, start, best.iterations, icp_converged, out_of_time);
+    r.T_scan_model = m.icp(scan, footing ? m.stood(*footing, start) : start, best.iterations, icp_converged, out_of_time);
     r.reinitialised = reinitialised;
     m.evaluate(*m.near_scan(scan, r.T_scan_model, m.gate_margin()), r.T_scan_model, r);
-    r.converged = icp_converged && m.passes(r);
+    const bool stands = !footing || m.stands(*footing, r);
+    r.converged = icp_converged && m.passes(r) && stands;
     r.iterations = best.iterations;
     if (better_than(r, best)) best = r;
   };
@@ -542,18 +599,24 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
       stage == SearchStage::full || stage == SearchStage::refine || stage == SearchStage::icp_only || stage == SearchStage::local;
   if (local) attempt(T_init, false);
   if (!best.converged && m.cfg.restart_angle_deg > 0.0 && (stage == SearchStage::full || stage == SearchStage::local)) {
-    // Local restarts: the guess turned about the target's centre, which ICP alone cannot leave.
+    // Local restarts: the guess turned about the target's centre, which ICP alone cannot leave; about
+    // each camera axis, or with a footing (upright is known) about the floor's normal by one and two steps.
     const Eigen::Vector3d c = m.extent.centre_in(T_init);
-    for (int axis = 0; axis < 3 && !best.converged && !out_of_time(); ++axis)
-      for (const double sign : {1.0, -1.0}) {
-        if (out_of_time()) break;
-        Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
-        turn.topLeftCorner<3, 3>() =
-            Eigen::AngleAxisd(sign * m.cfg.restart_angle_deg * M_PI / 180.0, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
-        turn.topRightCorner<3, 1>() = c - turn.topLeftCorner<3, 3>() * c;
-        attempt(turn * T_init, false);
-        if (best.converged) break;
-      }
+    std::vector<Eigen::AngleAxisd> turns;
+    const double step = m.cfg.restart_angle_deg * M_PI / 180.0;
+    for (int i = 0; i < 3; ++i)
+      for (const double sign : {1.0, -1.0})
+        if (!footing)
+          turns.emplace_back(sign * step, Eigen::Vector3d::Unit(i));
+        else if (i < 2)
+          turns.emplace_back(sign * step * (i + 1), footing->floor.normal);
+    for (const auto& axis_angle : turns) {
+      if (best.converged || out_of_time()) break;
+      Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
+      turn.topLeftCorner<3, 3>() = axis_angle.toRotationMatrix();
+      turn.topRightCorner<3, 1>() = c - turn.topLeftCorner<3, 3>() * c;
+      attempt(turn * T_init, false);
+    }
   }
   // Global re-initialisation: in `full` after the local attempts failed (as many points as the region
   // holds on the coarse grid, up to about max_scan_points); as a stage of its own, bounded by

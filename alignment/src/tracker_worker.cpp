@@ -39,9 +39,14 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
       filter_(cfg_.motion),
       silhouette_grow_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)) {}
 
+void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing) {
+  set_initial_guess(T_camera_target, footing.floor);
+  known_.footing = footing;
+}
+
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor) {
   guess_ = T_camera_target;
-  floor_ = floor;
+  known_ = Known{floor, std::nullopt};
   have_guess_ = true;
   pose_.reset();
   rejected_ = 0;
@@ -82,48 +87,49 @@ std::optional<PoseSample> TargetFollower::step(const DepthImage& frame) {
   return pose_ ? track(frame) : search(frame);
 }
 
-DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matrix4d& from, const std::optional<Plane>& floor,
+DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matrix4d& from, const Known& known,
                                       std::optional<double> grow_m) const {
   // The floor is known (map and camera pose): left out, so a figure standing on it is aligned to and
   // judged on its own points.
-  DepthImage known = floor ? without_plane(frame, k_, *floor, cfg_.floor_margin_m) : frame;
-  if (grow_m) known = crop_to_silhouette(known, k_, model_, from, *grow_m);
-  return known;
+  DepthImage left = known.floor ? without_plane(frame, k_, *known.floor, cfg_.floor_margin_m) : frame;
+  if (grow_m) left = crop_to_silhouette(left, k_, model_, from, *grow_m);
+  return left;
 }
 
-AlignmentResult TargetFollower::recropped(const DepthImage& frame, const AlignmentResult& r, const std::optional<Plane>& floor,
+AlignmentResult TargetFollower::recropped(const DepthImage& frame, const AlignmentResult& r, const Known& known,
                                           SearchStage stage) const {
   // The guess's crop, grown by all of its uncertainty, takes in what stands beside the target (the
   // shop's shelf beside the figure's hand), and that pulls ICP: from 10-degree guesses the figure
   // settled 11-19 mm sideways and failed the gate. Cropped again at the estimate, grown only by
   // recrop_m, most of it is left out, and ICP from the estimate settles on the target's own points.
-  const PointCloud tight = depth_to_cloud(near_guess(frame, r.T_scan_model, floor, cfg_.recrop_m), k_);
+  const PointCloud tight = depth_to_cloud(near_guess(frame, r.T_scan_model, known, cfg_.recrop_m), k_);
   if (tight.finite_count() < aligner_.config().min_points) return r;
-  AlignmentResult again = aligner_.align(tight, r.T_scan_model, stage);
+  AlignmentResult again = aligner_.align(tight, r.T_scan_model, stage, known.footing);
   again.iterations += r.iterations;
   again.time_ms += r.time_ms;
   return again.converged || !r.converged ? again : r;
 }
 
 AlignmentResult TargetFollower::align_near(const DepthImage& frame, const PointCloud& near, const Eigen::Matrix4d& guess,
-                                           const std::optional<Plane>& floor, double grow_m, SearchStage stage) const {
-  if (!(grow_m > cfg_.recrop_m)) return aligner_.align(near, guess, stage);
+                                           const Known& known, double grow_m, SearchStage stage) const {
+  if (!(grow_m > cfg_.recrop_m)) return aligner_.align(near, guess, stage, known.footing);
   // ICP from the guess and the refine on the tighter crop first: the restarts and the global search
   // of `stage` only when that fails.
   // (Bounded when `stage` is: a tracking-mode search runs one attempt per frame.)
   const SearchStage first = stage == SearchStage::full ? SearchStage::icp_only : SearchStage::refine;
-  AlignmentResult r = recropped(frame, aligner_.align(near, guess, first), floor, first);
+  AlignmentResult r = recropped(frame, aligner_.align(near, guess, first, known.footing), known, first);
   if (r.converged || stage == SearchStage::refine || stage == SearchStage::icp_only) return r;
-  AlignmentResult wider = recropped(frame, aligner_.align(near, guess, stage), floor, first);
+  AlignmentResult wider = recropped(frame, aligner_.align(near, guess, stage, known.footing), known, first);
   wider.iterations += r.iterations;
   wider.time_ms += r.time_ms;
   return wider;
 }
 
-AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Plane& floor,
+AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing,
                                         double grow_m) const {
+  const Known known{footing.floor, footing};
   AlignmentResult r =
-      align_near(frame, depth_to_cloud(near_guess(frame, guess, floor, grow_m), k_), guess, floor, grow_m, SearchStage::full);
+      align_near(frame, depth_to_cloud(near_guess(frame, guess, known, grow_m), k_), guess, known, grow_m, SearchStage::full);
   if (!r.converged) return r;
   for (int i = 0; i < 3; ++i) {  // the polish: projective association, which a touching neighbour pulls less
     const TrackResult t = tracker_.track(frame, r.T_scan_model);
@@ -138,9 +144,10 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   // uncertainty (a wall behind, a neighbour beside drop out). Global stages search wider on purpose, and
   // a refine after dropped frames starts from a pose the target may have left by more than that.
   const auto grow_m = stage == SearchStage::local ? std::optional<double>(silhouette_grow_m_) : std::nullopt;
-  const PointCloud scan = depth_to_cloud(near_guess(frame, from, floor_, grow_m), k_);
+  const PointCloud scan = depth_to_cloud(near_guess(frame, from, known_, grow_m), k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
-  last_attempt_ = grow_m ? align_near(frame, scan, from, floor_, *grow_m, stage) : aligner_.align(scan, from, stage);
+  last_attempt_ =
+      grow_m ? align_near(frame, scan, from, known_, *grow_m, stage) : aligner_.align(scan, from, stage, known_.footing);
   return last_attempt_;
 }
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
@@ -23,6 +24,20 @@ ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t sampl
 
 /// Model points from a loaded (scaled, recentred) model: area-uniform surface samples, reproducible.
 ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples = 50000);
+
+/// How the map says a target stands, in a camera's frame: upright on the floor or on a support, its
+/// model's `up_model` axis along the floor's normal and its lowest point height_m above the floor (0 for a
+/// figure on the floor). From the surveyed pose (footing_in_camera), not from Eq. 1's guess: the guess
+/// carries the localisation's error, the height of a table does not.
+struct Footing {
+  Plane floor;
+  Eigen::Vector3d up_model = Eigen::Vector3d::UnitZ();
+  double height_m = 0.0;
+};
+
+/// The footing of `model` surveyed at T_world_target, seen by a camera at T_world_camera (the floor is
+/// z = 0 in the world). Throws AlignmentError for an empty model or a non-finite pose.
+Footing footing_in_camera(const ModelCloud& model, const Eigen::Matrix4d& T_world_target, const Eigen::Matrix4d& T_world_camera);
 
 /// Defaults suit a Kinect-class camera 0.5-3 m from a 10-50 cm object.
 struct AcquisitionConfig {
@@ -73,6 +88,13 @@ struct AcquisitionConfig {
   /// already running finishes, so an attempt ends within about this plus one ICP (about 0.5 s here).
   double attempt_budget_ms = 500.0;
   std::size_t min_points = 30;  ///< fewer valid scan points than this is an error
+  /// With a Footing, an estimate passes only if the target stands as surveyed: its lowest point within
+  /// this of the surveyed height, and its up axis within footing_tilt_deg of the floor's normal. A box
+  /// seen face-on slid 3.3 cm up its own face, or fitted into the front edge of its table 30 cm lower,
+  /// or turned 90 degrees about a horizontal axis onto another face (a cube's symmetry), explains the
+  /// depth as well as the truth (bench acquire, gross guesses); none of them stands as surveyed.
+  double footing_height_m = 0.02;
+  double footing_tilt_deg = 5.0;
 };
 
 /// One estimate with the numbers the quality gate judged it by.
@@ -86,6 +108,11 @@ struct AlignmentResult {
   double time_ms = 0.0;          ///< wall time of align()
   bool reinitialised = false;    ///< the global re-initialisation produced this result
   std::size_t scan_points = 0;   ///< scan points after cropping and filtering
+  /// With a Footing: how far the estimate's lowest point is from the surveyed height (mm, signed: up is
+  /// positive) and how far its up axis is tilted from the floor's normal (degrees); both 0 without one.
+  double footing_height_error_mm = 0.0;
+  double footing_tilt_deg = 0.0;
+  bool stands = true;  ///< within the footing's tolerances (or no footing given); `converged` includes it
 };
 
 /// Which part of the acquisition align() runs. `full` is one acquisition as `projbot align` and the
@@ -107,12 +134,16 @@ class Aligner {
   Aligner(Aligner&&) noexcept;
   Aligner& operator=(Aligner&&) noexcept;
 
-  /// Refines T_init (model -> scan frame) against the scan. Throws AlignmentError when the scan has
-  /// fewer than min_points valid points (after cropping) or T_init is not finite.
-  AlignmentResult align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage = SearchStage::full) const;
+  /// Refines T_init (model -> scan frame) against the scan. With `footing` (in the scan's frame), only
+  /// an estimate that stands as surveyed passes, and restarts go on past one that does not. Throws
+  /// AlignmentError when the scan has fewer than min_points valid points (after cropping) or T_init is
+  /// not finite.
+  AlignmentResult align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage = SearchStage::full,
+                        const std::optional<Footing>& footing = std::nullopt) const;
 
   /// The quality-gate numbers of a given pose, without refining it (converged: the gate passes).
-  AlignmentResult score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model) const;
+  AlignmentResult score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model,
+                        const std::optional<Footing>& footing = std::nullopt) const;
 
   const AcquisitionConfig& config() const;
   /// How often the model's FPFH features were computed: once per Aligner, at its first global search.

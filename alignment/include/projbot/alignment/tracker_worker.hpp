@@ -94,6 +94,10 @@ class TargetFollower {
   /// A new stop: the next frame acquires from this guess (Eq. 1). With `floor` (from the map and the
   /// camera's pose), acquisition leaves out what lies on it (floor_margin_m).
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor = std::nullopt);
+  /// ...and with the target's surveyed footing (its floor left out as above), acquisition accepts only
+  /// poses that stand as surveyed (AcquisitionConfig::footing_height_m, footing_tilt_deg). Tracking is
+  /// not held to it: a target carried, lifted or tipped is followed, only not re-found so.
+  void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing);
   /// The target was already acquired at T_camera_target: the next frame tracks from there.
   void set_pose(const Eigen::Matrix4d& T_camera_target);
   /// One frame: the sample to publish (sequence left 0), or nothing when there is no guess yet, the
@@ -113,26 +117,29 @@ class TargetFollower {
   const Aligner& aligner() const { return aligner_; }
   const MotionFilter& motion() const { return filter_; }
   /// One whole acquisition (SearchStage::full) from `guess`, as the tour's localized mode runs it: the
-  /// floor left out, the depth cropped to the guess's silhouette grown by grow_m (silhouette_grow_m():
-  /// how far the configured uncertainty reaches), then refined on the depth cropped again at the
+  /// footing's floor left out, only poses that stand as it says accepted, the depth cropped to the guess's silhouette grown by
+  /// grow_m (silhouette_grow_m(): how far the configured uncertainty reaches), then refined on the depth cropped again at the
   /// estimate (recrop_m). A converged pose is then polished by up to three
   /// projective tracking passes on the whole frame (model points against the pixels they fall on: a
   /// neighbour touching the target pulls less than in ICP's nearest neighbours; the shop's figure, its
   /// hand at a shelf, went from 2.7-3.6 mm to about 1 mm). The ICP's inlier ratio and rmse are of the
   /// pose before the polish. Throws AlignmentError when too little depth is left.
-  AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Plane& floor, double grow_m) const;
+  AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing, double grow_m) const;
   double silhouette_grow_m() const { return silhouette_grow_m_; }
 
  private:
+  struct Known {  // what the map says at this stop (camera frame)
+    std::optional<Plane> floor;
+    std::optional<Footing> footing;
+  };
   /// ICP on `near` (the frame's depth near `guess`: near_guess, grown by grow_m), refined on the depth
   /// near its estimate (recropped); when that fails the gate, the same with `stage`'s restarts and
   /// global search.
-  AlignmentResult align_near(const DepthImage& frame, const PointCloud& near, const Eigen::Matrix4d& guess,
-                             const std::optional<Plane>& floor, double grow_m, SearchStage stage) const;
+  AlignmentResult align_near(const DepthImage& frame, const PointCloud& near, const Eigen::Matrix4d& guess, const Known& known,
+                             double grow_m, SearchStage stage) const;
   /// r refined by ICP (`stage`: refine or icp_only) on the depth near its estimate, grown by recrop_m;
   /// r itself when only it passes the gate.
-  AlignmentResult recropped(const DepthImage& frame, const AlignmentResult& r, const std::optional<Plane>& floor,
-                            SearchStage stage) const;
+  AlignmentResult recropped(const DepthImage& frame, const AlignmentResult& r, const Known& known, SearchStage stage) const;
   ModelCloud model_;  // for the free-space check
   Aligner aligner_;
   ProjectiveTracker tracker_;
@@ -148,13 +155,13 @@ class TargetFollower {
   SearchStats stats_;
   std::optional<AlignmentResult> last_attempt_;
   FreeSpaceCheck check_;
-  std::optional<Plane> floor_;  // this stop's floor, camera frame
-  MotionFilter filter_;         // fed with every pose found, reset when the target is lost or a stop begins
-  double silhouette_grow_m_;    // how far the guess's configured uncertainty reaches
-  double last_found_s_ = 0.0;   // capture time of the newest pose found
+  Known known_;                // this stop's floor and footing
+  MotionFilter filter_;        // fed with every pose found, reset when the target is lost or a stop begins
+  double silhouette_grow_m_;   // how far the guess's configured uncertainty reaches
+  double last_found_s_ = 0.0;  // capture time of the newest pose found
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
   // The frame without the known floor and, with grow_m, cropped to the silhouette at `from` grown by it.
-  DepthImage near_guess(const DepthImage& frame, const Eigen::Matrix4d& from, const std::optional<Plane>& floor,
+  DepthImage near_guess(const DepthImage& frame, const Eigen::Matrix4d& from, const Known& known,
                         std::optional<double> grow_m) const;
   // The target is at T (tracked, refined or found): the sample to publish.
   PoseSample found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm);
