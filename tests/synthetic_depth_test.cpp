@@ -9,6 +9,7 @@
 #include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/tracker.hpp"
+#include "projbot/alignment/verification.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
 
@@ -181,6 +182,43 @@ TEST_F(SyntheticDepthTest, AFootingFromTheMapHoldsThePoseUprightAtItsHeight) {
   const AlignmentResult without = icp_only.align(scan, moved(tipped), SearchStage::full);
   EXPECT_GT(rotation_angle_deg(rigid_inverse(T) * without.T_scan_model), 30.0);  // ICP alone cannot turn it back
   EXPECT_THROW(footing_in_camera(ModelCloud{}, T_world_target, T_world_camera), AlignmentError);
+}
+
+TEST_F(SyntheticDepthTest, ColourMovesABoxSeenFaceOnAlongItsFace) {
+  // The textured box, 30 cm, 1.6 m away, nearly face-on (turned 8 degrees, tipped 10). Depth and colour
+  // rendered at the truth (colour registered to depth, as a Kinect v1 delivers it). From the truth
+  // moved along its face 3 mm sideways and 2 mm down, the colour search along the face brings it back within 0.6 mm;
+  // a model without colours, or a colour image of another size, leaves the pose as it was.
+  auto box = projbot::assets::load_gltf(fs::path(PROJBOT_SHARED_DATA) / "gltf" / "BoxTextured" / "glTF" / "BoxTextured.gltf");
+  projbot::assets::scale_and_recenter(box, 0.3, true);
+  const std::size_t id = renderer_->add_model(box);
+  const ModelCloud cloud = model_cloud_from(box, 50000);
+  ASSERT_EQ(cloud.colours.size(), cloud.points.size());
+  const Eigen::Matrix4d T = projbot::config::pose_from_xyz_rpy({0.02, 0.05, 1.6}, {-10, 8, 0});
+  const std::vector<projbot::engine::DrawItem> items{{id, T}};
+  renderer_->draw_frame(*camera_, as_pinhole(k_), items);
+  const auto map = camera_->read_back_depth();
+  const DepthImage depth{map.width, map.height, map.z_m, 0.0};
+  const auto colour_target = renderer_->make_offscreen(k_.width_px, k_.height_px);
+  renderer_->draw_frame(*colour_target, as_pinhole(k_), items);
+  const projbot::assets::Image colour = colour_target->read_back();
+  EXPECT_GT(colour_agreement(cloud, T, depth, colour, k_), 0.9);
+  Eigen::Matrix4d off = T;
+  off.topRightCorner<3, 1>() += T.topLeftCorner<3, 3>() * Eigen::Vector3d(0.003, 0.002, 0.0);  // along the face
+  const double agreement_off = colour_agreement(cloud, off, depth, colour, k_);
+  EXPECT_LT(agreement_off, colour_agreement(cloud, T, depth, colour, k_) - 0.05);
+  const ColourRefinement r = colour_refined(cloud, off, depth, colour, k_);
+  EXPECT_NEAR(r.agreement_before, agreement_off, 1e-12);
+  EXPECT_GT(r.agreement_after, r.agreement_before + 0.05);
+  EXPECT_LT((r.T_camera_model.topRightCorner<3, 1>() - T.topRightCorner<3, 1>()).norm(), 0.0006);
+  EXPECT_TRUE((r.T_camera_model.topLeftCorner<3, 3>().isApprox(T.topLeftCorner<3, 3>())));
+  ModelCloud plain = cloud;
+  plain.colours.clear();
+  EXPECT_TRUE(std::isnan(colour_agreement(plain, T, depth, colour, k_)));
+  EXPECT_TRUE(colour_refined(plain, off, depth, colour, k_).T_camera_model.isApprox(off));
+  projbot::assets::Image small = colour;
+  small.width /= 2;
+  EXPECT_TRUE(colour_refined(cloud, off, depth, small, k_).T_camera_model.isApprox(off));
 }
 
 TEST_F(SyntheticDepthTest, AccurateWithoutNoise) {

@@ -472,7 +472,7 @@ Eigen::Matrix4d PclIcpBaseline::track(const PointCloud& scan, const Eigen::Matri
 
 ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
   const auto s = assets::sample_surface(model, samples, 1);
-  return {s.points, s.normals};
+  return {s.points, s.normals, s.colours};
 }
 
 ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t samples) {

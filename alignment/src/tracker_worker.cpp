@@ -126,7 +126,7 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const PointC
 }
 
 AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing,
-                                        double grow_m) const {
+                                        double grow_m, const assets::Image* colour) const {
   const Known known{footing.floor, footing};
   AlignmentResult r =
       align_near(frame, depth_to_cloud(near_guess(frame, guess, known, grow_m), k_), guess, known, grow_m, SearchStage::full);
@@ -135,6 +135,12 @@ AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Ma
     const TrackResult t = tracker_.track(frame, r.T_scan_model);
     if (!t.accepted) break;
     r.T_scan_model = t.T_camera_target;
+  }
+  if (colour) {  // last: the polish is depth alone and would not keep what colour fixed along the face
+    const ColourRefinement c = colour_refined(model_, r.T_scan_model, frame, *colour, k_);
+    r.T_scan_model = c.T_camera_model;
+    r.colour_shift_mm = 1000.0 * c.shift_m.norm();
+    r.colour_agreement = c.agreement_after;
   }
   return r;
 }

@@ -146,11 +146,122 @@ ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d&
   const double largest = std::max(eig.eigenvalues()(5), 1e-12);
   for (int i = 0; i < 6; ++i) {
     c.strength[static_cast<std::size_t>(i)] = eig.eigenvalues()(i) / largest;
-    if (c.strength[static_cast<std::size_t>(i)] >= ViewConstraints::kWeak) continue;
     const Eigen::Matrix<double, 6, 1> d = eig.eigenvectors().col(i);
-    c.weak.push_back({d.head<3>(), d.tail<3>(), c.strength[static_cast<std::size_t>(i)]});
+    c.all.push_back({d.head<3>(), d.tail<3>(), c.strength[static_cast<std::size_t>(i)]});
+    if (c.strength[static_cast<std::size_t>(i)] < ViewConstraints::kWeak) c.weak.push_back(c.all.back());
   }
   return c;
+}
+
+namespace {
+
+// The samples colour_agreement compares: camera-frame points and their luminance, seen at a pose.
+struct ColourSamples {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> luminance;
+};
+
+double luminance(double r, double g, double b) { return 0.299 * r + 0.587 * g + 0.114 * b; }
+
+ColourSamples seen_colours(const ModelCloud& model, const Eigen::Matrix4d& T, const DepthImage& depth,
+                           const assets::Image& colour, const CameraIntrinsics& k) {
+  ColourSamples s;
+  if (model.colours.size() != model.points.size() || !T.allFinite() || depth.width != k.width_px || depth.height != k.height_px ||
+      colour.width != k.width_px || colour.height != k.height_px)
+    return s;
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T.topRightCorner<3, 1>();
+  const auto nearest = nearest_samples(model, T, k);
+  // Measured within 2 cm of the sample: not hidden, and on the same surface.
+  const auto near = [&](int u, int v, float z) {
+    if (u < 0 || v < 0 || u >= depth.width || v >= depth.height) return false;
+    const float measured = depth.at(u, v);
+    return measured > 0.0F && std::abs(measured - z) <= 0.02F;
+  };
+  constexpr int kRim = 2;  // pixels: the image's colour there mixes the target's with what lies behind
+  for (std::size_t pixel = 0; pixel < nearest.size(); ++pixel) {
+    const auto& [z, i] = nearest[pixel];
+    const int u = static_cast<int>(pixel % depth.width), v = static_cast<int>(pixel / depth.width);
+    if (!std::isfinite(z) || !near(u, v, z) || !near(u - kRim, v, z) || !near(u + kRim, v, z) || !near(u, v - kRim, z) ||
+        !near(u, v + kRim, z))
+      continue;
+    const Eigen::Vector3f& c = model.colours[i];
+    s.points.push_back(R * model.points[i].cast<double>() + t);
+    s.luminance.push_back(luminance(c.x(), c.y(), c.z()));
+  }
+  return s;
+}
+
+// The image's luminance (0..1) at a sub-pixel position, bilinear; NaN outside.
+double image_luminance(const assets::Image& im, double x, double y) {
+  if (!(x >= 0.0 && y >= 0.0 && x <= im.width - 1.0 && y <= im.height - 1.0)) return std::nan("");
+  const int x0 = std::min(static_cast<int>(x), im.width - 2), y0 = std::min(static_cast<int>(y), im.height - 2);
+  const double fx = x - x0, fy = y - y0;
+  const auto at = [&](int u, int v) {
+    const std::uint8_t* p = im.pixel(u, v);
+    return luminance(p[0], p[1], p[2]) / 255.0;
+  };
+  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) + fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
+}
+
+// Pearson correlation of the samples' luminance with the image's where they land moved by `shift`.
+double correlation(const ColourSamples& s, const assets::Image& im, const CameraIntrinsics& k, const Eigen::Vector3d& shift) {
+  double n = 0, sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    const Eigen::Vector3d p = s.points[i] + shift;
+    const double b = image_luminance(im, k.fx_px * p.x() / p.z() + k.cx_px, k.fy_px * p.y() / p.z() + k.cy_px);
+    if (!std::isfinite(b)) continue;
+    const double a = s.luminance[i];
+    n += 1, sa += a, sb += b, saa += a * a, sbb += b * b, sab += a * b;
+  }
+  if (n < static_cast<double>(kMinColourSamples)) return std::nan("");
+  const double va = saa - sa * sa / n, vb = sbb - sb * sb / n;
+  if (!(va > 1e-6 * n && vb > 1e-6 * n)) return std::nan("");  // no contrast on one side
+  return (sab - sa * sb / n) / std::sqrt(va * vb);
+}
+
+}  // namespace
+
+double colour_agreement(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
+                        const assets::Image& colour, const CameraIntrinsics& k) {
+  return correlation(seen_colours(model, T_camera_model, depth, colour, k), colour, k, Eigen::Vector3d::Zero());
+}
+
+ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
+                                const assets::Image& colour, const CameraIntrinsics& k, double reach_m, double step_m,
+                                double min_gain) {
+  ColourRefinement out;
+  out.T_camera_model = T_camera_model;
+  const ColourSamples seen = seen_colours(model, T_camera_model, depth, colour, k);
+  out.agreement_before = out.agreement_after = correlation(seen, colour, k, Eigen::Vector3d::Zero());
+  if (!std::isfinite(out.agreement_before) || !(step_m > 0.0) || !(reach_m >= step_m)) return out;
+  // The plane of the two weakest slides (a box face-on: its face's plane), orthonormal.
+  std::vector<Eigen::Vector3d> axes;
+  for (const WeakDirection& d : view_constraints(model, T_camera_model, k).all) {
+    if (axes.size() == 2 || !d.is_slide()) continue;
+    Eigen::Vector3d a = d.translation;
+    for (const auto& b : axes) a -= a.dot(b) * b;
+    if (a.norm() > 0.3) axes.push_back(a.normalized());
+  }
+  if (axes.size() < 2) return out;
+  double best = out.agreement_before;
+  Eigen::Vector3d best_shift = Eigen::Vector3d::Zero();
+  const auto search = [&](const Eigen::Vector3d& centre, double reach, double step) {
+    const int n = static_cast<int>(std::lround(reach / step));
+    for (int i = -n; i <= n; ++i)
+      for (int j = -n; j <= n; ++j) {
+        const Eigen::Vector3d shift = centre + i * step * axes[0] + j * step * axes[1];
+        const double c = correlation(seen, colour, k, shift);
+        if (std::isfinite(c) && c > best) best = c, best_shift = shift;
+      }
+  };
+  search(Eigen::Vector3d::Zero(), reach_m, step_m);
+  search(best_shift, step_m, step_m / 4.0);
+  if (!(best >= out.agreement_before + min_gain)) return out;
+  out.T_camera_model.topRightCorner<3, 1>() += best_shift;
+  out.shift_m = best_shift;
+  out.agreement_after = best;
+  return out;
 }
 
 }  // namespace projbot::alignment

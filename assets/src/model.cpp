@@ -1,5 +1,6 @@
 #include "projbot/assets/model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -8,6 +9,30 @@ namespace projbot::assets {
 namespace {
 
 Eigen::Vector3d pos(const Vertex& v) { return {v.position[0], v.position[1], v.position[2]}; }
+
+// A texture coordinate wrapped into [0, 1] as the sampler says.
+double wrapped(double x, Wrap w) {
+  if (w == Wrap::kClampToEdge) return std::clamp(x, 0.0, 1.0);
+  const double f = x - std::floor(x);
+  if (w == Wrap::kRepeat) return f;
+  return static_cast<long>(std::floor(x)) % 2 == 0 ? f : 1.0 - f;  // mirrored
+}
+
+// The colour a material shows at texture coordinate (u, v) with vertex colour `vc`: texture (nearest
+// texel) x base colour factor x vertex colour, RGB 0..1 as stored (what the unlit renderer draws).
+Eigen::Vector3f surface_colour(const Model& model, int material, double u, double v, const Eigen::Vector3f& vc) {
+  if (model.materials.empty()) return vc;
+  const Material& m = model.materials[static_cast<std::size_t>(std::max(material, 0)) % model.materials.size()];
+  Eigen::Vector3f c(m.base_color_factor[0], m.base_color_factor[1], m.base_color_factor[2]);
+  c = c.cwiseProduct(vc);
+  if (m.base_color_image < 0 || static_cast<std::size_t>(m.base_color_image) >= model.images.size()) return c;
+  const Image& img = model.images[static_cast<std::size_t>(m.base_color_image)];
+  if (img.width <= 0 || img.height <= 0) return c;
+  const int x = std::min(img.width - 1, static_cast<int>(wrapped(u, m.sampler.wrap_s) * img.width));
+  const int y = std::min(img.height - 1, static_cast<int>(wrapped(v, m.sampler.wrap_t) * img.height));
+  const std::uint8_t* px = img.pixel(x, y);
+  return c.cwiseProduct(Eigen::Vector3f(px[0], px[1], px[2]) / 255.0F);
+}
 
 }  // namespace
 
@@ -55,13 +80,18 @@ void scale_and_recenter(Model& model, double scale, bool recenter) {
 SurfaceSamples sample_surface(const Model& model, std::size_t count, std::uint32_t seed) {
   struct Tri {
     Eigen::Vector3d a, b, c;
+    const Vertex *va, *vb, *vc;
+    int material;
   };
   std::vector<Tri> tris;
   std::vector<double> cumulative;
   double total = 0.0;
   for (const auto& p : model.primitives)
     for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
-      Tri tri{pos(p.vertices[p.indices[t]]), pos(p.vertices[p.indices[t + 1]]), pos(p.vertices[p.indices[t + 2]])};
+      const Vertex& va = p.vertices[p.indices[t]];
+      const Vertex& vb = p.vertices[p.indices[t + 1]];
+      const Vertex& vc = p.vertices[p.indices[t + 2]];
+      Tri tri{pos(va), pos(vb), pos(vc), &va, &vb, &vc, p.material};
       const double area = 0.5 * (tri.b - tri.a).cross(tri.c - tri.a).norm();
       if (!(area > 0.0)) continue;  // degenerate triangles carry no surface
       total += area;
@@ -74,6 +104,7 @@ SurfaceSamples sample_surface(const Model& model, std::size_t count, std::uint32
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   out.points.reserve(count);
   out.normals.reserve(count);
+  out.colours.reserve(count);
   for (std::size_t i = 0; i < count; ++i) {
     const double pick = uni(rng) * total;
     const auto it = std::lower_bound(cumulative.begin(), cumulative.end(), pick);
@@ -87,6 +118,15 @@ SurfaceSamples sample_surface(const Model& model, std::size_t count, std::uint32
     }
     out.points.push_back((t.a + u * (t.b - t.a) + v * (t.c - t.a)).cast<float>());
     out.normals.push_back((t.b - t.a).cross(t.c - t.a).normalized().cast<float>());
+    // The colour at the same barycentric point (no draw from rng: the points stay as they were).
+    const auto mix = [&](const auto& fa, const auto& fb, const auto& fc, std::size_t k) {
+      return fa[k] + u * (fb[k] - fa[k]) + v * (fc[k] - fa[k]);
+    };
+    const Eigen::Vector3f vertex_colour(static_cast<float>(mix(t.va->color, t.vb->color, t.vc->color, 0)),
+                                        static_cast<float>(mix(t.va->color, t.vb->color, t.vc->color, 1)),
+                                        static_cast<float>(mix(t.va->color, t.vb->color, t.vc->color, 2)));
+    out.colours.push_back(surface_colour(model, t.material, mix(t.va->uv, t.vb->uv, t.vc->uv, 0),
+                                         mix(t.va->uv, t.vb->uv, t.vc->uv, 1), vertex_colour));
   }
   return out;
 }

@@ -60,12 +60,12 @@ Outcome judged(const Eigen::Matrix4d& T_true, const Eigen::Matrix4d& T_est, bool
 // Ours, as the tour's localized mode runs it (TargetFollower::acquire: the floor left out, the silhouette
 // crop grown by `grow_m`, ICP with restarts and global re-initialisation), then the quality gate and
 // the free-space check.
-Outcome ours(const alignment::TargetFollower& follower, const alignment::DepthImage& depth, const alignment::Footing& footing,
-             const Eigen::Matrix4d& guess, double grow_m, const Eigen::Matrix4d& T_true) {
+Outcome ours(const alignment::TargetFollower& follower, const alignment::DepthImage& depth, const assets::Image& colour,
+             const alignment::Footing& footing, const Eigen::Matrix4d& guess, double grow_m, const Eigen::Matrix4d& T_true) {
   const auto t0 = std::chrono::steady_clock::now();
   alignment::AlignmentResult r;
   try {
-    r = follower.acquire(depth, guess, footing, grow_m);
+    r = follower.acquire(depth, guess, footing, grow_m, &colour);
   } catch (const alignment::AlignmentError&) {  // too little left to align: blank
   }
   const bool lit = r.converged && follower.passes(follower.verify(depth, r.T_scan_model));
@@ -153,11 +153,12 @@ const Command kBenchAcquire{
         Tally tallies[4];  // ours, PCL: small guesses; ours, PCL: gross guesses
         int k = 0;
         for (; k < trials && !interrupted(); ++k) {
-          const auto depth =
-              twin.capture(arrival.truth.T_world_camera.matrix(), static_cast<std::uint32_t>(seed * 7919 + i * 1000 + k));
+          const auto noise_seed = static_cast<std::uint32_t>(seed * 7919 + i * 1000 + k);
+          const auto depth = twin.capture(arrival.truth.T_world_camera.matrix(), noise_seed);
+          const auto colour = twin.capture_colour(arrival.truth.T_world_camera.matrix(), noise_seed);
           for (const int gross : {0, 1}) {
             const Eigen::Matrix4d guess = perturbed(T_true, gross ? 30.0 : cm, gross ? 40.0 : deg, rng);
-            tallies[2 * gross].add(ours(follower, depth, footing, guess, grow_m[gross], T_true));
+            tallies[2 * gross].add(ours(follower, depth, colour, footing, guess, grow_m[gross], T_true));
             tallies[2 * gross + 1].add(pcl_pipeline(pcl, twin, depth, guess, T_true));
           }
         }

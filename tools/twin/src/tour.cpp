@@ -67,7 +67,7 @@ Errors marker_errors(const Twin& twin, std::size_t target, const config::Project
 // one alignment per stop; odometry projects whatever it gives). Tracking mode: the follower's first
 // step, the bounded start of its search, as the live engine's worker does it.
 void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const alignment::DepthImage& depth,
-             const Eigen::Matrix4d& T_init, const alignment::Footing& footing, VisitReport& r) {
+             const Eigen::Matrix4d& T_init, const alignment::Footing& footing, const assets::Image* colour, VisitReport& r) {
   const auto t0 = Clock::now();
   r.icp.T_scan_model = T_init;  // too little in view: nothing to align
   r.icp.converged = false;
@@ -88,7 +88,7 @@ void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twi
       // Ours leaves out the floor (known from the map and where the robot believes its camera is) and
       // what lies outside the guess's silhouette, and takes only a pose that stands as surveyed; the
       // paper's set-up aligns to everything near the guess.
-      r.icp = mode == TourMode::localized ? follower.acquire(depth, T_init, footing, follower.silhouette_grow_m())
+      r.icp = mode == TourMode::localized ? follower.acquire(depth, T_init, footing, follower.silhouette_grow_m(), colour)
                                           : follower.aligner().align(alignment::depth_to_cloud(depth, twin.camera()), T_init);
     } catch (const alignment::AlignmentError&) {
     }
@@ -401,8 +401,12 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     const Eigen::Matrix4d guess_error = alignment::rigid_inverse(T_camera_true) * T_init;
     r.guess_error_cm = 100.0 * alignment::translation_norm_m(guess_error);
     r.guess_error_deg = alignment::rotation_angle_deg(guess_error);
+    // Localized: the colour the RGB-D camera registers to the depth, taken with it (before any light).
+    std::optional<assets::Image> colour;
+    if (options.mode == TourMode::localized) colour = twin.capture_colour(truth.T_world_camera.matrix(), noise_seed);
     acquire(options.mode, followers[i], twin, depth, T_init,
-            alignment::footing_in_camera(target.cloud, arrival.T_map_target, arrival.believed.T_world_camera.matrix()), r);
+            alignment::footing_in_camera(target.cloud, arrival.T_map_target, arrival.believed.T_world_camera.matrix()),
+            colour ? &*colour : nullptr, r);
     const Eigen::Matrix4d T_world_projector = truth.T_world_projector.matrix();
     r.view = alignment::view_constraints(target.cloud, r.icp.T_scan_model, twin.camera());
     r.T_projector_target_estimated = alignment::projector_from_target(rig.T_projector_camera, r.icp.T_scan_model);

@@ -4,6 +4,7 @@
 // gate fails. Not thread-safe: one Aligner per thread.
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -17,6 +18,9 @@ namespace projbot::alignment {
 struct ModelCloud {
   std::vector<Eigen::Vector3f> points;
   std::vector<Eigen::Vector3f> normals;  ///< unit; estimated from the points when a file has none
+  /// RGB 0..1 per point, as the model's texture shows it (the projection content); empty when the model
+  /// has none (a PCD / PLY cloud).
+  std::vector<Eigen::Vector3f> colours;
 };
 
 /// Model points from a glTF (area-uniform surface samples) or a PCD / PLY file (normals estimated).
@@ -113,6 +117,10 @@ struct AlignmentResult {
   double footing_height_error_mm = 0.0;
   double footing_tilt_deg = 0.0;
   bool stands = true;  ///< within the footing's tolerances (or no footing given); `converged` includes it
+  /// With a colour image (TargetFollower::acquire): how far colour moved the pose along its weakest
+  /// slides (mm), and the colour agreement after (NaN: colour said nothing, the pose was kept).
+  double colour_shift_mm = 0.0;
+  double colour_agreement = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Which part of the acquisition align() runs. `full` is one acquisition as `projbot align` and the

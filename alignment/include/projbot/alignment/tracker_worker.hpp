@@ -123,8 +123,11 @@ class TargetFollower {
   /// projective tracking passes on the whole frame (model points against the pixels they fall on: a
   /// neighbour touching the target pulls less than in ICP's nearest neighbours; the shop's figure, its
   /// hand at a shelf, went from 2.7-3.6 mm to about 1 mm). The ICP's inlier ratio and rmse are of the
-  /// pose before the polish. Throws AlignmentError when too little depth is left.
-  AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing, double grow_m) const;
+  /// pose before the polish. With `colour` (registered to the frame), the pose is last moved along its
+  /// weakest slides to where the model's colours agree best (colour_refined: the shop's face-on box).
+  /// Throws AlignmentError when too little depth is left.
+  AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing, double grow_m,
+                          const assets::Image* colour = nullptr) const;
   double silhouette_grow_m() const { return silhouette_grow_m_; }
 
  private:

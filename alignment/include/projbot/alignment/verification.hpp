@@ -11,6 +11,7 @@
 
 #include "projbot/alignment/depth.hpp"
 #include "projbot/alignment/registration.hpp"
+#include "projbot/assets/image.hpp"
 
 namespace projbot::alignment {
 
@@ -63,6 +64,7 @@ struct ViewConstraints {
   std::size_t points = 0;            ///< visible model samples used
   std::array<double, 6> strength{};  ///< eigenvalues over the largest, ascending
   std::vector<WeakDirection> weak;   ///< those with strength below kWeak, weakest first
+  std::vector<WeakDirection> all;    ///< every direction, weakest first
   static constexpr double kWeak = 0.02;
 };
 
@@ -70,5 +72,32 @@ struct ViewConstraints {
 /// over the model samples the camera sees at T_camera_model (front-facing, nearest per pixel). Depends
 /// on the model, the pose and the camera only: what any scan of this view can and cannot fix.
 ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k);
+
+/// How well the model's colours (the projection content) agree with a colour image registered to
+/// `depth` (the same pinhole, as a Kinect v1 registers RGB to depth) at T_camera_model: the correlation
+/// of their luminances over the model samples the camera sees there (front-facing, nearest per pixel,
+/// and not hidden: the measured depth within 2 cm of the sample), the image sampled bilinearly. In
+/// -1..1; NaN when the model has no colours, the images do not match the pinhole, fewer than
+/// kMinColourSamples samples are seen or either side has no contrast (a plain target says nothing).
+double colour_agreement(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
+                        const assets::Image& colour, const CameraIntrinsics& k);
+inline constexpr std::size_t kMinColourSamples = 200;
+
+/// A pose moved to where colour agrees best, in the plane of its two weakest slides.
+struct ColourRefinement {
+  Eigen::Matrix4d T_camera_model = Eigen::Matrix4d::Identity();
+  double agreement_before = 0.0;                      ///< colour_agreement at the pose given (NaN: colour says nothing)
+  double agreement_after = 0.0;                       ///< ...and at the result
+  Eigen::Vector3d shift_m = Eigen::Vector3d::Zero();  ///< the move, camera frame
+};
+
+/// Depth pins a box seen face-on only loosely along its face: the Kinect's edges are noisy and the
+/// shop's box came out 1.7-2.9 mm off sideways. Its texture does not slide. The pose is moved within
+/// +-reach_m in the plane of the two weakest slides of view_constraints (their translations, made
+/// orthonormal) to where colour_agreement is highest: a grid of step_m, then one of step_m / 4 around
+/// the best. The pose is kept when colour says nothing (NaN) or no move gains at least min_gain.
+ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
+                                const assets::Image& colour, const CameraIntrinsics& k, double reach_m = 0.008,
+                                double step_m = 0.001, double min_gain = 0.005);
 
 }  // namespace projbot::alignment

@@ -74,6 +74,9 @@ void scale_and_recenter(Model& model, double scale, bool recenter);
 struct SurfaceSamples {
   std::vector<Eigen::Vector3f> points;
   std::vector<Eigen::Vector3f> normals;  ///< unit, from the triangle's geometric normal
+  /// RGB 0..1 as stored: texture (nearest texel) x base colour factor x vertex colour, what the unlit
+  /// renderer draws there.
+  std::vector<Eigen::Vector3f> colours;
 };
 
 /// Samples `count` points uniformly over the model's surface area, reproducibly for a seed.
