@@ -58,6 +58,13 @@ struct WorkerConfig {
   /// ...and once ICP has an estimate, the depth is cropped again at it, grown by this, and ICP refines
   /// from there on what is left (what stood beside the target inside the first crop drops out).
   double recrop_m = 0.03;
+  /// Colour at acquisition (acquire with a colour image): a move along the weakest slides is taken only
+  /// if the depth's RMS error at the moved pose grows by at most this share...
+  double colour_max_rmse_growth = 0.10;
+  /// ...and a pose whose colours correlate with the image less than this is refused (when the model
+  /// has colour contrast at all). Correct poses in the twin: 0.95-0.99; the box fitted wrong from gross
+  /// guesses: 0.0-0.5.
+  double min_colour_agreement = 0.5;
 };
 
 /// What searching for a target has cost since its stop began.
@@ -124,7 +131,9 @@ class TargetFollower {
   /// neighbour touching the target pulls less than in ICP's nearest neighbours; the shop's figure, its
   /// hand at a shelf, went from 2.7-3.6 mm to about 1 mm). The ICP's inlier ratio and rmse are of the
   /// pose before the polish. With `colour` (registered to the frame), the pose is last moved along its
-  /// weakest slides to where the model's colours agree best (colour_refined: the shop's face-on box).
+  /// weakest slides to where the model's colours agree best (colour_refined: the shop's face-on box) as
+  /// far as the depth allows (colour_max_rmse_growth), and refused when its colours disagree
+  /// (min_colour_agreement).
   /// Throws AlignmentError when too little depth is left.
   AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing, double grow_m,
                           const assets::Image* colour = nullptr) const;
@@ -171,6 +180,8 @@ class TargetFollower {
 
   std::optional<PoseSample> track(const DepthImage& frame);
   std::optional<PoseSample> search(const DepthImage& frame);
+  // r moved by colour where depth allows, and refused when colour disagrees (see acquire).
+  void by_colour(const DepthImage& frame, const Known& known, const assets::Image& colour, AlignmentResult& r) const;
   std::optional<AlignmentResult> attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage);
 };
 
