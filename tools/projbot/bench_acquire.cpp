@@ -79,7 +79,8 @@ Outcome pcl_pipeline(const alignment::Aligner& aligner, const twin::Twin& twin, 
   const auto t0 = std::chrono::steady_clock::now();
   alignment::AlignmentResult r;
   try {
-    r = aligner.align(alignment::depth_to_cloud(depth, twin.camera()), guess, alignment::SearchStage::refine);
+    // icp_only: ICP from the guess, run to its end (refine would stop it after 500 ms, at the machine's load).
+    r = aligner.align(alignment::depth_to_cloud(depth, twin.camera()), guess, alignment::SearchStage::icp_only);
   } catch (const alignment::AlignmentError&) {
   }
   return judged(T_true, r.T_scan_model, r.converged,
