@@ -167,6 +167,23 @@ TEST(SamplingTest, PointsLieOnTheSurfaceUniformlyByArea) {
   EXPECT_EQ(again.points[42], s.points[42]);  // reproducible for a seed
 }
 
+// Each sample's colour is the texel it falls on, wrapped as the sampler says: a 2x1 texture (red, blue)
+// mirrored at u = 1.25 reads u = 0.75 (blue); a coordinate of 1e30 (even: no mirror) reads u = 0 (red)
+// without overflowing an integer on the way.
+TEST(SamplingTest, ColoursFollowTheTextureAndItsWrap) {
+  Model m = projbot::assets::make_box({0, 0, 0}, {1, 1, 1}, {1.0F, 1.0F, 1.0F, 1.0F});
+  projbot::assets::Image texture{2, 1, {255, 0, 0, 255, 0, 0, 255, 255}};
+  m.images.push_back(texture);
+  m.materials[0].base_color_image = 0;
+  m.materials[0].sampler.wrap_s = projbot::assets::Wrap::kMirroredRepeat;
+  for (const float u : {1.25F, 1e30F}) {
+    for (auto& v : m.primitives[0].vertices) v.uv = {u, 0.5F};
+    const auto s = projbot::assets::sample_surface(m, 50, 3);
+    ASSERT_EQ(s.colours.size(), s.points.size());
+    for (const auto& c : s.colours) EXPECT_EQ(c, u < 2.0F ? Eigen::Vector3f(0, 0, 1) : Eigen::Vector3f(1, 0, 0)) << u;
+  }
+}
+
 TEST(ProceduralTest, UvSphereIsLargeAndRound) {
   const Model m = projbot::assets::make_uv_sphere(0.25, 224, 224);
   EXPECT_GE(m.triangle_count(), 100000U);

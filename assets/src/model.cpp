@@ -15,7 +15,7 @@ double wrapped(double x, Wrap w) {
   if (w == Wrap::kClampToEdge) return std::clamp(x, 0.0, 1.0);
   const double f = x - std::floor(x);
   if (w == Wrap::kRepeat) return f;
-  return static_cast<long>(std::floor(x)) % 2 == 0 ? f : 1.0 - f;  // mirrored
+  return std::fmod(std::floor(x), 2.0) == 0.0 ? f : 1.0 - f;  // mirrored (fmod: no overflow for a huge coordinate)
 }
 
 // The colour a material shows at texture coordinate (u, v) with vertex colour `vc`: texture (nearest
