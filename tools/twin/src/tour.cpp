@@ -422,7 +422,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
       r.frame_ms = ms_since(t0);
       assets::write_png(frame_path(options, r, ""), image);
       // What the RGB-D camera saw at the capture: its colour, registered to the depth that was used.
-      assets::write_png(frame_path(options, r, "_camera"), twin.capture_colour(truth.T_world_camera.matrix(), noise_seed));
+      assets::write_png(frame_path(options, r, "_camera"),
+                        colour ? *colour : twin.capture_colour(truth.T_world_camera.matrix(), noise_seed));
       // What a visitor beside the robot sees: the frame's light on the true surfaces.
       assets::write_png(frame_path(options, r, "_spectator"),
                         spectator->draw(twin, spectator_at(target), T_world_projector, image));
