@@ -546,6 +546,52 @@ TEST(TourTest, TheShopBoxSeenFaceOnIsPlacedAlongItsFaceByItsColour) {
   EXPECT_LT(std::abs(tour.visits[0].icp.footing_height_error_mm), 5.0);
 }
 
+// Tracking mode: the box's first pose is placed by colour, and tracking holds it there. Before the
+// hold, tracking slid it back along the face to the depth's optimum within a frame: 2.2-2.8 mm.
+TEST(TourTest, TrackingHoldsTheShopBoxWhereColourPlacedIt) {
+  auto scene = projbot::config::load_scene(kAssets + "/scenes/shop.yaml");
+  scene.visits = {"box"};
+  projbot::twin::TourOptions o;
+  o.visits = 1;
+  o.mode = projbot::twin::TourMode::tracking;
+  o.dwell_s = 1.5;
+  const auto tour = projbot::twin::run_tour(scene, o);
+  ASSERT_EQ(tour.visits.size(), 1U);
+  const auto& v = tour.visits[0];
+  EXPECT_EQ(v.lit_frames, static_cast<int>(v.timeline.size()) + 1);  // every frame, the arrival's too
+  EXPECT_GT(v.icp.colour_shift_mm, 0.5);
+  EXPECT_LT(v.still_mean_mm, 1.0);
+  ASSERT_FALSE(v.timeline.empty());
+  EXPECT_LT(v.timeline.back().mean_mm, 1.0);
+}
+
+// ...and lets go of it when the box is moved: from there on depth alone follows it. Held, tracking
+// would drag 10 % of each frame's move back towards the held pose.
+TEST(TourTest, AHeldBoxThatIsMovedIsFollowed) {
+  auto scene = projbot::config::load_scene(kAssets + "/scenes/shop.yaml");
+  scene.visits = {"box"};
+  projbot::config::TargetMotion move;
+  move.visit = 1;
+  move.start_s = 0.5;
+  move.duration_s = 1.0;
+  move.translation_m = Eigen::Vector3d(0.05, 0.03, 0.0);
+  move.stays = true;
+  for (auto& t : scene.targets)
+    if (t.name == "box") t.motions = {move};
+  projbot::twin::TourOptions o;
+  o.visits = 1;
+  o.mode = projbot::twin::TourMode::tracking;
+  o.dwell_s = 2.5;
+  const auto tour = projbot::twin::run_tour(scene, o);
+  ASSERT_EQ(tour.visits.size(), 1U);
+  const auto& v = tour.visits[0];
+  EXPECT_GT(v.icp.colour_shift_mm, 0.5);  // it was held
+  EXPECT_EQ(v.moving_blank_frames, 0);
+  ASSERT_FALSE(v.timeline.empty());
+  EXPECT_TRUE(v.timeline.back().shown);
+  EXPECT_LT(v.timeline.back().mean_mm, 4.0);  // depth alone along the face: about 2 mm
+}
+
 // From a guess 5 cm and 10 degrees off (bench acquire's), the crop grown by that much takes in the
 // shelf beside the figure's hand, and ICP settled 11-19 mm sideways, turned 0.7 degrees about the line of
 // sight, where the gate refused it. Cropped again at that estimate and refined, the shelf drops out.

@@ -113,9 +113,11 @@ void add_start_prior(Eigen::Matrix<double, 6, 6>& H, Eigen::Matrix<double, 6, 1>
   g += Hp * xi;
 }
 
-TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matrix4d& T_prev) const {
+TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matrix4d& T_prev,
+                                     const Eigen::Matrix4d* T_hold) const {
   const auto t0 = std::chrono::steady_clock::now();
   if (!T_prev.allFinite()) throw AlignmentError("tracker: previous pose is not finite");
+  if (T_hold && !T_hold->allFinite()) throw AlignmentError("tracker: held pose is not finite");
   const std::vector<Level> levels = pyramid(depth);
   TrackResult out;
   Eigen::Matrix4d T = T_prev;
@@ -171,7 +173,10 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       ++out.iterations;
       if (p.used < 6 * 3) break;
       p.H.triangularView<Eigen::Lower>() = p.H.transpose();
-      add_start_prior(p.H, p.g, T, T_prev, cfg_.start_prior, model_radius_m_);
+      if (T_hold)
+        add_start_prior(p.H, p.g, T, *T_hold, cfg_.hold_prior, model_radius_m_);
+      else
+        add_start_prior(p.H, p.g, T, T_prev, cfg_.start_prior, model_radius_m_);
       const Eigen::Matrix<double, 6, 1> xi = p.H.ldlt().solve(-p.g);
       if (!xi.allFinite()) break;
       T = twist_to_transform(xi) * T;

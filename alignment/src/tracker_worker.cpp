@@ -56,6 +56,7 @@ void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, c
   stats_ = {};
   last_attempt_.reset();
   filter_.reset();
+  hold_.reset();
 }
 
 void TargetFollower::set_pose(const Eigen::Matrix4d& T_camera_target) {
@@ -83,9 +84,24 @@ PoseSample TargetFollower::found(const DepthImage& frame, const Eigen::Matrix4d&
   return sample;
 }
 
-std::optional<PoseSample> TargetFollower::step(const DepthImage& frame) {
+std::optional<PoseSample> TargetFollower::step(const DepthImage& frame, const assets::Image* colour) {
   if (!have_guess_ && !pose_) return std::nullopt;  // nothing to start from yet
-  return pose_ ? track(frame) : search(frame);
+  return pose_ ? track(frame) : search(frame, colour);
+}
+
+bool TargetFollower::coloured(const DepthImage& frame, const assets::Image* colour, Eigen::Matrix4d& T) {
+  hold_.reset();
+  if (!colour) return true;
+  AlignmentResult r;
+  r.T_scan_model = T;
+  r.converged = true;
+  by_colour(frame, known_, *colour, r);
+  stats_.colour_shift_mm = r.colour_shift_mm;
+  stats_.colour_agreement = r.colour_agreement;
+  if (!r.converged) return false;
+  if (r.colour_shift_mm > 0.0) hold_ = r.T_scan_model;
+  T = r.T_scan_model;
+  return true;
 }
 
 DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matrix4d& from, const Known& known,
@@ -178,8 +194,19 @@ std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
   // A moving target is looked for where its motion has taken it by this frame's capture: 1 m/s is
   // 3.3 cm between 30 Hz frames, most of the tracker's reach from the last pose.
   const Eigen::Matrix4d start = cfg_.predict ? filter_.predict(frame.capture_time_s) : *pose_;
-  const TrackResult r = tracker_.track(frame, start);
-  if (r.accepted && verified(frame, r.T_camera_target)) return found(frame, r.T_camera_target, r.inlier_ratio, r.rmse_mm);
+  const TrackResult r = tracker_.track(frame, start, hold_ ? &*hold_ : nullptr);
+  if (r.accepted && verified(frame, r.T_camera_target)) {
+    PoseSample s = found(frame, r.T_camera_target, r.inlier_ratio, r.rmse_mm);
+    // Colour's placement holds while the target stays where it was placed.
+    if (hold_) {
+      const Eigen::Matrix4d moved = rigid_inverse(*hold_) * r.T_camera_target;
+      if (filter_.state().moving() || translation_norm_m(moved) > cfg_.hold_release_m ||
+          rotation_angle_deg(moved) > cfg_.hold_release_deg)
+        hold_.reset();
+    }
+    return s;
+  }
+  hold_.reset();  // tracking lost it on this frame: whatever finds it again is depth alone
   // The target moved more than tracking follows: once more on this same frame with a wider reach
   // (reach_m), a few milliseconds. Only when frames were dropped since the last pose (the worker was
   // busy, the target may be far from it) one ICP from there as well: on consecutive frames that ICP
@@ -200,7 +227,7 @@ std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
   return still_sample(guess_, frame.capture_time_s, true, w.inlier_ratio, w.rmse_mm);
 }
 
-std::optional<PoseSample> TargetFollower::search(const DepthImage& frame) {
+std::optional<PoseSample> TargetFollower::search(const DepthImage& frame, const assets::Image* colour) {
   if (wait_ > 0) {
     --wait_;
     ++stats_.frames_waited;
@@ -222,14 +249,16 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame) {
   // almost everywhere: from a guess 10 cm off it once settled half-way with 80 % inliers.
   const TrackResult quick = tracker_.track(frame, guess_);
   const Eigen::Matrix4d correction = rigid_inverse(guess_) * quick.T_camera_target;
+  Eigen::Matrix4d T = quick.T_camera_target;
   if (quick.accepted && quick.inlier_ratio >= 0.95 && translation_norm_m(correction) < 0.02 &&
-      rotation_angle_deg(correction) < 3.0 && verified(frame, quick.T_camera_target) && check_.behind_ratio() < 0.05) {
+      rotation_angle_deg(correction) < 3.0 && verified(frame, T) && check_.behind_ratio() < 0.05 && coloured(frame, colour, T)) {
     elapsed();
-    return found(frame, quick.T_camera_target, quick.inlier_ratio, quick.rmse_mm);
+    return found(frame, T, quick.inlier_ratio, quick.rmse_mm);
   }
   const auto a = attempt(frame, guess_, stage);
   elapsed();
-  if (a && a->converged && verified(frame, a->T_scan_model)) return found(frame, a->T_scan_model, a->inlier_ratio, a->rmse_mm);
+  if (a && a->converged && verified(frame, T = a->T_scan_model) && coloured(frame, colour, T))
+    return found(frame, T, a->inlier_ratio, a->rmse_mm);
   const auto& spacing = cfg_.search_spacing_frames;
   if (!spacing.empty()) wait_ = spacing[std::min(static_cast<std::size_t>(stats_.attempts - 1), spacing.size() - 1)];
   const double last_ms = stats_.last_attempt_ms;

@@ -73,8 +73,11 @@ void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twi
   r.icp.converged = false;
   if (mode == TourMode::tracking) {
     follower.set_initial_guess(T_init, footing);
-    const auto sample = follower.step(depth);
+    const auto sample = follower.step(depth, colour);
     if (follower.last_attempt()) r.icp = *follower.last_attempt();
+    if (sample && !sample->lost) r.icp.T_scan_model = sample->T_camera_target;  // colour may have moved it
+    r.icp.colour_shift_mm = follower.search_stats().colour_shift_mm;
+    r.icp.colour_agreement = follower.search_stats().colour_agreement;
     if (sample && !sample->lost && !follower.last_attempt()) {  // the projective tracker found it from the guess
       r.icp.T_scan_model = sample->T_camera_target;
       r.icp.converged = true;
@@ -401,9 +404,10 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     const Eigen::Matrix4d guess_error = alignment::rigid_inverse(T_camera_true) * T_init;
     r.guess_error_cm = 100.0 * alignment::translation_norm_m(guess_error);
     r.guess_error_deg = alignment::rotation_angle_deg(guess_error);
-    // Localized: the colour the RGB-D camera registers to the depth, taken with it (before any light).
+    // Localized and tracking: the colour the RGB-D camera registers to the depth, taken with it (before
+    // any light).
     std::optional<assets::Image> colour;
-    if (options.mode == TourMode::localized) colour = twin.capture_colour(truth.T_world_camera.matrix(), noise_seed);
+    if (options.mode != TourMode::odometry) colour = twin.capture_colour(truth.T_world_camera.matrix(), noise_seed);
     acquire(options.mode, followers[i], twin, depth, T_init,
             alignment::footing_in_camera(target.cloud, arrival.T_map_target, arrival.believed.T_world_camera.matrix()),
             colour ? &*colour : nullptr, r);

@@ -6,6 +6,7 @@
 
 #include <condition_variable>
 #include <exception>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -65,6 +66,12 @@ struct WorkerConfig {
   /// has colour contrast at all). Correct poses in the twin: 0.95-0.99; the box fitted wrong from gross
   /// guesses: 0.0-0.5.
   double min_colour_agreement = 0.5;
+  /// A pose that colour moved (a stop's first, with a colour image) is held: tracking pulls towards it
+  /// (TrackerConfig::start_prior) instead of its start, so it does not slide back along the directions
+  /// depth leaves free. Let go when the target is seen moving (the motion filter) or tracked this far
+  /// from it; from then on tracking is depth alone until the next stop.
+  double hold_release_m = 0.003;
+  double hold_release_deg = 1.0;
 };
 
 /// What searching for a target has cost since its stop began.
@@ -74,6 +81,10 @@ struct SearchStats {
   double max_attempt_ms = 0.0;   ///< the longest one
   double last_attempt_ms = 0.0;  ///< the newest one
   int frames_waited = 0;         ///< frames skipped between attempts (spacing)
+  /// The found pose's colour check (step with a colour image): how far colour moved it, and how well
+  /// its colours agree with the image (NaN: no colour image, or a model without colour contrast).
+  double colour_shift_mm = 0.0;
+  double colour_agreement = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// What the render thread reads: the newest accepted pose, or the news that the target is lost.
@@ -108,8 +119,13 @@ class TargetFollower {
   /// The target was already acquired at T_camera_target: the next frame tracks from there.
   void set_pose(const Eigen::Matrix4d& T_camera_target);
   /// One frame: the sample to publish (sequence left 0), or nothing when there is no guess yet, the
-  /// frame was rejected without the target being lost yet, or a search attempt is not due.
-  std::optional<PoseSample> step(const DepthImage& frame);
+  /// frame was rejected without the target being lost yet, or a search attempt is not due. With
+  /// `colour` (registered to the frame, taken before the projector lights the target), a pose found
+  /// by the search is moved by colour where depth allows and refused when its colours disagree, as in
+  /// acquire(), and a moved pose is then held while the target stays still (hold_release_m).
+  std::optional<PoseSample> step(const DepthImage& frame, const assets::Image* colour = nullptr);
+  /// Whether tracking holds a pose that colour placed.
+  bool holding() const { return hold_.has_value(); }
   /// The search since the last guess or pose was set.
   const SearchStats& search_stats() const { return stats_; }
   /// The newest acquisition attempt's result (refine or search stage), if any since the last guess.
@@ -179,7 +195,11 @@ class TargetFollower {
   PoseSample found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm);
 
   std::optional<PoseSample> track(const DepthImage& frame);
-  std::optional<PoseSample> search(const DepthImage& frame);
+  std::optional<PoseSample> search(const DepthImage& frame, const assets::Image* colour);
+  // The pose a search found, moved by colour where depth allows (and then held); false when its
+  // colours disagree.
+  bool coloured(const DepthImage& frame, const assets::Image* colour, Eigen::Matrix4d& T);
+  std::optional<Eigen::Matrix4d> hold_;  // where colour placed the target, while it stays still
   // r moved by colour where depth allows, and refused when colour disagrees (see acquire).
   void by_colour(const DepthImage& frame, const Known& known, const assets::Image& colour, AlignmentResult& r) const;
   std::optional<AlignmentResult> attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage);
