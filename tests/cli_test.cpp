@@ -395,7 +395,8 @@ TEST_F(CliTest, LocalizeInterruptedKeepsTheScansDone) {
 // second visit (the tour's fourth), is seen elsewhere with the light left where it stood.
 TEST_F(CliTest, TourShowsAMovedTargetAtTheEndOfItsVisit) {
   const fs::path frames = dir_ / "frames";
-  const CliRun r = run_projbot("tour --visits 4 --frames " + frames.string());
+  const CliRun r =
+      run_projbot("tour --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml --visits 4 --frames " + frames.string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_FALSE(fs::exists(frames / "visit02_box_spectator_end.png"));  // not moved on its first visit
   const auto arrival = projbot::assets::read_image(frames / "visit04_box_spectator.png");
@@ -486,9 +487,19 @@ TEST_F(CliTest, RenderModelFramesAnySize) {
   EXPECT_NE(empty.output.find("the frame is empty"), std::string::npos) << empty.output;
 }
 
+// The README's main command: with no options, the shop in tracking mode, the other modes named.
+TEST_F(CliTest, TourRunsTheShopInTrackingModeByDefault) {
+  const CliRun r = run_projbot("tour --visits 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("scenes/shop.yaml in tracking mode (--mode localized"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| visit | figure | paper target 1 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| 1 | figure | no | - |"), std::string::npos) << r.output;  // the tracking table
+  EXPECT_NE(r.output.find("181/181"), std::string::npos) << r.output;                  // lit all along
+}
+
 TEST_F(CliTest, TourPrintsTheTableAndWritesReportAndFrames) {
-  const CliRun r =
-      run_projbot("tour --visits 1 --report " + (dir_ / "r.json").string() + " --frames " + (dir_ / "frames").string());
+  const CliRun r = run_projbot("tour --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml --mode localized" +
+                               " --visits 1 --report " + (dir_ / "r.json").string() + " --frames " + (dir_ / "frames").string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("| visit | duck | paper target 1 |"), std::string::npos) << r.output;
   std::ifstream in(dir_ / "r.json");

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Quick start, command 1: install what is missing, build (Release), and run the main job on the
-# built-in default: the demo tour in the digital twin (two targets, three visits each), printing the
-# projection error at the markers beside the paper's Table 1; report and projector frames in out/.
+# built-in default: the shipped shop in the digital twin (a figure on the floor, the Duck, a box seen
+# face-on; three visits each; tracking mode), printing the projection error at the markers beside the
+# paper's Table 1; report and projector, camera and spectator pictures in out/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup-debian.sh

@@ -2,6 +2,8 @@
 
 #include <iomanip>
 #include <iostream>
+#include <map>
+#include <string>
 
 #include "commands.hpp"
 #include "interrupt.hpp"
@@ -9,6 +11,15 @@
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
+namespace {
+
+// What the other modes would show, printed with the tour's first line.
+const std::map<std::string, std::string> kModeHints{
+    {"tracking", " (--mode localized: one alignment per stop; --mode odometry: the paper's set-up)"},
+    {"localized", " (one alignment per stop; --mode tracking follows the targets while projecting)"},
+    {"odometry", " (the paper's set-up: odometry and one plain ICP per stop, always projected)"}};
+
+}  // namespace
 
 const Command kTour{
     "tour",
@@ -21,18 +32,22 @@ const Command kTour{
     "ICP, moves it to the projector (Eq. 2) and projects (Eq. 3). The projection error is measured at the\n"
     "target's markers the projector can light: the projector pixel carrying each marker is cast into the\n"
     "true scene and the distance to the true marker is reported, in mm, with the paper's Table 1 beside it\n"
-    "(a marker outside the projector's image, turned away or hidden is left out). Without --scene the shipped\n"
-    "demo tour runs (two targets, three visits each; the box is moved on its second visit).\n\n"
-    "Modes: odometry = the paper's set-up (odometry only, one plain point-to-point ICP per stop, always\n"
-    "projected; assets/scenes/paper.yaml is the paper's experiment, nothing moved); localized = MRPT\n"
-    "localisation and robust acquisition with a quality gate (rejected estimates are blanked); tracking =\n"
-    "localized, and the projective tracker follows the target at 30 Hz while projecting.\n\n"
+    "(a marker outside the projector's image, turned away or hidden is left out).\n\n"
+    "Without --scene the shipped shop runs (assets/scenes/shop.yaml, 10 x 7 m: a 1.45 m figure standing on\n"
+    "the floor by a wall and a shelf, the Duck with a vase touching it, a box on a table seen nearly face-on,\n"
+    "partly behind a pillar; three visits each). assets/scenes/tour.yaml is the earlier demo tour (two\n"
+    "targets on pedestals; the box is moved on its second visit), assets/scenes/motion.yaml has moving targets.\n\n"
+    "Modes: tracking (the default) = MRPT localisation, robust acquisition with a quality gate (a rejected\n"
+    "estimate is blanked), then the projective tracker follows the target at 30 Hz while projecting;\n"
+    "localized = the same acquisition once per stop, nothing followed afterwards; odometry = the paper's\n"
+    "set-up (odometry only, one plain point-to-point ICP per stop, always projected;\n"
+    "assets/scenes/paper.yaml is the paper's experiment).\n\n"
     "A line per visit is printed as it finishes. Ctrl-C stops after the visit in progress, prints and writes\n"
     "the finished visits (the report says \"interrupted\": true) and exits 130.\n",
-    {{"scene", "FILE", "tour scene (default: the shipped demo tour, assets/scenes/tour.yaml)"},
+    {{"scene", "FILE", "tour scene (default: the shipped shop, assets/scenes/shop.yaml)"},
      {"visits", "N", "number of visits, cycling through the scene's list (default: the list once)"},
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
-     {"mode", "M", "odometry | localized | tracking (default localized)"},
+     {"mode", "M", "tracking | localized | odometry (default tracking)"},
      {"report", "FILE", "write the per-visit report as JSON"},
      {"frames", "DIR",
       "write per visit DIR/visitNN_TARGET.png (projector), _camera.png (RGB-D colour), _spectator.png (a visitor's view; "
@@ -42,7 +57,7 @@ const Command kTour{
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"}},
     [](const cli::Args& args) {
       twin::TourOptions o;
-      const std::string mode = args.get_or("mode", "localized");
+      const std::string mode = args.get_or("mode", "tracking");
       if (mode == "odometry")
         o.mode = twin::TourMode::odometry;
       else if (mode == "localized")
@@ -60,7 +75,9 @@ const Command kTour{
       o.predict = !args.flag("no-predict");
       args.check_output_files({"report"});
       args.check_output_folders({"frames"});
-      const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "tour.yaml").string()));
+      const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
+      const auto scene = config::load_scene(scene_path);
+      std::cout << "Tour of " << scene_path << " in " << mode << " mode" << kModeHints.at(mode) << std::endl;
       catch_interrupts();  // Ctrl-C: stop after the visit in progress, keep the finished ones
       o.stop_requested = [] { return interrupted(); };
       o.on_visit = [](const twin::VisitReport& v) {
