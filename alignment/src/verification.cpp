@@ -255,8 +255,12 @@ ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& 
         if (std::isfinite(c) && c > best) best = c, best_shift = shift;
       }
   };
-  search(Eigen::Vector3d::Zero(), reach_m, step_m);
-  search(best_shift, step_m, step_m / 4.0);
+  // Coarse to fine: 2 steps, then half a step, then a quarter around the best so far (139 agreements
+  // at the defaults instead of the 370 of a full grid of steps and quarter steps: the acquisition's
+  // colour took 80-100 ms on the shop's duck and box).
+  search(Eigen::Vector3d::Zero(), reach_m, 2.0 * step_m);
+  search(best_shift, 1.5 * step_m, step_m / 2.0);
+  search(best_shift, step_m / 4.0, step_m / 4.0);
   if (!(best >= out.agreement_before + min_gain)) return out;
   out.T_camera_model.topRightCorner<3, 1>() += best_shift;
   out.shift_m = best_shift;

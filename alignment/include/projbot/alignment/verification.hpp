@@ -94,8 +94,8 @@ struct ColourRefinement {
 /// Depth pins a box seen face-on only loosely along its face: the Kinect's edges are noisy and the
 /// shop's box came out 1.7-2.9 mm off sideways. Its texture does not slide. The pose is moved within
 /// +-reach_m in the plane of the two weakest slides of view_constraints (their translations, made
-/// orthonormal) to where colour_agreement is highest: a grid of step_m, then one of step_m / 4 around
-/// the best. The pose is kept when colour says nothing (NaN) or no move gains at least min_gain.
+/// orthonormal) to where colour_agreement is highest: a grid of 2 step_m, then finer ones of step_m / 2
+/// and step_m / 4 around the best. The pose is kept when colour says nothing (NaN) or no move gains at least min_gain.
 ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
                                 const assets::Image& colour, const CameraIntrinsics& k, double reach_m = 0.008,
                                 double step_m = 0.001, double min_gain = 0.005);
