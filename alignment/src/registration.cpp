@@ -238,11 +238,11 @@ struct Aligner::Impl {
   // what the target stands on drops out as the estimate tightens.
   // Out of time (a bounded attempt's deadline, checked between stages): not converged.
   Eigen::Matrix4d icp(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model_init, int& iterations, bool& converged,
-                      const std::function<bool()>& out_of_time) const {
+                      const std::function<bool()>& out_of_time, std::size_t first_stage = 0) const {
     Eigen::Matrix4f T_model_scan = rigid_inverse(T_scan_model_init).cast<float>();
     converged = true;
-    for (std::size_t stage = 0; stage < cfg.icp_distances_m.size(); ++stage) {
-      if (stage > 0 && out_of_time()) {
+    for (std::size_t stage = first_stage; stage < cfg.icp_distances_m.size(); ++stage) {
+      if (stage > first_stage && out_of_time()) {
         converged = false;
         break;
       }
@@ -272,8 +272,10 @@ struct Aligner::Impl {
       icp.setInputTarget(model_icp);
       icp.setSearchMethodTarget(model_icp_tree, true);
       icp.setMaxCorrespondenceDistance(distance);
-      icp.setMaximumIterations(cfg.icp_iterations);
-      icp.setTransformationEpsilon(1e-10);
+      const bool last = stage + 1 == cfg.icp_distances_m.size();
+      icp.setMaximumIterations(last ? cfg.icp_iterations : std::min(cfg.icp_iterations, cfg.coarse_iterations));
+      const double step_m = last ? 1e-5 : std::max(1e-5, cfg.coarse_step_ratio * distance);
+      icp.setTransformationEpsilon(step_m * step_m);
       icp.setEuclideanFitnessEpsilon(1e-12);
       CloudN aligned;
       icp.align(aligned, T_model_scan);
@@ -587,7 +589,9 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   const auto attempt = [&](const Eigen::Matrix4d& start, bool reinitialised) {
     AlignmentResult r;
     bool icp_converged = false;
-    r.T_scan_model = m.icp(scan, footing ? m.stood(*footing, start) : start, best.iterations, icp_converged, out_of_time);
+    const std::size_t first_stage = stage == SearchStage::finish ? m.cfg.icp_distances_m.size() - 1 : 0;
+    r.T_scan_model =
+        m.icp(scan, footing ? m.stood(*footing, start) : start, best.iterations, icp_converged, out_of_time, first_stage);
     r.reinitialised = reinitialised;
     m.evaluate(*m.near_scan(scan, r.T_scan_model, m.gate_margin()), r.T_scan_model, r);
     const bool stands = !footing || m.stands(*footing, r);
@@ -595,8 +599,8 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     r.iterations = best.iterations;
     if (better_than(r, best)) best = r;
   };
-  const bool local =
-      stage == SearchStage::full || stage == SearchStage::refine || stage == SearchStage::icp_only || stage == SearchStage::local;
+  const bool local = stage == SearchStage::full || stage == SearchStage::refine || stage == SearchStage::icp_only ||
+                     stage == SearchStage::local || stage == SearchStage::finish;
   if (local) attempt(T_init, false);
   if (!best.converged && m.cfg.restart_angle_deg > 0.0 && (stage == SearchStage::full || stage == SearchStage::local)) {
     // Local restarts: the guess turned about the target's centre, which ICP alone cannot leave; about

@@ -121,7 +121,8 @@ AlignmentResult TargetFollower::recropped(const DepthImage& frame, const Alignme
   // recrop_m, most of it is left out, and ICP from the estimate settles on the target's own points.
   const PointCloud tight = depth_to_cloud(near_guess(frame, r.T_scan_model, known, cfg_.recrop_m), k_);
   if (tight.finite_count() < aligner_.config().min_points) return r;
-  AlignmentResult again = aligner_.align(tight, r.T_scan_model, stage, known.footing);
+  // From a converged estimate only ICP's finest stage: the coarse ones would find it where it is.
+  AlignmentResult again = aligner_.align(tight, r.T_scan_model, r.converged ? SearchStage::finish : stage, known.footing);
   again.iterations += r.iterations;
   again.time_ms += r.time_ms;
   return again.converged || !r.converged ? again : r;
