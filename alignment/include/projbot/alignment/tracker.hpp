@@ -48,7 +48,7 @@ class ProjectiveTracker {
   ProjectiveTracker(ModelCloud model, CameraIntrinsics intrinsics, TrackerConfig config = {});
 
   /// Refines T_prev (target -> camera) against `depth` (metres, 0 = missing). With T_hold, hold_prior
-  /// pulls towards it instead of start_prior of towards T_prev: a pose that colour placed along the directions the
+  /// pulls towards it instead of start_prior towards T_prev: a pose that colour placed along the directions the
   /// depth leaves free (a box seen face-on) stays there instead of sliding back to the depth's optimum.
   TrackResult track(const DepthImage& depth, const Eigen::Matrix4d& T_prev, const Eigen::Matrix4d* T_hold = nullptr) const;
 

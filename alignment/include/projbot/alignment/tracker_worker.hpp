@@ -67,7 +67,7 @@ struct WorkerConfig {
   /// guesses: 0.0-0.5.
   double min_colour_agreement = 0.5;
   /// A pose that colour moved (a stop's first, with a colour image) is held: tracking pulls towards it
-  /// (TrackerConfig::start_prior) instead of its start, so it does not slide back along the directions
+  /// (TrackerConfig::hold_prior) instead of its start, so it does not slide back along the directions
   /// depth leaves free. Let go when the target is seen moving (the motion filter) or tracked this far
   /// from it; from then on tracking is depth alone until the next stop.
   double hold_release_m = 0.003;
