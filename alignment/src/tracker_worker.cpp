@@ -99,7 +99,7 @@ bool TargetFollower::coloured(const DepthImage& frame, const assets::Image* colo
   stats_.colour_shift_mm = r.colour_shift_mm;
   stats_.colour_agreement = r.colour_agreement;
   if (!r.converged) return false;
-  if (r.colour_shift_mm > 0.0) hold_ = r.T_scan_model;
+  hold_ = r.T_scan_model;
   T = r.T_scan_model;
   return true;
 }

@@ -66,9 +66,10 @@ struct WorkerConfig {
   /// has colour contrast at all). Correct poses in the twin: 0.95-0.99; the box fitted wrong from gross
   /// guesses: 0.0-0.5.
   double min_colour_agreement = 0.5;
-  /// A pose that colour moved (a stop's first, with a colour image) is held: tracking pulls towards it
-  /// (TrackerConfig::hold_prior) instead of its start, so it does not slide back along the directions
-  /// depth leaves free. Let go when the target is seen moving (the motion filter) or tracked this far
+  /// A pose that colour placed or confirmed (a stop's first, with a colour image) is held: tracking
+  /// pulls towards it (TrackerConfig::hold_prior) instead of its start, so it does not slide along the
+  /// directions depth leaves free (a face-on box, back 1.6-2.0 mm; the display's box seen from the
+  /// side, 0.6 -> 2.0 mm). Let go when the target is seen moving (the motion filter) or tracked this far
   /// from it; from then on tracking is depth alone until the next stop.
   double hold_release_m = 0.003;
   double hold_release_deg = 1.0;
@@ -122,9 +123,10 @@ class TargetFollower {
   /// frame was rejected without the target being lost yet, or a search attempt is not due. With
   /// `colour` (registered to the frame, taken before the projector lights the target), a pose found
   /// by the search is moved by colour where depth allows and refused when its colours disagree, as in
-  /// acquire(), and a moved pose is then held while the target stays still (hold_release_m).
+  /// acquire(), and the pose colour placed or confirmed is then held while the target stays still
+  /// (hold_release_m).
   std::optional<PoseSample> step(const DepthImage& frame, const assets::Image* colour = nullptr);
-  /// Whether tracking holds a pose that colour placed.
+  /// Whether tracking holds a pose that colour placed or confirmed.
   bool holding() const { return hold_.has_value(); }
   /// The search since the last guess or pose was set.
   const SearchStats& search_stats() const { return stats_; }
