@@ -497,6 +497,31 @@ TEST_F(CliTest, TourRunsTheShopInTrackingModeByDefault) {
   EXPECT_NE(r.output.find("181/181"), std::string::npos) << r.output;                  // lit all along
 }
 
+// Two targets side by side: at the duck's stop the box is lit in the same projector frames, on the
+// right of the duck (the box stands 0.6 m east of it).
+TEST_F(CliTest, TourLightsANeighbourInTheSameFrame) {
+  const CliRun r = run_projbot("tour --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/display.yaml --visits 1" +
+                               " --dwell 0.5 --report " + (dir_ / "r.json").string() + " --frames " + (dir_ / "frames").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("; neighbour box lit in 31/31 frames"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| 1 | duck | box |"), std::string::npos) << r.output;  // the neighbours table
+  std::ifstream in(dir_ / "r.json");
+  std::ostringstream json;
+  json << in.rdbuf();
+  EXPECT_NE(json.str().find("\"neighbours\": [\n        {"), std::string::npos) << json.str().substr(0, 400);
+  // The projector frame carries both: the yellow duck left of the middle, the box's white and blue right.
+  const auto image = projbot::assets::read_image(dir_ / "frames" / "visit01_duck.png");
+  std::size_t left = 0, right = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const auto* p = image.pixel(x, y);
+      if (p[0] + p[1] + p[2] < 60) continue;
+      (x < image.width * 3 / 4 ? left : right) += 1;
+    }
+  EXPECT_GT(left, 20000U);
+  EXPECT_GT(right, 20000U);
+}
+
 TEST_F(CliTest, TourPrintsTheTableAndWritesReportAndFrames) {
   const CliRun r = run_projbot("tour --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml --mode localized" +
                                " --visits 1 --report " + (dir_ / "r.json").string() + " --frames " + (dir_ / "frames").string());

@@ -527,6 +527,7 @@ TEST(TourTest, TheShopFigureOnTheFloorIsLit) {
   ASSERT_EQ(tracked.visits.size(), 1U);
   EXPECT_EQ(tracked.visits[0].lit_frames, 61);
   EXPECT_LT(tracked.visits[0].still_mean_mm, 2.0);
+  EXPECT_TRUE(tracked.visits[0].neighbours.empty());  // the shelf beside it is no target
 }
 
 // The shop's box, seen nearly face-on past a pillar: depth pinned it only loosely along its face (1.7-2.9
@@ -781,4 +782,60 @@ TEST_F(ShopDuckStop, SpectatorSeesLightFallOnTheTargetOrSpillPastIt) {
   std::size_t dim = 0;
   for (std::size_t i = 0; i < unlit.rgba.size(); i += 4) dim += unlit.rgba[i] < 0.35 * 255 ? 1 : 0;
   EXPECT_EQ(dim, unlit.rgba.size() / 4);
+}
+
+// Two targets side by side (assets/scenes/display.yaml, issue 11 item 5): from either one's stop the
+// other stands in the projector's image too. Both are acquired from the same capture and lit in the
+// same frames; in tracking mode both are tracked all along.
+TEST(TourTest, ANeighbourInViewIsTrackedAndLitWithTheVisitedTarget) {
+  const auto scene = projbot::config::load_scene(kAssets + "/scenes/display.yaml");
+  const auto tracked = tracking_tour(scene, 2, 1.0);
+  ASSERT_EQ(tracked.visits.size(), 2U);
+  for (const auto& v : tracked.visits) {
+    SCOPED_TRACE(v.target);
+    EXPECT_EQ(v.lit_frames, 61);
+    EXPECT_LT(v.still_mean_mm, 1.5);
+    ASSERT_EQ(v.neighbours.size(), 1U);
+    const auto& n = v.neighbours.front();
+    EXPECT_EQ(n.target, v.target == "duck" ? "box" : "duck");
+    EXPECT_TRUE(n.projected);
+    EXPECT_LT(n.mean_mm, 1.5);
+    EXPECT_EQ(n.frames, 61);  // arrival + 60 projector frames
+    EXPECT_EQ(n.lit_frames, 61);
+    EXPECT_LT(n.lit_mean_mm, 1.5);  // measured 0.42-0.93 (2.0 mm on the box before colour's hold)
+    EXPECT_LT(n.worst_mm, 2.0);
+  }
+  projbot::twin::TourOptions o;
+  o.visits = 2;
+  const auto localized = projbot::twin::run_tour(scene, o);
+  ASSERT_EQ(localized.visits.size(), 2U);
+  for (const auto& v : localized.visits) {
+    SCOPED_TRACE(v.target);
+    ASSERT_EQ(v.neighbours.size(), 1U);
+    EXPECT_TRUE(v.neighbours.front().projected);
+    EXPECT_EQ(v.neighbours.front().frames, 1);  // one alignment per stop, one frame
+    EXPECT_LT(v.neighbours.front().mean_mm, 1.5);
+  }
+}
+
+// The box is not on its plinth: at the duck's stop the robot still expects it there (the map), finds
+// nothing and blanks it, while the duck beside it is lit all along.
+TEST(TourTest, AnAbsentNeighbourIsBlankedOnItsOwn) {
+  std::ifstream in(kAssets + "/scenes/display.yaml");
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string from = "    model: ../models/BoxTextured/BoxTextured.gltf\n";
+  ASSERT_NE(yaml.find(from), std::string::npos);
+  yaml.replace(yaml.find(from), from.size(), from + "    present: false\n");
+  const auto report = tracking_tour(projbot::config::parse_scene(yaml, kAssets + "/scenes/display.yaml"), 1, 1.0);
+  ASSERT_EQ(report.visits.size(), 1U);
+  const auto& duck = report.visits.front();
+  EXPECT_EQ(duck.target, "duck");
+  EXPECT_EQ(duck.lit_frames, 61);
+  EXPECT_LT(duck.still_mean_mm, 1.5);
+  ASSERT_EQ(duck.neighbours.size(), 1U);
+  EXPECT_FALSE(duck.neighbours.front().projected);
+  EXPECT_EQ(duck.neighbours.front().frames, 61);
+  EXPECT_EQ(duck.neighbours.front().lit_frames, 0);
 }

@@ -3,6 +3,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <sstream>
 #include <string>
 
 #include "commands.hpp"
@@ -11,6 +12,14 @@
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
+namespace {
+std::string fixed_mm(double v) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(1) << v;
+  return s.str();
+}
+}  // namespace
+
 namespace {
 
 // What the other modes would show, printed with the tour's first line.
@@ -36,7 +45,11 @@ const Command kTour{
     "Without --scene the shipped shop runs (assets/scenes/shop.yaml, 10 x 7 m: a 1.45 m figure standing on\n"
     "the floor by a wall and a shelf, the Duck with a vase touching it, a box on a table seen nearly face-on,\n"
     "partly behind a pillar; three visits each). assets/scenes/tour.yaml is the earlier demo tour (two\n"
-    "targets on pedestals; the box is moved on its second visit), assets/scenes/motion.yaml has moving targets.\n\n"
+    "targets on pedestals; the box is moved on its second visit), assets/scenes/motion.yaml has moving targets,\n"
+    "assets/scenes/display.yaml two targets side by side.\n\n"
+    "Other targets the robot expects in the projector's view at a stop (from the map and where it believes\n"
+    "it is) are acquired from the same capture, tracked and lit in the same frames, each blanked on its own;\n"
+    "the report lists them as the visit's neighbours.\n\n"
     "Modes: tracking (the default) = MRPT localisation, robust acquisition with a quality gate (a rejected\n"
     "estimate is blanked), then the projective tracker follows the target at 30 Hz while projecting;\n"
     "localized = the same acquisition once per stop, nothing followed afterwards; odometry = the paper's\n"
@@ -92,6 +105,9 @@ const Command kTour{
         if (v.first_light_s > 0) std::cout << ", first light after " << std::setprecision(2) << v.first_light_s << " s";
         if (v.search.attempts > 0)
           std::cout << ", " << v.search.attempts << " search attempts (" << std::setprecision(0) << v.search.total_ms << " ms)";
+        for (const auto& n : v.neighbours)
+          std::cout << "; neighbour " << n.target << " lit in " << n.lit_frames << "/" << n.frames << " frames"
+                    << (n.lit_frames > 0 ? ", mean " + fixed_mm(n.lit_mean_mm) + " mm" : std::string());
         std::cout << std::endl;
       };
       const twin::TourReport report = twin::run_tour(scene, o);

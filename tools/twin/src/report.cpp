@@ -38,11 +38,46 @@ nlohmann::json matrix_json(const Eigen::Matrix4d& T) {
 
 nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
+// The other targets lit at a stop (issue 11, item 5).
+nlohmann::json neighbours_json(const std::vector<NeighbourReport>& neighbours) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& n : neighbours)
+    out.push_back({{"target", n.target},
+                   {"projected", n.projected},
+                   {"mean_mm", finite_or_null(n.mean_mm)},
+                   {"max_mm", finite_or_null(n.max_mm)},
+                   {"guess_error_cm", n.guess_error_cm},
+                   {"guess_error_deg", n.guess_error_deg},
+                   {"align_ms", n.align_ms},
+                   {"frames", n.frames},
+                   {"lit_frames", n.lit_frames},
+                   {"lit_mean_mm", finite_or_null(n.lit_mean_mm)},
+                   {"worst_mm", finite_or_null(n.worst_mm)}});
+  return out;
+}
+
 std::string fixed(double v, int decimals) {
   if (std::isnan(v)) return "-";  // nothing measured (no marker in the projector's light, no lit frame)
   std::ostringstream s;
   s << std::fixed << std::setprecision(decimals) << v;
   return s.str();
+}
+
+// The other targets in view at each stop, lit with the visited one and each blanked on its own.
+void print_neighbours(const TourReport& report, std::ostream& out) {
+  bool any = false;
+  for (const auto& v : report.visits) any = any || !v.neighbours.empty();
+  if (!any) return;
+  out << "\nNeighbours in view, lit with the visited target (each blanked on its own):\n\n| # | visited | neighbour | Eq. 1 "
+         "guess error cm / deg | at arrival mean / max mm | lit frames | mean / worst mm over them | align ms |\n"
+         "|---|---|---|---|---|---|---|---|\n";
+  for (const auto& v : report.visits)
+    for (const auto& n : v.neighbours)
+      out << "| " << v.visit << " | " << v.target << " | " << n.target << " | " << fixed(n.guess_error_cm, 1) << " / "
+          << fixed(n.guess_error_deg, 1) << " | "
+          << (n.projected ? fixed(n.mean_mm, 2) + " / " + fixed(n.max_mm, 2) : std::string("blanked")) << " | " << n.lit_frames
+          << "/" << n.frames << " | " << fixed(n.lit_mean_mm, 2) << " / " << fixed(n.worst_mm, 2) << " | " << fixed(n.align_ms, 0)
+          << " |\n";
 }
 
 }  // namespace
@@ -120,6 +155,7 @@ void print_table(const TourReport& report, std::ostream& out) {
           << " |\n";
     }
   }
+  print_neighbours(report, out);
   double simulated_s = 0.0;
   for (const auto& v : report.visits) simulated_s += v.drive_s + (v.timeline.empty() ? 0.0 : v.timeline.back().t_s);
   out << "\nTour: " << report.visits.size() << " visits in " << fixed(report.wall_s, 1) << " s wall time, "
@@ -200,6 +236,7 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
                         {"max_attempt_ms", v.search.max_attempt_ms},
                         {"frames_waited", v.search.frames_waited}}},
                       {"blank_after_removal_s", v.blank_after_removal_s},
+                      {"neighbours", neighbours_json(v.neighbours)},
                       {"timeline", timeline}});
   }
   const auto& k = report.projector;

@@ -108,6 +108,18 @@ void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twi
   }
 }
 
+// A neighbour lit with the visited target (issue 11, item 5): what the projector draws for it, and the
+// error of its lit frames so far.
+struct NeighbourLight {
+  std::size_t target = 0;  // index into Twin::targets()
+  alignment::PoseSample drawn;
+  bool shown = false;
+  int frames = 0, lit = 0;  // projector frames, and those that lit it
+  double sum_mm = 0.0, worst_mm = 0.0;
+  int measured = 0;  // lit frames with a marker in the light
+  NeighbourReport report;
+};
+
 struct DwellContext {
   Twin& twin;
   std::size_t target;
@@ -115,6 +127,7 @@ struct DwellContext {
   const robot::HeadPoses& truth;
   const TourOptions& options;
   std::uint32_t noise_seed;
+  std::vector<NeighbourLight>& neighbours;
 };
 
 // A tracker result on the simulated clock: usable by projector frames that start at or after ready_s.
@@ -123,55 +136,72 @@ struct InFlight {
   double ready_s = 0.0;
 };
 
-// The camera side of the dwell, on the simulated clock: frames captured at 30 Hz and handed to one
-// tracker worker, as in `projbot run`. A frame reaches the worker after its capture time (the twin's
-// rendering, standing in for the camera's readout); the worker takes it when it is free before the
-// next frame arrives, else the frame is dropped (the worker always takes the newest). Its result is
-// ready when the worker's step ends: measured wall time, or options.processing_ms for both together.
+// One target's tracker worker on the simulated clock (`projbot run` runs one per target).
+struct Lane {
+  alignment::TargetFollower* follower = nullptr;
+  std::deque<InFlight> in_flight;
+  double free_s = 0.0;  // when its current step ends
+  double track_ms = 0.0;
+  int tracked = 0;  // frames it took
+};
+
+// The camera side of the dwell, on the simulated clock: frames captured at 30 Hz and handed to the
+// tracker workers (the visited target's first, then its neighbours'), as in `projbot run`. A frame
+// reaches a worker after its capture time (the twin's rendering, standing in for the camera's
+// readout); a worker takes it when it is free before the next frame arrives, else the frame is dropped
+// for it (a worker always takes the newest). Its result is ready when the worker's step ends: measured
+// wall time, or options.processing_ms for both together.
 class CameraSide {
  public:
-  CameraSide(const DwellContext& c, alignment::TargetFollower& follower, VisitReport& r) : c_(c), follower_(follower), r_(r) {}
-  // Captures and tracks every frame taken up to t_s; returns the results ready by then, oldest first.
-  std::vector<alignment::PoseSample> ready_by(double t_s);
-  double track_ms = 0.0;
+  CameraSide(const DwellContext& c, const std::vector<alignment::TargetFollower*>& followers, VisitReport& r) : c_(c), r_(r) {
+    for (auto* f : followers) lanes_.push_back(Lane{f, {}, 0.0, 0.0, 0});
+  }
+  // Captures and tracks every frame taken up to t_s; returns, per lane, the results ready by then,
+  // oldest first.
+  std::vector<std::vector<alignment::PoseSample>> ready_by(double t_s);
+  const Lane& visited() const { return lanes_.front(); }
   int frames = 0;        // captured
-  int tracked = 0;       // taken by the worker
   double gone_s = -1.0;  // capture time of the first frame without the target (motion.removed)
 
  private:
   const DwellContext& c_;
-  alignment::TargetFollower& follower_;
   VisitReport& r_;
-  std::deque<InFlight> in_flight_;
-  double worker_free_s_ = 0.0;
+  std::vector<Lane> lanes_;
 };
 
-std::vector<alignment::PoseSample> CameraSide::ready_by(double t_s) {
+std::vector<std::vector<alignment::PoseSample>> CameraSide::ready_by(double t_s) {
   TwinTarget& target = c_.twin.targets()[c_.target];
   for (double t_k = (frames + 1) / kCameraHz; t_k <= t_s + 1e-9; t_k = (frames + 1) / kCameraHz) {
     ++frames;
     target.T_world_target_true = c_.twin.scripted_pose(c_.target, r_.target_visit, t_k);
     target.in_world = c_.twin.scripted_presence(c_.target, r_.target_visit, t_k);
     if (!target.in_world && r_.target_present && gone_s < 0.0) gone_s = t_k;
-    if (worker_free_s_ > t_k + 1.0 / kCameraHz) continue;  // still busy when the next frame comes: dropped
+    const double next_s = t_k + 1.0 / kCameraHz;
+    if (std::none_of(lanes_.begin(), lanes_.end(), [&](const Lane& l) { return l.free_s <= next_s; })) continue;
     const auto t0 = Clock::now();
     alignment::DepthImage frame =
         c_.twin.capture(c_.truth.T_world_camera.matrix(), c_.noise_seed + static_cast<std::uint32_t>(frames));
     frame.capture_time_s = t_k;  // the exposure, on the simulated clock
     const double capture_ms = ms_since(t0);
-    const auto tt = Clock::now();
-    InFlight f{follower_.step(frame), 0.0};
-    const double step_ms = ms_since(tt);
-    track_ms += step_ms;
-    ++tracked;
-    const double start_s = std::max(worker_free_s_, t_k + (c_.options.processing_ms ? 0.0 : 1e-3 * capture_ms));
-    f.ready_s = worker_free_s_ = start_s + 1e-3 * c_.options.processing_ms.value_or(step_ms);
-    in_flight_.push_back(std::move(f));
+    for (Lane& l : lanes_) {
+      if (l.free_s > next_s) continue;  // still busy when the next frame comes: dropped
+      const auto tt = Clock::now();
+      InFlight f{l.follower->step(frame), 0.0};
+      const double step_ms = ms_since(tt);
+      l.track_ms += step_ms;
+      ++l.tracked;
+      const double start_s = std::max(l.free_s, t_k + (c_.options.processing_ms ? 0.0 : 1e-3 * capture_ms));
+      f.ready_s = l.free_s = start_s + 1e-3 * c_.options.processing_ms.value_or(step_ms);
+      l.in_flight.push_back(std::move(f));
+    }
   }
-  std::vector<alignment::PoseSample> out;
-  while (!in_flight_.empty() && in_flight_.front().ready_s <= t_s + 1e-9) {
-    if (in_flight_.front().sample) out.push_back(*in_flight_.front().sample);
-    in_flight_.pop_front();
+  std::vector<std::vector<alignment::PoseSample>> out(lanes_.size());
+  for (std::size_t k = 0; k < lanes_.size(); ++k) {
+    auto& q = lanes_[k].in_flight;
+    while (!q.empty() && q.front().ready_s <= t_s + 1e-9) {
+      if (q.front().sample) out[k].push_back(*q.front().sample);
+      q.pop_front();
+    }
   }
   return out;
 }
@@ -196,6 +226,22 @@ TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double
   s.mean_mm = e.mean_mm;
   s.max_mm = e.max_mm;
   return s;
+}
+
+// A neighbour's projector frame: counted, and its error measured at display time when it is lit
+// (neighbours stand still: their motion scripts run on their own visits).
+void measure_neighbour(const DwellContext& c, NeighbourLight& n, double display_s) {
+  ++n.frames;
+  if (!n.shown) return;
+  ++n.lit;
+  const Eigen::Matrix4d T_camera_target =
+      c.options.predict ? alignment::predict_pose(n.drawn.motion, display_s) : n.drawn.T_camera_target;
+  const Errors e = marker_errors(c.twin, n.target, c.projector, c.truth.T_world_projector.matrix(),
+                                 alignment::projector_from_target(c.twin.scene().pan_tilt.T_projector_camera, T_camera_target));
+  if (std::isnan(e.mean_mm)) return;
+  n.sum_mm += e.mean_mm;
+  n.worst_mm = std::max(n.worst_mm, e.mean_mm);
+  ++n.measured;
 }
 
 void summarise_timeline(VisitReport& r) {
@@ -238,7 +284,7 @@ void summarise_timeline(VisitReport& r) {
 // its frame starts, predicted to the frame's display time (one refresh later, plus the projector's
 // input lag). Each projector frame's error is measured against the target's true pose at its display
 // time. Returns false when the tour was asked to stop in the middle.
-bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitReport& r) {
+bool dwell(const DwellContext& c, const std::vector<alignment::TargetFollower*>& followers, VisitReport& r) {
   const TwinTarget& target = c.twin.targets()[c.target];
   const bool tracking = c.options.mode == TourMode::tracking;
   const double period_s = 1.0 / c.projector.refresh_hz;
@@ -246,7 +292,7 @@ bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitRepo
   alignment::PoseSample drawn;  // the newest result: at first the arrival's estimate
   drawn.T_camera_target = drawn.motion.T = r.icp.T_scan_model;
   bool shown = r.projected;
-  CameraSide camera(c, follower, r);
+  CameraSide camera(c, followers, r);
   double wall_to_light_ms = r.align_ms;
   const config::TargetMotion* motion = target.config.motion_on(r.target_visit);
   const double motion_end_s = motion ? motion->end_s() : 0.0;
@@ -257,14 +303,21 @@ bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitRepo
     if (c.options.stop_requested && c.options.stop_requested()) return false;
     const double start_s = j * period_s;
     if (tracking) {
-      const double before_ms = camera.track_ms;
-      for (const auto& sample : camera.ready_by(start_s)) {
+      const double before_ms = camera.visited().track_ms;
+      const auto ready = camera.ready_by(start_s);
+      for (const auto& sample : ready.front()) {
         shown = !sample.lost;
         if (shown) drawn = sample;
       }
-      if (r.first_light_s < 0.0) wall_to_light_ms += camera.track_ms - before_ms;
+      for (std::size_t k = 0; k < c.neighbours.size(); ++k)
+        for (const auto& sample : ready[k + 1]) {
+          c.neighbours[k].shown = !sample.lost;
+          if (!sample.lost) c.neighbours[k].drawn = sample;
+        }
+      if (r.first_light_s < 0.0) wall_to_light_ms += camera.visited().track_ms - before_ms;
     }
     const TimelineSample s = measure_frame(c, r, start_s + display_delay_s, shown, drawn, c.options.predict);
+    for (NeighbourLight& n : c.neighbours) measure_neighbour(c, n, start_s + display_delay_s);
     r.timeline.push_back(s);
     r.lit_frames += shown ? 1 : 0;
     if (shown && r.first_light_s < 0.0) {
@@ -284,13 +337,59 @@ bool dwell(const DwellContext& c, alignment::TargetFollower& follower, VisitRepo
   }
   r.shown_at_end = shown;
   r.T_camera_target_at_end = drawn.T_camera_target;
-  r.track_ms_mean = tracking && camera.tracked > 0 ? camera.track_ms / camera.tracked : 0.0;
-  r.tracked_frames = camera.tracked;
-  r.dropped_frames = camera.frames - camera.tracked;
-  if (tracking) r.search = follower.search_stats();
+  const Lane& lane = camera.visited();
+  r.track_ms_mean = tracking && lane.tracked > 0 ? lane.track_ms / lane.tracked : 0.0;
+  r.tracked_frames = lane.tracked;
+  r.dropped_frames = camera.frames - lane.tracked;
+  if (tracking) r.search = followers.front()->search_stats();
   r.reconverge_s = !ever_over ? 0.0 : back_under >= 0.0 ? std::max(0.0, back_under - motion_end_s) : -1.0;
   summarise_timeline(r);
   return true;
+}
+
+// A neighbour at arrival: acquired from the stop's capture (and colour) from its own Eq. 1 guess, as
+// the visited target is, and its error at the markers measured.
+NeighbourLight acquire_neighbour(TourMode mode, const Twin& twin, alignment::TargetFollower& follower, const Neighbour& n,
+                                 const Arrival& arrival, const alignment::DepthImage& depth,
+                                 const std::optional<assets::Image>& colour) {
+  const TwinTarget& t = twin.targets()[n.target];
+  VisitReport scratch;
+  acquire(mode, follower, twin, depth, n.T_camera_target_guess,
+          alignment::footing_in_camera(t.cloud, n.T_map_target, arrival.believed.T_world_camera.matrix()),
+          colour ? &*colour : nullptr, scratch);
+  NeighbourLight l;
+  l.target = n.target;
+  l.shown = scratch.projected;
+  l.drawn.T_camera_target = l.drawn.motion.T = scratch.icp.T_scan_model;
+  NeighbourReport& r = l.report;
+  r.target = t.config.name;
+  r.projected = scratch.projected;
+  r.align_ms = scratch.align_ms;
+  const Eigen::Matrix4d T_camera_true = alignment::rigid_inverse(arrival.truth.T_world_camera.matrix()) * t.T_world_target_true;
+  const Eigen::Matrix4d guess_error = alignment::rigid_inverse(T_camera_true) * n.T_camera_target_guess;
+  r.guess_error_cm = 100.0 * alignment::translation_norm_m(guess_error);
+  r.guess_error_deg = alignment::rotation_angle_deg(guess_error);
+  const Errors e =
+      marker_errors(twin, n.target, twin.scene().projector, arrival.truth.T_world_projector.matrix(),
+                    alignment::projector_from_target(twin.scene().pan_tilt.T_projector_camera, scratch.icp.T_scan_model));
+  r.mean_mm = e.mean_mm;
+  r.max_mm = e.max_mm;
+  ++l.frames;
+  if (l.shown) ++l.lit;
+  if (l.shown && !std::isnan(e.mean_mm)) {
+    l.sum_mm += e.mean_mm;
+    l.worst_mm = e.mean_mm;
+    ++l.measured;
+  }
+  return l;
+}
+
+// A neighbour after the stop: its projector frames, lit ones, and their error.
+void finish_neighbour(const NeighbourLight& l, NeighbourReport& r) {
+  r.frames = l.frames;
+  r.lit_frames = l.lit;
+  r.lit_mean_mm = l.measured > 0 ? l.sum_mm / l.measured : std::nan("");
+  r.worst_mm = l.measured > 0 ? l.worst_mm : std::nan("");
 }
 
 // Where --frames writes one of a visit's pictures: DIR/visitNN_TARGET<suffix>.png.
@@ -381,10 +480,15 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     r.odometry_error_cm = 100.0 * arrival.drive.odometry_error_m;
     const robot::HeadPoses& truth = arrival.truth;
     // A visitor beside the robot, looking at the target where it truly stands now.
-    // The projector's frame: the target drawn at T_projector_target when lit, else all black.
+    // The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else all black.
+    std::vector<NeighbourLight> lights;
     const auto projector_image = [&](bool lit, const Eigen::Matrix4d& T_projector_target) {
       std::vector<engine::DrawItem> items;
       if (lit) items.push_back({twin.target_model_ids()[i], T_projector_target});
+      for (const NeighbourLight& n : lights)
+        if (n.shown)
+          items.push_back({twin.target_model_ids()[n.target],
+                           alignment::projector_from_target(rig.T_projector_camera, n.drawn.T_camera_target)});
       renderer.draw_frame(*projector_frame, scene.projector, items);
       return projector_frame->read_back();
     };
@@ -419,6 +523,10 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     r.markers = e.markers;
     r.mean_mm = e.mean_mm;
     r.max_mm = e.max_mm;
+    for (const Neighbour& n : twin.neighbours(i, arrival)) {
+      lights.push_back(acquire_neighbour(options.mode, twin, followers[n.target], n, arrival, depth, colour));
+      r.neighbours.push_back(lights.back().report);
+    }
 
     if (projector_frame) {
       t0 = Clock::now();
@@ -436,8 +544,12 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     // Projecting: the target may be moved or taken away; the tracker (tracking mode) follows it at
     // camera rate, and a lost or missing target is searched for within the follower's budget.
     r.moved = target.config.motion_on(r.target_visit) != nullptr;
-    if (options.mode == TourMode::tracking || r.moved)
-      report.interrupted = !dwell(DwellContext{twin, i, scene.projector, truth, options, noise_seed}, followers[i], r);
+    if (options.mode == TourMode::tracking || r.moved) {
+      std::vector<alignment::TargetFollower*> lanes{&followers[i]};
+      for (const NeighbourLight& n : lights) lanes.push_back(&followers[n.target]);
+      report.interrupted = !dwell(DwellContext{twin, i, scene.projector, truth, options, noise_seed, lights}, lanes, r);
+    }
+    for (std::size_t k = 0; k < lights.size(); ++k) finish_neighbour(lights[k], r.neighbours[k]);
     if (spectator && r.moved && !report.interrupted) {
       // A moved target: what the visitor sees at the end of the dwell, where the target went and where
       // the light went (followed, or left where the target was).

@@ -9,6 +9,7 @@
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
+#include "projbot/engine/projection.hpp"
 
 namespace projbot::twin {
 namespace {
@@ -184,6 +185,34 @@ Arrival Twin::arrive(std::size_t target, int index) {
   a.believed = robot::head_poses(robot_->believed_pose(), reported, scene_.pan_tilt);
   a.T_camera_target_guess = alignment::camera_from_target_initial(a.believed.T_world_camera.matrix(), a.T_map_target);
   return a;
+}
+
+std::vector<Neighbour> Twin::neighbours(std::size_t target, const Arrival& arrival) const {
+  const Eigen::Matrix4d T_camera_world = alignment::rigid_inverse(arrival.believed.T_world_camera.matrix());
+  const Eigen::Matrix4d T_projector_world = alignment::rigid_inverse(arrival.believed.T_world_projector.matrix());
+  const config::ProjectorConfig camera = camera_pinhole();
+  const auto inside = [](const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
+    if (p.z() < 0.3 || p.z() > 5.0) return false;
+    const Eigen::Vector2d x = engine::project_to_pixel(k, p);
+    return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < k.width_px && x.y() < k.height_px;
+  };
+  std::vector<Neighbour> out;
+  std::vector<double> range;
+  for (std::size_t j = 0; j < targets_.size(); ++j) {
+    if (j == target) continue;
+    const Eigen::Vector4d middle = surveyed_middle(j).homogeneous();
+    const Eigen::Vector3d in_camera = (T_camera_world * middle).head<3>();
+    if (!inside(camera, in_camera) || !inside(scene_.projector, (T_projector_world * middle).head<3>())) continue;
+    const TwinTarget& t = targets_[j];
+    Neighbour n;
+    n.target = j;
+    n.T_map_target = t.config.T_map_target.value_or(*t.config.T_world_target);
+    n.T_camera_target_guess = alignment::camera_from_target_initial(arrival.believed.T_world_camera.matrix(), n.T_map_target);
+    const auto at = std::upper_bound(range.begin(), range.end(), in_camera.z());
+    out.insert(out.begin() + (at - range.begin()), n);
+    range.insert(at, in_camera.z());
+  }
+  return out;
 }
 
 double motion_fraction(config::MotionProfile profile, double x) {

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <iosfwd>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,6 +61,19 @@ struct TimelineSample {
   bool in_world = true;  ///< the target was there (not carried away)
 };
 
+/// A target that shared the view at a stop besides the visited one (issue 11, item 5): acquired from
+/// the same capture, tracked with the visited one in tracking mode, and lit or blanked on its own.
+struct NeighbourReport {
+  std::string target;
+  bool projected = false;                                         ///< lit at arrival
+  double mean_mm = 0.0, max_mm = 0.0;                             ///< at arrival; NaN when no marker is in the light
+  double guess_error_cm = 0.0, guess_error_deg = 0.0;             ///< its Eq. 1 guess vs truth
+  double align_ms = 0.0;                                          ///< wall time of its acquisition
+  int lit_frames = 0, frames = 0;                                 ///< projector frames, the arrival's included
+  double lit_mean_mm = std::numeric_limits<double>::quiet_NaN();  ///< over its lit frames (the arrival's included)
+  double worst_mm = std::numeric_limits<double>::quiet_NaN();     ///< the worst of those frames' means
+};
+
 struct VisitReport {
   int visit = 0;         ///< 1-based, over the tour
   int target_visit = 0;  ///< 1-based, this target's n-th visit
@@ -107,6 +121,7 @@ struct VisitReport {
   /// motion.removed: seconds from the first depth frame without the target to the first blank
   /// projector frame; -1 when it was never blanked (or nothing was removed).
   double blank_after_removal_s = -1.0;
+  std::vector<NeighbourReport> neighbours;  ///< other targets in view at this stop, nearest first
 };
 
 struct TourReport {

@@ -62,6 +62,14 @@ struct Arrival {
   Eigen::Matrix4d T_camera_target_guess = Eigen::Matrix4d::Identity();
 };
 
+/// A target besides the visited one that the robot believes shares the view at a stop (issue 11,
+/// item 5): it is acquired, tracked and lit with the visited one, and blanks on its own.
+struct Neighbour {
+  std::size_t target = 0;                                               ///< index into Twin::targets()
+  Eigen::Matrix4d T_map_target = Eigen::Matrix4d::Identity();           ///< as surveyed
+  Eigen::Matrix4d T_camera_target_guess = Eigen::Matrix4d::Identity();  ///< Eq. 1 from the believed head
+};
+
 class Twin {
  public:
   /// Loads every target's model, checks the tour sections and markers, builds the room map and the
@@ -82,6 +90,11 @@ class Twin {
   /// Drives to the target's stop (`index` goes into the report), aims the pan-tilt at the target's
   /// surveyed position from where the robot believes it is, and takes Eq. 1's initial guess.
   Arrival arrive(std::size_t target, int index);
+
+  /// The other targets the robot believes it sees at this stop, from the map and its believed head:
+  /// a target's surveyed middle 0.3-5 m in front of the camera, inside the camera's image and the
+  /// projector's. Nearest first.
+  std::vector<Neighbour> neighbours(std::size_t target, const Arrival& arrival) const;
 
   /// The target's pose `t_s` into a projection during its `target_visit`-th visit (motion script);
   /// visit 0 is where it stands between visits.
