@@ -615,6 +615,23 @@ TEST_F(CliTest, RunMeasuresTheErrorAtDisplayTime) {
   EXPECT_LT(std::stod(r.output.substr(still + 11)), 2.0) << r.output;
 }
 
+// run lights the neighbour in view with the visited target (assets/scenes/display.yaml: the box beside
+// the duck), each from its own tracker worker.
+TEST_F(CliTest, RunLightsANeighbourInTheSameFrames) {
+  const CliRun r =
+      run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) + "/scenes/display.yaml --visits 1 --dwell 2");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string key = " frames lit a neighbour too";
+  const auto at = r.output.find(key);
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const auto from = r.output.rfind("; ", at);
+  ASSERT_NE(from, std::string::npos);
+  EXPECT_GT(std::stoi(r.output.substr(from + 2)), 60) << r.output;  // of about 120 frames in the 2 s dwell
+  const auto still = r.output.find("still mean ");
+  ASSERT_NE(still, std::string::npos) << r.output;
+  EXPECT_LT(std::stod(r.output.substr(still + 11)), 2.5) << r.output;  // both targets' frames
+}
+
 // bench acquire through the executable, one trial per target on the demo tour: a row per target, kind
 // of guess and method, and the duck acquired from a 5 cm / 10 degree guess without a false accept.
 TEST_F(CliTest, BenchAcquireReportsEveryTargetAndMethod) {

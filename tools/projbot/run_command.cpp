@@ -30,17 +30,23 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double now_s() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
 
-// What the robot thread tells the render thread: which target the robot is projecting onto (-1 while
-// it drives) and since when; poses captured before that belong to an earlier stop.
+// A target the robot projects onto at a stop: the visited one, or a neighbour it expects in the
+// projector's view there (issue 11, item 5).
+struct LitTarget {
+  int target = -1;  // scene index: its worker and draw item
+  // The twin's truth, so the render thread can measure each frame at its display time:
+  int target_visit = 0;                                        // this target's n-th visit (its motion script); 0: still
+  Eigen::Matrix4d T_world_home = Eigen::Matrix4d::Identity();  // where it stood when the stop began
+};
+
+// What the robot thread tells the render thread: which targets the robot is projecting onto (none while
+// it drives; the visited one first) and since when; poses captured before that belong to an earlier stop.
 struct RobotState {
-  int target = -1;
+  std::vector<LitTarget> lit;
   double since_s = 0.0;
   int visit = 0;
   bool done = false;
-  // The twin's truth for the stop, so the render thread can measure each frame at its display time:
-  int target_visit = 0;                                          // this target's n-th visit (its motion script)
-  Eigen::Matrix4d T_camera_world = Eigen::Matrix4d::Identity();  // the camera's true pose at the stop
-  Eigen::Matrix4d T_world_home = Eigen::Matrix4d::Identity();    // where the target stood when the stop began
+  Eigen::Matrix4d T_camera_world = Eigen::Matrix4d::Identity();  // the camera's true pose at the stop (twin)
 };
 
 // The projector's frame period as the render loop sees it: the median interval between the last frame
@@ -82,13 +88,13 @@ struct DisplayErrors {
 
 // The mean marker error of a target drawn at T_camera_target, against the twin's truth at display_s.
 // Returns NaN for a target without markers; sets `moving` when its motion script runs at that instant.
-double marker_error_mm(const config::TargetConfig& target, const RobotState& robot, const Eigen::Matrix4d& T_camera_target,
-                       double display_s, bool& moving) {
+double marker_error_mm(const config::TargetConfig& target, const RobotState& robot, const LitTarget& lit,
+                       const Eigen::Matrix4d& T_camera_target, double display_s, bool& moving) {
   const double t = display_s - robot.since_s;
-  const config::TargetMotion* m = target.motion_on(robot.target_visit);
+  const config::TargetMotion* m = target.motion_on(lit.target_visit);
   moving = m && m->moving_at(t);
   if (target.markers_m.empty()) return std::nan("");
-  const Eigen::Matrix4d T_true = robot.T_camera_world * twin::scripted_pose(target, robot.T_world_home, robot.target_visit, t);
+  const Eigen::Matrix4d T_true = robot.T_camera_world * twin::scripted_pose(target, lit.T_world_home, lit.target_visit, t);
   double sum = 0.0;
   for (const auto& p : target.markers_m)
     sum += ((T_camera_target * p.homogeneous()).head<3>() - (T_true * p.homogeneous()).head<3>()).norm();
@@ -114,15 +120,21 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
   for (int v = 0; v < visits && !stop.stop_requested(); ++v) {
     const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
     const std::size_t i = twin.target_index(name);
-    const auto scene_index = static_cast<std::size_t>(scene.target_index(name));  // workers and draw items
-    state.publish({.target = -1, .since_s = now_s(), .visit = v + 1});
+    state.publish({.lit = {}, .since_s = now_s(), .visit = v + 1});
     const twin::Arrival arrival = twin.arrive(i, v);
     const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
-    workers[scene_index]->set_initial_guess(arrival.T_camera_target_guess);  // Eq. 1
     const int target_visit = ++count[i];
+    // The visited target, then the others the robot expects in the projector's view: each from its own
+    // Eq. 1 guess, tracked by its own worker, lit or blanked on its own.
+    std::vector<LitTarget> lit{{scene.target_index(name), target_visit, twin.home(i)}};
+    std::vector<Eigen::Matrix4d> guesses{arrival.T_camera_target_guess};
+    for (const twin::Neighbour& n : twin.neighbours(i, arrival)) {
+      lit.push_back({scene.target_index(targets[n.target].config.name), 0, twin.home(n.target)});
+      guesses.push_back(n.T_camera_target_guess);
+    }
+    for (std::size_t k = 0; k < lit.size(); ++k) workers[static_cast<std::size_t>(lit[k].target)]->set_initial_guess(guesses[k]);
     const double since = now_s();
-    state.publish({static_cast<int>(scene_index), since, v + 1, false, target_visit, alignment::rigid_inverse(T_world_camera),
-                   twin.home(i)});
+    state.publish({lit, since, v + 1, false, alignment::rigid_inverse(T_world_camera)});
     auto tick = Clock::now();
     for (std::uint32_t k = 0; !stop.stop_requested(); ++k) {
       const double t = now_s() - since;
@@ -135,14 +147,14 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
       // rendering counts in the pose's age, as a real camera's readout and transfer would.
       frame->capture_time_s = captured;
       capture_ms.push_back(1000.0 * (now_s() - captured));
-      workers[scene_index]->submit(std::move(frame));
+      for (const LitTarget& l : lit) workers[static_cast<std::size_t>(l.target)]->submit(frame);
       tick += std::chrono::microseconds(33333);  // 30 Hz, like the Kinect
       std::this_thread::sleep_until(tick);
       if (Clock::now() > tick + std::chrono::milliseconds(100)) tick = Clock::now();  // fell behind: do not burst
     }
     twin.end_visit(i, target_visit);
   }
-  state.publish({.target = -1, .since_s = now_s(), .visit = visits, .done = true});
+  state.publish({.lit = {}, .since_s = now_s(), .visit = visits, .done = true});
 }
 
 }  // namespace
@@ -153,7 +165,8 @@ const Command kRun{
     "projbot run [--config C.yaml] [--sim] [--fullscreen] [--monitor N] [--headless] [--profile p.csv]\n"
     "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n"
     "            [--no-predict]\n\n"
-    "Opens the projector output and draws, every frame, each target the robot is projecting onto at the\n"
+    "Opens the projector output and draws, every frame, each target the robot is projecting onto (the\n"
+    "visited one and the others it expects in the projector's view at that stop) at the\n"
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
     "expected display time (one frame period as measured, plus the projector's input_lag_ms); targets not\n"
     "yet found or lost are blanked.\n"
@@ -243,31 +256,35 @@ const Command kRun{
         int target;
       };
       std::vector<Row> rows;
+      struct Drawn {  // a target drawn in this frame: from which capture, for which display time, where
+        const LitTarget* lit;
+        double capture_s, display_s;
+        Eigen::Matrix4d T_camera_target;
+      };
       RobotState robot;
       const double t0 = now_s();
-      std::size_t blank = 0;
+      std::size_t blank = 0, frames_with_neighbours = 0;
       auto next_frame = Clock::now();
       while (!interrupted() && !target->poll_close() && !robot_done && (seconds == 0.0 || now_s() - t0 < seconds)) {
-        double used_capture = -1.0, used_display = 0.0;
-        Eigen::Matrix4d used_pose = Eigen::Matrix4d::Identity();
         state.read(robot);
+        std::vector<Drawn> drawn;  // this frame's lit targets, the visited one first
         const auto read_poses = [&](std::vector<engine::DrawItem>& out) {
           out.clear();
-          if (robot.target < 0) return;
-          alignment::PoseSample pose;
-          auto& worker = *workers[static_cast<std::size_t>(robot.target)];
-          if (!worker.latest(pose) || pose.lost || pose.capture_time_s < robot.since_s) return;
-          // Drawn where the target will be when this frame is lit: one frame period after it starts (FIFO
+          drawn.clear();
+          // Drawn where each target will be when this frame is lit: one frame period after it starts (FIFO
           // presents at the next vblank; the period as measured) plus the projector's input lag (issue 14).
           const double display_s =
               now_s() + cadence.period_s(1.0 / scene.projector.refresh_hz) + 1e-3 * scene.projector.input_lag_ms;
-          const Eigen::Matrix4d T_camera_target =
-              predict ? alignment::predict_pose(pose.motion, display_s) : pose.T_camera_target;
-          out.push_back({items[static_cast<std::size_t>(robot.target)].model,
-                         alignment::projector_from_target(scene.pan_tilt.T_projector_camera, T_camera_target)});  // Eq. 2
-          used_capture = pose.capture_time_s;
-          used_display = display_s;
-          used_pose = T_camera_target;
+          for (const LitTarget& lit : robot.lit) {
+            alignment::PoseSample pose;
+            auto& worker = *workers[static_cast<std::size_t>(lit.target)];
+            if (!worker.latest(pose) || pose.lost || pose.capture_time_s < robot.since_s) continue;  // blanked on its own
+            const Eigen::Matrix4d T_camera_target =
+                predict ? alignment::predict_pose(pose.motion, display_s) : pose.T_camera_target;
+            out.push_back({items[static_cast<std::size_t>(lit.target)].model,
+                           alignment::projector_from_target(scene.pan_tilt.T_projector_camera, T_camera_target)});  // Eq. 2
+            drawn.push_back({&lit, pose.capture_time_s, display_s, T_camera_target});
+          }
         };
         if (headless) {  // an offscreen target has no vsync: pace it like a 60 Hz projector
           next_frame += std::chrono::microseconds(16667);
@@ -277,22 +294,28 @@ const Command kRun{
         const double start_ms = profiler.now_ms(), start_s = now_s();
         cadence.frame_started(start_s);
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
-        // The pose's age when the frame is lit: capture to the expected display time.
-        const double age_ms = used_capture >= 0.0 ? 1000.0 * (std::max(now_s(), used_display) - used_capture) : -1.0;
-        double error_mm = std::nan("");
-        if (age_ms >= 0.0) {
-          ages_ms.push_back(age_ms);
-          bool moving = false;
-          error_mm =
-              marker_error_mm(scene.targets[static_cast<std::size_t>(robot.target)], robot, used_pose, used_display, moving);
-          if (!std::isnan(error_mm)) (moving ? errors.moving_mm : errors.still_mm).push_back(error_mm);
-        } else {
-          ++blank;
-        }
         const double nan = std::nan("");
-        rows.push_back({start_ms, age_ms, age_ms >= 0.0 ? start_ms + 1000.0 * (used_capture - start_s) : nan,
-                        age_ms >= 0.0 ? start_ms + 1000.0 * (used_display - start_s) : nan, error_mm,
-                        age_ms >= 0.0 ? robot.target : -1});
+        if (drawn.empty()) {
+          ++blank;
+          rows.push_back({start_ms, -1.0, nan, nan, nan, -1});
+          continue;
+        }
+        // Each lit target's error against the twin's truth at the display time; the row (and the pose's
+        // age, capture to the expected display time) is the first drawn one's.
+        std::vector<double> row_error;
+        for (const Drawn& d : drawn) {
+          bool moving = false;
+          const double e = marker_error_mm(scene.targets[static_cast<std::size_t>(d.lit->target)], robot, *d.lit,
+                                           d.T_camera_target, d.display_s, moving);
+          if (!std::isnan(e)) (moving ? errors.moving_mm : errors.still_mm).push_back(e);
+          row_error.push_back(e);
+        }
+        if (drawn.size() > 1) ++frames_with_neighbours;
+        const Drawn& first = drawn.front();
+        const double age_ms = 1000.0 * (std::max(now_s(), first.display_s) - first.capture_s);
+        ages_ms.push_back(age_ms);
+        rows.push_back({start_ms, age_ms, start_ms + 1000.0 * (first.capture_s - start_s),
+                        start_ms + 1000.0 * (first.display_s - start_s), row_error.front(), first.lit->target});
       }
       renderer.finish(*target);
       robot_thread.request_stop();
@@ -305,7 +328,9 @@ const Command kRun{
       std::cout << std::fixed << std::setprecision(1) << "pose age at display (depth capture to expected display), "
                 << ages_ms.size() << " frames with a target: p50 " << engine::percentile(ages_ms, 0.5) << " ms, p95 "
                 << engine::percentile(ages_ms, 0.95) << " ms, p99 " << engine::percentile(ages_ms, 0.99) << " ms, max "
-                << engine::percentile(ages_ms, 1.0) << " ms; " << blank << " frames blank (driving, acquiring or lost)\n";
+                << engine::percentile(ages_ms, 1.0) << " ms; " << blank << " frames blank (driving, acquiring or lost)";
+      if (frames_with_neighbours > 0) std::cout << "; " << frames_with_neighbours << " frames lit a neighbour too";
+      std::cout << "\n";
       errors.print(std::cout);
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
