@@ -632,6 +632,20 @@ TEST_F(CliTest, RunLightsANeighbourInTheSameFrames) {
   EXPECT_LT(std::stod(r.output.substr(still + 11)), 2.5) << r.output;  // both targets' frames
 }
 
+// run in the shop: each worker starts a stop with the target's footing and the colour taken on arrival,
+// as the tour does; the face-on box slid 2.9 mm along its face on depth alone (all frames: 1.1 mm).
+TEST_F(CliTest, RunPlacesTheShopTargetsWithFootingAndColour) {
+  const CliRun r =
+      run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) + "/scenes/shop.yaml --visits 3 --dwell 2");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto still = r.output.find("still mean ");
+  ASSERT_NE(still, std::string::npos) << r.output;
+  EXPECT_LT(std::stod(r.output.substr(still + 11)), 0.8) << r.output;  // measured 0.4
+  const auto over = r.output.find(" mm over ", still);
+  ASSERT_NE(over, std::string::npos);
+  EXPECT_GT(std::stoi(r.output.substr(over + 9)), 200) << r.output;  // of about 360 frames: all three lit
+}
+
 // bench acquire through the executable, one trial per target on the demo tour: a row per target, kind
 // of guess and method, and the duck acquired from a 5 cm / 10 degree guess without a false accept.
 TEST_F(CliTest, BenchAcquireReportsEveryTargetAndMethod) {

@@ -309,7 +309,14 @@ void TrackerWorker::submit(std::shared_ptr<const DepthImage> frame) {
 void TrackerWorker::set_initial_guess(const Eigen::Matrix4d& T_camera_target) {
   if (!T_camera_target.allFinite()) throw AlignmentError("initial guess is not finite");
   std::lock_guard lock(mutex_);
-  guess_ = T_camera_target;
+  guess_ = Start{T_camera_target, std::nullopt, nullptr};
+}
+
+void TrackerWorker::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing,
+                                      std::shared_ptr<const assets::Image> colour) {
+  if (!T_camera_target.allFinite()) throw AlignmentError("initial guess is not finite");
+  std::lock_guard lock(mutex_);
+  guess_ = Start{T_camera_target, footing, std::move(colour)};
 }
 
 std::exception_ptr TrackerWorker::error() const {
@@ -319,6 +326,7 @@ std::exception_ptr TrackerWorker::error() const {
 
 void TrackerWorker::run(std::stop_token stop) {
   std::uint64_t sequence = 0;
+  std::shared_ptr<const assets::Image> colour;  // the stop's arrival colour, until its first frame
   try {
     while (!stop.stop_requested()) {
       std::shared_ptr<const DepthImage> frame;
@@ -326,14 +334,21 @@ void TrackerWorker::run(std::stop_token stop) {
         std::unique_lock lock(mutex_);
         if (!wake_.wait(lock, stop, [&] { return inbox_ != nullptr || guess_.has_value(); })) break;
         if (guess_) {  // a new stop: acquire afresh from Eq. 1's guess
-          follower_.set_initial_guess(*guess_);
+          if (guess_->footing)
+            follower_.set_initial_guess(guess_->T_camera_target, *guess_->footing);
+          else
+            follower_.set_initial_guess(guess_->T_camera_target);
+          colour = std::move(guess_->colour);
           guess_.reset();
         }
         frame = std::move(inbox_);
       }
       if (!frame) continue;
       ++processed_;
-      if (auto sample = follower_.step(*frame)) {
+      // The arrival's colour serves the stop's first frame only: later the projector lights the target.
+      auto sample = follower_.step(*frame, colour.get());
+      colour.reset();
+      if (sample) {
         sample->sequence = ++sequence;
         poses_.publish(*sample);
       }

@@ -126,13 +126,19 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
     const int target_visit = ++count[i];
     // The visited target, then the others the robot expects in the projector's view: each from its own
     // Eq. 1 guess, tracked by its own worker, lit or blanked on its own.
-    std::vector<LitTarget> lit{{scene.target_index(name), target_visit, twin.home(i)}};
-    std::vector<Eigen::Matrix4d> guesses{arrival.T_camera_target_guess};
-    for (const twin::Neighbour& n : twin.neighbours(i, arrival)) {
-      lit.push_back({scene.target_index(targets[n.target].config.name), 0, twin.home(n.target)});
-      guesses.push_back(n.T_camera_target_guess);
-    }
-    for (std::size_t k = 0; k < lit.size(); ++k) workers[static_cast<std::size_t>(lit[k].target)]->set_initial_guess(guesses[k]);
+    // Each also gets its surveyed footing and the colour taken on arrival, before any light.
+    const Eigen::Matrix4d T_world_believed = arrival.believed.T_world_camera.matrix();
+    const auto colour =
+        std::make_shared<const assets::Image>(twin.capture_colour(T_world_camera, static_cast<std::uint32_t>(o.seed * 7919 + v)));
+    const auto start = [&](std::size_t twin_index, const Eigen::Matrix4d& T_map_target, const Eigen::Matrix4d& guess) {
+      const int s = scene.target_index(targets[twin_index].config.name);
+      workers[static_cast<std::size_t>(s)]->set_initial_guess(
+          guess, alignment::footing_in_camera(targets[twin_index].cloud, T_map_target, T_world_believed), colour);
+      return s;
+    };
+    std::vector<LitTarget> lit{{start(i, arrival.T_map_target, arrival.T_camera_target_guess), target_visit, twin.home(i)}};
+    for (const twin::Neighbour& n : twin.neighbours(i, arrival))
+      lit.push_back({start(n.target, n.T_map_target, n.T_camera_target_guess), 0, twin.home(n.target)});
     const double since = now_s();
     state.publish({lit, since, v + 1, false, alignment::rigid_inverse(T_world_camera)});
     auto tick = Clock::now();
@@ -170,8 +176,9 @@ const Command kRun{
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
     "expected display time (one frame period as measured, plus the projector's input_lag_ms); targets not\n"
     "yet found or lost are blanked.\n"
-    "The robot thread drives the tour of the config's `tour.visits`, aims the pan-tilt, gives the worker\n"
-    "the initial guess (Eq. 1) and dwells while the camera streams depth. Per frame it records the pose's\n"
+    "The robot thread drives the tour of the config's `tour.visits`, aims the pan-tilt, gives each worker\n"
+    "the initial guess (Eq. 1), the target's surveyed footing and the colour taken on arrival, and dwells\n"
+    "while the camera streams depth. Per frame it records the pose's\n"
     "age at display (depth capture to the frame's expected display time), the frame time and, in the twin,\n"
     "the error of the markers as drawn against where they truly are at that display time; it prints\n"
     "percentiles at the end (the error while a target moves and while it stands still, mm).\n"

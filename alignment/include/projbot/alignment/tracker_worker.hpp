@@ -224,6 +224,12 @@ class TrackerWorker {
   void submit(std::shared_ptr<const DepthImage> frame);
   /// The stop's initial guess (Eq. 1): the next frame acquires from it.
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target);
+  /// ...with what the robot knows at the stop, as the tour uses it: the target's surveyed footing (its
+  /// floor left out, only poses that stand as surveyed found) and the colour image taken on arrival,
+  /// before the projector lit anything, registered to the depth (null: none). The next frame's search
+  /// is moved and checked by that colour (TargetFollower::step), later ones are depth alone.
+  void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing,
+                         std::shared_ptr<const assets::Image> colour);
   /// The newest published sample (reader thread only); false before the first.
   bool latest(PoseSample& out) { return poses_.read(out); }
   /// Frames taken and processed so far (for tests and statistics).
@@ -241,7 +247,12 @@ class TrackerWorker {
   mutable std::mutex mutex_;  // guards the inbox below, not the pose hand-off
   std::condition_variable_any wake_;
   std::shared_ptr<const DepthImage> inbox_;
-  std::optional<Eigen::Matrix4d> guess_;
+  struct Start {
+    Eigen::Matrix4d T_camera_target;
+    std::optional<Footing> footing;
+    std::shared_ptr<const assets::Image> colour;
+  };
+  std::optional<Start> guess_;
   std::exception_ptr error_;
   std::jthread thread_;  // last: started after everything it uses exists, stopped first
 };
