@@ -274,7 +274,7 @@ struct Aligner::Impl {
       icp.setMaxCorrespondenceDistance(distance);
       const bool last = stage + 1 == cfg.icp_distances_m.size();
       icp.setMaximumIterations(last ? cfg.icp_iterations : std::min(cfg.icp_iterations, cfg.coarse_iterations));
-      const double step_m = last ? 1e-5 : std::max(1e-5, cfg.coarse_step_ratio * distance);
+      const double step_m = last ? cfg.fine_step_m : std::max(cfg.fine_step_m, cfg.coarse_step_ratio * distance);
       icp.setTransformationEpsilon(step_m * step_m);
       icp.setEuclideanFitnessEpsilon(1e-12);
       CloudN aligned;

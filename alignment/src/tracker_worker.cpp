@@ -38,7 +38,8 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
       k_(intrinsics),
       cfg_(std::move(config)),
       filter_(cfg_.motion),
-      silhouette_grow_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)) {}
+      silhouette_grow_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)),
+      model_radius_m_(guess_reach_m(model_, 0.0, 60.0)) {}  // a 60 degree turn moves the farthest point by the radius
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing) {
   set_initial_guess(T_camera_target, footing.floor);
@@ -107,9 +108,18 @@ bool TargetFollower::coloured(const DepthImage& frame, const assets::Image* colo
 DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matrix4d& from, const Known& known,
                                       std::optional<double> grow_m) const {
   // The floor is known (map and camera pose): left out, so a figure standing on it is aligned to and
-  // judged on its own points.
+  // judged on its own points. With the target's footing, so is what it stands on: what lies below the
+  // surveyed height of its lowest point (a table's top, a pedestal's sides). A neighbour that touches
+  // the crop is left out by clustering (crop_to_silhouette), for a guess known to within half the
+  // model's size.
   DepthImage left = known.floor ? without_plane(frame, k_, *known.floor, cfg_.floor_margin_m) : frame;
-  if (grow_m) left = crop_to_silhouette(left, k_, model_, from, *grow_m);
+  if (known.floor && known.footing && known.footing->height_m > cfg_.floor_margin_m) {
+    Plane top = *known.floor;
+    top.d -= known.footing->height_m;
+    left = without_plane(left, k_, top, cfg_.support_margin_m);
+  }
+  if (grow_m)
+    left = crop_to_silhouette(left, k_, model_, from, *grow_m, cfg_.cluster_neighbours && *grow_m < 0.5 * model_radius_m_);
   return left;
 }
 

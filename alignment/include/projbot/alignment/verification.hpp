@@ -32,9 +32,12 @@ struct FreeSpaceCheck {
 
 /// The depth inside the model's silhouette at T_camera_model, grown by grow_m (the guess's
 /// uncertainty) in the image and in depth; the rest set to 0 (missing). What acquisition aligns to:
-/// the wall behind a target and a neighbour beside it drop out before ICP sees them.
+/// the wall behind a target and a neighbour beside it drop out before ICP sees them. With `cluster`,
+/// also each connected surface that runs on past the crop's edge and lies mostly (three quarters)
+/// outside the silhouette itself: a neighbour touching the crop. (Only for a guess known to within a
+/// fraction of the model's size: from a gross guess the target's own support would go with it.)
 DepthImage crop_to_silhouette(const DepthImage& depth, const CameraIntrinsics& k, const ModelCloud& model,
-                              const Eigen::Matrix4d& T_camera_model, double grow_m);
+                              const Eigen::Matrix4d& T_camera_model, double grow_m, bool cluster = false);
 
 /// How far a guess off by translation_m and rotation_deg (about the model's origin) can put a model
 /// point: the silhouette crop's growth.
