@@ -5,6 +5,8 @@
 #include <cmath>
 #include <deque>
 #include <optional>
+#include <tuple>
+#include <utility>
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
@@ -114,11 +116,28 @@ struct NeighbourLight {
   std::size_t target = 0;  // index into Twin::targets()
   alignment::PoseSample drawn;
   bool shown = false;
-  int frames = 0, lit = 0;  // projector frames, and those that lit it
-  double sum_mm = 0.0, worst_mm = 0.0;
-  int measured = 0;  // lit frames with a marker in the light
-  NeighbourReport report;
+  double sum_mm = 0.0;     // over the lit frames with a marker in the light...
+  int measured = 0;        // ...this many
+  NeighbourReport report;  // frames, lit_frames and worst_mm counted as the frames come
 };
+
+// One projector frame of a neighbour: counted, and its error added when it was lit and measured.
+void count_frame(NeighbourLight& n, double mean_mm) {
+  ++n.report.frames;
+  if (!n.shown) return;
+  ++n.report.lit_frames;
+  if (std::isnan(mean_mm)) return;
+  n.sum_mm += mean_mm;
+  n.report.worst_mm = n.measured == 0 ? mean_mm : std::max(n.report.worst_mm, mean_mm);
+  ++n.measured;
+}
+
+// Eq. 1's guess against the truth: how far off it is (cm, degrees).
+std::pair<double, double> guess_error(const robot::HeadPoses& truth, const TwinTarget& t, const Eigen::Matrix4d& guess) {
+  const Eigen::Matrix4d T_camera_true = alignment::rigid_inverse(truth.T_world_camera.matrix()) * t.T_world_target_true;
+  const Eigen::Matrix4d error = alignment::rigid_inverse(T_camera_true) * guess;
+  return {100.0 * alignment::translation_norm_m(error), alignment::rotation_angle_deg(error)};
+}
 
 struct DwellContext {
   Twin& twin;
@@ -231,17 +250,12 @@ TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double
 // A neighbour's projector frame: counted, and its error measured at display time when it is lit
 // (neighbours stand still: their motion scripts run on their own visits).
 void measure_neighbour(const DwellContext& c, NeighbourLight& n, double display_s) {
-  ++n.frames;
-  if (!n.shown) return;
-  ++n.lit;
+  if (!n.shown) return count_frame(n, std::nan(""));
   const Eigen::Matrix4d T_camera_target =
       c.options.predict ? alignment::predict_pose(n.drawn.motion, display_s) : n.drawn.T_camera_target;
   const Errors e = marker_errors(c.twin, n.target, c.projector, c.truth.T_world_projector.matrix(),
                                  alignment::projector_from_target(c.twin.scene().pan_tilt.T_projector_camera, T_camera_target));
-  if (std::isnan(e.mean_mm)) return;
-  n.sum_mm += e.mean_mm;
-  n.worst_mm = std::max(n.worst_mm, e.mean_mm);
-  ++n.measured;
+  count_frame(n, e.mean_mm);
 }
 
 void summarise_timeline(VisitReport& r) {
@@ -365,31 +379,21 @@ NeighbourLight acquire_neighbour(TourMode mode, const Twin& twin, alignment::Tar
   r.target = t.config.name;
   r.projected = scratch.projected;
   r.align_ms = scratch.align_ms;
-  const Eigen::Matrix4d T_camera_true = alignment::rigid_inverse(arrival.truth.T_world_camera.matrix()) * t.T_world_target_true;
-  const Eigen::Matrix4d guess_error = alignment::rigid_inverse(T_camera_true) * n.T_camera_target_guess;
-  r.guess_error_cm = 100.0 * alignment::translation_norm_m(guess_error);
-  r.guess_error_deg = alignment::rotation_angle_deg(guess_error);
+  std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(arrival.truth, t, n.T_camera_target_guess);
   const Errors e =
       marker_errors(twin, n.target, twin.scene().projector, arrival.truth.T_world_projector.matrix(),
                     alignment::projector_from_target(twin.scene().pan_tilt.T_projector_camera, scratch.icp.T_scan_model));
   r.mean_mm = e.mean_mm;
   r.max_mm = e.max_mm;
-  ++l.frames;
-  if (l.shown) ++l.lit;
-  if (l.shown && !std::isnan(e.mean_mm)) {
-    l.sum_mm += e.mean_mm;
-    l.worst_mm = e.mean_mm;
-    ++l.measured;
-  }
+  count_frame(l, e.mean_mm);  // the arrival's frame
   return l;
 }
 
-// A neighbour after the stop: its projector frames, lit ones, and their error.
-void finish_neighbour(const NeighbourLight& l, NeighbourReport& r) {
-  r.frames = l.frames;
-  r.lit_frames = l.lit;
+// A neighbour's report after the stop: the mean over its lit frames added.
+NeighbourReport finished(const NeighbourLight& l) {
+  NeighbourReport r = l.report;
   r.lit_mean_mm = l.measured > 0 ? l.sum_mm / l.measured : std::nan("");
-  r.worst_mm = l.measured > 0 ? l.worst_mm : std::nan("");
+  return r;
 }
 
 // Where --frames writes one of a visit's pictures: DIR/visitNN_TARGET<suffix>.png.
@@ -504,10 +508,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     const alignment::DepthImage depth = twin.capture(truth.T_world_camera.matrix(), noise_seed);
     r.capture_ms = ms_since(t0);
     const Eigen::Matrix4d& T_init = arrival.T_camera_target_guess;
-    const Eigen::Matrix4d T_camera_true = alignment::rigid_inverse(truth.T_world_camera.matrix()) * target.T_world_target_true;
-    const Eigen::Matrix4d guess_error = alignment::rigid_inverse(T_camera_true) * T_init;
-    r.guess_error_cm = 100.0 * alignment::translation_norm_m(guess_error);
-    r.guess_error_deg = alignment::rotation_angle_deg(guess_error);
+    std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth, target, T_init);
     // Localized and tracking: the colour the RGB-D camera registers to the depth, taken with it (before
     // any light).
     std::optional<assets::Image> colour;
@@ -523,10 +524,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     r.markers = e.markers;
     r.mean_mm = e.mean_mm;
     r.max_mm = e.max_mm;
-    for (const Neighbour& n : twin.neighbours(i, arrival)) {
+    for (const Neighbour& n : twin.neighbours(i, arrival))
       lights.push_back(acquire_neighbour(options.mode, twin, followers[n.target], n, arrival, depth, colour));
-      r.neighbours.push_back(lights.back().report);
-    }
 
     if (projector_frame) {
       t0 = Clock::now();
@@ -549,7 +548,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
       for (const NeighbourLight& n : lights) lanes.push_back(&followers[n.target]);
       report.interrupted = !dwell(DwellContext{twin, i, scene.projector, truth, options, noise_seed, lights}, lanes, r);
     }
-    for (std::size_t k = 0; k < lights.size(); ++k) finish_neighbour(lights[k], r.neighbours[k]);
+    for (const NeighbourLight& l : lights) r.neighbours.push_back(finished(l));
     if (spectator && r.moved && !report.interrupted) {
       // A moved target: what the visitor sees at the end of the dwell, where the target went and where
       // the light went (followed, or left where the target was).
