@@ -112,12 +112,11 @@ DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matr
   // surveyed height of its lowest point (a table's top, a pedestal's sides). A neighbour that touches
   // the crop is left out by clustering (crop_to_silhouette), for a guess known to within half the
   // model's size.
-  DepthImage left = known.floor ? without_plane(frame, k_, *known.floor, cfg_.floor_margin_m) : frame;
-  if (known.floor && known.footing && known.footing->height_m > cfg_.floor_margin_m) {
-    Plane top = *known.floor;
-    top.d -= known.footing->height_m;
-    left = without_plane(left, k_, top, cfg_.support_margin_m);
-  }
+  // Both are cuts below one horizontal plane: one pass, at the higher of the two.
+  double cut_m = cfg_.floor_margin_m;
+  if (known.footing && known.footing->height_m > cfg_.floor_margin_m)
+    cut_m = std::max(cut_m, known.footing->height_m + cfg_.support_margin_m);
+  DepthImage left = known.floor ? without_plane(frame, k_, *known.floor, cut_m) : frame;
   if (grow_m)
     left = crop_to_silhouette(left, k_, model_, from, *grow_m, cfg_.cluster_neighbours && *grow_m < 0.5 * model_radius_m_);
   return left;
@@ -157,9 +156,9 @@ std::optional<AlignmentResult> TargetFollower::projective_first(const DepthImage
   return r;
 }
 
-AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthImage& near_depth, const Eigen::Matrix4d& guess,
-                                           const Known& known, double grow_m, SearchStage stage) const {
-  const PointCloud near = depth_to_cloud(near_depth, k_);
+AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthImage& near_depth, const PointCloud& near,
+                                           const Eigen::Matrix4d& guess, const Known& known, double grow_m,
+                                           SearchStage stage) const {
   // Too little near the guess: the aligner's error says so.
   if (!(grow_m > cfg_.recrop_m) || near.finite_count() < aligner_.config().min_points)
     return aligner_.align(near, guess, stage, known.footing);
@@ -184,7 +183,8 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthI
 AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing,
                                         double grow_m, const assets::Image* colour) const {
   const Known known{footing.floor, footing};
-  AlignmentResult r = align_near(frame, near_guess(frame, guess, known, grow_m), guess, known, grow_m, SearchStage::full);
+  const DepthImage near = near_guess(frame, guess, known, grow_m);
+  AlignmentResult r = align_near(frame, near, depth_to_cloud(near, k_), guess, known, grow_m, SearchStage::full);
   if (!r.converged) return r;
   for (int i = 0; i < 3; ++i) {  // the polish: projective association, which a touching neighbour pulls less
     const TrackResult t = tracker_.track(frame, r.T_scan_model);
@@ -225,7 +225,7 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   const PointCloud scan = depth_to_cloud(near, k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
   last_attempt_ =
-      grow_m ? align_near(frame, near, from, known_, *grow_m, stage) : aligner_.align(scan, from, stage, known_.footing);
+      grow_m ? align_near(frame, near, scan, from, known_, *grow_m, stage) : aligner_.align(scan, from, stage, known_.footing);
   return last_attempt_;
 }
 

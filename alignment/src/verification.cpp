@@ -61,12 +61,11 @@ bool continuous(float a, float b) {
 void drop_cut_neighbours(DepthImage& out, const DepthImage& in, const std::vector<unsigned char>& mask,
                          const std::vector<unsigned char>& core) {
   const int w = out.width, h = out.height;
-  std::vector<int> label(out.depth_m.size(), -1);
+  std::vector<unsigned char> seen(out.depth_m.size(), 0);
   std::vector<std::size_t> stack, members;
-  int next = 0;
   for (std::size_t seed = 0; seed < out.depth_m.size(); ++seed) {
-    if (!(out.depth_m[seed] > 0.0F) || label[seed] >= 0) continue;
-    label[seed] = next;
+    if (!(out.depth_m[seed] > 0.0F) || seen[seed]) continue;
+    seen[seed] = 1;
     stack.assign(1, seed);
     members.clear();
     bool cut = false;
@@ -87,12 +86,11 @@ void drop_cut_neighbours(DepthImage& out, const DepthImage& in, const std::vecto
             cut = cut || (in.depth_m[j] > 0.0F && continuous(z, in.depth_m[j]));
             continue;
           }
-          if (label[j] >= 0 || !(out.depth_m[j] > 0.0F) || !continuous(z, out.depth_m[j])) continue;
-          label[j] = next;
+          if (seen[j] || !(out.depth_m[j] > 0.0F) || !continuous(z, out.depth_m[j])) continue;
+          seen[j] = 1;
           stack.push_back(j);
         }
     }
-    ++next;
     if (cut && in_core * 4 < members.size())
       for (const std::size_t i : members) out.depth_m[i] = 0.0F;
   }

@@ -171,11 +171,11 @@ class TargetFollower {
     std::optional<Plane> floor;
     std::optional<Footing> footing;
   };
-  /// From a guess: projective_first; when that fails, ICP on `near` (the frame's depth near `guess`:
-  /// near_guess, grown by grow_m), refined on the depth near its estimate (recropped); when that fails
-  /// the gate, the same with `stage`'s restarts and global search.
-  AlignmentResult align_near(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess, const Known& known,
-                             double grow_m, SearchStage stage) const;
+  /// From a guess: projective_first on `near_depth` (the frame's depth near `guess`: near_guess, grown
+  /// by grow_m); when that fails, ICP on `near` (the same as points), refined on the depth near its
+  /// estimate (recropped); when that fails the gate, the same with `stage`'s restarts and global search.
+  AlignmentResult align_near(const DepthImage& frame, const DepthImage& near_depth, const PointCloud& near,
+                             const Eigen::Matrix4d& guess, const Known& known, double grow_m, SearchStage stage) const;
   /// Projective ICP from `guess` on `near` (the tracker's association at its wide reach), then ICP's
   /// finest stage on the depth cropped tight at that estimate: the estimate when it passes the gate.
   std::optional<AlignmentResult> projective_first(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess,
