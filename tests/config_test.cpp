@@ -202,6 +202,52 @@ TEST(SceneTest, TourSectionsAndTheirDefaults) {
   EXPECT_THROW(parse_scene(std::string(kGood) + "camera: {fx: -1}\n", "/scenes/s.yaml"), projbot::config::ConfigError);
 }
 
+TEST(SceneTest, DevicesSectionNamesEachDevice) {
+  EXPECT_FALSE(parse_scene(kGood, "/scenes/s.yaml").devices.any());  // none: the twin serves every role
+  const auto s =
+      parse_scene(std::string(kGood) +
+                      "devices:\n"
+                      "  camera: {driver: freenect, index: 1}\n"
+                      "  pan_tilt: {port: /dev/ttyUSB0}\n"
+                      "  laser: {class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM0, HOKUYO_MOTOR_SPEED_rpm: 600}}\n"
+                      "  base: {domain: 7, cmd_vel: youbot/cmd_vel}\n"
+                      "  projector: {monitor: 1}\n",
+                  "/scenes/s.yaml");
+  ASSERT_TRUE(s.devices.camera && s.devices.pan_tilt && s.devices.laser && s.devices.base && s.devices.projector);
+  EXPECT_EQ(s.devices.camera->driver, "freenect");
+  EXPECT_EQ(s.devices.camera->index, 1);
+  EXPECT_EQ(s.devices.pan_tilt->driver, "ptu-d46");
+  EXPECT_EQ(s.devices.pan_tilt->baud, 9600);
+  EXPECT_EQ(s.devices.laser->class_name, "CHokuyoURG");
+  EXPECT_EQ(s.devices.laser->params.at("HOKUYO_MOTOR_SPEED_rpm"), "600");
+  EXPECT_EQ(s.devices.base->domain, 7);
+  EXPECT_EQ(s.devices.base->cmd_vel, "youbot/cmd_vel");
+  EXPECT_EQ(s.devices.base->odom, "odom");
+  EXPECT_EQ(s.devices.projector->monitor, 1);
+  EXPECT_TRUE(s.devices.projector->fullscreen);
+  const auto lines = s.devices.describe();
+  ASSERT_EQ(lines.size(), 5U);
+  EXPECT_EQ(lines[0], "camera: freenect #1");
+  EXPECT_EQ(lines[1], "pan_tilt: ptu-d46 on /dev/ttyUSB0 at 9600 baud");
+
+  const std::string base = std::string(kGood) + "devices:\n";
+  EXPECT_NE(error_of(base + "  camera: {driver: kinect2}\n").find(":12: devices.camera.driver: must be openni2"),
+            std::string::npos)
+      << error_of(base + "  camera: {driver: kinect2}\n");
+  EXPECT_NE(error_of(base + "  camera: {driver: openni2, index: 2}\n").find("devices.camera.index: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  pan_tilt: {port: /dev/ttyUSB0, baud: 115200}\n").find("devices.pan_tilt.baud: must be 9600"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  pan_tilt: {}\n").find("devices.pan_tilt.port: missing required key"), std::string::npos);
+  EXPECT_NE(error_of(base + "  laser: {class: CHokuyoURG, params: [a]}\n").find("devices.laser.params: expected a mapping"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  base: {odom: 'odom topic'}\n").find("devices.base.odom: 'odom topic' is not a ROS 2 topic name"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "  base: {domain: 300}\n").find("devices.base.domain: must be a DDS domain id"), std::string::npos);
+  EXPECT_NE(error_of(base + "  projector: {screen: 1}\n").find("devices.projector.screen: unknown key"), std::string::npos);
+  EXPECT_NE(error_of(base + "  kinect: {}\n").find("devices.kinect: unknown key"), std::string::npos);
+}
+
 TEST(SceneTest, MissingFileIsNamed) {
   try {
     projbot::config::load_scene("/nonexistent/scene.yaml");

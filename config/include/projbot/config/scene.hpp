@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "projbot/config/devices.hpp"
 #include "projbot/config/robot.hpp"
 
 namespace projbot::config {
@@ -154,6 +155,7 @@ struct Scene {
   ProjectorConfig depth_camera = kinect_v1_depth_camera();  ///< `camera:`, the RGB-D camera's depth intrinsics
   std::vector<std::string> visits;                          ///< `tour.visits:` target names in order
   std::vector<PropConfig> props;                            ///< `props:` the twin's static non-targets
+  DevicesConfig devices;                                    ///< `devices:` real devices (none: the twin)
 
   /// Kinect v1 depth: 640x480, fx = fy = 525 px, 0.5-4.5 m.
   static ProjectorConfig kinect_v1_depth_camera() { return {640, 480, 525.0, 525.0, 319.5, 239.5, 0.5, 4.5}; }
