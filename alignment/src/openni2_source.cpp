@@ -167,4 +167,14 @@ int OpenNi2Source::recorded_frames() const {
   return playback != nullptr && playback->isValid() ? playback->getNumberOfFrames(impl_->depth) : -1;
 }
 
+std::vector<OpenNi2DeviceInfo> openni2_devices() {
+  if (openni::OpenNI::initialize() != openni::STATUS_OK)
+    throw AlignmentError(std::string("OpenNI2 cannot start: ") + openni::OpenNI::getExtendedError());
+  openni::Array<openni::DeviceInfo> found;
+  openni::OpenNI::enumerateDevices(&found);
+  std::vector<OpenNi2DeviceInfo> out;
+  for (int i = 0; i < found.getSize(); ++i) out.push_back({found[i].getUri(), found[i].getName(), found[i].getVendor()});
+  return out;
+}
+
 }  // namespace projbot::alignment

@@ -16,6 +16,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "projbot/alignment/depth.hpp"
 
@@ -52,6 +53,15 @@ class OpenNi2Source {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// A device OpenNI2 sees: its URI (what `devices.camera.uri` takes), name and vendor.
+struct OpenNi2DeviceInfo {
+  std::string uri;
+  std::string name;
+  std::string vendor;
+};
+/// The devices OpenNI2's drivers see now. Throws AlignmentError when OpenNI2 cannot start.
+std::vector<OpenNi2DeviceInfo> openni2_devices();
 
 /// Whether an .oni recording declares a stream's cropping (see above). Throws AlignmentError naming the
 /// file when it is missing or not an .oni recording.

@@ -1,0 +1,80 @@
+#pragma once
+// Kinect v1 (the paper's sensor) through libfreenect: depth + colour at 640x480, 30 Hz, with the
+// device's timestamps. Debian's OpenNI2 has no Kinect v1 driver, hence this second source. libfreenect
+// types stay in src/.
+//
+// libfreenect's `fakenect` (Debian libfreenect-bin) is a drop-in libfreenect.so that plays a dump
+// folder (INDEX.txt plus one PGM / PPM file per frame) through the same API: write_fakenect_dump()
+// writes the twin's frames in that format, so CI runs this driver on them (FAKENECT_PATH, and the
+// fakenect library first on LD_LIBRARY_PATH).
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "projbot/alignment/depth.hpp"
+#include "projbot/assets/image.hpp"
+
+namespace projbot::alignment {
+
+/// Kinect v1 raw 11-bit disparity to depth in metres (the published fit z = 1 / (3.3309495161 -
+/// 0.0030711016 raw)); 0 for 2047 ("no reading") and for values outside 0.3..10 m.
+float kinect_raw_to_metres(std::uint16_t raw);
+/// The raw disparity whose depth is nearest to depth_m; 2047 (no reading) for 0, NaN and depths outside
+/// what the sensor reports.
+std::uint16_t kinect_metres_to_raw(float depth_m);
+
+struct FreenectOptions {
+  int index = 0;  ///< which Kinect (0-based)
+  /// true: depth registered to the colour camera in millimetres (FREENECT_DEPTH_REGISTERED, the device's
+  /// factory registration); false: raw 11-bit disparity converted by kinect_raw_to_metres(), in the depth
+  /// camera's own frame (what a fakenect dump without registration tables can play).
+  bool registered = true;
+  int timeout_ms = 2000;  ///< next() gives up after this long without a frame pair
+};
+
+/// One depth frame and the colour frame that followed it.
+struct RgbdFrame {
+  DepthImage depth;                   ///< metres; capture_time_s on the host's steady clock at arrival
+  assets::Image colour;               ///< RGBA, 640x480
+  std::uint32_t depth_timestamp = 0;  ///< the device's own counters
+  std::uint32_t colour_timestamp = 0;
+};
+
+class FreenectSource {
+ public:
+  /// Opens Kinect `index` and starts depth and colour. Throws AlignmentError naming the index and how many
+  /// Kinects libfreenect found (or why it could not look).
+  explicit FreenectSource(const FreenectOptions& options);
+  ~FreenectSource();
+  FreenectSource(const FreenectSource&) = delete;
+  FreenectSource& operator=(const FreenectSource&) = delete;
+
+  /// The next depth frame and a colour frame newer than the previous call's. Throws AlignmentError when
+  /// none arrives within timeout_ms or the device (or a fakenect dump) stops.
+  RgbdFrame next();
+  /// Frame pairs returned so far.
+  int frames_read() const;
+
+  /// How many Kinects libfreenect sees; throws AlignmentError with libfreenect's failure when it cannot look.
+  static int count_devices();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One frame of a fakenect dump: depth in metres (640x480), colour (640x480, alpha ignored), and the
+/// time it was taken, seconds (the dump's playback keeps the gaps between frames).
+struct FakenectFrame {
+  const DepthImage* depth = nullptr;
+  const assets::Image* colour = nullptr;
+  double time_s = 0.0;
+};
+/// Writes `frames` into `folder` (created; must be empty or absent) as a fakenect dump: raw 11-bit depth
+/// PGMs, RGB PPMs, INDEX.txt. Throws AlignmentError naming the file on a write failure or a frame that is
+/// not 640x480.
+void write_fakenect_dump(const std::filesystem::path& folder, const std::vector<FakenectFrame>& frames);
+
+}  // namespace projbot::alignment
