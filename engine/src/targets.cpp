@@ -283,3 +283,27 @@ std::unique_ptr<TargetBackend> make_window_backend(std::shared_ptr<Gpu> gpu, con
 }
 
 }  // namespace projbot::engine::detail
+
+namespace projbot::engine {
+
+std::vector<MonitorInfo> connected_monitors() {
+  if (glfwInit() != GLFW_TRUE) throw EngineError("no display: GLFW cannot see any monitor (set DISPLAY, or run under xvfb-run)");
+  std::vector<MonitorInfo> out;
+  int count = 0;
+  GLFWmonitor** monitors = glfwGetMonitors(&count);
+  for (int i = 0; i < count; ++i) {
+    MonitorInfo m;
+    const char* name = glfwGetMonitorName(monitors[i]);
+    m.name = name != nullptr ? name : "";
+    if (const GLFWvidmode* mode = glfwGetVideoMode(monitors[i]); mode != nullptr) {
+      m.width_px = mode->width;
+      m.height_px = mode->height;
+      m.refresh_hz = mode->refreshRate;
+    }
+    out.push_back(m);
+  }
+  glfwTerminate();
+  return out;
+}
+
+}  // namespace projbot::engine

@@ -29,5 +29,6 @@ extern const Command kLocalize;
 extern const Command kBenchLocalize;
 extern const Command kTour;
 extern const Command kRun;
+extern const Command kDevices;
 
 }  // namespace projbot::tools

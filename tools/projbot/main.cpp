@@ -18,7 +18,8 @@ const std::vector<const Command*>& commands() {
   static const std::vector<const Command*> all{
       &projbot::tools::kRender,     &projbot::tools::kShow,          &projbot::tools::kBenchRender,  &projbot::tools::kAlign,
       &projbot::tools::kBenchTrack, &projbot::tools::kBenchMotion,   &projbot::tools::kBenchAcquire, &projbot::tools::kSlam,
-      &projbot::tools::kLocalize,   &projbot::tools::kBenchLocalize, &projbot::tools::kTour,         &projbot::tools::kRun};
+      &projbot::tools::kLocalize,   &projbot::tools::kBenchLocalize, &projbot::tools::kTour,         &projbot::tools::kRun,
+      &projbot::tools::kDevices};
   return all;
 }
 
@@ -43,6 +44,7 @@ void print_help() {
                "  projbot tour                                      the demo tour in the digital twin (Table 1)\n"
                "  projbot tour --mode odometry --report r.json      the paper's set-up, with a JSON report\n"
                "  projbot run --sim --fullscreen                    the live engine against the twin\n"
+               "  projbot devices --config site.yaml                what this machine has; do the scene's devices work?\n"
                "  projbot bench render\n";
 }
 

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "commands.hpp"
+#include "devices.hpp"
 #include "interrupt.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/latest_value.hpp"
@@ -163,6 +164,23 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
   state.publish({.lit = {}, .since_s = now_s(), .visit = visits, .done = true});
 }
 
+// Without --sim: a config naming real devices has them opened (each absent one an error naming it); one
+// naming none runs the twin and says so.
+void check_devices_or_sim(const config::Scene& scene) {
+  if (!scene.devices.any()) {
+    std::cout << "no devices configured in " << scene.source.filename().string()
+              << " (a `devices:` section; projbot devices lists what this machine has): running against the digital twin (--sim)"
+              << std::endl;
+    return;
+  }
+  std::vector<DeviceCheck> checks;
+  const Devices devices = open_devices(scene.devices, checks, true);  // throws DeviceError at the first that fails
+  for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
+  throw DeviceError(
+      "every configured device answered, but projecting with real devices is not built yet (the session "
+      "that drives them is issue 12's next step); run the twin with --sim");
+}
+
 }  // namespace
 
 const Command kRun{
@@ -182,10 +200,13 @@ const Command kRun{
     "age at display (depth capture to the frame's expected display time), the frame time and, in the twin,\n"
     "the error of the markers as drawn against where they truly are at that display time; it prints\n"
     "percentiles at the end (the error while a target moves and while it stands still, mm).\n"
-    "No robot or camera drivers are configured in a scene file yet, so it runs against the digital twin\n"
-    "(--sim, the default). Without --config the shipped demo tour runs.\n",
+    "Devices come from the config's `devices:` section (projbot devices --help shows it): each one configured\n"
+    "is opened and read once at start, and one that is absent stops the run with a message naming it.\n"
+    "With none configured, or with --sim, the digital twin serves every device. Projecting with real devices\n"
+    "is not built yet: a config whose devices all work says so and stops. Without --config the shipped demo\n"
+    "tour runs in the twin.\n",
     {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)"},
-     {"sim", "", "run against the digital twin (the default while no hardware is configured)"},
+     {"sim", "", "run against the digital twin, whatever `devices:` configures (the default without one)"},
      {"fullscreen", "", "fullscreen on --monitor (the projector)"},
      {"monitor", "N", "monitor index for --fullscreen (default 0)"},
      {"headless", "", "draw offscreen at 60 Hz instead of a window (profiling without a display)"},
@@ -201,8 +222,7 @@ const Command kRun{
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
-      if (!args.flag("sim"))
-        std::cout << "no robot or camera hardware configured: running against the digital twin (--sim)" << std::endl;
+      if (!args.flag("sim")) check_devices_or_sim(scene);
       RunOptions o;
       o.visits = args.get_int("visits", 0, 1, 1000);
       o.dwell_s = args.get_double("dwell", 4.0);

@@ -52,6 +52,18 @@ struct WindowOptions {
   PresentMode present_mode = PresentMode::kFifo;  ///< falls back to FIFO where unsupported
 };
 
+/// A connected monitor as GLFW reports it (the projector is one).
+struct MonitorInfo {
+  std::string name;
+  int width_px = 0;
+  int height_px = 0;
+  int refresh_hz = 0;
+};
+/// The connected monitors in GLFW's order (the index --monitor and `devices.projector.monitor` take).
+/// Throws EngineError when there is no display. Starts and stops GLFW: call it while no windowing
+/// Renderer exists.
+std::vector<MonitorInfo> connected_monitors();
+
 /// A simulated depth camera's image: camera-frame depth Z of the nearest surface, metres, row-major,
 /// top row first; 0 where no surface was hit (as a Kinect reports missing depth).
 struct DepthMap {

@@ -1,0 +1,124 @@
+// `projbot devices` and `projbot run` with a `devices:` section (issue 12), through the executable: a
+// Kinect v1 played by libfreenect's fakenect and a PTU-D46 emulated on a pseudo-terminal are found and
+// read; absent devices are named.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "cli_run.hpp"
+#include "projbot/alignment/freenect_source.hpp"
+#include "projbot/robot/ptu_d46.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class DevicesCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("projbot_devices_cli_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    ::unsetenv("LD_LIBRARY_PATH");
+    ::unsetenv("FAKENECT_PATH");
+    fs::remove_all(dir_);
+  }
+  // The shipped demo tour with `devices_yaml` appended.
+  fs::path site(const std::string& devices_yaml) const {
+    std::ifstream in(std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml");
+    std::ostringstream text;
+    text << in.rdbuf();
+    // Model paths in tour.yaml are relative to its folder: keep them valid from here.
+    std::string yaml = text.str();
+    for (std::size_t at = 0; (at = yaml.find("model: ", at)) != std::string::npos; at += 7)
+      if (yaml[at + 7] != '/') yaml.insert(at + 7, std::string(PROJBOT_ASSET_DIR) + "/scenes/");
+    std::ofstream(dir_ / "site.yaml") << yaml << "devices:\n" << devices_yaml;
+    return dir_ / "site.yaml";
+  }
+  fs::path dir_;
+};
+
+// A 640x480 wall 1.5 m away with a box 1.2 m away in the middle, two frames, as a fakenect dump.
+fs::path write_dump(const fs::path& folder) {
+  projbot::alignment::DepthImage depth;
+  depth.width = 640;
+  depth.height = 480;
+  depth.depth_m.assign(640 * 480, 1.5F);
+  for (int y = 180; y < 300; ++y)
+    for (int x = 260; x < 380; ++x) depth.depth_m[static_cast<std::size_t>(y) * 640 + x] = 1.2F;
+  projbot::assets::Image colour;
+  colour.width = 640;
+  colour.height = 480;
+  colour.rgba.assign(640 * 480 * 4, 128);
+  projbot::alignment::write_fakenect_dump(folder, {{&depth, &colour, 10.0}, {&depth, &colour, 10.0 + 1.0 / 30.0}});
+  return folder;
+}
+
+}  // namespace
+
+TEST_F(DevicesCli, ListsWhatThisMachineOffers) {
+  const CliRun r = run_projbot("devices");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* line :
+       {"RGB-D cameras (OpenNI2: PrimeSense, Xtion): ", "Kinect v1 (libfreenect): ", "serial ports (pan-tilt unit, laser): ",
+        "monitors (the projector is one): ", "mobile base (ROS 2 topics over DDS): "})
+    EXPECT_NE(r.output.find(line), std::string::npos) << line << "\n" << r.output;
+  EXPECT_EQ(run_projbot("devices --config " + site("").string()).code, 0);  // an empty section: the twin's
+}
+
+// Every configured device that is not there is named with what failed, and the exit status says so.
+TEST_F(DevicesCli, NamesEachAbsentDevice) {
+  const fs::path scene = site(
+      "  pan_tilt: {port: /dev/ttyUSB97}\n"
+      "  laser: {class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM97}}\n"
+      "  base: {domain: 3}\n");
+  const CliRun r = run_projbot("devices --config " + scene.string(), 60);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("pan_tilt: ptu-d46 on /dev/ttyUSB97 at 9600 baud: FAILED: PTU-D46 on /dev/ttyUSB97: cannot open"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("laser: mrpt CHokuyoURG: FAILED: laser (MRPT CHokuyoURG): cannot start: Error trying to open the "
+                          "serial port /dev/ttyACM97"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("base: ros2-dds (domain 3, rt/cmd_vel out, rt/odom in): FAILED: "), std::string::npos) << r.output;
+  // run stops at the first, before opening any window or twin, naming it.
+  const CliRun run = run_projbot("run --headless --config " + scene.string(), 60);
+  EXPECT_EQ(run.code, 1) << run.output;
+  EXPECT_NE(run.output.find("projbot run: devices.pan_tilt (ptu-d46 on /dev/ttyUSB97 at 9600 baud): PTU-D46 on /dev/ttyUSB97"),
+            std::string::npos)
+      << run.output;
+  EXPECT_EQ(run.output.find("device: "), std::string::npos) << "a renderer was started: " << run.output;
+}
+
+// A Kinect v1 (libfreenect through fakenect) and a PTU-D46 (emulated) that are there are opened and read.
+TEST_F(DevicesCli, OpensAKinectAndAPanTiltThatAreThere) {
+  const fs::path dump = write_dump(dir_ / "dump");
+  const projbot::robot::PtuD46Emulator ptu;
+  const fs::path scene =
+      site("  camera: {driver: freenect, index: 0, registered: false}\n  pan_tilt: {port: " + ptu.port() + "}\n");
+  ::setenv("LD_LIBRARY_PATH", PROJBOT_FAKENECT_DIR, 1);  // for the projbot child: libfreenect's fakenect player
+  ::setenv("FAKENECT_PATH", dump.c_str(), 1);
+  const CliRun r = run_projbot("devices --config " + scene.string(), 60);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("Kinect v1 (libfreenect): 1 found (index 0..0)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("camera: freenect #0: ok, 640x480 depth, 100% valid, 1.2-1.5 m + 640x480 colour"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("pan_tilt: ptu-d46 on " + ptu.port() + " at 9600 baud: ok, at pan 0 deg, tilt 0 deg"),
+            std::string::npos)
+      << r.output;
+  // With every device there, run says what is not built yet and stops; --sim runs the twin regardless.
+  const CliRun run = run_projbot("run --headless --seconds 1 --config " + scene.string(), 60);
+  EXPECT_EQ(run.code, 1) << run.output;
+  EXPECT_NE(run.output.find("opened camera: freenect #0: 640x480 depth"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("projecting with real devices is not built yet"), std::string::npos) << run.output;
+  ::unsetenv("LD_LIBRARY_PATH");
+  const CliRun sim = run_projbot("run --headless --sim --seconds 1 --config " + scene.string(), 120);
+  EXPECT_EQ(sim.code, 0) << sim.output;
+}

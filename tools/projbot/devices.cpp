@@ -1,0 +1,100 @@
+#include "devices.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "projbot/engine/renderer.hpp"
+
+namespace projbot::tools {
+namespace {
+
+// "640x480 depth, 87% valid, 0.62-3.90 m": what a first frame says about a camera that works.
+std::string describe_depth(const alignment::DepthImage& d) {
+  std::size_t valid = 0;
+  float lo = 1e9F, hi = 0.0F;
+  for (const float z : d.depth_m)
+    if (z > 0.0F && std::isfinite(z)) {
+      ++valid;
+      lo = std::min(lo, z);
+      hi = std::max(hi, z);
+    }
+  std::ostringstream out;
+  out.precision(3);
+  out << d.width << "x" << d.height << " depth, " << (d.depth_m.empty() ? 0 : 100 * valid / d.depth_m.size()) << "% valid";
+  if (valid > 0) out << ", " << lo << "-" << hi << " m";
+  return out.str();
+}
+
+std::string open_camera(const config::CameraDevice& c, Devices& out) {
+  if (c.driver == "freenect") {
+    alignment::FreenectOptions o;
+    o.index = c.index;
+    o.registered = c.registered;
+    out.freenect = std::make_unique<alignment::FreenectSource>(o);
+    const alignment::RgbdFrame f = out.freenect->next();
+    return describe_depth(f.depth) + " + " + std::to_string(f.colour.width) + "x" + std::to_string(f.colour.height) + " colour";
+  }
+  alignment::OpenNi2Options o;
+  o.uri = c.uri;
+  out.openni2 = std::make_unique<alignment::OpenNi2Source>(o);
+  return describe_depth(out.openni2->next());
+}
+
+std::string open_pan_tilt(const config::PanTiltDevice& p, Devices& out) {
+  out.pan_tilt = std::make_unique<robot::PtuD46>(p.port);
+  robot::PanTiltAngles at;
+  if (const auto status = out.pan_tilt->position(at); !status.ok) throw robot::RobotError(status.error);
+  std::ostringstream s;
+  s.precision(3);
+  s << "at pan " << at.pan_rad * 180.0 / M_PI << " deg, tilt " << at.tilt_rad * 180.0 / M_PI << " deg";
+  return s.str();
+}
+
+std::string open_laser(const config::LaserDevice& l, Devices& out) {
+  out.laser = std::make_unique<robot::MrptLaser>(l.class_name, l.params);
+  const robot::LaserScan scan = out.laser->next();
+  return std::to_string(scan.ranges_m.size()) + " rays over " + std::to_string(std::lround(scan.aperture_rad * 180.0 / M_PI)) +
+         " deg";
+}
+
+std::string check_monitor(const config::ProjectorDevice& p) {
+  const auto monitors = engine::connected_monitors();
+  if (p.monitor >= static_cast<int>(monitors.size()))
+    throw DeviceError("monitor " + std::to_string(p.monitor) + " is not connected (" + std::to_string(monitors.size()) +
+                      " connected: projbot devices lists them)");
+  const auto& m = monitors[static_cast<std::size_t>(p.monitor)];
+  return m.name + ", " + std::to_string(m.width_px) + "x" + std::to_string(m.height_px) +
+         (m.refresh_hz > 0 ? " at " + std::to_string(m.refresh_hz) + " Hz" : std::string(", refresh unknown"));
+}
+
+}  // namespace
+
+Devices open_devices(const config::DevicesConfig& config, std::vector<DeviceCheck>& checks, bool stop_at_first) {
+  Devices out;
+  const auto lines = config.describe();
+  std::size_t line = 0;
+  const auto attempt = [&](const char* role, auto&& open) {
+    DeviceCheck check{role, lines[line++], false, ""};
+    try {
+      check.detail = open();
+      check.ok = true;
+    } catch (const std::exception& e) {  // AlignmentError, RobotError, EngineError, DeviceError
+      check.detail = e.what();
+    }
+    checks.push_back(check);
+    if (!check.ok && stop_at_first)
+      throw DeviceError("devices." + check.role + " (" + check.config.substr(check.config.find(": ") + 2) + "): " + check.detail);
+  };
+  if (config.camera) attempt("camera", [&] { return open_camera(*config.camera, out); });
+  if (config.pan_tilt) attempt("pan_tilt", [&] { return open_pan_tilt(*config.pan_tilt, out); });
+  if (config.laser) attempt("laser", [&] { return open_laser(*config.laser, out); });
+  if (config.base)
+    attempt("base", []() -> std::string {
+      throw DeviceError("the ros2-dds base driver is not in this build yet (issue 12): drive the twin's base with --sim");
+    });
+  if (config.projector) attempt("projector", [&] { return check_monitor(*config.projector); });
+  return out;
+}
+
+}  // namespace projbot::tools

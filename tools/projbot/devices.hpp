@@ -1,0 +1,46 @@
+#pragma once
+// The real devices a scene's `devices:` section names (issue 12): opened at start, each checked by
+// reading from it once, so a configured device that is absent fails before any work with a message that
+// names it.
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "projbot/alignment/freenect_source.hpp"
+#include "projbot/alignment/openni2_source.hpp"
+#include "projbot/config/devices.hpp"
+#include "projbot/robot/mrpt_laser.hpp"
+#include "projbot/robot/ptu_d46.hpp"
+
+namespace projbot::tools {
+
+/// A configured device that could not be opened or read: "devices.camera (freenect #0): not found ...".
+class DeviceError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The opened devices; each null where the config names none (the twin serves it).
+struct Devices {
+  std::unique_ptr<alignment::OpenNi2Source> openni2;
+  std::unique_ptr<alignment::FreenectSource> freenect;
+  std::unique_ptr<robot::PtuD46> pan_tilt;
+  std::unique_ptr<robot::MrptLaser> laser;
+};
+
+/// What checking one configured device found.
+struct DeviceCheck {
+  std::string role;    ///< "camera", "pan_tilt", ...
+  std::string config;  ///< the config's line for it (DevicesConfig::describe)
+  bool ok = false;
+  std::string detail;  ///< what it read, or why it failed
+};
+
+/// Opens and reads each configured device in turn (camera: one depth frame; pan-tilt: its position;
+/// laser: one scan; projector: its monitor is connected). `stop_at_first` throws DeviceError at the first
+/// failure; otherwise every device is tried and `checks` says how each went.
+Devices open_devices(const config::DevicesConfig& config, std::vector<DeviceCheck>& checks, bool stop_at_first);
+
+}  // namespace projbot::tools

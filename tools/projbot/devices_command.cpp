@@ -1,0 +1,106 @@
+// projbot devices: what this machine offers Projbot, and whether a scene's configured devices work.
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include "commands.hpp"
+#include "devices.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/engine/renderer.hpp"
+
+namespace projbot::tools {
+namespace {
+
+// Serial devices a PTU-D46 or a Hokuyo / SICK laser appears as, with their stable by-id names.
+std::vector<std::string> serial_ports() {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/dev", ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("ttyUSB", 0) == 0 || name.rfind("ttyACM", 0) == 0) out.push_back(entry.path().string());
+  }
+  std::sort(out.begin(), out.end());
+  for (const auto& entry : std::filesystem::directory_iterator("/dev/serial/by-id", ec)) {
+    const auto target = std::filesystem::canonical(entry.path(), ec);
+    for (auto& port : out)
+      if (!ec && target.string() == port) port += " (" + entry.path().string() + ")";
+  }
+  return out;
+}
+
+void list_found(std::ostream& out) {
+  out << "RGB-D cameras (OpenNI2: PrimeSense, Xtion): ";
+  try {
+    const auto found = alignment::openni2_devices();
+    if (found.empty()) out << "none found";
+    for (std::size_t i = 0; i < found.size(); ++i)
+      out << (i ? "; " : "") << found[i].vendor << " " << found[i].name << " (uri: " << found[i].uri << ")";
+  } catch (const std::exception& e) {
+    out << "cannot look: " << e.what();
+  }
+  out << "\nKinect v1 (libfreenect): ";
+  try {
+    const int n = alignment::FreenectSource::count_devices();
+    out << (n == 0 ? std::string("none found") : std::to_string(n) + " found (index 0.." + std::to_string(n - 1) + ")");
+  } catch (const std::exception& e) {
+    out << "cannot look: " << e.what();
+  }
+  const auto ports = serial_ports();
+  out << "\nserial ports (pan-tilt unit, laser): " << (ports.empty() ? "none found" : "");
+  for (std::size_t i = 0; i < ports.size(); ++i) out << (i ? ", " : "") << ports[i];
+  out << "\nmonitors (the projector is one): ";
+  try {
+    const auto monitors = engine::connected_monitors();
+    if (monitors.empty()) out << "none connected";
+    for (std::size_t i = 0; i < monitors.size(); ++i)
+      out << (i ? "; " : "") << i << ": " << monitors[i].name << " " << monitors[i].width_px << "x" << monitors[i].height_px
+          << (monitors[i].refresh_hz > 0 ? " at " + std::to_string(monitors[i].refresh_hz) + " Hz"
+                                         : std::string(", refresh unknown"));
+  } catch (const std::exception& e) {
+    out << e.what();
+  }
+  out << "\nmobile base (ROS 2 topics over DDS): not in this build yet\n";
+}
+
+}  // namespace
+
+const Command kDevices{"devices",
+                       "list the cameras, serial ports and monitors Projbot can use here; check a scene's configured devices",
+                       "projbot devices [--config site.yaml]\n\n"
+                       "A first step on a new machine: lists the RGB-D cameras OpenNI2 sees (PrimeSense, Xtion), the\n"
+                       "Kinect v1 sensors libfreenect sees, the serial ports a PTU-D46 pan-tilt unit or a laser scanner can\n"
+                       "sit on, and the monitors (the projector is one; --monitor takes the index shown).\n"
+                       "With --config, it then opens each device the scene's `devices:` section names and reads from it once\n"
+                       "(a depth frame, the pan-tilt's position, a laser scan, the monitor), and says which work. Exit status\n"
+                       "1 when a configured device fails. A `devices:` section, each entry optional (absent: the twin):\n"
+                       "  devices:\n"
+                       "    camera: {driver: freenect, index: 0}           # or {driver: openni2, uri: \"\"} (an .oni file too)\n"
+                       "    pan_tilt: {driver: ptu-d46, port: /dev/ttyUSB0, baud: 9600}\n"
+                       "    laser: {driver: mrpt, class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM0}}\n"
+                       "    base: {driver: ros2-dds, domain: 0, cmd_vel: cmd_vel, odom: odom}\n"
+                       "    projector: {monitor: 1, fullscreen: true}\n",
+                       {{"config", "FILE", "a scene whose `devices:` section to check"}},
+                       [](const cli::Args& args) {
+                         std::optional<config::Scene> scene;
+                         if (const auto path = args.get("config"))
+                           scene = config::load_scene(*path);  // a bad file fails before the listing
+                         list_found(std::cout);
+                         if (!scene) return 0;
+                         std::cout << "\nconfigured in " << scene->source.string() << ":\n";
+                         if (!scene->devices.any()) {
+                           std::cout << "  no `devices:` section: every device is the digital twin's (projbot run --sim)\n";
+                           return 0;
+                         }
+                         std::vector<DeviceCheck> checks;
+                         open_devices(scene->devices, checks, false);
+                         bool all_ok = true;
+                         for (const auto& c : checks) {
+                           std::cout << "  " << c.config << ": " << (c.ok ? "ok, " : "FAILED: ") << c.detail << "\n";
+                           all_ok = all_ok && c.ok;
+                         }
+                         return all_ok ? 0 : 1;
+                       }};
+
+}  // namespace projbot::tools
