@@ -5,9 +5,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <thread>
 
 #include "cli_run.hpp"
 #include "projbot/alignment/freenect_source.hpp"
@@ -23,6 +26,13 @@ class DevicesCli : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("projbot_devices_cli_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
+    // DDS discovery over loopback only, by unicast: works on a machine without multicast (CI containers).
+    ::setenv("CYCLONEDDS_URI",
+             "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
+             "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
+             "<MaxAutoParticipantIndex>60</MaxAutoParticipantIndex><Peers><Peer Address=\"127.0.0.1\"/></Peers></Discovery>"
+             "</Domain></CycloneDDS>",
+             0);
   }
   void TearDown() override {
     ::unsetenv("LD_LIBRARY_PATH");
@@ -87,7 +97,10 @@ TEST_F(DevicesCli, NamesEachAbsentDevice) {
                           "serial port /dev/ttyACM97"),
             std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("base: ros2-dds (domain 3, rt/cmd_vel out, rt/odom in): FAILED: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("base: ros2-dds (domain 3, rt/cmd_vel out, rt/odom in): FAILED: base (ros2-dds, domain 3, rt/odom): "
+                          "no odometry within 2000 ms"),
+            std::string::npos)
+      << r.output;
   // run stops at the first, before opening any window or twin, naming it.
   const CliRun run = run_projbot("run --headless --config " + scene.string(), 60);
   EXPECT_EQ(run.code, 1) << run.output;
@@ -121,4 +134,31 @@ TEST_F(DevicesCli, OpensAKinectAndAPanTiltThatAreThere) {
   ::unsetenv("LD_LIBRARY_PATH");
   const CliRun sim = run_projbot("run --headless --sim --seconds 1 --config " + scene.string(), 120);
   EXPECT_EQ(sim.code, 0) << sim.output;
+}
+
+// The twin's youBot served over DDS by `projbot sim-base` in a second process, found by `projbot devices`.
+TEST_F(DevicesCli, FindsTheTwinsBaseServedInASecondProcess) {
+  const int domain = 100 + static_cast<int>(::getpid() % 50);
+  const fs::path log = dir_ / "sim-base.txt";
+  ASSERT_EQ(std::system(("timeout -s KILL 30 " + std::string(PROJBOT_EXE) + " sim-base --domain " + std::to_string(domain) +
+                         " --seconds 6 > " + log.string() + " 2>&1 &")
+                            .c_str()),
+            0);
+  const CliRun r = run_projbot("devices --config " + site("  base: {domain: " + std::to_string(domain) + "}\n").string(), 60);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("base: ros2-dds (domain " + std::to_string(domain) +
+                          ", rt/cmd_vel out, rt/odom in): ok, odometry at x 1 m, y 1 m, heading 0 deg"),
+            std::string::npos)
+      << r.output;  // the demo tour's robot.start
+  std::string served;
+  for (int i = 0; i < 200 && served.find("served ") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::ifstream in(log);
+    served.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  EXPECT_NE(
+      served.find("serving the twin's youBot on DDS domain " + std::to_string(domain) + ": rt/cmd_vel in, rt/odom out at 50 Hz"),
+      std::string::npos)
+      << served;
+  EXPECT_NE(served.find("served 300 odometry messages, 0 commands received"), std::string::npos) << served;
 }

@@ -8,7 +8,7 @@ packages=(
   libvulkan-dev vulkan-validationlayers mesa-vulkan-drivers glslang-tools vulkan-tools
   libglm-dev libeigen3-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
   libglfw3-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libpcl-dev libopenni2-dev libfreenect-dev libfreenect-bin libtiff-dev libboost-dev libmrpt-dev
+  libpcl-dev libopenni2-dev libfreenect-dev libfreenect-bin cyclonedds-dev cyclonedds-tools libtiff-dev libboost-dev libmrpt-dev
   libx11-dev libxrandr-dev xvfb x11-apps xauth bc valgrind
 )
 

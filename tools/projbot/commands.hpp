@@ -30,5 +30,6 @@ extern const Command kBenchLocalize;
 extern const Command kTour;
 extern const Command kRun;
 extern const Command kDevices;
+extern const Command kSimBase;
 
 }  // namespace projbot::tools

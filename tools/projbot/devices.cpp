@@ -58,6 +58,16 @@ std::string open_laser(const config::LaserDevice& l, Devices& out) {
          " deg";
 }
 
+std::string open_base(const config::BaseDevice& b, Devices& out) {
+  out.base = std::make_unique<robot::Ros2Base>(b);
+  const robot::Odometry2D odo = out.base->odometry(2.0);
+  std::ostringstream s;
+  s.precision(3);
+  s << "odometry at x " << odo.pose.x_m << " m, y " << odo.pose.y_m << " m, heading " << odo.pose.theta_rad * 180.0 / M_PI
+    << " deg";
+  return s.str();
+}
+
 std::string check_monitor(const config::ProjectorDevice& p) {
   const auto monitors = engine::connected_monitors();
   if (p.monitor >= static_cast<int>(monitors.size()))
@@ -89,10 +99,7 @@ Devices open_devices(const config::DevicesConfig& config, std::vector<DeviceChec
   if (config.camera) attempt("camera", [&] { return open_camera(*config.camera, out); });
   if (config.pan_tilt) attempt("pan_tilt", [&] { return open_pan_tilt(*config.pan_tilt, out); });
   if (config.laser) attempt("laser", [&] { return open_laser(*config.laser, out); });
-  if (config.base)
-    attempt("base", []() -> std::string {
-      throw DeviceError("the ros2-dds base driver is not in this build yet (issue 12): drive the twin's base with --sim");
-    });
+  if (config.base) attempt("base", [&] { return open_base(*config.base, out); });
   if (config.projector) attempt("projector", [&] { return check_monitor(*config.projector); });
   return out;
 }

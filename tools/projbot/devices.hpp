@@ -13,6 +13,7 @@
 #include "projbot/config/devices.hpp"
 #include "projbot/robot/mrpt_laser.hpp"
 #include "projbot/robot/ptu_d46.hpp"
+#include "projbot/robot/ros2_base.hpp"
 
 namespace projbot::tools {
 
@@ -28,6 +29,7 @@ struct Devices {
   std::unique_ptr<alignment::FreenectSource> freenect;
   std::unique_ptr<robot::PtuD46> pan_tilt;
   std::unique_ptr<robot::MrptLaser> laser;
+  std::unique_ptr<robot::Ros2Base> base;
 };
 
 /// What checking one configured device found.
@@ -39,8 +41,8 @@ struct DeviceCheck {
 };
 
 /// Opens and reads each configured device in turn (camera: one depth frame; pan-tilt: its position;
-/// laser: one scan; projector: its monitor is connected). `stop_at_first` throws DeviceError at the first
-/// failure; otherwise every device is tried and `checks` says how each went.
+/// laser: one scan; base: one odometry message; projector: its monitor is connected). `stop_at_first` throws DeviceError at the
+/// first failure; otherwise every device is tried and `checks` says how each went.
 Devices open_devices(const config::DevicesConfig& config, std::vector<DeviceCheck>& checks, bool stop_at_first);
 
 }  // namespace projbot::tools

@@ -1,0 +1,73 @@
+#pragma once
+// A mobile base driven through ROS 2 topics over Eclipse Cyclone DDS (issue 12, `devices.base`), with no
+// ROS 2 installed: geometry_msgs/msg/Twist published on `cmd_vel`, nav_msgs/msg/Odometry read from
+// `odom`, with ROS 2's names on the wire (topics `rt/<name>`, types `<pkg>::msg::dds_::<Type>_`, CDR),
+// so any ROS 2 base driver (the youBot's through a bridge) answers it and `ros2 topic echo` shows it.
+// Also the other side: the twin's simulated youBot served on the same topics, for tests and for
+// trying a ROS 2 tool without a robot. Cyclone DDS types stay in src/.
+
+#include <memory>
+#include <string>
+
+#include "projbot/config/devices.hpp"
+#include "projbot/robot/error.hpp"
+#include "projbot/robot/pose2d.hpp"
+#include "projbot/robot/sim_base.hpp"
+#include "projbot/robot/youbot.hpp"
+
+namespace projbot::robot {
+
+/// A planar odometry reading: nav_msgs/Odometry's pose (x, y, yaw) and twist, stamped by its sender.
+struct Odometry2D {
+  double stamp_s = 0.0;
+  Pose2D pose;
+  BaseTwist twist;
+};
+
+/// The robot's side: commands a base and reads its odometry.
+class Ros2Base {
+ public:
+  /// Joins DDS domain `config.domain` and creates the writer and reader. Throws RobotError naming the
+  /// domain when DDS cannot start.
+  explicit Ros2Base(const config::BaseDevice& config);
+  ~Ros2Base();
+  Ros2Base(const Ros2Base&) = delete;
+  Ros2Base& operator=(const Ros2Base&) = delete;
+
+  /// Publishes a velocity command (base frame: x forward, y left, yaw counter-clockwise).
+  void send(const BaseTwist& twist);
+  /// The newest odometry received, waiting up to timeout_s for the first. Throws RobotError naming the
+  /// topic when none arrives (no base driver running, or another domain).
+  Odometry2D odometry(double timeout_s);
+  /// What this base is, for messages: "base (ros2-dds, domain 0, rt/odom)".
+  const std::string& name() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The twin's side: a simulated youBot (SimulatedBase, wheel odometry) that follows the newest cmd_vel
+/// (stopping when none came for 0.5 s, as base drivers do) and publishes its wheel odometry on `odom`.
+class Ros2BaseServer {
+ public:
+  Ros2BaseServer(const config::BaseDevice& config, const Pose2D& start, const BaseErrorModel& errors = BaseErrorModel::none());
+  ~Ros2BaseServer();
+  Ros2BaseServer(const Ros2BaseServer&) = delete;
+  Ros2BaseServer& operator=(const Ros2BaseServer&) = delete;
+
+  /// Takes the newest command, moves the simulation dt_s forward (at clock time now_s) and publishes
+  /// the odometry.
+  void step(double now_s, double dt_s);
+  /// Ground truth and the odometry as published.
+  const Pose2D& true_pose() const;
+  const Pose2D& odometry_pose() const;
+  /// Velocity commands received so far.
+  int commands_received() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace projbot::robot
