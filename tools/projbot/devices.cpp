@@ -26,19 +26,31 @@ std::string describe_depth(const alignment::DepthImage& d) {
   return out.str();
 }
 
+// An OpenNI2 device or recording as the session's camera: depth only (OpenNi2Source reads no colour yet).
+class OpenNi2Camera final : public alignment::RgbdCamera {
+ public:
+  explicit OpenNi2Camera(const alignment::OpenNi2Options& o) : source_(o) {}
+  alignment::RgbdFrame next() override { return {source_.next(), {}, 0, 0}; }
+
+ private:
+  alignment::OpenNi2Source source_;
+};
+
 std::string open_camera(const config::CameraDevice& c, Devices& out) {
   if (c.driver == "freenect") {
     alignment::FreenectOptions o;
     o.index = c.index;
     o.registered = c.registered;
-    out.freenect = std::make_unique<alignment::FreenectSource>(o);
-    const alignment::RgbdFrame f = out.freenect->next();
-    return describe_depth(f.depth) + " + " + std::to_string(f.colour.width) + "x" + std::to_string(f.colour.height) + " colour";
+    out.camera = std::make_unique<alignment::FreenectSource>(o);
+  } else {
+    alignment::OpenNi2Options o;
+    o.uri = c.uri;
+    out.camera = std::make_unique<OpenNi2Camera>(o);
   }
-  alignment::OpenNi2Options o;
-  o.uri = c.uri;
-  out.openni2 = std::make_unique<alignment::OpenNi2Source>(o);
-  return describe_depth(out.openni2->next());
+  const alignment::RgbdFrame f = out.camera->next();
+  return describe_depth(f.depth) +
+         (f.colour.rgba.empty() ? std::string(", no colour")
+                                : " + " + std::to_string(f.colour.width) + "x" + std::to_string(f.colour.height) + " colour");
 }
 
 std::string open_pan_tilt(const config::PanTiltDevice& p, Devices& out) {

@@ -10,6 +10,7 @@
 
 #include "projbot/alignment/freenect_source.hpp"
 #include "projbot/alignment/openni2_source.hpp"
+#include "projbot/alignment/rgbd_camera.hpp"
 #include "projbot/config/devices.hpp"
 #include "projbot/robot/mrpt_laser.hpp"
 #include "projbot/robot/ptu_d46.hpp"
@@ -25,8 +26,7 @@ class DeviceError : public std::runtime_error {
 
 /// The opened devices; each null where the config names none (the twin serves it).
 struct Devices {
-  std::unique_ptr<alignment::OpenNi2Source> openni2;
-  std::unique_ptr<alignment::FreenectSource> freenect;
+  std::unique_ptr<alignment::RgbdCamera> camera;
   std::unique_ptr<robot::PtuD46> pan_tilt;
   std::unique_ptr<robot::MrptLaser> laser;
   std::unique_ptr<robot::Ros2Base> base;

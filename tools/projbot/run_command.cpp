@@ -108,9 +108,12 @@ struct RunOptions {
   std::uint64_t seed = 1;
 };
 
-// The robot thread against the twin: drive, aim, Eq. 1, then capture depth at 30 Hz while dwelling.
+// The robot thread against the twin: drive, aim, Eq. 1, then capture depth at 30 Hz while dwelling. A
+// configured camera (`devices.camera`) replaces the twin's: its frames, at its own rate, are what the
+// workers see and its colour is the arrival's.
 void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std::unique_ptr<alignment::TrackerWorker>>& workers,
-                alignment::LatestValue<RobotState>& state, std::vector<double>& capture_ms, const std::stop_token& stop) {
+                alignment::LatestValue<RobotState>& state, std::vector<double>& capture_ms, const std::stop_token& stop,
+                alignment::RgbdCamera* camera) {
   engine::Renderer depth_renderer(engine::RendererOptions{});
   twin::TwinOptions to;
   to.seed = o.seed;
@@ -129,8 +132,13 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
     // Eq. 1 guess, tracked by its own worker, lit or blanked on its own.
     // Each also gets its surveyed footing and the colour taken on arrival, before any light.
     const Eigen::Matrix4d T_world_believed = arrival.believed.T_world_camera.matrix();
-    const auto colour =
-        std::make_shared<const assets::Image>(twin.capture_colour(T_world_camera, static_cast<std::uint32_t>(o.seed * 7919 + v)));
+    std::shared_ptr<const assets::Image> colour;
+    if (camera == nullptr) {
+      colour = std::make_shared<const assets::Image>(
+          twin.capture_colour(T_world_camera, static_cast<std::uint32_t>(o.seed * 7919 + v)));
+    } else if (alignment::RgbdFrame first = camera->next(); !first.colour.rgba.empty()) {
+      colour = std::make_shared<const assets::Image>(std::move(first.colour));
+    }
     const auto start = [&](std::size_t twin_index, const Eigen::Matrix4d& T_map_target, const Eigen::Matrix4d& guess) {
       const int s = scene.target_index(targets[twin_index].config.name);
       workers[static_cast<std::size_t>(s)]->set_initial_guess(
@@ -148,6 +156,12 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
       if (t >= o.dwell_s) break;
       targets[i].T_world_target_true = twin.scripted_pose(i, target_visit, t);
       const double captured = now_s();
+      if (camera != nullptr) {  // it paces itself; its frames carry their own arrival times
+        auto frame = std::make_shared<alignment::DepthImage>(camera->next().depth);
+        capture_ms.push_back(1000.0 * (now_s() - captured));
+        for (const LitTarget& l : lit) workers[static_cast<std::size_t>(l.target)]->submit(frame);
+        continue;
+      }
       auto frame =
           std::make_shared<alignment::DepthImage>(twin.capture(T_world_camera, static_cast<std::uint32_t>(o.seed * 7919 + k)));
       // Stamped with the instant the scene was sampled (the exposure), so the simulated sensor's own
@@ -164,21 +178,25 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
   state.publish({.lit = {}, .since_s = now_s(), .visit = visits, .done = true});
 }
 
-// Without --sim: a config naming real devices has them opened (each absent one an error naming it); one
-// naming none runs the twin and says so.
-void check_devices_or_sim(const config::Scene& scene) {
+// Without --sim: the devices the config names, opened and read once (each absent one an error naming it);
+// the twin serves the rest. A config naming none runs the twin and says so.
+Devices open_configured(const config::Scene& scene) {
   if (!scene.devices.any()) {
     std::cout << "no devices configured in " << scene.source.filename().string()
               << " (a `devices:` section; projbot devices lists what this machine has): running against the digital twin (--sim)"
               << std::endl;
-    return;
+    return {};
   }
   std::vector<DeviceCheck> checks;
-  const Devices devices = open_devices(scene.devices, checks, true);  // throws DeviceError at the first that fails
+  Devices devices = open_devices(scene.devices, checks, true);  // throws DeviceError at the first that fails
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
-  throw DeviceError(
-      "every configured device answered, but projecting with real devices is not built yet (the session "
-      "that drives them is issue 12's next step); run the twin with --sim");
+  if (scene.devices.pan_tilt || scene.devices.laser || scene.devices.base)
+    throw DeviceError(
+        "every configured device answered, but run drives only a real camera and projector so far: the robot "
+        "(pan_tilt, laser, base) stays the twin's until the session drives real ones (issue 12); leave them out "
+        "of `devices:` or run the twin with --sim");
+  std::cout << "the twin serves the robot" << (scene.devices.camera ? "" : " and the camera") << std::endl;
+  return devices;
 }
 
 }  // namespace
@@ -202,9 +220,10 @@ const Command kRun{
     "percentiles at the end (the error while a target moves and while it stands still, mm).\n"
     "Devices come from the config's `devices:` section (projbot devices --help shows it): each one configured\n"
     "is opened and read once at start, and one that is absent stops the run with a message naming it.\n"
-    "With none configured, or with --sim, the digital twin serves every device. Projecting with real devices\n"
-    "is not built yet: a config whose devices all work says so and stops. Without --config the shipped demo\n"
-    "tour runs in the twin.\n",
+    "A configured camera replaces the twin's (its frames at its own rate, its colour on arrival) and a\n"
+    "configured projector sets the window's monitor and fullscreen; the robot (pan_tilt, laser, base) is still\n"
+    "the twin's, and configuring one of them stops the run saying so. With none configured, or with --sim,\n"
+    "the digital twin serves every device. Without --config the shipped demo tour runs in the twin.\n",
     {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)"},
      {"sim", "", "run against the digital twin, whatever `devices:` configures (the default without one)"},
      {"fullscreen", "", "fullscreen on --monitor (the projector)"},
@@ -222,7 +241,7 @@ const Command kRun{
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
-      if (!args.flag("sim")) check_devices_or_sim(scene);
+      const Devices devices = args.flag("sim") ? Devices{} : open_configured(scene);
       RunOptions o;
       o.visits = args.get_int("visits", 0, 1, 1000);
       o.dwell_s = args.get_double("dwell", 4.0);
@@ -244,8 +263,12 @@ const Command kRun{
       if (headless) {
         target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
       } else {
-        target = open_window(renderer, window_options(args, scene.projector, "projbot run: " + scene.source.filename().string()),
-                             scene.projector);
+        engine::WindowOptions wo = window_options(args, scene.projector, "projbot run: " + scene.source.filename().string());
+        if (scene.devices.projector && !args.flag("sim")) {  // the config's projector, unless the command line says otherwise
+          wo.fullscreen = args.flag("fullscreen") || scene.devices.projector->fullscreen;
+          if (!args.get("monitor")) wo.monitor = scene.devices.projector->monitor;
+        }
+        target = open_window(renderer, wo, scene.projector);
       }
 
       // One tracker worker per target the tour visits.
@@ -268,7 +291,7 @@ const Command kRun{
       std::vector<double> capture_ms;  // the robot thread's until it is joined
       std::jthread robot_thread([&](std::stop_token stop) {
         try {
-          drive_twin(scene, o, workers, state, capture_ms, stop);
+          drive_twin(scene, o, workers, state, capture_ms, stop, devices.camera.get());
         } catch (...) {
           robot_error = std::current_exception();
         }
@@ -361,10 +384,15 @@ const Command kRun{
       errors.print(std::cout);
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
-      std::cout << "robot: " << robot.visit << " visit(s); the twin's depth camera delivered " << capture_ms.size()
-                << " frames (render + Kinect noise p50 " << engine::percentile(capture_ms, 0.5) << " ms, p95 "
-                << engine::percentile(capture_ms, 0.95) << " ms of each pose's age); the tracker workers processed " << tracked
-                << "\n";
+      std::cout << "robot: " << robot.visit << " visit(s); ";
+      if (devices.camera)
+        std::cout << "the configured camera delivered " << capture_ms.size() << " frames (waited for p50 "
+                  << engine::percentile(capture_ms, 0.5) << " ms)";
+      else
+        std::cout << "the twin's depth camera delivered " << capture_ms.size() << " frames (render + Kinect noise p50 "
+                  << engine::percentile(capture_ms, 0.5) << " ms, p95 " << engine::percentile(capture_ms, 0.95)
+                  << " ms of each pose's age)";
+      std::cout << "; the tracker workers processed " << tracked << "\n";
       if (const auto csv = args.get("profile")) {
         std::ostringstream f;
         // Per frame: when it started, the capture time of the depth its pose came from and its expected

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/rgbd_camera.hpp"
 #include "projbot/assets/image.hpp"
 
 namespace projbot::alignment {
@@ -34,26 +35,18 @@ struct FreenectOptions {
   int timeout_ms = 2000;  ///< next() gives up after this long without a frame pair
 };
 
-/// One depth frame and the colour frame that followed it.
-struct RgbdFrame {
-  DepthImage depth;                   ///< metres; capture_time_s on the host's steady clock at arrival
-  assets::Image colour;               ///< RGBA, 640x480
-  std::uint32_t depth_timestamp = 0;  ///< the device's own counters
-  std::uint32_t colour_timestamp = 0;
-};
-
-class FreenectSource {
+class FreenectSource final : public RgbdCamera {
  public:
   /// Opens Kinect `index` and starts depth and colour. Throws AlignmentError naming the index and how many
   /// Kinects libfreenect found (or why it could not look).
   explicit FreenectSource(const FreenectOptions& options);
-  ~FreenectSource();
+  ~FreenectSource() override;
   FreenectSource(const FreenectSource&) = delete;
   FreenectSource& operator=(const FreenectSource&) = delete;
 
-  /// The next depth frame and a colour frame newer than the previous call's. Throws AlignmentError when
-  /// none arrives within timeout_ms or the device (or a fakenect dump) stops.
-  RgbdFrame next();
+  /// The next depth frame and the colour frame that followed it (depth: capture_time_s at its arrival).
+  /// Throws AlignmentError when none arrives within timeout_ms or the device (or a fakenect dump) stops.
+  RgbdFrame next() override;
   /// Frame pairs returned so far.
   int frames_read() const;
 
