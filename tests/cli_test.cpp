@@ -188,6 +188,36 @@ TEST_F(CliTest, SlamThenLocalize) {
   EXPECT_EQ(trajectory_lines(dir_ / "loc.txt"), 225);
 }
 
+// Long commands show a line per step with elapsed and expected time on a terminal (a pseudo-terminal
+// from `script` here), and nothing of it when their output is a pipe.
+TEST_F(CliTest, LongCommandsShowProgressOnATerminalOnly) {
+  const std::string tour =
+      std::string(PROJBOT_EXE) + " tour --scene " + PROJBOT_ASSET_DIR + "/scenes/tour.yaml --visits 2 --dwell 0.3";
+  FILE* pipe = popen(("script -qec '" + tour + "' /dev/null 2>&1").c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  std::array<char, 512> buf{};
+  while (fgets(buf.data(), buf.size(), pipe) != nullptr) out += buf.data();
+  ASSERT_EQ(pclose(pipe), 0) << out;
+  EXPECT_NE(out.find("  visit 1/2 done, "), std::string::npos) << out;
+  EXPECT_NE(out.find(" elapsed, about "), std::string::npos) << out;  // the time left, after the first visit
+  EXPECT_NE(out.find("  visit 2/2 done, "), std::string::npos) << out;
+  const std::string rawlog = std::string(PROJBOT_SHARED_DATA) + "/mrpt/2006-01ENE-21-SENA_Telecom_Faculty_one_loop_only.rawlog";
+  pipe = popen(("script -qec '" + std::string(PROJBOT_EXE) + " slam --rawlog " + rawlog + " --out-map " +
+                (dir_ / "map").string() + " --out-trajectory " + (dir_ / "slam.txt").string() + "' /dev/null 2>&1")
+                   .c_str(),
+               "r");
+  ASSERT_NE(pipe, nullptr);
+  out.clear();
+  while (fgets(buf.data(), buf.size(), pipe) != nullptr) out += buf.data();
+  ASSERT_EQ(pclose(pipe), 0) << out;
+  EXPECT_NE(out.find("  scan 12/225 done, "), std::string::npos) << out;  // every 12th of 225: at most 20 lines
+  EXPECT_EQ(out.find("  scan 13/225 done, "), std::string::npos) << out;
+  const CliRun piped = run_projbot("tour --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml --visits 1 --dwell 0.3");
+  ASSERT_EQ(piped.code, 0) << piped.output;
+  EXPECT_EQ(piped.output.find(" done, "), std::string::npos) << piped.output;
+}
+
 TEST_F(CliTest, AlignPrintsJson) {
   const std::string bunny = std::string(PROJBOT_SHARED_DATA) + "/bunny/";
   const CliRun r = run_projbot("align --model " + bunny + "bun0.pcd --scan " + bunny +

@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "progress.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/alignment/verification.hpp"
@@ -140,6 +141,8 @@ const Command kBenchAcquire{
           "|---|---|---|---|---|---|---|---|\n");
       char small[48];
       std::snprintf(small, sizeof small, "%.0f cm, %.0f deg", cm, deg);
+      Progress progress("trial", static_cast<int>(twin.targets().size()) * trials);
+      int trials_done = 0;
       for (std::size_t i = 0; i < twin.targets().size(); ++i) {
         const twin::TwinTarget& target = twin.targets()[i];
         const twin::Arrival arrival = twin.arrive(i, static_cast<int>(i));
@@ -164,6 +167,7 @@ const Command kBenchAcquire{
             tallies[2 * gross].add(ours(follower, depth, colour, footing, guess, grow_m[gross], T_true));
             tallies[2 * gross + 1].add(pcl_pipeline(pcl, twin, depth, guess, T_true));
           }
+          progress.step(++trials_done);
         }
         if (k > 0) {  // Ctrl-C: the trials finished for this target are printed too (their count says how many)
           tallies[0].print(target.config.name, small, "ours");

@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "progress.hpp"
 #include "projbot/twin/tour.hpp"
 #include "scene_setup.hpp"
 
@@ -79,10 +80,15 @@ const Command kBenchMotion{
       catch_interrupts();
       o.stop_requested = [] { return interrupted(); };
       twin::TourReport runs[2];
+      const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
+      Progress progress("visit", 2 * visits);
       for (const bool predict : {false, true}) {
         o.predict = predict;
         std::cout << "prediction " << (predict ? "on" : "off") << ": " << std::flush;
-        o.on_visit = [](const twin::VisitReport& v) { std::cout << v.visit << ' ' << std::flush; };
+        o.on_visit = [&](const twin::VisitReport& v) {
+          std::cout << v.visit << ' ' << std::flush;
+          progress.step((predict ? visits : 0) + v.visit);
+        };
         runs[predict ? 1 : 0] = twin::run_tour(scene, o);
         std::cout << "visits done in " << cell(runs[predict ? 1 : 0].wall_s) << " s" << std::endl;
         if (runs[predict ? 1 : 0].interrupted) break;

@@ -14,6 +14,7 @@
 
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "progress.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/localization.hpp"
 #include "projbot/robot/sim_tour.hpp"
@@ -103,8 +104,15 @@ const Command kSlam{
       catch_interrupts();  // Ctrl-C: map and write the scans done so far, then exit 130
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
       std::cout << "mapping " << steps.size() << " scans (Ctrl-C stops and keeps the map of the scans done)..." << std::endl;
+      Progress progress("scan", static_cast<int>(steps.size()));
+      int asked = 0;  // build_map asks before each scan: the scans done so far are one fewer
       const robot::SlamResult r = robot::build_map(
-          steps, ini, *args.get("out-map"), [] { return interrupted(); }, args.flag("verbose"));
+          steps, ini, *args.get("out-map"),
+          [&] {
+            if (++asked > 1) progress.step(asked - 1);
+            return interrupted();
+          },
+          args.flag("verbose"));
       robot::write_trajectory(*args.get("out-trajectory"), r.trajectory);
       if (r.interrupted) {
         std::cout << "ICP-SLAM interrupted after " << r.trajectory.size() << " of " << steps.size()
@@ -155,6 +163,7 @@ const Command kLocalize{
       std::cout << "localising " << steps.size() << " scans (Ctrl-C stops and keeps the trajectory of the scans done)..."
                 << std::endl;
       loc.reset(start);
+      Progress progress("scan", static_cast<int>(steps.size()));
       std::vector<robot::TrajectoryPoint> out;
       int accepted = 0;
       double ms = 0;
@@ -165,6 +174,7 @@ const Command kLocalize{
         accepted += u.accepted;
         ms += u.time_ms;
         out.push_back({s.timestamp_s, loc.pose()});
+        progress.step(static_cast<int>(out.size()));
       }
       robot::write_trajectory(*args.get("out-trajectory"), out);
       if (interrupted()) {

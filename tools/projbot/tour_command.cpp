@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "progress.hpp"
 #include "projbot/twin/tour.hpp"
 #include "scene_setup.hpp"
 
@@ -93,7 +94,8 @@ const Command kTour{
       std::cout << "Tour of " << scene_path << " in " << mode << " mode" << kModeHints.at(mode) << std::endl;
       catch_interrupts();  // Ctrl-C: stop after the visit in progress, keep the finished ones
       o.stop_requested = [] { return interrupted(); };
-      o.on_visit = [](const twin::VisitReport& v) {
+      Progress progress("visit", o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size()));
+      o.on_visit = [&progress](const twin::VisitReport& v) {
         std::cout << "visit " << v.visit << " (" << v.target << ", " << v.target_visit << "): " << std::fixed;
         if (!v.target_present)
           std::cout << "target absent, "
@@ -109,6 +111,7 @@ const Command kTour{
           std::cout << "; neighbour " << n.target << " lit in " << n.lit_frames << "/" << n.frames << " frames"
                     << (n.lit_frames > 0 ? ", mean " + fixed_mm(n.lit_mean_mm) + " mm" : std::string());
         std::cout << std::endl;
+        progress.step(v.visit);
       };
       const twin::TourReport report = twin::run_tour(scene, o);
       std::cout << '\n';
