@@ -196,12 +196,16 @@ TEST_F(DevicesCli, RunTracksThroughAConfiguredKinect) {
   std::vector<projbot::alignment::FakenectFrame> frames;
   for (std::size_t k = 0; k < depths.size(); ++k) frames.push_back({&depths[k], &colours[k], static_cast<double>(k) / 30.0});
   projbot::alignment::write_fakenect_dump(dir_ / "dump", frames);
-  {  // played 12 times over (Debian's fakenect does not loop): 120 frames, 4 s at 30 Hz, from 10 files
+  std::string once;
+  {
     std::ifstream in(dir_ / "dump" / "INDEX.txt");
-    const std::string once((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::ofstream out(dir_ / "dump" / "INDEX.txt");
-    for (int i = 0; i < 12; ++i) out << once;
+    once.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
+  const auto play_times = [&](int n) {  // Debian's fakenect does not loop: list the 10 frames n times over
+    std::ofstream out(dir_ / "dump" / "INDEX.txt");
+    for (int i = 0; i < n; ++i) out << once;
+  };
+  play_times(12);  // 120 frames, 4 s at 30 Hz
   ::setenv("LD_LIBRARY_PATH", PROJBOT_FAKENECT_DIR, 1);
   ::setenv("FAKENECT_PATH", (dir_ / "dump").c_str(), 1);
   const CliRun r = run_projbot(
@@ -214,4 +218,18 @@ TEST_F(DevicesCli, RunTracksThroughAConfiguredKinect) {
   // Measured: 148 of 171 frames lit, 0.1 mm (the twin's own camera: 147, 0.1 mm).
   EXPECT_GT(number_after(r.output, "pose age at display (depth capture to expected display), "), 90.0) << r.output;
   EXPECT_LT(number_after(r.output, "still mean "), 1.0) << r.output;
+
+  // The camera stops in the middle of the dwell (the dump ends after 30 frames, 1 s): the projection is
+  // blanked, what was measured is printed and written, and the failure is reported with exit status 1.
+  play_times(3);
+  const fs::path profile = dir_ / "profile.csv";
+  const CliRun cut = run_projbot(
+      "run --headless --visits 1 --dwell 2.5 --profile " + profile.string() + " --config " + (dir_ / "site.yaml").string(), 120);
+  EXPECT_EQ(cut.code, 1) << cut.output;
+  EXPECT_NE(cut.output.find("projbot run: Kinect v1 #0 (libfreenect): stopped delivering frames"), std::string::npos)
+      << cut.output;
+  EXPECT_NE(cut.output.find("(the projection was blanked; what was measured until then is above)"), std::string::npos)
+      << cut.output;
+  EXPECT_GT(number_after(cut.output, "pose age at display (depth capture to expected display), "), 10.0) << cut.output;
+  EXPECT_TRUE(fs::exists(profile)) << cut.output;
 }

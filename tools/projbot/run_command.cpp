@@ -367,10 +367,21 @@ const Command kRun{
         rows.push_back({start_ms, age_ms, start_ms + 1000.0 * (first.capture_s - start_s),
                         start_ms + 1000.0 * (first.display_s - start_s), row_error.front(), first.lit->target});
       }
+      // A device (or the twin) failed while projecting: black at once, so nothing it last showed stays lit;
+      // what was measured until then is still printed and written, then the failure is reported.
+      std::string failure;
+      if (robot_done && robot_error) {
+        renderer.draw_frame(*target, scene.projector, std::span<const engine::DrawItem>{});
+        try {
+          std::rethrow_exception(robot_error);
+        } catch (const std::exception& e) {
+          failure = e.what();
+        }
+      }
       renderer.finish(*target);
       robot_thread.request_stop();
       robot_thread.join();
-      if (robot_error) std::rethrow_exception(robot_error);
+      if (robot_error && failure.empty()) std::rethrow_exception(robot_error);
       for (const auto& w : workers)
         if (w && w->error()) std::rethrow_exception(w->error());
 
@@ -405,6 +416,10 @@ const Command kRun{
             << opt(rows[i].capture_ms) << ',' << opt(rows[i].display_ms) << ',' << opt(rows[i].error_mm) << '\n';
         config::write_file_atomically(*csv, f.str());
         std::cout << "per-frame profile written to " << *csv << '\n';
+      }
+      if (!failure.empty()) {
+        std::cerr << "projbot run: " << failure << " (the projection was blanked; what was measured until then is above)\n";
+        return 1;
       }
       return interrupt_exit_code();  // 0, or 130 / 143 after Ctrl-C / SIGTERM
     }};
