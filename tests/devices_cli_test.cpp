@@ -86,7 +86,7 @@ TEST_F(DevicesCli, ListsWhatThisMachineOffers) {
   ASSERT_EQ(r.code, 0) << r.output;
   for (const char* line :
        {"RGB-D cameras (OpenNI2: PrimeSense, Xtion): ", "Kinect v1 (libfreenect): ", "serial ports (pan-tilt unit, laser): ",
-        "monitors (the projector is one): ", "mobile base (ROS 2 topics over DDS): "})
+        "monitors (the projector is one): ", "ROS 2 / DDS on domain 0: "})
     EXPECT_NE(r.output.find(line), std::string::npos) << line << "\n" << r.output;
   EXPECT_EQ(run_projbot("devices --config " + site("").string()).code, 0);  // an empty section: the twin's
 }
@@ -162,6 +162,12 @@ TEST_F(DevicesCli, FindsTheTwinsBaseServedInASecondProcess) {
                           ", rt/cmd_vel out, rt/odom in): ok, odometry at x 1 m, y 1 m, heading 0 deg"),
             std::string::npos)
       << r.output;  // the demo tour's robot.start
+  // What DDS shows on that domain: the base driver's topics with ROS 2's names and types on the wire.
+  EXPECT_NE(r.output.find("ROS 2 / DDS on domain " + std::to_string(domain) +
+                          ": 1 other participant heard in 1 s; published: "
+                          "rt/odom (nav_msgs::msg::dds_::Odometry_); subscribed: rt/cmd_vel (geometry_msgs::msg::dds_::Twist_)"),
+            std::string::npos)
+      << r.output;
   std::string served;
   for (int i = 0; i < 200 && served.find("served ") == std::string::npos; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));

@@ -34,7 +34,7 @@ std::vector<std::string> serial_ports() {
   return out;
 }
 
-void list_found(std::ostream& out) {
+void list_found(std::ostream& out, int dds_domain) {
   out << "RGB-D cameras (OpenNI2: PrimeSense, Xtion): ";
   try {
     const auto found = alignment::openni2_devices();
@@ -65,7 +65,22 @@ void list_found(std::ostream& out) {
   } catch (const std::exception& e) {
     out << e.what();
   }
-  out << "\nmobile base (ROS 2 topics over DDS): give its domain and topics in `devices.base`; --config checks it\n";
+  out << "\nROS 2 / DDS on domain " << dds_domain << ": ";
+  try {
+    const auto seen = robot::survey_dds(dds_domain, 1.0);
+    out << seen.participants << " other participant" << (seen.participants == 1 ? "" : "s") << " heard in 1 s";
+    const auto list = [&](const char* what, const auto& topics) {
+      if (topics.empty()) return;
+      out << "; " << what << ": ";
+      for (std::size_t i = 0; i < topics.size(); ++i)
+        out << (i ? ", " : "") << topics[i].first << " (" << topics[i].second << ")";
+    };
+    list("published", seen.published);
+    list("subscribed", seen.subscribed);
+  } catch (const std::exception& e) {
+    out << "cannot look: " << e.what();
+  }
+  out << "\n";
 }
 
 }  // namespace
@@ -75,7 +90,8 @@ const Command kDevices{"devices",
                        "projbot devices [--config site.yaml]\n\n"
                        "A first step on a new machine: lists the RGB-D cameras OpenNI2 sees (PrimeSense, Xtion), the\n"
                        "Kinect v1 sensors libfreenect sees, the serial ports a PTU-D46 pan-tilt unit or a laser scanner can\n"
-                       "sit on, and the monitors (the projector is one; --monitor takes the index shown).\n"
+                       "sit on, the monitors (the projector is one; --monitor takes the index shown), and what ROS 2 / DDS\n"
+                       "participants publish and subscribe on the base's domain (a base driver publishes rt/odom).\n"
                        "With --config, it then opens each device the scene's `devices:` section names and reads from it once\n"
                        "(a depth frame, the pan-tilt's position, a laser scan, the monitor), and says which work. Exit status\n"
                        "1 when a configured device fails. A `devices:` section, each entry optional (absent: the twin):\n"
@@ -85,12 +101,15 @@ const Command kDevices{"devices",
                        "    laser: {driver: mrpt, class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM0}}\n"
                        "    base: {driver: ros2-dds, domain: 0, cmd_vel: cmd_vel, odom: odom}\n"
                        "    projector: {monitor: 1, fullscreen: true}\n",
-                       {{"config", "FILE", "a scene whose `devices:` section to check"}},
+                       {{"config", "FILE", "a scene whose `devices:` section to check"},
+                        {"domain", "N", "the DDS domain to listen on (default: devices.base.domain, else 0)"}},
                        [](const cli::Args& args) {
                          std::optional<config::Scene> scene;
                          if (const auto path = args.get("config"))
                            scene = config::load_scene(*path);  // a bad file fails before the listing
-                         list_found(std::cout);
+                         int domain = scene && scene->devices.base ? scene->devices.base->domain : 0;
+                         domain = args.get_int("domain", domain, 0, 232);
+                         list_found(std::cout, domain);
                          if (!scene) return 0;
                          std::cout << "\nconfigured in " << scene->source.string() << ":\n";
                          if (!scene->devices.any()) {

@@ -8,6 +8,8 @@
 
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "projbot/config/devices.hpp"
 #include "projbot/robot/error.hpp"
@@ -69,5 +71,15 @@ class Ros2BaseServer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// What DDS shows on a domain after listening a while: the other participants, and the topics they
+/// publish and subscribe (name and type as on the wire: "rt/odom", "nav_msgs::msg::dds_::Odometry_").
+struct DdsSurvey {
+  int participants = 0;                                         ///< not counting the one that listened
+  std::vector<std::pair<std::string, std::string>> published;   ///< topic, type; sorted, once each
+  std::vector<std::pair<std::string, std::string>> subscribed;  ///< topic, type; sorted, once each
+};
+/// Joins `domain`, listens `listen_s` seconds and reports what it saw. Throws RobotError when DDS cannot start.
+DdsSurvey survey_dds(int domain, double listen_s);
 
 }  // namespace projbot::robot
