@@ -313,3 +313,54 @@ TEST(IsolatedRead, EveryWayTheChildEndsIsNamed) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
   std::filesystem::remove(file);
 }
+
+// `calibration: calib.yaml` (issue 13's output) gives A_p and R_cp, T_cp in place of the scene's.
+TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
+  const auto dir = std::filesystem::temp_directory_path() / ("projbot_calib_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, const std::string& text) { std::ofstream(dir / name) << text; };
+  write("calib.yaml",
+        "projector: {width: 1024, height: 768, fx: 1500.5, fy: 1499.5, cx: 511.2, cy: 383.9, distortion: [0, 0, 0, 0, 0]}\n"
+        "projector_from_camera: {translation: [0.05, -0.1, 0.02], rpy_deg: [1, 2, 3]}\n"
+        "reprojection_rms_px: {camera: 0.21, projector: 0.34}\n");
+  const std::string targets = "targets:\n  - {name: a, model: a.glb, pose: {translation: [0, 0, 1.5]}}\n";
+  write("scene.yaml", "calibration: calib.yaml\nprojector: {near: 0.2, far: 6, refresh_hz: 120}\n" + targets);
+  const auto s = projbot::config::load_scene(dir / "scene.yaml");
+  EXPECT_EQ(s.projector.width_px, 1024);
+  EXPECT_DOUBLE_EQ(s.projector.fx_px, 1500.5);
+  EXPECT_DOUBLE_EQ(s.projector.cy_px, 383.9);
+  EXPECT_DOUBLE_EQ(s.projector.near_m, 0.2);  // what a calibration does not measure stays the scene's
+  EXPECT_DOUBLE_EQ(s.projector.refresh_hz, 120.0);
+  EXPECT_NEAR(s.pan_tilt.T_projector_camera(0, 3), 0.05, 1e-12);
+  EXPECT_NEAR(s.pan_tilt.T_projector_camera(1, 3), -0.1, 1e-12);
+  const auto error = [&](const std::string& scene, const std::string& calib) -> std::string {
+    write("calib2.yaml", calib);
+    write("scene2.yaml", scene + targets);
+    try {
+      projbot::config::load_scene(dir / "scene2.yaml");
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string good_pose = "projector_from_camera: {translation: [0, 0, 0]}\n";
+  EXPECT_NE(error("calibration: calib2.yaml\n",
+                  "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512, cy: 384, "
+                  "distortion: [0.1, 0, 0, 0, 0]}\n" +
+                      good_pose)
+                .find("calib2.yaml:1: projector.distortion: the renderer does not pre-distort"),
+            std::string::npos);
+  EXPECT_NE(
+      error("calibration: calib2.yaml\n", "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512}\n" + good_pose)
+          .find("calib2.yaml:1: projector.cy: missing required key"),
+      std::string::npos);
+  EXPECT_NE(error("calibration: calib2.yaml\n", "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512, cy: 384}\n")
+                .find("calib2.yaml:1: projector_from_camera: missing required key"),
+            std::string::npos);
+  EXPECT_NE(error("calibration: calib2.yaml\nprojector: {fx: 900}\n",
+                  "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512, cy: 384}\n" + good_pose)
+                .find("scene2.yaml:1: calibration: projector.fx is the calibration's; leave it out of the scene"),
+            std::string::npos);
+  EXPECT_NE(error("calibration: none.yaml\n", "").find("scene2.yaml:1: calibration: cannot open"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}

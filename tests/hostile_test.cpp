@@ -127,9 +127,8 @@ TEST_P(HostileTest, ExitsCleanlyNamingTheProblemAndWritesNothing) {
 }
 
 const std::string kProj = "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\n";
-const std::string kRoom =
-    "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24, near: 0.1, far: 10}\n"
-    "room: {width: 6, depth: 5, obstacles: [[0, 0, 1, 1]]}\n";
+const std::string kRoomProjector = "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24, near: 0.1, far: 10}\n";
+const std::string kRoom = kRoomProjector + "room: {width: 6, depth: 5, obstacles: [[0, 0, 1, 1]]}\n";
 const std::string kDuckTarget =
     "  - {name: duck, model: {data}/gltf/Duck/glTF-Binary/Duck.glb, scale: 0.25, recenter: true,\n"
     "     world_pose: {translation: [3, 3.5, 0.9], rpy_deg: [90, 0, 0]}, stop: [3, 2, 90]}\n";
@@ -567,6 +566,19 @@ const std::vector<Hostile> kArgumentCases{
     Hostile{"run_missing_config", "run --headless --config {dir}/none.yaml", {}, 1, {"none.yaml"}},
     // The devices: section (issue 12): wrong drivers and values are file:line errors; a configured device
     // that is absent stops run (and devices) before any work, named, and nothing is written.
+    Hostile{"calibration_is_dev_zero",
+            "run --headless --config {dir}/bad.yaml --profile {dir}/prev.csv",
+            {{"bad.yaml", "calibration: /dev/zero\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}},
+            1,
+            {"bad.yaml:1: calibration", "/dev/zero", "not a file"}},
+    Hostile{"calibration_with_distortion",
+            "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
+            {{"calib.yaml",
+              "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24, distortion: [0.2]}\n"
+              "projector_from_camera: {translation: [0, 0, 0]}\n"},
+             {"bad.yaml", "calibration: calib.yaml\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}},
+            1,
+            {"calib.yaml:1: projector.distortion", "pre-distort"}},
     Hostile{"devices_unknown_camera_driver",
             "run --headless --config {dir}/bad.yaml --profile {dir}/prev.csv",
             {{"bad.yaml", kTour + "devices: {camera: {driver: kinect2}}\n"}},

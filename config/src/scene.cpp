@@ -416,6 +416,73 @@ DevicesConfig read_devices(MapReader& root) {
   return d;
 }
 
+// `calibration: calib.yaml` (issue 13's output): the projector's intrinsics A_p and the camera-to-projector
+// extrinsics R_cp, T_cp as a calibration measured them; they replace the scene's own.
+void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::path& base) {
+  YAML::Node node = root.child("calibration", false);
+  if (!node) return;
+  if (!node.IsScalar() || node.Scalar().empty()) root.fail(node, "calibration", "expected the path of a calibration file");
+  // One source for each value: the calibration's are not also given in the scene.
+  for (const char* key : {"width", "height", "fx", "fy", "cx", "cy"})
+    if (root.has("projector") && root.child("projector", false)[key])
+      root.fail(node, "calibration", std::string("projector.") + key + " is the calibration's; leave it out of the scene");
+  if (YAML::Node robot = root.child("robot", false);
+      robot && robot.IsMap() && robot["pan_tilt"] && robot["pan_tilt"].IsMap() && robot["pan_tilt"]["projector_from_camera"])
+    root.fail(node, "calibration", "robot.pan_tilt.projector_from_camera is the calibration's; leave it out of the scene");
+  const std::filesystem::path path =
+      std::filesystem::path(node.Scalar()).is_absolute() ? std::filesystem::path(node.Scalar()) : base / node.Scalar();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    root.fail(node, "calibration", "cannot open '" + path.string() + "': not a file");
+  if (std::filesystem::file_size(path, ec) > (1U << 20))
+    root.fail(node, "calibration", "'" + path.string() + "' is larger than 1 MB: not a calibration file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) root.fail(node, "calibration", "cannot open '" + path.string() + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  const std::string file = path.string();
+  YAML::Node c;
+  try {
+    c = YAML::Load(text.str());
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(file + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+  }
+  if (!c || c.IsNull()) throw ConfigError(file + ": the calibration file is empty");
+  MapReader r(c, "", file);
+  MapReader p(r.child("projector", true), "projector", file);
+  ProjectorConfig& k = scene.projector;
+  k.width_px = p.get<int>("width", 0, true);
+  k.height_px = p.get<int>("height", 0, true);
+  k.fx_px = p.get<double>("fx", 0.0, true);
+  k.fy_px = p.get<double>("fy", 0.0, true);
+  k.cx_px = p.get<double>("cx", 0.0, true);
+  k.cy_px = p.get<double>("cy", 0.0, true);
+  if (YAML::Node d = p.child("distortion", false)) {
+    if (!d.IsSequence() || d.size() == 0 || d.size() > 8)
+      p.fail(d, "projector.distortion", "expected a list of up to 8 coefficients");
+    for (const double v : p.numbers(d, "projector.distortion", d.size()))
+      if (v != 0.0)
+        p.fail(d, "projector.distortion",
+               "the renderer does not pre-distort its image yet, so a projector with lens distortion would be drawn "
+               "wrong; only zeros are accepted");
+  }
+  p.reject_unknown();
+  try {
+    validate_projector(k, "projector");
+  } catch (const ConfigError& e) {
+    r.fail(c["projector"], "", e.what());
+  }
+  scene.pan_tilt.T_projector_camera = read_pose(r, "projector_from_camera", "projector_from_camera");
+  if (!c["projector_from_camera"]) r.fail(c, "projector_from_camera", "missing required key");
+  if (YAML::Node rms = r.child("reprojection_rms_px", false)) {  // what the calibration measured: informational here
+    MapReader m(rms, "reprojection_rms_px", file);
+    m.get<double>("camera", 0.0);
+    m.get<double>("projector", 0.0);
+    m.reject_unknown();
+  }
+  r.reject_unknown();
+}
+
 }  // namespace
 
 std::vector<std::string> DevicesConfig::describe() const {
@@ -462,7 +529,9 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
   Scene scene;
   scene.source = source;
   MapReader r(root, "", file);
-  scene.projector = read_pinhole(r, "projector", std::nullopt);
+  // With a calibration file, the scene's projector section only adds what a calibration does not measure.
+  scene.projector =
+      read_pinhole(r, "projector", r.has("calibration") ? std::optional<ProjectorConfig>(ProjectorConfig{}) : std::nullopt);
   scene.pan_tilt = read_robot(r, scene);
   scene.depth_camera = read_pinhole(r, "camera", Scene::kinect_v1_depth_camera());
   if (YAML::Node room = r.child("room", false)) {
@@ -551,6 +620,7 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
     }
   }
   scene.devices = read_devices(r);
+  apply_calibration(r, scene, base);
   if (YAML::Node tour = r.child("tour", false)) {
     MapReader m(tour, "tour", file);
     YAML::Node visits = m.child("visits", true);
