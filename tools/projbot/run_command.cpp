@@ -223,7 +223,9 @@ const Command kRun{
     "A configured camera replaces the twin's (its frames at its own rate, its colour on arrival) and a\n"
     "configured projector sets the window's monitor and fullscreen; the robot (pan_tilt, laser, base) is still\n"
     "the twin's, and configuring one of them stops the run saying so. With none configured, or with --sim,\n"
-    "the digital twin serves every device. Without --config the shipped demo tour runs in the twin.\n",
+    "the digital twin serves every device. A device that fails while projecting blanks the projector at\n"
+    "once; what was measured until then is printed and written, and the failure is reported (exit 1).\n"
+    "Without --config the shipped demo tour runs in the twin.\n",
     {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)"},
      {"sim", "", "run against the digital twin, whatever `devices:` configures (the default without one)"},
      {"fullscreen", "", "fullscreen on --monitor (the projector)"},
