@@ -2,6 +2,7 @@
 
 #include "projbot/alignment/freenect_source.hpp"
 
+#include <dlfcn.h>
 #include <libfreenect.h>
 
 #include <chrono>
@@ -115,6 +116,12 @@ FreenectSource::FreenectSource(const FreenectOptions& options) : impl_(std::make
   Impl& m = *impl_;
   m.options = options;
   const std::string who = kinect_name(options.index);
+  // Debian's fakenect (a libfreenect.so that plays a dump) aborts on any depth mode but raw 11-bit; it is
+  // recognised by a helper only it exports.
+  if (options.registered && dlsym(RTLD_DEFAULT, "sleep_highres") != nullptr)
+    throw AlignmentError(who +
+                         ": this libfreenect is fakenect (playing a recorded dump), which plays raw depth only: "
+                         "set the camera's registered: false");
   m.context = open_context(who);
   const int found = freenect_num_devices(m.context);
   if (options.index < 0 || options.index >= found)
