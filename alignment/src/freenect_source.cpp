@@ -202,33 +202,34 @@ void write_dump_colour(const std::filesystem::path& path, const assets::Image& c
 
 }  // namespace
 
-void write_fakenect_dump(const std::filesystem::path& folder, const std::vector<FakenectFrame>& frames) {
+FakenectDumpWriter::FakenectDumpWriter(const std::filesystem::path& folder) : folder_(folder) {
   std::error_code ec;
   if (std::filesystem::exists(folder, ec) && !std::filesystem::is_empty(folder, ec))
     throw AlignmentError(folder.string() + ": not empty; a fakenect dump needs a new folder");
   std::filesystem::create_directories(folder, ec);
   if (ec) throw AlignmentError(folder.string() + ": cannot create: " + ec.message());
-  std::string index;
-  for (std::size_t k = 0; k < frames.size(); ++k) {
-    const FakenectFrame& f = frames[k];
-    if (f.depth == nullptr || f.colour == nullptr || f.depth->width != kWidth || f.depth->height != kHeight ||
-        f.colour->width != kWidth || f.colour->height != kHeight)
-      throw AlignmentError(folder.string() + ": frame " + std::to_string(k) + " is not a 640x480 depth and colour pair");
-    const std::string d = dump_name('d', f.time_s, static_cast<int>(k));
-    const std::string r = dump_name('r', f.time_s + 0.001, static_cast<int>(k));
-    try {
-      write_dump_depth(folder / d, *f.depth);
-      write_dump_colour(folder / r, *f.colour);
-    } catch (const config::OutputError& e) {
-      throw AlignmentError(e.what());
-    }
-    index += d + "\n" + r + "\n";
-  }
+}
+
+void FakenectDumpWriter::add(const FakenectFrame& f) {
+  if (f.depth == nullptr || f.colour == nullptr || f.depth->width != kWidth || f.depth->height != kHeight ||
+      f.colour->width != kWidth || f.colour->height != kHeight)
+    throw AlignmentError(folder_.string() + ": frame " + std::to_string(frames_) + " is not a 640x480 depth and colour pair");
+  const std::string d = dump_name('d', f.time_s, frames_);
+  const std::string r = dump_name('r', f.time_s + 0.001, frames_);
   try {
-    config::write_file_atomically(folder / "INDEX.txt", index);
+    write_dump_depth(folder_ / d, *f.depth);
+    write_dump_colour(folder_ / r, *f.colour);
+    index_ += d + "\n" + r + "\n";
+    config::write_file_atomically(folder_ / "INDEX.txt", index_);
   } catch (const config::OutputError& e) {
     throw AlignmentError(e.what());
   }
+  ++frames_;
+}
+
+void write_fakenect_dump(const std::filesystem::path& folder, const std::vector<FakenectFrame>& frames) {
+  FakenectDumpWriter writer(folder);
+  for (const FakenectFrame& f : frames) writer.add(f);
 }
 
 }  // namespace projbot::alignment

@@ -31,5 +31,6 @@ extern const Command kTour;
 extern const Command kRun;
 extern const Command kDevices;
 extern const Command kSimBase;
+extern const Command kRecord;
 
 }  // namespace projbot::tools

@@ -19,7 +19,7 @@ const std::vector<const Command*>& commands() {
       &projbot::tools::kRender,     &projbot::tools::kShow,          &projbot::tools::kBenchRender,  &projbot::tools::kAlign,
       &projbot::tools::kBenchTrack, &projbot::tools::kBenchMotion,   &projbot::tools::kBenchAcquire, &projbot::tools::kSlam,
       &projbot::tools::kLocalize,   &projbot::tools::kBenchLocalize, &projbot::tools::kTour,         &projbot::tools::kRun,
-      &projbot::tools::kDevices,    &projbot::tools::kSimBase};
+      &projbot::tools::kDevices,    &projbot::tools::kSimBase,       &projbot::tools::kRecord};
   return all;
 }
 

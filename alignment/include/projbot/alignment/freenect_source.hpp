@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
@@ -65,9 +66,22 @@ struct FakenectFrame {
   const assets::Image* colour = nullptr;
   double time_s = 0.0;
 };
-/// Writes `frames` into `folder` (created; must be empty or absent) as a fakenect dump: raw 11-bit depth
-/// PGMs, RGB PPMs, INDEX.txt. Throws AlignmentError naming the file on a write failure or a frame that is
-/// not 640x480.
+/// A fakenect dump written frame by frame: raw 11-bit depth PGMs, RGB PPMs and INDEX.txt, which is
+/// rewritten (atomically) after every frame, so a dump cut short (Ctrl-C, a full disk) plays what it holds.
+class FakenectDumpWriter {
+ public:
+  /// Creates `folder`, which must be empty or absent. Throws AlignmentError naming it.
+  explicit FakenectDumpWriter(const std::filesystem::path& folder);
+  /// Appends a frame. Throws AlignmentError naming the file on a write failure or a frame that is not 640x480.
+  void add(const FakenectFrame& frame);
+  int frames() const { return frames_; }
+
+ private:
+  std::filesystem::path folder_;
+  std::string index_;
+  int frames_ = 0;
+};
+/// Writes `frames` into `folder` (created; must be empty or absent) as a fakenect dump.
 void write_fakenect_dump(const std::filesystem::path& folder, const std::vector<FakenectFrame>& frames);
 
 }  // namespace projbot::alignment
