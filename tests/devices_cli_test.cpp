@@ -119,6 +119,14 @@ TEST_F(DevicesCli, NamesEachAbsentDevice) {
   EXPECT_EQ(run.output.find("device: "), std::string::npos) << "a renderer was started: " << run.output;
 }
 
+// A configured projector has no monitor to check when run draws offscreen: it is left out, said so.
+TEST_F(DevicesCli, HeadlessRunLeavesTheProjectorOut) {
+  const fs::path scene = site("  projector: {monitor: 3}\n");
+  const CliRun run = run_projbot("run --headless --seconds 1 --config " + scene.string(), 120);
+  EXPECT_EQ(run.code, 0) << run.output;
+  EXPECT_NE(run.output.find("devices.projector is not used with --headless"), std::string::npos) << run.output;
+}
+
 // A Kinect v1 (libfreenect through fakenect) and a PTU-D46 (emulated) that are there are opened and read.
 TEST_F(DevicesCli, OpensAKinectAndAPanTiltThatAreThere) {
   const fs::path dump = write_dump(dir_ / "dump");

@@ -180,15 +180,22 @@ void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std
 
 // Without --sim: the devices the config names, opened and read once (each absent one an error naming it);
 // the twin serves the rest. A config naming none runs the twin and says so.
-Devices open_configured(const config::Scene& scene) {
-  if (!scene.devices.any()) {
-    std::cout << "no devices configured in " << scene.source.filename().string()
-              << " (a `devices:` section; projbot devices lists what this machine has): running against the digital twin (--sim)"
-              << std::endl;
+Devices open_configured(const config::Scene& scene, bool headless) {
+  config::DevicesConfig wanted = scene.devices;
+  if (headless && wanted.projector) {  // drawn offscreen: no monitor to check
+    std::cout << "devices.projector is not used with --headless" << std::endl;
+    wanted.projector.reset();
+  }
+  if (!wanted.any()) {
+    if (!scene.devices.any())
+      std::cout
+          << "no devices configured in " << scene.source.filename().string()
+          << " (a `devices:` section; projbot devices lists what this machine has): running against the digital twin (--sim)"
+          << std::endl;
     return {};
   }
   std::vector<DeviceCheck> checks;
-  Devices devices = open_devices(scene.devices, checks, true);  // throws DeviceError at the first that fails
+  Devices devices = open_devices(wanted, checks, true);  // throws DeviceError at the first that fails
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
   if (scene.devices.pan_tilt || scene.devices.laser || scene.devices.base)
     throw DeviceError(
@@ -243,7 +250,7 @@ const Command kRun{
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
-      const Devices devices = args.flag("sim") ? Devices{} : open_configured(scene);
+      const Devices devices = args.flag("sim") ? Devices{} : open_configured(scene, args.flag("headless"));
       RunOptions o;
       o.visits = args.get_int("visits", 0, 1, 1000);
       o.dwell_s = args.get_double("dwell", 4.0);
