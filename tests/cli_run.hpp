@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -38,4 +39,11 @@ inline CliRun run_projbot(const std::string& args, int limit_s = 300) {
   if (status == -1) return {-1, out};
   // sh reports a child's death by signal N as exit 128 + N.
   return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), out};
+}
+
+// The number printed right after `key` (searched from `from`) in a command's output; NaN when the key
+// is missing, so a comparison with it fails.
+inline double number_after(const std::string& text, const std::string& key, std::size_t from = 0) {
+  const auto at = text.find(key, from);
+  return at == std::string::npos ? std::nan("") : std::stod(text.substr(at + key.size()));
 }

@@ -24,13 +24,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The number printed right after `key` (searched from `from`) in a command's output; NaN when the key
-// is missing, so a comparison with it fails.
-double number_after(const std::string& text, const std::string& key, std::size_t from = 0) {
-  const auto at = text.find(key, from);
-  return at == std::string::npos ? std::nan("") : std::stod(text.substr(at + key.size()));
-}
-
 // projbot started in the background with its output in a file, for tests that signal it.
 struct Background {
   pid_t pid = -1;

@@ -14,6 +14,8 @@
 #include <thread>
 
 #include "cli_run.hpp"
+#include "dds_loopback.hpp"
+#include "device_fixtures.hpp"
 #include "projbot/alignment/freenect_source.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/ptu_d46.hpp"
@@ -29,13 +31,7 @@ class DevicesCli : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("projbot_devices_cli_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    // DDS discovery over loopback only, by unicast: works on a machine without multicast (CI containers).
-    ::setenv("CYCLONEDDS_URI",
-             "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
-             "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
-             "<MaxAutoParticipantIndex>60</MaxAutoParticipantIndex><Peers><Peer Address=\"127.0.0.1\"/></Peers></Discovery>"
-             "</Domain></CycloneDDS>",
-             0);
+    use_loopback_dds();
   }
   void TearDown() override {
     ::unsetenv("LD_LIBRARY_PATH");
@@ -71,12 +67,6 @@ fs::path write_dump(const fs::path& folder) {
   colour.rgba.assign(640 * 480 * 4, 128);
   projbot::alignment::write_fakenect_dump(folder, {{&depth, &colour, 10.0}, {&depth, &colour, 10.0 + 1.0 / 30.0}});
   return folder;
-}
-
-// The number printed right after `key` in `text` (NaN when the key is missing).
-double number_after(const std::string& text, const std::string& key) {
-  const auto at = text.find(key);
-  return at == std::string::npos ? std::nan("") : std::strtod(text.c_str() + at + key.size(), nullptr);
 }
 
 }  // namespace
@@ -201,15 +191,7 @@ TEST_F(DevicesCli, RunTracksThroughAConfiguredKinect) {
   projbot::twin::Twin twin{scene, options, renderer};
   const auto arrival = twin.arrive(twin.target_index("duck"), 0);
   const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
-  std::vector<projbot::alignment::DepthImage> depths;
-  std::vector<projbot::assets::Image> colours;
-  for (std::uint32_t k = 0; k < 10; ++k) {
-    depths.push_back(twin.capture(T_world_camera, 100 + k));
-    colours.push_back(twin.capture_colour(T_world_camera, 100 + k));
-  }
-  std::vector<projbot::alignment::FakenectFrame> frames;
-  for (std::size_t k = 0; k < depths.size(); ++k) frames.push_back({&depths[k], &colours[k], static_cast<double>(k) / 30.0});
-  projbot::alignment::write_fakenect_dump(dir_ / "dump", frames);
+  projbot::alignment::write_fakenect_dump(dir_ / "dump", twin_frames(twin, T_world_camera, 10, 100, 0.0).frames());
   std::string once;
   {
     std::ifstream in(dir_ / "dump" / "INDEX.txt");

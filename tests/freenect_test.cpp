@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <string>
 
+#include "device_fixtures.hpp"
 #include "projbot/alignment/freenect_source.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/twin/world.hpp"
@@ -60,14 +61,10 @@ TEST(FreenectSource, PlaysTheTwinsFramesThroughFakenect) {
   projbot::twin::Twin twin{scene, {}, renderer};
   const auto arrival = twin.arrive(twin.target_index("duck"), 0);
   const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
-  std::vector<projbot::alignment::DepthImage> depths;
-  std::vector<projbot::assets::Image> colours;
-  for (std::uint32_t k = 0; k < 3; ++k) {
-    depths.push_back(twin.capture(T_world_camera, 11 + k));
-    colours.push_back(twin.capture_colour(T_world_camera, 11 + k));
-  }
-  std::vector<projbot::alignment::FakenectFrame> frames;
-  for (std::size_t k = 0; k < 3; ++k) frames.push_back({&depths[k], &colours[k], 100.0 + static_cast<double>(k) / 30.0});
+  const TwinFrames captured = twin_frames(twin, T_world_camera, 3, 11, 100.0);
+  const auto& depths = captured.depths;
+  const auto& colours = captured.colours;
+  const auto frames = captured.frames();
   const fs::path dump = fs::temp_directory_path() / ("projbot_fakenect_" + std::to_string(::getpid()));
   fs::remove_all(dump);
   projbot::alignment::write_fakenect_dump(dump, frames);

@@ -11,17 +11,13 @@
 #include <cstdlib>
 #include <thread>
 
+#include "dds_loopback.hpp"
+
 namespace {
 
 // A domain of this process's own, so suites running side by side do not hear each other.
 projbot::config::BaseDevice base_on_own_domain() {
-  // Discovery over loopback only, by unicast: works on a machine without multicast (CI containers).
-  ::setenv("CYCLONEDDS_URI",
-           "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
-           "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
-           "<MaxAutoParticipantIndex>60</MaxAutoParticipantIndex><Peers><Peer Address=\"127.0.0.1\"/></Peers></Discovery>"
-           "</Domain></CycloneDDS>",
-           0);
+  use_loopback_dds();
   projbot::config::BaseDevice c;
   c.domain = 150 + static_cast<int>(::getpid() % 50);
   return c;
