@@ -12,6 +12,7 @@
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/config/scene.hpp"
+#include "projbot/session/session.hpp"
 #include "projbot/twin/raycast.hpp"
 #include "projbot/twin/spectator.hpp"
 #include "projbot/twin/tour.hpp"
@@ -881,4 +882,54 @@ TEST_F(ShopDuckStop, ClusteringLeavesOutTheVaseTouchingTheDucksCrop) {
   EXPECT_GT(vase_plain, 100) << numbers;  // the vase is in the plain crop (157 pixels; 0 clustered)
   EXPECT_LT(vase_clustered, vase_plain / 10) << numbers;
   EXPECT_GT(duck_clustered, 0.95 * duck_plain) << numbers;  // the duck stays
+}
+
+// The session (issue 12) on the twin's base and pan-tilt: at the Duck's stop of the display it plans the
+// Duck first and the box beside it, each from Eq. 1 on the believed head, with its surveyed footing; the
+// believed head is the twin's truth within the localisation's error, and the guesses are the truth's
+// within that too.
+TEST(SessionTest, PlansTheVisitedTargetAndItsNeighbourFromTheBelievedHead) {
+  const auto scene = projbot::config::load_scene(kAssets + "/scenes/display.yaml");
+  projbot::engine::Renderer renderer{projbot::engine::RendererOptions{}};
+  projbot::twin::Twin twin{scene, {}, renderer};
+  projbot::session::Session session(scene, twin.session_targets(), twin.robot(), twin.pan_tilt());
+  const projbot::session::Stop stop = session.arrive(0);
+  EXPECT_EQ(stop.target, scene.target_index("duck"));
+  EXPECT_EQ(stop.target_visit, 1);
+  EXPECT_TRUE(stop.drive.arrived);
+  ASSERT_EQ(stop.lit.size(), 2U);
+  EXPECT_EQ(stop.lit[0].target, scene.target_index("duck"));
+  EXPECT_EQ(stop.lit[1].target, scene.target_index("box"));
+  using projbot::alignment::rigid_inverse;
+  const Eigen::Matrix4d T_world_camera = stop.believed.T_world_camera.matrix();
+  const Eigen::Matrix4d T_true_camera = twin.true_head().T_world_camera.matrix();
+  EXPECT_LT(projbot::alignment::translation_norm_m(rigid_inverse(T_true_camera) * T_world_camera), 0.03);
+  for (const auto& l : stop.lit) {
+    const auto& target = scene.targets[static_cast<std::size_t>(l.target)];
+    SCOPED_TRACE(target.name);
+    EXPECT_TRUE(l.T_camera_target_guess.isApprox(rigid_inverse(T_world_camera) * *target.T_world_target, 1e-12));  // Eq. 1
+    const Eigen::Matrix4d T_true = rigid_inverse(T_true_camera) * *target.T_world_target;
+    EXPECT_LT(projbot::alignment::translation_norm_m(rigid_inverse(T_true) * l.T_camera_target_guess), 0.05);
+    EXPECT_GT(l.footing.height_m, 0.6);  // on its plinth, below the model's middle (0.9 m up)
+    EXPECT_LT(l.footing.height_m, 0.9);
+  }
+  // The second visit is the box's; the Duck's next one is its second.
+  EXPECT_EQ(session.arrive(1).target, scene.target_index("box"));
+  EXPECT_EQ(session.arrive(2).target_visit, 2);
+}
+
+// A session needs a model of every visited target; told of none, it names the first it lacks.
+TEST(SessionTest, AVisitedTargetWithoutAModelIsNamed) {
+  const auto scene = projbot::config::load_scene(kAssets + "/scenes/display.yaml");
+  projbot::engine::Renderer renderer{projbot::engine::RendererOptions{}};
+  projbot::twin::Twin twin{scene, {}, renderer};
+  auto targets = twin.session_targets();
+  targets.erase(targets.begin() + 1);  // the box
+  try {
+    projbot::session::Session session(scene, targets, twin.robot(), twin.pan_tilt());
+    FAIL() << "no error";
+  } catch (const projbot::session::SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("target 'box' is visited but the session was given no model of it"), std::string::npos)
+        << e.what();
+  }
 }

@@ -22,6 +22,8 @@
 #include "projbot/config/output_file.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
+#include "projbot/session/session.hpp"
+#include "projbot/twin/camera.hpp"
 #include "projbot/twin/world.hpp"
 #include "scene_setup.hpp"
 
@@ -108,72 +110,46 @@ struct RunOptions {
   std::uint64_t seed = 1;
 };
 
-// The robot thread against the twin: drive, aim, Eq. 1, then capture depth at 30 Hz while dwelling. A
-// configured camera (`devices.camera`) replaces the twin's: its frames, at its own rate, are what the
-// workers see and its colour is the arrival's.
-void drive_twin(const config::Scene& scene, const RunOptions& o, std::vector<std::unique_ptr<alignment::TrackerWorker>>& workers,
-                alignment::LatestValue<RobotState>& state, std::vector<double>& capture_ms, const std::stop_token& stop,
-                alignment::RgbdCamera* camera) {
+// The robot thread: the session drives the tour (drive, aim, Eq. 1 for the visited target and its
+// neighbours), each lit target's worker gets its guess, footing and the colour of the stop's first
+// frame, then the camera's frames go to the workers while the robot dwells. The robot is the twin's (so
+// each stop also records the truth the render thread measures against); the camera is the configured
+// one, or the twin's.
+void drive(const config::Scene& scene, const RunOptions& o, std::vector<std::unique_ptr<alignment::TrackerWorker>>& workers,
+           alignment::LatestValue<RobotState>& state, std::vector<double>& handoff_ms, const std::stop_token& stop,
+           alignment::RgbdCamera* configured) {
   engine::Renderer depth_renderer(engine::RendererOptions{});
   twin::TwinOptions to;
   to.seed = o.seed;
   twin::Twin twin(scene, to, depth_renderer);
-  auto& targets = twin.targets();
+  twin::TwinCamera twin_camera(twin, o.seed);
+  alignment::RgbdCamera& camera = configured ? *configured : twin_camera;
+  session::Session session(scene, twin.session_targets(), twin.robot(), twin.pan_tilt());
   const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
-  std::vector<int> count(targets.size(), 0);
   for (int v = 0; v < visits && !stop.stop_requested(); ++v) {
-    const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
-    const std::size_t i = twin.target_index(name);
     state.publish({.lit = {}, .since_s = now_s(), .visit = v + 1});
-    const twin::Arrival arrival = twin.arrive(i, v);
-    const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
-    const int target_visit = ++count[i];
-    // The visited target, then the others the robot expects in the projector's view: each from its own
-    // Eq. 1 guess, tracked by its own worker, lit or blanked on its own.
-    // Each also gets its surveyed footing and the colour taken on arrival, before any light.
-    const Eigen::Matrix4d T_world_believed = arrival.believed.T_world_camera.matrix();
+    const session::Stop at = session.arrive(v);
+    const std::size_t i = twin.target_index(scene.targets[static_cast<std::size_t>(at.target)].name);
+    const double since = now_s();  // poses from frames captured before this belong to an earlier stop
+    twin_camera.at_stop(i, at.target_visit, v, since);
+    auto first = std::make_shared<alignment::RgbdFrame>(camera.next());
     std::shared_ptr<const assets::Image> colour;
-    if (camera == nullptr) {
-      colour = std::make_shared<const assets::Image>(
-          twin.capture_colour(T_world_camera, static_cast<std::uint32_t>(o.seed * 7919 + v)));
-    } else if (alignment::RgbdFrame first = camera->next(); !first.colour.rgba.empty()) {
-      colour = std::make_shared<const assets::Image>(std::move(first.colour));
+    if (!first->colour.rgba.empty()) colour = std::shared_ptr<const assets::Image>(first, &first->colour);
+    std::vector<LitTarget> lit;
+    for (const session::LitTarget& l : at.lit) {
+      workers[static_cast<std::size_t>(l.target)]->set_initial_guess(l.T_camera_target_guess, l.footing, colour);
+      const std::size_t t = twin.target_index(scene.targets[static_cast<std::size_t>(l.target)].name);
+      lit.push_back({l.target, l.target == at.target ? at.target_visit : 0, twin.home(t)});
     }
-    const auto start = [&](std::size_t twin_index, const Eigen::Matrix4d& T_map_target, const Eigen::Matrix4d& guess) {
-      const int s = scene.target_index(targets[twin_index].config.name);
-      workers[static_cast<std::size_t>(s)]->set_initial_guess(
-          guess, alignment::footing_in_camera(targets[twin_index].cloud, T_map_target, T_world_believed), colour);
-      return s;
-    };
-    std::vector<LitTarget> lit{{start(i, arrival.T_map_target, arrival.T_camera_target_guess), target_visit, twin.home(i)}};
-    for (const twin::Neighbour& n : twin.neighbours(i, arrival))
-      lit.push_back({start(n.target, n.T_map_target, n.T_camera_target_guess), 0, twin.home(n.target)});
-    const double since = now_s();
-    state.publish({lit, since, v + 1, false, alignment::rigid_inverse(T_world_camera)});
-    auto tick = Clock::now();
-    for (std::uint32_t k = 0; !stop.stop_requested(); ++k) {
-      const double t = now_s() - since;
-      if (t >= o.dwell_s) break;
-      targets[i].T_world_target_true = twin.scripted_pose(i, target_visit, t);
-      const double captured = now_s();
-      if (camera != nullptr) {  // it paces itself; its frames carry their own arrival times
-        auto frame = std::make_shared<alignment::DepthImage>(camera->next().depth);
-        capture_ms.push_back(1000.0 * (now_s() - captured));
-        for (const LitTarget& l : lit) workers[static_cast<std::size_t>(l.target)]->submit(frame);
-        continue;
-      }
-      auto frame =
-          std::make_shared<alignment::DepthImage>(twin.capture(T_world_camera, static_cast<std::uint32_t>(o.seed * 7919 + k)));
-      // Stamped with the instant the scene was sampled (the exposure), so the simulated sensor's own
-      // rendering counts in the pose's age, as a real camera's readout and transfer would.
-      frame->capture_time_s = captured;
-      capture_ms.push_back(1000.0 * (now_s() - captured));
+    state.publish({lit, since, v + 1, false, alignment::rigid_inverse(twin.true_head().T_world_camera.matrix())});
+    std::shared_ptr<const alignment::DepthImage> frame(first, &first->depth);
+    while (true) {
+      handoff_ms.push_back(1000.0 * (now_s() - frame->capture_time_s));
       for (const LitTarget& l : lit) workers[static_cast<std::size_t>(l.target)]->submit(frame);
-      tick += std::chrono::microseconds(33333);  // 30 Hz, like the Kinect
-      std::this_thread::sleep_until(tick);
-      if (Clock::now() > tick + std::chrono::milliseconds(100)) tick = Clock::now();  // fell behind: do not burst
+      if (stop.stop_requested() || now_s() - since >= o.dwell_s) break;
+      frame = std::make_shared<alignment::DepthImage>(camera.next().depth);
     }
-    twin.end_visit(i, target_visit);
+    twin.end_visit(i, at.target_visit);
   }
   state.publish({.lit = {}, .since_s = now_s(), .visit = visits, .done = true});
 }
@@ -281,7 +257,7 @@ const Command kRun{
       }
 
       // One tracker worker per target the tour visits.
-      const alignment::CameraIntrinsics k = twin::depth_intrinsics(scene);
+      const alignment::CameraIntrinsics k = session::depth_intrinsics(scene);
       std::vector<std::unique_ptr<alignment::TrackerWorker>> workers(scene.targets.size());
       const bool predict = !args.flag("no-predict");
       PresentCadence cadence;
@@ -297,10 +273,10 @@ const Command kRun{
       alignment::LatestValue<RobotState> state;
       std::exception_ptr robot_error;
       std::atomic<bool> robot_done{false};
-      std::vector<double> capture_ms;  // the robot thread's until it is joined
+      std::vector<double> capture_ms;  // capture to hand-off per frame: the robot thread's until it is joined
       std::jthread robot_thread([&](std::stop_token stop) {
         try {
-          drive_twin(scene, o, workers, state, capture_ms, stop, devices.camera.get());
+          drive(scene, o, workers, state, capture_ms, stop, devices.camera.get());
         } catch (...) {
           robot_error = std::current_exception();
         }
@@ -404,14 +380,10 @@ const Command kRun{
       errors.print(std::cout);
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
-      std::cout << "robot: " << robot.visit << " visit(s); ";
-      if (devices.camera)
-        std::cout << "the configured camera delivered " << capture_ms.size() << " frames (waited for p50 "
-                  << engine::percentile(capture_ms, 0.5) << " ms)";
-      else
-        std::cout << "the twin's depth camera delivered " << capture_ms.size() << " frames (render + Kinect noise p50 "
-                  << engine::percentile(capture_ms, 0.5) << " ms, p95 " << engine::percentile(capture_ms, 0.95)
-                  << " ms of each pose's age)";
+      std::cout << "robot: " << robot.visit << " visit(s); " << (devices.camera ? "the configured" : "the twin's")
+                << " camera delivered " << capture_ms.size() << " frames (capture to hand-off to the workers p50 "
+                << engine::percentile(capture_ms, 0.5) << " ms, p95 " << engine::percentile(capture_ms, 0.95) << " ms"
+                << (devices.camera ? ")" : ": the twin's render and Kinect noise)");
       std::cout << "; the tracker workers processed " << tracked << "\n";
       if (const auto csv = args.get("profile")) {
         std::ostringstream f;

@@ -363,25 +363,23 @@ bool dwell(const DwellContext& c, const std::vector<alignment::TargetFollower*>&
 
 // A neighbour at arrival: acquired from the stop's capture (and colour) from its own Eq. 1 guess, as
 // the visited target is, and its error at the markers measured.
-NeighbourLight acquire_neighbour(TourMode mode, const Twin& twin, alignment::TargetFollower& follower, const Neighbour& n,
-                                 const Arrival& arrival, const alignment::DepthImage& depth,
+NeighbourLight acquire_neighbour(TourMode mode, const Twin& twin, alignment::TargetFollower& follower, std::size_t target,
+                                 const session::LitTarget& n, const robot::HeadPoses& truth, const alignment::DepthImage& depth,
                                  const std::optional<assets::Image>& colour) {
-  const TwinTarget& t = twin.targets()[n.target];
+  const TwinTarget& t = twin.targets()[target];
   VisitReport scratch;
-  acquire(mode, follower, twin, depth, n.T_camera_target_guess,
-          alignment::footing_in_camera(t.cloud, n.T_map_target, arrival.believed.T_world_camera.matrix()),
-          colour ? &*colour : nullptr, scratch);
+  acquire(mode, follower, twin, depth, n.T_camera_target_guess, n.footing, colour ? &*colour : nullptr, scratch);
   NeighbourLight l;
-  l.target = n.target;
+  l.target = target;
   l.shown = scratch.projected;
   l.drawn.T_camera_target = l.drawn.motion.T = scratch.icp.T_scan_model;
   NeighbourReport& r = l.report;
   r.target = t.config.name;
   r.projected = scratch.projected;
   r.align_ms = scratch.align_ms;
-  std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(arrival.truth, t, n.T_camera_target_guess);
+  std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth, t, n.T_camera_target_guess);
   const Errors e =
-      marker_errors(twin, n.target, twin.scene().projector, arrival.truth.T_world_projector.matrix(),
+      marker_errors(twin, target, twin.scene().projector, truth.T_world_projector.matrix(),
                     alignment::projector_from_target(twin.scene().pan_tilt.T_projector_camera, scratch.icp.T_scan_model));
   r.mean_mm = e.mean_mm;
   r.max_mm = e.max_mm;
@@ -450,6 +448,9 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   follow.motion = options.motion;
   std::vector<alignment::TargetFollower> followers;
   for (const auto& t : targets) followers.emplace_back(t.cloud, twin.camera(), follow);
+  // The stop sequence (drive, aim, Eq. 1 for the visited target and its neighbours) is the session's;
+  // the twin serves its base and pan-tilt.
+  session::Session session(scene, twin.session_targets(), twin.robot(), twin.pan_tilt());
   std::unique_ptr<engine::RenderTarget> projector_frame;
   std::unique_ptr<SpectatorView> spectator;
   if (!options.frames_dir.empty()) {
@@ -464,25 +465,23 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   report.predict = options.predict;
   report.projector = scene.projector;
   const int visits = options.visits > 0 ? options.visits : static_cast<int>(scene.visits.size());
-  std::vector<int> visit_count(targets.size(), 0);
   const auto stop = [&] { return options.stop_requested && options.stop_requested(); };
   for (int v = 0; v < visits && !(report.interrupted = stop()); ++v) {
-    const std::string& name = scene.visits[static_cast<std::size_t>(v) % scene.visits.size()];
+    // Drive to the stop, closing the loop on localisation (or odometry, the paper's set-up), and aim at
+    // where the map says the target is, from where the robot believes it is.
+    const session::Stop arrival = session.arrive(v);
+    const std::string& name = scene.targets[static_cast<std::size_t>(arrival.target)].name;
     const std::size_t i = twin.target_index(name);
     TwinTarget& target = targets[i];
     VisitReport r;
     r.visit = v + 1;
-    r.target_visit = ++visit_count[i];
+    r.target_visit = arrival.target_visit;
     r.target = name;
-
-    // Drive to the stop, closing the loop on localisation (or odometry, the paper's set-up), and aim at
-    // where the map says the target is, from where the robot believes it is.
-    const Arrival arrival = twin.arrive(i, v);
     r.drive_s = arrival.drive.drive_seconds;
     r.base_error_cm = 100.0 * arrival.drive.error_m;
     r.base_error_deg = arrival.drive.error_rad * 180.0 / M_PI;
     r.odometry_error_cm = 100.0 * arrival.drive.odometry_error_m;
-    const robot::HeadPoses& truth = arrival.truth;
+    const robot::HeadPoses truth = twin.true_head();
     // A visitor beside the robot, looking at the target where it truly stands now.
     // The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else all black.
     std::vector<NeighbourLight> lights;
@@ -507,15 +506,14 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     const std::uint32_t noise_seed = static_cast<std::uint32_t>(options.seed * 100003 + static_cast<std::uint64_t>(v) * 1009);
     const alignment::DepthImage depth = twin.capture(truth.T_world_camera.matrix(), noise_seed);
     r.capture_ms = ms_since(t0);
-    const Eigen::Matrix4d& T_init = arrival.T_camera_target_guess;
+    const session::LitTarget& visited = arrival.lit.front();
+    const Eigen::Matrix4d& T_init = visited.T_camera_target_guess;
     std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth, target, T_init);
     // Localized and tracking: the colour the RGB-D camera registers to the depth, taken with it (before
     // any light).
     std::optional<assets::Image> colour;
     if (options.mode != TourMode::odometry) colour = twin.capture_colour(truth.T_world_camera.matrix(), noise_seed);
-    acquire(options.mode, followers[i], twin, depth, T_init,
-            alignment::footing_in_camera(target.cloud, arrival.T_map_target, arrival.believed.T_world_camera.matrix()),
-            colour ? &*colour : nullptr, r);
+    acquire(options.mode, followers[i], twin, depth, T_init, visited.footing, colour ? &*colour : nullptr, r);
     const Eigen::Matrix4d T_world_projector = truth.T_world_projector.matrix();
     r.view = alignment::view_constraints(target.cloud, r.icp.T_scan_model, twin.camera());
     r.T_projector_target_estimated = alignment::projector_from_target(rig.T_projector_camera, r.icp.T_scan_model);
@@ -524,8 +522,11 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     r.markers = e.markers;
     r.mean_mm = e.mean_mm;
     r.max_mm = e.max_mm;
-    for (const Neighbour& n : twin.neighbours(i, arrival))
-      lights.push_back(acquire_neighbour(options.mode, twin, followers[n.target], n, arrival, depth, colour));
+    for (std::size_t k = 1; k < arrival.lit.size(); ++k) {
+      const session::LitTarget& n = arrival.lit[k];
+      const std::size_t j = twin.target_index(scene.targets[static_cast<std::size_t>(n.target)].name);
+      lights.push_back(acquire_neighbour(options.mode, twin, followers[j], j, n, truth, depth, colour));
+    }
 
     if (projector_frame) {
       t0 = Clock::now();

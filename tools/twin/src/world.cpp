@@ -54,11 +54,6 @@ assets::Model room_model(const config::Scene& scene) {
 
 }  // namespace
 
-alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene) {
-  const config::ProjectorConfig& k = scene.depth_camera;
-  return {k.width_px, k.height_px, k.fx_px, k.fy_px, k.cx_px, k.cy_px};
-}
-
 robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed,
                                   const std::vector<std::array<double, 4>>& footprints) {
   robot::SimTourConfig c;
@@ -79,7 +74,11 @@ robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource 
 }
 
 Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Renderer& renderer)
-    : scene_(scene), options_(options), renderer_(renderer), pan_tilt_(scene.pan_tilt), camera_(depth_intrinsics(scene)) {
+    : scene_(scene),
+      options_(options),
+      renderer_(renderer),
+      pan_tilt_(scene.pan_tilt),
+      camera_(session::depth_intrinsics(scene)) {
   const std::string where = scene.source.empty() ? std::string("<scene>") : scene.source.string();
   if (scene.visits.empty()) throw TwinError(where + ": the twin needs a 'tour: {visits: [...]}' section");
   const assets::Model room = room_model(scene);
@@ -166,52 +165,29 @@ Eigen::Vector3d model_middle(const TwinTarget& t, const Eigen::Matrix4d& T_world
 
 Eigen::Vector3d Twin::surveyed_middle(std::size_t target) const {
   const TwinTarget& t = targets_.at(target);
-  return model_middle(t, t.config.T_map_target.value_or(*t.config.T_world_target));
+  return model_middle(t, session::surveyed_pose(t.config));
 }
 
 Arrival Twin::arrive(std::size_t target, int index) {
   const TwinTarget& t = targets_.at(target);
+  session::Stop stop;
+  session::drive_and_aim(scene_, t.config, surveyed_middle(target), *robot_, pan_tilt_, index, stop);
   Arrival a;
-  const Eigen::Vector3d& stop = *t.config.stop;
-  a.drive = robot_->drive_to({stop.x(), stop.y(), stop.z()}, index);
-  a.T_map_target = t.config.T_map_target.value_or(*t.config.T_world_target);
-  // Aim at the middle of the model, not its origin: a standing figure's origin is at its feet, and
-  // aiming there left its chest above the projector's image.
-  const auto aim = robot::aim_at(robot_->believed_pose(), surveyed_middle(target), scene_.pan_tilt);
-  if (const auto s = pan_tilt_.move_to(aim.angles); !s.ok) throw TwinError("pan-tilt: " + s.error);
-  robot::PanTiltAngles reported;
-  if (const auto s = pan_tilt_.position(reported); !s.ok) throw TwinError("pan-tilt: " + s.error);
-  a.truth = robot::head_poses(robot_->true_pose(), pan_tilt_.true_angles(), scene_.pan_tilt);
-  a.believed = robot::head_poses(robot_->believed_pose(), reported, scene_.pan_tilt);
+  a.drive = stop.drive;
+  a.truth = true_head();
+  a.believed = stop.believed;
+  a.T_map_target = session::surveyed_pose(t.config);
   a.T_camera_target_guess = alignment::camera_from_target_initial(a.believed.T_world_camera.matrix(), a.T_map_target);
   return a;
 }
 
-std::vector<Neighbour> Twin::neighbours(std::size_t target, const Arrival& arrival) const {
-  const Eigen::Matrix4d T_camera_world = alignment::rigid_inverse(arrival.believed.T_world_camera.matrix());
-  const Eigen::Matrix4d T_projector_world = alignment::rigid_inverse(arrival.believed.T_world_projector.matrix());
-  const config::ProjectorConfig camera = camera_pinhole();
-  const auto inside = [](const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
-    if (p.z() < 0.3 || p.z() > 5.0) return false;
-    const Eigen::Vector2d x = engine::project_to_pixel(k, p);
-    return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < k.width_px && x.y() < k.height_px;
-  };
-  std::vector<Neighbour> out;
-  std::vector<double> range;
-  for (std::size_t j = 0; j < targets_.size(); ++j) {
-    if (j == target) continue;
-    const Eigen::Vector4d middle = surveyed_middle(j).homogeneous();
-    const Eigen::Vector3d in_camera = (T_camera_world * middle).head<3>();
-    if (!inside(camera, in_camera) || !inside(scene_.projector, (T_projector_world * middle).head<3>())) continue;
-    const TwinTarget& t = targets_[j];
-    Neighbour n;
-    n.target = j;
-    n.T_map_target = t.config.T_map_target.value_or(*t.config.T_world_target);
-    n.T_camera_target_guess = alignment::camera_from_target_initial(arrival.believed.T_world_camera.matrix(), n.T_map_target);
-    const auto at = std::upper_bound(range.begin(), range.end(), in_camera.z());
-    out.insert(out.begin() + (at - range.begin()), n);
-    range.insert(at, in_camera.z());
-  }
+robot::HeadPoses Twin::true_head() const {
+  return robot::head_poses(robot_->true_pose(), pan_tilt_.true_angles(), scene_.pan_tilt);
+}
+
+std::vector<session::Target> Twin::session_targets() const {
+  std::vector<session::Target> out;
+  for (const TwinTarget& t : targets_) out.push_back({scene_.target_index(t.config.name), &t.cloud, t.model.bounds().center()});
   return out;
 }
 

@@ -11,6 +11,7 @@
 #include "projbot/robot/base.hpp"
 #include "projbot/robot/laser.hpp"
 #include "projbot/robot/localization.hpp"
+#include "projbot/robot/navigator.hpp"
 #include "projbot/robot/sim_base.hpp"
 
 namespace projbot::robot {
@@ -35,29 +36,17 @@ struct SimTourConfig {
   double survey_spacing_m = 1.0;  ///< the map: scans at true poses on this grid over free space
 };
 
-struct StopReport {
-  int index = 0;
-  Pose2D goal, truth, estimate, odometry;
-  double error_m = 0.0, error_rad = 0.0;                    ///< estimate (what the robot believes) vs truth
-  double odometry_error_m = 0.0, odometry_error_rad = 0.0;  ///< raw wheel odometry vs truth
-  double arrival_error_m = 0.0;                             ///< truth vs goal
-  bool arrived = false;
-  double drive_seconds = 0.0;  ///< simulated time to reach the stop
-  int corrections = 0, rejected = 0;
-  double correct_ms_mean = 0.0;  ///< wall time per localisation update
-};
-
 /// The simulated robot of a tour, one stop at a time: the room and its map, the drifting base, wheel
 /// odometry and the MRPT localiser. The twin drives it and asks where the robot believes it is.
 /// Deterministic for a given config. Not thread-safe: one owner thread.
-class SimRobot {
+class SimRobot final : public Navigator {
  public:
   explicit SimRobot(const SimTourConfig& config);
   /// Drives to `goal` under the controller (closing the loop on config.source), then settles.
   /// `index` is copied into the report.
-  StopReport drive_to(const Pose2D& goal, int index);
+  StopReport drive_to(const Pose2D& goal, int index) override;
   /// What the robot believes (localisation or odometry, by config.source) and the ground truth.
-  Pose2D believed_pose() const;
+  Pose2D believed_pose() const override;
   Pose2D true_pose() const { return base_.true_pose(); }
   Pose2D odometry_pose() const { return odometry_.pose(); }
   const OccupancyMap& map() const { return map_; }

@@ -18,6 +18,7 @@
 #include "projbot/engine/renderer.hpp"
 #include "projbot/robot/pan_tilt.hpp"
 #include "projbot/robot/sim_tour.hpp"
+#include "projbot/session/session.hpp"
 #include "projbot/twin/raycast.hpp"
 
 namespace projbot::twin {
@@ -62,14 +63,6 @@ struct Arrival {
   Eigen::Matrix4d T_camera_target_guess = Eigen::Matrix4d::Identity();
 };
 
-/// A target besides the visited one that the robot believes shares the view at a stop (issue 11,
-/// item 5): it is acquired, tracked and lit with the visited one, and blanks on its own.
-struct Neighbour {
-  std::size_t target = 0;                                               ///< index into Twin::targets()
-  Eigen::Matrix4d T_map_target = Eigen::Matrix4d::Identity();           ///< as surveyed
-  Eigen::Matrix4d T_camera_target_guess = Eigen::Matrix4d::Identity();  ///< Eq. 1 from the believed head
-};
-
 class Twin {
  public:
   /// Loads every target's model, checks the tour sections and markers, builds the room map and the
@@ -88,13 +81,15 @@ class Twin {
   /// Index into targets() of the target named `name`. Throws TwinError if the twin has none.
   std::size_t target_index(const std::string& name) const;
   /// Drives to the target's stop (`index` goes into the report), aims the pan-tilt at the target's
-  /// surveyed position from where the robot believes it is, and takes Eq. 1's initial guess.
+  /// surveyed position from where the robot believes it is (session::drive_and_aim, the session's own
+  /// step), and takes Eq. 1's initial guess; with the head's true frames. For tests and benches that
+  /// need one target at its stop; a tour runs through session::Session.
   Arrival arrive(std::size_t target, int index);
-
-  /// The other targets the robot believes it sees at this stop, from the map and its believed head:
-  /// a target's surveyed middle 0.3-5 m in front of the camera, inside the camera's image and the
-  /// projector's. Nearest first.
-  std::vector<Neighbour> neighbours(std::size_t target, const Arrival& arrival) const;
+  /// The head's true frames now (the robot's true pose and the pan-tilt's true angles).
+  robot::HeadPoses true_head() const;
+  /// The targets as a session knows them (scene index, surface samples, model middle); they point into
+  /// the twin, which must outlive the session.
+  std::vector<session::Target> session_targets() const;
 
   /// The target's pose `t_s` into a projection during its `target_visit`-th visit (motion script);
   /// visit 0 is where it stands between visits.
@@ -162,9 +157,6 @@ Eigen::Matrix4d scripted_pose(const config::TargetConfig& target, const Eigen::M
 
 /// How far through a scripted motion (0..1) its profile is at the fraction x (0..1) of its duration.
 double motion_fraction(config::MotionProfile profile, double x);
-
-/// The scene's depth camera as the estimator's intrinsics.
-alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene);
 
 /// The twin's robot set-up for a scene: its room (with `footprints`, x0 y0 x1 y1, of what stands on the
 /// floor: supports, floor-standing targets, props), start pose and drift, closing the loop on `source`.

@@ -1,0 +1,33 @@
+#pragma once
+// The mobile base as the projection session drives it (issue 12): to a stop under closed-loop control,
+// then where the robot believes it is. The twin's simulated robot is one implementation; a real base
+// (the youBot over ROS 2 topics, localised on its laser) is another.
+
+#include "projbot/robot/pose2d.hpp"
+
+namespace projbot::robot {
+
+/// One drive to a stop, as the robot measured it (truth fields only where a simulation knows them).
+struct StopReport {
+  int index = 0;
+  Pose2D goal, truth, estimate, odometry;
+  double error_m = 0.0, error_rad = 0.0;                    ///< estimate (what the robot believes) vs truth
+  double odometry_error_m = 0.0, odometry_error_rad = 0.0;  ///< raw wheel odometry vs truth
+  double arrival_error_m = 0.0;                             ///< truth vs goal
+  bool arrived = false;
+  double drive_seconds = 0.0;  ///< simulated time to reach the stop
+  int corrections = 0, rejected = 0;
+  double correct_ms_mean = 0.0;  ///< wall time per localisation update
+};
+
+class Navigator {
+ public:
+  virtual ~Navigator() = default;
+  /// Drives to `goal` in the map and settles there; `index` is copied into the report. Throws
+  /// RobotError naming the device when the base cannot be driven.
+  virtual StopReport drive_to(const Pose2D& goal, int index) = 0;
+  /// Where the robot believes its base stands in the map (localisation, or odometry alone).
+  virtual Pose2D believed_pose() const = 0;
+};
+
+}  // namespace projbot::robot

@@ -1,0 +1,93 @@
+#pragma once
+// The projection session (issue 12): the stop sequence written once, against device interfaces. At each
+// stop of the tour it drives the base to the visited target's stop (robot::Navigator), aims the pan-tilt
+// at the middle of the target where the map says it stands, from where the robot believes it is
+// (robot::PanTilt), reads the angles back, and takes Eq. 1's initial guess and the surveyed footing of
+// the visited target and of each neighbour the robot expects in the projector's view. Acquiring,
+// tracking and drawing or blanking follow from there: `projbot tour` runs them on a simulated clock,
+// `projbot run` live. Nothing here knows which implementation of a device it drives (twin or hardware).
+
+#include <Eigen/Core>
+#include <stdexcept>
+#include <vector>
+
+#include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/registration.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/robot/navigator.hpp"
+#include "projbot/robot/pan_tilt.hpp"
+
+namespace projbot::session {
+
+/// A scene the session cannot run (a visited target without a stop or a surveyed pose).
+class SessionError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The scene's depth camera as the estimator's intrinsics.
+alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene);
+
+/// Where the map says a target stands: its surveyed map_pose, else its world_pose.
+Eigen::Matrix4d surveyed_pose(const config::TargetConfig& target);
+
+/// A target the session can visit or light, as the estimator knows it.
+struct Target {
+  int scene_index = -1;                                    ///< into config::Scene::targets
+  const alignment::ModelCloud* cloud = nullptr;            ///< its model's surface samples; outlives the session
+  Eigen::Vector3d middle_model = Eigen::Vector3d::Zero();  ///< its model's bounding-box centre: where the pan-tilt aims
+};
+
+/// A target the robot projects onto at a stop.
+struct LitTarget {
+  int target = -1;                                                      ///< scene index
+  Eigen::Matrix4d T_map_target = Eigen::Matrix4d::Identity();           ///< as surveyed
+  Eigen::Matrix4d T_camera_target_guess = Eigen::Matrix4d::Identity();  ///< Eq. 1, from the believed head
+  alignment::Footing footing;                                           ///< the surveyed footing, seen from the believed camera
+};
+
+/// The robot at a stop, aimed.
+struct Stop {
+  int visit = 0;         ///< 0-based, over the whole tour
+  int target = -1;       ///< scene index of the visited target
+  int target_visit = 0;  ///< 1-based: the visited target's n-th visit
+  robot::StopReport drive;
+  robot::PanTiltAngles angles;  ///< as the pan-tilt reported them after aiming
+  robot::HeadPoses believed;    ///< where the robot believes its camera and projector are
+  std::vector<LitTarget> lit;   ///< the visited target first, then its neighbours, nearest first
+};
+
+/// Drives to the target's stop, aims at `middle_world` from the believed pose and reads the angles back.
+/// Fills drive, angles and believed; throws robot::RobotError naming the pan-tilt when it fails.
+void drive_and_aim(const config::Scene& scene, const config::TargetConfig& target, const Eigen::Vector3d& middle_world,
+                   robot::Navigator& base, robot::PanTilt& pan_tilt, int index, Stop& stop);
+
+class Session {
+ public:
+  /// `targets` are those the tour may visit or light; every visit in scene.visits must name one with a
+  /// stop. Throws SessionError naming the first that does not. The devices outlive the session.
+  Session(const config::Scene& scene, std::vector<Target> targets, robot::Navigator& base, robot::PanTilt& pan_tilt);
+
+  /// The target of the tour's `visit`-th stop (0-based, cycling through scene.visits): its scene index.
+  int target_of(int visit) const;
+  /// Drives to the `visit`-th stop, aims, and plans what to light there.
+  Stop arrive(int visit);
+  /// The targets besides the visited one that a robot with this believed head expects to share the
+  /// view: each one's surveyed middle 0.3-5 m in front of the camera, inside the depth camera's image
+  /// and the projector's. Nearest first.
+  std::vector<LitTarget> neighbours(int visited, const robot::HeadPoses& believed) const;
+  /// Eq. 1 and the surveyed footing of one target from a believed head.
+  LitTarget plan(int target, const robot::HeadPoses& believed) const;
+  /// Where the map says a target's middle stands (world frame).
+  Eigen::Vector3d surveyed_middle(int target) const;
+
+ private:
+  const Target& find(int target) const;
+  const config::Scene& scene_;
+  std::vector<Target> targets_;
+  robot::Navigator& base_;
+  robot::PanTilt& pan_tilt_;
+  std::vector<int> visits_per_target_;  // by scene index
+};
+
+}  // namespace projbot::session
