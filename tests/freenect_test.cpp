@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "device_fixtures.hpp"
@@ -111,6 +112,47 @@ TEST(FreenectSource, PlaysTheTwinsFramesThroughFakenect) {
     ADD_FAILURE() << "a fourth frame from a three-frame dump";
   } catch (const projbot::alignment::AlignmentError& e) {
     EXPECT_NE(std::string(e.what()).find("Kinect v1 #0 (libfreenect): stopped delivering frames"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dump);
+}
+
+// The replay's camera (issue 12): a dump read back without libfreenect gives depth as the Kinect driver
+// converts it (exactly what kinect_quantised() makes of the original) and the colour byte for byte, stamped
+// with the recorded gaps; its end and a malformed index are named.
+TEST(FakenectDumpReader, ReadsBackWhatTheWriterWrote) {
+  const auto scene = projbot::config::load_scene(std::string(PROJBOT_ASSET_DIR) + "/scenes/shop.yaml");
+  projbot::engine::Renderer renderer{projbot::engine::RendererOptions{}};
+  projbot::twin::Twin twin{scene, {}, renderer};
+  const auto arrival = twin.arrive(twin.target_index("duck"), 0);
+  const TwinFrames captured = twin_frames(twin, arrival.truth.T_world_camera.matrix(), 2, 5, 10.0);
+  const fs::path dump = fs::temp_directory_path() / ("projbot_dump_reader_" + std::to_string(::getpid()));
+  fs::remove_all(dump);
+  projbot::alignment::write_fakenect_dump(dump, captured.frames());
+  projbot::alignment::FakenectDumpReader reader(dump, false);
+  ASSERT_EQ(reader.frames(), 2);
+  double first_s = 0.0;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto f = reader.next();
+    EXPECT_EQ(f.depth.depth_m, projbot::alignment::kinect_quantised(captured.depths[k]).depth_m) << "frame " << k;
+    ASSERT_EQ(f.colour.rgba.size(), captured.colours[k].rgba.size());
+    EXPECT_EQ(f.colour.rgba, captured.colours[k].rgba) << "frame " << k;  // the twin's alpha is 255, as read back
+    if (k == 0) first_s = f.depth.capture_time_s;
+    EXPECT_NEAR(f.depth.capture_time_s - first_s, static_cast<double>(k) / 30.0, 2e-6);
+    EXPECT_EQ(f.depth_timestamp, static_cast<std::uint32_t>(k) * 1000000U);
+  }
+  try {
+    reader.next();
+    ADD_FAILURE() << "a frame after the end";
+  } catch (const projbot::alignment::AlignmentError& e) {
+    EXPECT_NE(std::string(e.what()).find("the recording ends after 2 frames"), std::string::npos) << e.what();
+  }
+  std::ofstream(dump / "INDEX.txt", std::ios::app) << "d-garbage.pgm\n";
+  try {
+    projbot::alignment::FakenectDumpReader bad(dump, false);
+    ADD_FAILURE() << "a malformed index read";
+  } catch (const projbot::alignment::AlignmentError& e) {
+    EXPECT_NE(std::string(e.what()).find("INDEX.txt:5: 'd-garbage.pgm' is not a fakenect frame name"), std::string::npos)
+        << e.what();
   }
   fs::remove_all(dump);
 }

@@ -149,6 +149,37 @@ TEST(TrackerWorkerTest, AcquiresTracksAndReportsLost) {
   EXPECT_EQ(worker.error(), nullptr);
 }
 
+// Lockstep (record and replay, issue 12): track() hands over a frame and returns once it is tracked,
+// every frame in order, and two workers given the same frames give the same poses.
+TEST(TrackerWorkerTest, TrackInLockstepTakesEveryFrameAndRepeatsItself) {
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  WorkerConfig cfg;
+  cfg.acquisition.reinitialise = false;
+  cfg.acquisition.attempt_budget_ms = std::numeric_limits<double>::infinity();
+  const auto truth = [](int f) {
+    return projbot::config::pose_from_xyz_rpy({0.05 + 0.003 * f, -0.02, 1.0 + 0.002 * f}, {20 + 0.5 * f, 30, 10});
+  };
+  std::vector<std::shared_ptr<DepthImage>> frames;
+  for (int f = 0; f < 12; ++f) frames.push_back(cube_depth(truth(f), k, f));
+  std::vector<Eigen::Matrix4d> first;
+  for (int run = 0; run < 2; ++run) {
+    TrackerWorker worker(cube_model(), k, cfg);
+    worker.set_initial_guess(projbot::config::pose_from_xyz_rpy({0.06, -0.02, 1.0}, {23, 30, 10}));
+    for (int f = 0; f < 12; ++f) {
+      const auto s = worker.track(frames[static_cast<std::size_t>(f)]);
+      ASSERT_TRUE(s.has_value()) << "frame " << f;
+      EXPECT_EQ(worker.frames_processed(), static_cast<std::uint64_t>(f + 1));  // none dropped
+      EXPECT_EQ(s->capture_time_s, frames[static_cast<std::size_t>(f)]->capture_time_s);
+      EXPECT_FALSE(s->lost) << "frame " << f;
+      EXPECT_LT(translation_norm_m(rigid_inverse(truth(f)) * s->T_camera_target), 0.002) << "frame " << f;
+      if (run == 0)
+        first.push_back(s->T_camera_target);
+      else
+        EXPECT_LT(translation_norm_m(rigid_inverse(first[static_cast<std::size_t>(f)]) * s->T_camera_target), 1e-9);
+    }
+  }
+}
+
 TEST(TrackerWorkerTest, StopsWithFramesPendingAndRejectsBadGuesses) {
   const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
   auto worker = std::make_unique<TrackerWorker>(cube_model(), k);

@@ -320,8 +320,19 @@ void TrackerWorker::submit(std::shared_ptr<const DepthImage> frame) {
   {
     std::lock_guard lock(mutex_);
     inbox_ = std::move(frame);  // a frame not yet taken is dropped: only the newest matters
+    ++submitted_;
   }
   wake_.notify_one();
+}
+
+std::optional<PoseSample> TrackerWorker::track(std::shared_ptr<const DepthImage> frame) {
+  std::unique_lock lock(mutex_);
+  inbox_ = std::move(frame);
+  const std::uint64_t ticket = ++submitted_;
+  wake_.notify_one();
+  done_.wait(lock, [&] { return finished_ >= ticket || error_; });
+  if (error_) std::rethrow_exception(error_);
+  return finished_sample_;
 }
 
 void TrackerWorker::set_initial_guess(const Eigen::Matrix4d& T_camera_target) {
@@ -345,6 +356,7 @@ std::exception_ptr TrackerWorker::error() const {
 void TrackerWorker::run(std::stop_token stop) {
   std::uint64_t sequence = 0;
   std::shared_ptr<const assets::Image> colour;  // the stop's arrival colour, until its first frame
+  std::uint64_t ticket = 0;                     // the frame taken: the submitted_ count when it was
   try {
     while (!stop.stop_requested()) {
       std::shared_ptr<const DepthImage> frame;
@@ -360,6 +372,7 @@ void TrackerWorker::run(std::stop_token stop) {
           guess_.reset();
         }
         frame = std::move(inbox_);
+        ticket = submitted_;
       }
       if (!frame) continue;
       ++processed_;
@@ -370,12 +383,19 @@ void TrackerWorker::run(std::stop_token stop) {
         sample->sequence = ++sequence;
         poses_.publish(*sample);
       }
+      {
+        std::lock_guard lock(mutex_);
+        finished_ = ticket;
+        finished_sample_ = sample;
+      }
+      done_.notify_all();
     }
   } catch (...) {
     {
       std::lock_guard lock(mutex_);
       error_ = std::current_exception();
     }
+    done_.notify_all();
     PoseSample lost = still_sample(follower_.last_pose(), 0.0, true, 0.0, 0.0);  // the renderer blanks the target
     lost.sequence = ++sequence;
     poses_.publish(lost);

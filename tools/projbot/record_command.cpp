@@ -1,8 +1,10 @@
-// projbot record: the RGB-D camera's stream (a configured camera, or the twin's at the tour's first
-// stop) as a libfreenect fakenect dump, so a scene seen in the field replays on a desk through the real
-// Kinect driver (issue 12, item 4, for the camera stream).
+// projbot record: the projection session at every stop of the tour, written so that `projbot run
+// --replay` runs it again with no device and no twin (issue 12, item 4): each stop's camera stream as a
+// fakenect dump (it also replays through the real Kinect driver), what the base and pan-tilt answered
+// there, and the pose every lit target's tracker gave for every frame, tracked in lockstep.
 
-#include <chrono>
+#include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -11,106 +13,157 @@
 #include "interrupt.hpp"
 #include "progress.hpp"
 #include "projbot/config/output_file.hpp"
-#include "projbot/config/scene.hpp"
-#include "projbot/engine/renderer.hpp"
-#include "projbot/twin/world.hpp"
+#include "projbot/config/recording.hpp"
+#include "rigs.hpp"
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
 namespace {
 
-// Frames from the configured camera for `seconds` of its own time (or until Ctrl-C).
-int record_camera(alignment::RgbdCamera& camera, double seconds, alignment::FakenectDumpWriter& out, Progress& progress) {
-  double first_s = -1.0;
-  while (!interrupted()) {
-    const alignment::RgbdFrame f = camera.next();
-    if (f.colour.rgba.empty())
-      throw DeviceError("the configured camera delivers no colour, and a fakenect dump holds depth and colour together");
-    if (first_s < 0.0) first_s = f.depth.capture_time_s;
-    if (f.depth.capture_time_s - first_s >= seconds) break;
-    out.add({&f.depth, &f.colour, f.depth.capture_time_s});
-    progress.step(out.frames());
-  }
-  return out.frames();
-}
+namespace fs = std::filesystem;
 
-// The twin's camera at the first stop of the tour, 30 frames per simulated second, its noise seeded per frame.
-int record_twin(const config::Scene& scene, std::uint64_t seed, double seconds, alignment::FakenectDumpWriter& out,
-                Progress& progress, std::string& where) {
-  if (scene.visits.empty())
-    throw config::ConfigError(scene.source.string() + ": recording the twin needs a 'tour: {visits: [...]}' section");
-  engine::Renderer renderer(engine::RendererOptions{});
-  twin::TwinOptions options;
-  options.seed = seed;
-  twin::Twin twin(scene, options, renderer);
-  const std::size_t i = twin.target_index(scene.visits.front());
-  const twin::Arrival arrival = twin.arrive(i, 0);
-  const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
-  where = "the twin's camera at the stop for '" + scene.visits.front() + "' (its first visit, seed " + std::to_string(seed) + ")";
-  for (int k = 0; k / 30.0 < seconds && !interrupted(); ++k) {
-    const auto noise = static_cast<std::uint32_t>(seed * 7919 + static_cast<std::uint64_t>(k));
-    const alignment::DepthImage depth = twin.capture(T_world_camera, noise);
-    const assets::Image colour = twin.capture_colour(T_world_camera, noise);
-    out.add({&depth, &colour, k / 30.0});
-    progress.step(out.frames());
+// The camera's frames as a fakenect dump holds them (depth through the Kinect's 11-bit disparity), so the
+// trackers see here what a replay of the dump will see.
+class QuantisedCamera final : public alignment::RgbdCamera {
+ public:
+  alignment::RgbdCamera* inner = nullptr;
+  alignment::RgbdFrame next() override {
+    alignment::RgbdFrame f = inner->next();
+    if (f.colour.rgba.empty())
+      throw DeviceError("the camera delivers no colour, and a fakenect dump holds depth and colour together");
+    for (float& z : f.depth.depth_m) z = alignment::kinect_raw_to_metres(alignment::kinect_metres_to_raw(z));
+    return f;
   }
-  return out.frames();
-}
+};
+
+// Writes each stop as it ends: its dump (frame by frame), then recording.yaml and poses.csv rewritten,
+// so a recording cut short holds every stop that was left.
+class RecordObserver final : public session::StopObserver {
+ public:
+  RecordObserver(const config::Scene& scene, config::Recording& recording, const fs::path& out, Progress& progress)
+      : scene_(scene), rec_(recording), out_(out), progress_(progress) {}
+  void lit(const session::Stop& stop, double) override {
+    char name[32];
+    std::snprintf(name, sizeof name, "stop%02d", stop.visit + 1);
+    current_ = config::RecordedStop{};
+    current_.visit = stop.visit;
+    current_.target = scene_.targets[static_cast<std::size_t>(stop.target)].name;
+    current_.goal = {stop.drive.goal.x_m, stop.drive.goal.y_m, stop.drive.goal.theta_rad};
+    current_.believed = {stop.drive.estimate.x_m, stop.drive.estimate.y_m, stop.drive.estimate.theta_rad};
+    current_.pan_rad = stop.angles.pan_rad;
+    current_.tilt_rad = stop.angles.tilt_rad;
+    current_.drive_s = stop.drive.drive_seconds;
+    current_.arrived = stop.drive.arrived;
+    current_.frames = name;
+    writer_ = std::make_unique<alignment::FakenectDumpWriter>(out_ / name);
+  }
+  void frame(const session::Stop& stop, int k, const alignment::RgbdFrame& f,
+             const std::vector<std::optional<alignment::PoseSample>>& samples) override {
+    if (t0_s_ < 0.0) t0_s_ = f.depth.capture_time_s;
+    writer_->add({&f.depth, &f.colour, f.depth.capture_time_s - t0_s_});
+    poses_.add(scene_, stop, k, samples);
+    current_.frame_count = k + 1;
+    progress_.step(++frames);
+  }
+  void left(const session::Stop&) override {
+    rec_.stops.push_back(current_);
+    save();
+  }
+  void save() const {
+    config::write_file_atomically(out_ / "poses.csv", poses_.text());
+    config::write_file_atomically(out_ / "recording.yaml", config::recording_yaml(rec_));
+  }
+  int frames = 0;
+
+ private:
+  const config::Scene& scene_;
+  config::Recording& rec_;
+  fs::path out_;
+  Progress& progress_;
+  config::RecordedStop current_;
+  std::unique_ptr<alignment::FakenectDumpWriter> writer_;
+  PoseLog poses_;
+  double t0_s_ = -1.0;
+};
 
 }  // namespace
 
 const Command kRecord{
     "record",
-    "record the RGB-D camera's stream (the configured camera, or the twin's) as a fakenect dump to replay",
-    "projbot record --out DIR [--config site.yaml] [--sim] [--seconds S] [--seed K]\n\n"
-    "Writes S seconds of depth + colour frames from the config's `devices.camera` (or, with none or with\n"
-    "--sim, from the twin's camera at the tour's first stop) into DIR in libfreenect's fakenect format\n"
-    "(INDEX.txt, raw 11-bit depth PGMs, RGB PPMs) with recording.yaml beside them. They replay on a desk\n"
-    "through the real Kinect driver, with `devices.camera: {driver: freenect, registered: false}`:\n"
-    "  fakenect DIR projbot run --config site.yaml      (libfreenect-bin's wrapper: FAKENECT_PATH=DIR and its\n"
-    "                                                  libfreenect.so first on LD_LIBRARY_PATH)\n"
-    "Depth is kept to the Kinect's disparity steps. Ctrl-C keeps the frames recorded so far (INDEX.txt is\n"
-    "rewritten after each). Only the camera is recorded yet: not the pan-tilt, laser, odometry or the\n"
-    "session's decisions.\n",
-    {{"out", "DIR", "the dump folder (new or empty)"},
+    "run the session through the tour and record it (camera, base, pan-tilt, poses) to replay with run --replay",
+    "projbot record --out DIR [--config site.yaml] [--sim] [--visits N] [--dwell S] [--seed K]\n\n"
+    "Runs the projection session at every stop of the config's tour, as run does, with every camera frame\n"
+    "tracked in lockstep (each frame tracked before the next is read; a search bounded by its work, not by\n"
+    "wall time), and writes into DIR:\n"
+    "  stopNN/         each stop's depth + colour frames, in libfreenect's fakenect format (INDEX.txt, raw\n"
+    "                  11-bit depth PGMs, RGB PPMs, the capture times kept)\n"
+    "  recording.yaml  the scene, and per stop what the session asked and the devices answered: the stop\n"
+    "                  driven to, where the robot then believed it stood, the pan-tilt's angles\n"
+    "  poses.csv       the pose each lit target's tracker gave for every frame (the session's decisions)\n"
+    "`projbot run --replay DIR` runs the same session from them with no device and no twin, and compares\n"
+    "its poses with poses.csv frame for frame. A stop's dump also replays through the real Kinect driver:\n"
+    "  fakenect DIR/stop01 projbot run --config site.yaml   (camera: {driver: freenect, registered: false})\n"
+    "The camera is the config's `devices.camera` (or, with none or with --sim, the twin's); the robot is\n"
+    "the twin's. Depth is kept to the Kinect's disparity steps, for the trackers too. The laser scans and\n"
+    "wheel odometry behind the robot's belief are not recorded (the belief is). Ctrl-C ends the stop in\n"
+    "progress and keeps every stop recorded.\n",
+    {{"out", "DIR", "the recording's folder (new or empty)"},
      {"config", "FILE", "scene (default: assets/scenes/tour.yaml)"},
      {"sim", "", "record the twin's camera whatever `devices:` configures"},
-     {"seconds", "S", "how long to record (default 5)"},
+     {"visits", "N", "visits, cycling through the tour (default: the list once)"},
+     {"dwell", "S", "seconds at each stop (default 2)"},
      {"seed", "K", "seed of the twin's drive and noise (default 1, as run's)"}},
     [](const cli::Args& args) {
       const auto out = args.get("out");
       if (!out) throw cli::UsageError("--out DIR is required");
-      const double seconds = args.get_double("seconds", 5.0);
-      if (!(seconds > 0.0 && seconds <= 3600.0)) throw cli::UsageError("--seconds must be in (0, 3600]");
+      const double dwell_s = args.get_double("dwell", 2.0);
+      if (!(dwell_s > 0.0 && dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
       const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
       args.check_output_folders({"out"});
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
-      catch_interrupts();  // Ctrl-C: keep the frames recorded so far
-      alignment::FakenectDumpWriter writer(*out);
-      Progress progress("frame", static_cast<int>(std::ceil(seconds * 30.0)));
-      std::string where;
-      int frames = 0;
+      if (scene.visits.empty())
+        throw config::ConfigError(scene.source.string() + ": `projbot record` needs a 'tour: {visits: [...]}' section");
+      const int visits = args.get_int("visits", static_cast<int>(scene.visits.size()), 1, 1000);
+      std::error_code ec;
+      if (fs::exists(*out, ec) && !fs::is_empty(*out, ec))
+        throw cli::UsageError(*out + ": not empty; a recording needs a new folder");
+      fs::create_directories(*out, ec);
+      if (ec) throw cli::UsageError(*out + ": cannot create: " + ec.message());
+
+      Devices devices;
+      config::Recording rec;
+      rec.camera = "the twin's camera";
       if (scene.devices.camera && !args.flag("sim")) {
         config::DevicesConfig camera_only;
         camera_only.camera = scene.devices.camera;
         std::vector<DeviceCheck> checks;
-        Devices devices = open_devices(camera_only, checks, true);
-        where = checks.front().config;
-        frames = record_camera(*devices.camera, seconds, writer, progress);
-      } else {
-        frames = record_twin(scene, seed, seconds, writer, progress, where);
+        devices = open_devices(camera_only, checks, true);
+        rec.camera = checks.front().config;
       }
-      const auto& k = scene.depth_camera;
-      std::ostringstream manifest;
-      manifest << "# projbot record: a libfreenect fakenect dump (INDEX.txt lists the frames)\n"
-               << "source: \"" << where << "\"\nscene: \"" << scene.source.string() << "\"\nframes: " << frames
-               << "\ncamera: {width: " << k.width_px << ", height: " << k.height_px << ", fx: " << k.fx_px << ", fy: " << k.fy_px
-               << ", cx: " << k.cx_px << ", cy: " << k.cy_px << "}\ndepth: raw 11-bit Kinect disparity\n"
-               << "interrupted: " << (interrupted() ? "true" : "false") << "\n";
-      config::write_file_atomically(std::filesystem::path(*out) / "recording.yaml", manifest.str());
-      std::cout << "recorded " << frames << " frames from " << where << " to " << *out
-                << "\nreplay through the Kinect driver: fakenect " << *out
-                << " projbot run --config SITE.yaml (with devices.camera: {driver: freenect, registered: false})\n";
+      rec.scene = fs::absolute(scene.source);
+      rec.seed = seed;
+      rec.dwell_s = dwell_s;
+      SceneTrackers trackers = make_trackers(scene, worker_config(true, true));
+      TwinRig rig(scene, trackers.targets, seed, devices.camera.get(), true);
+      catch_interrupts();  // Ctrl-C: end the stop in progress, keep every stop recorded
+      Progress progress("frame", static_cast<int>(std::ceil(visits * dwell_s * 30.0)));
+      RecordObserver observer(scene, rec, *out, progress);
+      session::Dwell dwell = rig.dwell(dwell_s, true);
+      QuantisedCamera quantised;
+      dwell.camera = [&, camera = dwell.camera](const session::Stop& stop, double since_s) -> alignment::RgbdCamera& {
+        quantised.inner = &camera(stop, since_s);
+        return quantised;
+      };
+      dwell.over = [over = dwell.over](const session::Stop& stop, int frames, double elapsed_s) {
+        return interrupted() || over(stop, frames, elapsed_s);
+      };
+      const std::stop_source never;
+      for (int v = 0; v < visits && !interrupted(); ++v)
+        rig.session().visit(v, trackers.workers, dwell, observer, never.get_token());
+      rec.interrupted = interrupted();
+      observer.save();
+      std::cout << "recorded " << rec.stops.size() << " stop(s), " << observer.frames << " frames from " << rec.camera << " to "
+                << *out << "\nreplay: projbot run --replay " << *out << "\n";
       return interrupt_exit_code();
     }};
 

@@ -25,6 +25,7 @@
 #include "projbot/session/session.hpp"
 #include "projbot/twin/camera.hpp"
 #include "projbot/twin/world.hpp"
+#include "rigs.hpp"
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
@@ -50,6 +51,7 @@ struct RobotState {
   int visit = 0;
   bool done = false;
   Eigen::Matrix4d T_camera_world = Eigen::Matrix4d::Identity();  // the camera's true pose at the stop (twin)
+  bool measured = false;  // the truth above is known (the twin's robot), so each frame's error is measured
 };
 
 // The projector's frame period as the render loop sees it: the median interval between the last frame
@@ -110,48 +112,64 @@ struct RunOptions {
   std::uint64_t seed = 1;
 };
 
-// The robot thread: the session drives the tour (drive, aim, Eq. 1 for the visited target and its
-// neighbours), each lit target's worker gets its guess, footing and the colour of the stop's first
-// frame, then the camera's frames go to the workers while the robot dwells. The robot is the twin's (so
-// each stop also records the truth the render thread measures against); the camera is the configured
-// one, or the twin's.
-void drive(const config::Scene& scene, const RunOptions& o, std::vector<std::unique_ptr<alignment::TrackerWorker>>& workers,
-           alignment::LatestValue<RobotState>& state, std::vector<double>& handoff_ms, const std::stop_token& stop,
-           alignment::RgbdCamera* configured) {
-  engine::Renderer depth_renderer(engine::RendererOptions{});
-  twin::TwinOptions to;
-  to.seed = o.seed;
-  twin::Twin twin(scene, to, depth_renderer);
-  twin::TwinCamera twin_camera(twin, o.seed);
-  alignment::RgbdCamera& camera = configured ? *configured : twin_camera;
-  session::Session session(scene, twin.session_targets(), twin.robot(), twin.pan_tilt());
-  const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
-  for (int v = 0; v < visits && !stop.stop_requested(); ++v) {
-    state.publish({.lit = {}, .since_s = now_s(), .visit = v + 1});
-    const session::Stop at = session.arrive(v);
-    const std::size_t i = twin.target_index(scene.targets[static_cast<std::size_t>(at.target)].name);
-    const double since = now_s();  // poses from frames captured before this belong to an earlier stop
-    twin_camera.at_stop(i, at.target_visit, v, since);
-    auto first = std::make_shared<alignment::RgbdFrame>(camera.next());
-    std::shared_ptr<const assets::Image> colour;
-    if (!first->colour.rgba.empty()) colour = std::shared_ptr<const assets::Image>(first, &first->colour);
+// What the robot thread tells the render thread at each step of the session, with the twin's truth when
+// the twin serves the robot; in a replay, each lockstep frame's poses are also checked against the recording's.
+class RunObserver final : public session::StopObserver {
+ public:
+  RunObserver(const config::Scene& scene, alignment::LatestValue<RobotState>& state, std::vector<double>& handoff_ms,
+              twin::Twin* twin, PoseCheck* check)
+      : scene_(scene), state_(state), handoff_ms_(handoff_ms), twin_(twin), check_(check) {}
+  void driving(int visit) override { state_.publish({.lit = {}, .since_s = now_s(), .visit = visit + 1}); }
+  void lit(const session::Stop& stop, double since_s) override {
     std::vector<LitTarget> lit;
-    for (const session::LitTarget& l : at.lit) {
-      workers[static_cast<std::size_t>(l.target)]->set_initial_guess(l.T_camera_target_guess, l.footing, colour);
-      const std::size_t t = twin.target_index(scene.targets[static_cast<std::size_t>(l.target)].name);
-      lit.push_back({l.target, l.target == at.target ? at.target_visit : 0, twin.home(t)});
-    }
-    state.publish({lit, since, v + 1, false, alignment::rigid_inverse(twin.true_head().T_world_camera.matrix())});
-    std::shared_ptr<const alignment::DepthImage> frame(first, &first->depth);
-    while (true) {
-      handoff_ms.push_back(1000.0 * (now_s() - frame->capture_time_s));
-      for (const LitTarget& l : lit) workers[static_cast<std::size_t>(l.target)]->submit(frame);
-      if (stop.stop_requested() || now_s() - since >= o.dwell_s) break;
-      frame = std::make_shared<alignment::DepthImage>(camera.next().depth);
-    }
-    twin.end_visit(i, at.target_visit);
+    for (const session::LitTarget& l : stop.lit)
+      lit.push_back({l.target, l.target == stop.target ? stop.target_visit : 0,
+                     twin_ ? twin_->home(twin_index(l.target)) : Eigen::Matrix4d::Identity()});
+    const Eigen::Matrix4d T_camera_world =
+        twin_ ? alignment::rigid_inverse(twin_->true_head().T_world_camera.matrix()) : Eigen::Matrix4d::Identity();
+    state_.publish({lit, since_s, stop.visit + 1, false, T_camera_world, twin_ != nullptr});
   }
-  state.publish({.lit = {}, .since_s = now_s(), .visit = visits, .done = true});
+  void frame(const session::Stop& stop, int k, const alignment::RgbdFrame& f,
+             const std::vector<std::optional<alignment::PoseSample>>& samples) override {
+    if (samples.empty()) handoff_ms_.push_back(1000.0 * (now_s() - f.depth.capture_time_s));  // live: at the hand-off
+    if (check_) check_->compare(scene_, stop, k, samples);
+    ++frames;
+  }
+  void left(const session::Stop& stop) override {
+    if (twin_) twin_->end_visit(twin_index(stop.target), stop.target_visit);  // back home, or left where it was moved
+  }
+  int frames = 0;
+
+ private:
+  std::size_t twin_index(int target) const { return twin_->target_index(scene_.targets[static_cast<std::size_t>(target)].name); }
+  const config::Scene& scene_;
+  alignment::LatestValue<RobotState>& state_;
+  std::vector<double>& handoff_ms_;
+  twin::Twin* twin_;
+  PoseCheck* check_;
+};
+
+// The robot thread: the session at each stop of the tour (the twin's robot, the configured camera or the
+// twin's), or at each stop of a recording (`replay`, in lockstep, checked by `check`).
+void drive(const config::Scene& scene, const RunOptions& o, SceneTrackers& trackers, alignment::LatestValue<RobotState>& state,
+           std::vector<double>& handoff_ms, const std::stop_token& stop, alignment::RgbdCamera* configured,
+           const config::Recording* replay, PoseCheck* check) {
+  if (replay) {
+    ReplayRig rig(scene, *replay, trackers.targets);
+    RunObserver observer(scene, state, handoff_ms, nullptr, check);
+    const session::Dwell dwell = rig.dwell();
+    for (int v = 0; v < static_cast<int>(replay->stops.size()) && !stop.stop_requested(); ++v)
+      rig.session().visit(v, trackers.workers, dwell, observer, stop);
+  } else {
+    TwinRig rig(scene, trackers.targets, o.seed, configured);
+    RunObserver observer(scene, state, handoff_ms, &rig.twin(), nullptr);
+    const session::Dwell dwell = rig.dwell(o.dwell_s, false);
+    const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
+    for (int v = 0; v < visits && !stop.stop_requested(); ++v) rig.session().visit(v, trackers.workers, dwell, observer, stop);
+  }
+  RobotState last;
+  state.read(last);
+  state.publish({.lit = {}, .since_s = now_s(), .visit = last.visit, .done = true});
 }
 
 // Without --sim: the devices the config names, opened and read once (each absent one an error naming it);
@@ -182,12 +200,31 @@ Devices open_configured(const config::Scene& scene, bool headless) {
   return devices;
 }
 
+void print_robot(std::ostream& out, const RobotState& robot, bool configured_camera, const std::vector<double>& capture_ms,
+                 std::size_t tracked) {
+  out << "robot: " << robot.visit << " visit(s); " << (configured_camera ? "the configured" : "the twin's")
+      << " camera delivered " << capture_ms.size() << " frames (capture to hand-off to the workers p50 "
+      << engine::percentile(capture_ms, 0.5) << " ms, p95 " << engine::percentile(capture_ms, 0.95) << " ms"
+      << (configured_camera ? ")" : ": the twin's render and Kinect noise)") << "; the tracker workers processed " << tracked
+      << "\n";
+}
+
+// --replay DIR: the recording, read before anything else starts (and the options it rules out refused).
+std::optional<config::Recording> replay_of(const cli::Args& args) {
+  const auto dir = args.get("replay");
+  if (!dir) return std::nullopt;
+  if (args.flag("sim")) throw cli::UsageError("--sim does not apply to --replay: the recording serves every device");
+  for (const char* k : {"visits", "dwell", "seed"})
+    if (args.get(k)) throw cli::UsageError(std::string("--") + k + " does not apply to --replay: it plays the recording's stops");
+  return config::load_recording(*dir);
+}
+
 }  // namespace
 
 const Command kRun{
     "run",
     "the live engine: project onto the tracked targets while the robot tours (the twin with --sim)",
-    "projbot run [--config C.yaml] [--sim] [--fullscreen] [--monitor N] [--headless] [--profile p.csv]\n"
+    "projbot run [--config C.yaml] [--sim | --replay DIR] [--fullscreen] [--monitor N] [--headless] [--profile p.csv]\n"
     "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n"
     "            [--no-predict]\n\n"
     "Opens the projector output and draws, every frame, each target the robot is projecting onto (the\n"
@@ -208,9 +245,14 @@ const Command kRun{
     "the twin's, and configuring one of them stops the run saying so. With none configured, or with --sim,\n"
     "the digital twin serves every device. A device that fails while projecting blanks the projector at\n"
     "once; what was measured until then is printed and written, and the failure is reported (exit 1).\n"
+    "With --replay DIR the session runs from a recording (projbot record): the base and pan-tilt answer\n"
+    "what they answered then, each stop's frames play at their recorded pace and are tracked in lockstep,\n"
+    "and every pose is compared with the recording's (the largest difference is printed); no device and\n"
+    "no twin is used, so nothing is measured against a truth.\n"
     "Without --config the shipped demo tour runs in the twin.\n",
     {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)"},
      {"sim", "", "run against the digital twin, whatever `devices:` configures (the default without one)"},
+     {"replay", "DIR", "run the session from a recording (projbot record): no device, no twin; its scene unless --config"},
      {"fullscreen", "", "fullscreen on --monitor (the projector)"},
      {"monitor", "N", "monitor index for --fullscreen (default 0)"},
      {"headless", "", "draw offscreen at 60 Hz instead of a window (profiling without a display)"},
@@ -223,10 +265,14 @@ const Command kRun{
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time"}},
     [](const cli::Args& args) {
       catch_interrupts();  // Ctrl-C / SIGTERM: leave the frame loop at the next frame, then write what was measured
-      const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
+      const std::optional<config::Recording> recording = replay_of(args);
+      const config::Scene scene = config::load_scene(
+          args.get_or("config", recording ? recording->scene.string() : (asset_dir() / "scenes" / "tour.yaml").string()));
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
-      const Devices devices = args.flag("sim") ? Devices{} : open_configured(scene, args.flag("headless"));
+      std::optional<PoseCheck> check;
+      if (recording) check.emplace(recording->folder() / "poses.csv");
+      const Devices devices = args.flag("sim") || recording ? Devices{} : open_configured(scene, args.flag("headless"));
       RunOptions o;
       o.visits = args.get_int("visits", 0, 1, 1000);
       o.dwell_s = args.get_double("dwell", 4.0);
@@ -249,26 +295,19 @@ const Command kRun{
         target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
       } else {
         engine::WindowOptions wo = window_options(args, scene.projector, "projbot run: " + scene.source.filename().string());
-        if (scene.devices.projector && !args.flag("sim")) {  // the config's projector, unless the command line says otherwise
+        if (scene.devices.projector && !args.flag("sim") &&
+            !recording) {  // the config's projector, unless the command line says otherwise
           wo.fullscreen = args.flag("fullscreen") || scene.devices.projector->fullscreen;
           if (!args.get("monitor")) wo.monitor = scene.devices.projector->monitor;
         }
         target = open_window(renderer, wo, scene.projector);
       }
 
-      // One tracker worker per target the tour visits.
-      const alignment::CameraIntrinsics k = session::depth_intrinsics(scene);
-      std::vector<std::unique_ptr<alignment::TrackerWorker>> workers(scene.targets.size());
+      // One tracker worker per target on the map.
       const bool predict = !args.flag("no-predict");
       PresentCadence cadence;
-      alignment::WorkerConfig worker_config;
-      worker_config.predict = predict;
-      for (std::size_t i = 0; i < scene.targets.size(); ++i) {
-        if (!scene.targets[i].T_world_target) continue;
-        auto model = assets::load_gltf(scene.targets[i].model);
-        assets::scale_and_recenter(model, scene.targets[i].scale, scene.targets[i].recenter);
-        workers[i] = std::make_unique<alignment::TrackerWorker>(alignment::model_cloud_from(model, 50000), k, worker_config);
-      }
+      SceneTrackers trackers = make_trackers(scene, worker_config(predict, recording.has_value()));
+      const auto& workers = trackers.owned;
 
       alignment::LatestValue<RobotState> state;
       std::exception_ptr robot_error;
@@ -276,7 +315,8 @@ const Command kRun{
       std::vector<double> capture_ms;  // capture to hand-off per frame: the robot thread's until it is joined
       std::jthread robot_thread([&](std::stop_token stop) {
         try {
-          drive(scene, o, workers, state, capture_ms, stop, devices.camera.get());
+          drive(scene, o, trackers, state, capture_ms, stop, devices.camera.get(), recording ? &*recording : nullptr,
+                check ? &*check : nullptr);
         } catch (...) {
           robot_error = std::current_exception();
         }
@@ -339,6 +379,10 @@ const Command kRun{
         // age, capture to the expected display time) is the first drawn one's.
         std::vector<double> row_error;
         for (const Drawn& d : drawn) {
+          if (!robot.measured) {  // no truth to measure against (a replay)
+            row_error.push_back(std::nan(""));
+            continue;
+          }
           bool moving = false;
           const double e = marker_error_mm(scene.targets[static_cast<std::size_t>(d.lit->target)], robot, *d.lit,
                                            d.T_camera_target, d.display_s, moving);
@@ -377,14 +421,18 @@ const Command kRun{
                 << engine::percentile(ages_ms, 1.0) << " ms; " << blank << " frames blank (driving, acquiring or lost)";
       if (frames_with_neighbours > 0) std::cout << "; " << frames_with_neighbours << " frames lit a neighbour too";
       std::cout << "\n";
-      errors.print(std::cout);
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
-      std::cout << "robot: " << robot.visit << " visit(s); " << (devices.camera ? "the configured" : "the twin's")
-                << " camera delivered " << capture_ms.size() << " frames (capture to hand-off to the workers p50 "
-                << engine::percentile(capture_ms, 0.5) << " ms, p95 " << engine::percentile(capture_ms, 0.95) << " ms"
-                << (devices.camera ? ")" : ": the twin's render and Kinect noise)");
-      std::cout << "; the tracker workers processed " << tracked << "\n";
+      if (recording) {
+        std::cout << "replay of " << recording->folder().string() << ": " << robot.visit << " of " << recording->stops.size()
+                  << " stops, " << tracked
+                  << " poses tracked in lockstep (each lit target's, every frame); against the recording's: " << check->compared
+                  << " compared, largest difference " << std::setprecision(4) << check->max_mm << " mm, " << check->max_deg
+                  << " deg; " << check->mismatched << " found or lost in one and not the other\n";
+      } else {
+        errors.print(std::cout);
+        print_robot(std::cout, robot, devices.camera != nullptr, capture_ms, tracked);
+      }
       if (const auto csv = args.get("profile")) {
         std::ostringstream f;
         // Per frame: when it started, the capture time of the depth its pose came from and its expected

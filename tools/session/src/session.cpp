@@ -1,6 +1,7 @@
 #include "projbot/session/session.hpp"
 
 #include <algorithm>
+#include <chrono>
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/engine/projection.hpp"
@@ -110,6 +111,45 @@ Stop Session::arrive(int visit) {
   stop.lit.push_back(plan(stop.target, stop.believed));
   for (LitTarget& n : neighbours(stop.target, stop.believed)) stop.lit.push_back(std::move(n));
   return stop;
+}
+
+Stop Session::visit(int visit, const std::vector<alignment::TrackerWorker*>& workers, const Dwell& dwell, StopObserver& observer,
+                    const std::stop_token& stop) {
+  observer.driving(visit);
+  Stop at = arrive(visit);
+  std::vector<alignment::TrackerWorker*> lit;
+  for (const LitTarget& l : at.lit) {
+    const auto t = static_cast<std::size_t>(l.target);
+    if (t >= workers.size() || workers[t] == nullptr)
+      throw SessionError("target '" + scene_.targets[t].name + "' is lit at visit " + std::to_string(visit + 1) +
+                         " but has no tracker worker");
+    lit.push_back(workers[t]);
+  }
+  const auto now_s = [] { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); };
+  const double since = now_s();
+  alignment::RgbdCamera& camera = dwell.camera(at, since);
+  // The first frame's colour, taken before anything is lit, guides each lit target's acquisition.
+  auto frame = std::make_shared<alignment::RgbdFrame>(camera.next());
+  std::shared_ptr<const assets::Image> colour;
+  if (!frame->colour.rgba.empty()) colour = std::shared_ptr<const assets::Image>(frame, &frame->colour);
+  for (std::size_t k = 0; k < at.lit.size(); ++k)
+    lit[k]->set_initial_guess(at.lit[k].T_camera_target_guess, at.lit[k].footing, colour);
+  observer.lit(at, since);
+  std::vector<std::optional<alignment::PoseSample>> samples;
+  for (int k = 0;; ++k) {
+    const std::shared_ptr<const alignment::DepthImage> depth(frame, &frame->depth);  // shared, never copied
+    samples.clear();
+    for (alignment::TrackerWorker* w : lit)
+      if (dwell.lockstep)
+        samples.push_back(w->track(depth));
+      else
+        w->submit(depth);
+    observer.frame(at, k, *frame, samples);
+    if (stop.stop_requested() || dwell.over(at, k + 1, now_s() - since)) break;
+    frame = std::make_shared<alignment::RgbdFrame>(camera.next());
+  }
+  observer.left(at);
+  return at;
 }
 
 }  // namespace projbot::session

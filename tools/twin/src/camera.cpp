@@ -28,7 +28,8 @@ alignment::RgbdFrame TwinCamera::next() {
   const Eigen::Matrix4d T_world_camera = twin_.true_head().T_world_camera.matrix();
   alignment::RgbdFrame f;
   f.depth = twin_.capture(T_world_camera, static_cast<std::uint32_t>(seed_ * 7919 + frame_));
-  if (frame_ == 0) f.colour = twin_.capture_colour(T_world_camera, static_cast<std::uint32_t>(seed_ * 7919 + visit_));
+  if (frame_ == 0 || colour_every_frame_)
+    f.colour = twin_.capture_colour(T_world_camera, static_cast<std::uint32_t>(seed_ * 7919 + visit_ * 1009 + frame_));
   f.depth.capture_time_s = captured;
   f.depth_timestamp = f.colour_timestamp = frame_++;
   last_capture_ms_ = 1000.0 * (now_s() - captured);

@@ -84,4 +84,37 @@ class FakenectDumpWriter {
 /// Writes `frames` into `folder` (created; must be empty or absent) as a fakenect dump.
 void write_fakenect_dump(const std::filesystem::path& folder, const std::vector<FakenectFrame>& frames);
 
+/// Depth as a fakenect dump gives it back: each value through the Kinect's raw 11-bit disparity and back
+/// (kinect_metres_to_raw, then kinect_raw_to_metres). What a recording's tracker sees, so a replay of the
+/// dump sees the same.
+DepthImage kinect_quantised(const DepthImage& depth);
+
+/// A fakenect dump read back frame by frame without libfreenect (`projbot run --replay` plays one per
+/// stop): depth through kinect_raw_to_metres() as the Kinect driver converts raw disparity, colour as
+/// RGBA. Frame k is stamped on the host's steady clock at the first frame's reading time plus its
+/// recorded offset from the first; with `realtime`, next() also waits until then.
+class FakenectDumpReader final : public RgbdCamera {
+ public:
+  /// Reads folder/INDEX.txt (pairs of d-TIME-STAMP.pgm and r-TIME-STAMP.ppm lines, as libfreenect's
+  /// record tool and FakenectDumpWriter write them). Throws AlignmentError naming the file (and line).
+  FakenectDumpReader(const std::filesystem::path& folder, bool realtime);
+  /// The next frame. Throws AlignmentError naming the file for a missing or malformed one, and at the end
+  /// of the dump.
+  RgbdFrame next() override;
+  int frames() const { return static_cast<int>(entries_.size()); }
+  int frames_read() const { return next_; }
+
+ private:
+  struct Entry {
+    std::string depth, colour;  // file names in the folder
+    double time_s = 0.0;        // recorded, seconds
+    std::uint32_t depth_stamp = 0, colour_stamp = 0;
+  };
+  std::filesystem::path folder_;
+  bool realtime_;
+  std::vector<Entry> entries_;
+  int next_ = 0;
+  double offset_s_ = 0.0;  // host steady time minus recorded time, set at the first frame
+};
+
 }  // namespace projbot::alignment

@@ -232,6 +232,10 @@ class TrackerWorker {
 
   /// A new depth frame (from the sensor thread). Replaces any frame not yet taken.
   void submit(std::shared_ptr<const DepthImage> frame);
+  /// Submits `frame` and waits until the worker has tracked it, so that every frame is tracked, in order,
+  /// and the same frames give the same poses (record and replay). Returns the sample published for it
+  /// (none when the step published none). Rethrows what the worker died of.
+  std::optional<PoseSample> track(std::shared_ptr<const DepthImage> frame);
   /// The stop's initial guess (Eq. 1): the next frame acquires from it.
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target);
   /// ...with what the robot knows at the stop, as the tour uses it: the target's surveyed footing (its
@@ -257,6 +261,9 @@ class TrackerWorker {
   mutable std::mutex mutex_;  // guards the inbox below, not the pose hand-off
   std::condition_variable_any wake_;
   std::shared_ptr<const DepthImage> inbox_;
+  std::uint64_t submitted_ = 0, finished_ = 0;  // frames submitted, and the last one tracked (track())
+  std::optional<PoseSample> finished_sample_;   // what that one published
+  std::condition_variable done_;
   struct Start {
     Eigen::Matrix4d T_camera_target;
     std::optional<Footing> footing;

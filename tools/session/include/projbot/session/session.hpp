@@ -4,15 +4,22 @@
 // at the middle of the target where the map says it stands, from where the robot believes it is
 // (robot::PanTilt), reads the angles back, and takes Eq. 1's initial guess and the surveyed footing of
 // the visited target and of each neighbour the robot expects in the projector's view. Acquiring,
-// tracking and drawing or blanking follow from there: `projbot tour` runs them on a simulated clock,
-// `projbot run` live. Nothing here knows which implementation of a device it drives (twin or hardware).
+// Session::visit then hands the camera's frames (alignment::RgbdCamera) to the lit targets' tracker
+// workers while the robot dwells, live (`projbot run`) or in lockstep (`record`, `run --replay`); the
+// tour runs the same arrival on a simulated clock. Nothing here knows which implementation of a device it
+// drives (twin, hardware or recording).
 
 #include <Eigen/Core>
+#include <functional>
+#include <optional>
 #include <stdexcept>
+#include <stop_token>
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
 #include "projbot/alignment/registration.hpp"
+#include "projbot/alignment/rgbd_camera.hpp"
+#include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/navigator.hpp"
 #include "projbot/robot/pan_tilt.hpp"
@@ -62,6 +69,34 @@ struct Stop {
 void drive_and_aim(const config::Scene& scene, const config::TargetConfig& target, const Eigen::Vector3d& middle_world,
                    robot::Navigator& base, robot::PanTilt& pan_tilt, int index, Stop& stop);
 
+/// What a session's stops tell whoever runs them (run's render thread, record's writer, replay's check).
+class StopObserver {
+ public:
+  virtual ~StopObserver() = default;
+  /// The robot sets off for the `visit`-th stop: nothing is lit while it drives.
+  virtual void driving(int /*visit*/) {}
+  /// Aimed, each lit target's worker given its guess: the stop's lit targets, from `since_s` on (steady
+  /// clock; poses of frames captured before belong to an earlier stop).
+  virtual void lit(const Stop& /*stop*/, double /*since_s*/) {}
+  /// The stop's k-th frame (0-based) was handed to the lit targets' workers. In lockstep, `samples`
+  /// holds what each one's worker published for it (stop.lit's order); live, it is empty.
+  virtual void frame(const Stop& /*stop*/, int /*k*/, const alignment::RgbdFrame& /*frame*/,
+                     const std::vector<std::optional<alignment::PoseSample>>& /*samples*/) {}
+  /// The dwell at the stop is over.
+  virtual void left(const Stop& /*stop*/) {}
+};
+
+/// How a stop's dwell runs.
+struct Dwell {
+  /// The camera to read at this stop (the robot has just aimed; frames from `since_s` on count).
+  std::function<alignment::RgbdCamera&(const Stop&, double since_s)> camera;
+  /// Whether the dwell is over after `frames` frames, `elapsed_s` after since_s.
+  std::function<bool(const Stop&, int frames, double elapsed_s)> over;
+  /// Every frame tracked, in order, before the next is read (record and replay: the same frames give the
+  /// same poses); otherwise the workers take the newest frame when they are free (live).
+  bool lockstep = false;
+};
+
 class Session {
  public:
   /// `targets` are those the tour may visit or light; every visit in scene.visits must name one with a
@@ -72,6 +107,12 @@ class Session {
   int target_of(int visit) const;
   /// Drives to the `visit`-th stop, aims, and plans what to light there.
   Stop arrive(int visit);
+  /// The whole `visit`-th stop: arrive, give each lit target's worker (`workers`, by scene index) its
+  /// guess, footing and the colour of the stop's first frame, then hand the camera's frames to them until
+  /// the dwell is over or `stop` is requested. Throws SessionError for a lit target without a worker, and
+  /// what a device throws.
+  Stop visit(int visit, const std::vector<alignment::TrackerWorker*>& workers, const Dwell& dwell, StopObserver& observer,
+             const std::stop_token& stop);
   /// The targets besides the visited one that a robot with this believed head expects to share the
   /// view: each one's surveyed middle 0.3-5 m in front of the camera, inside the depth camera's image
   /// and the projector's. Nearest first.

@@ -1,7 +1,7 @@
 #pragma once
 // The twin's RGB-D camera as a session reads it (alignment::RgbdCamera): depth rendered from the camera's
 // true pose with the Kinect v1 noise, at 30 Hz on the host's steady clock, the colour registered to it on
-// the first frame of each stop. Before each capture the visited target is moved by its motion script to
+// the first frame of each stop (or on every frame). Before each capture the visited target is moved by its motion script to
 // the capture instant, so a live run sees it move as a real one would. Not thread-safe: the twin's owner
 // thread reads it.
 
@@ -15,8 +15,10 @@ namespace projbot::twin {
 
 class TwinCamera final : public alignment::RgbdCamera {
  public:
-  /// `twin` outlives the camera; `seed` seeds its noise (with the stop and frame numbers).
-  TwinCamera(Twin& twin, std::uint64_t seed) : twin_(twin), seed_(seed) {}
+  /// `twin` outlives the camera; `seed` seeds its noise (with the stop and frame numbers). Colour comes
+  /// with every frame when `colour_every_frame` (a recording's), else with a stop's first only.
+  TwinCamera(Twin& twin, std::uint64_t seed, bool colour_every_frame = false)
+      : twin_(twin), seed_(seed), colour_every_frame_(colour_every_frame) {}
   /// A new stop: the visited target (index into Twin::targets()) and its visit number, whose motion
   /// script runs from `since_s` (steady clock, seconds); `visit` numbers the stop for the noise seeds.
   void at_stop(std::size_t target, int target_visit, int visit, double since_s);
@@ -30,6 +32,7 @@ class TwinCamera final : public alignment::RgbdCamera {
  private:
   Twin& twin_;
   std::uint64_t seed_;
+  bool colour_every_frame_;
   std::size_t target_ = 0;
   int target_visit_ = 0, visit_ = 0;
   double since_s_ = 0.0;
