@@ -18,6 +18,7 @@
 #include "device_fixtures.hpp"
 #include "projbot/alignment/freenect_source.hpp"
 #include "projbot/config/scene.hpp"
+#include "projbot/robot/pan_tilt.hpp"
 #include "projbot/robot/ptu_d46.hpp"
 #include "projbot/twin/world.hpp"
 
@@ -133,12 +134,10 @@ TEST_F(DevicesCli, OpensAKinectAndAPanTiltThatAreThere) {
   EXPECT_NE(r.output.find("pan_tilt: ptu-d46 on " + ptu.port() + " at 9600 baud: ok, at pan 0 deg, tilt 0 deg"),
             std::string::npos)
       << r.output;
-  // With every device there, run says it cannot drive a real pan-tilt yet and stops; --sim runs the twin regardless.
+  // A pan-tilt without a base is part of a robot: run says what is missing and stops; --sim runs the twin regardless.
   const CliRun run = run_projbot("run --headless --seconds 1 --config " + scene.string(), 60);
   EXPECT_EQ(run.code, 1) << run.output;
-  EXPECT_NE(run.output.find("opened camera: freenect #0: 640x480 depth"), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find("run drives only a real camera and projector so far: the robot (pan_tilt, laser, base) stays the "
-                            "twin's"),
+  EXPECT_NE(run.output.find("a real robot needs its base, pan_tilt and camera configured together, and devices.base is not"),
             std::string::npos)
       << run.output;
   ::unsetenv("LD_LIBRARY_PATH");
@@ -313,4 +312,55 @@ TEST_F(DevicesCli, RunReplaysARecordingFrameForFrame) {
   const CliRun none = run_projbot("run --headless --replay " + (dir_ / "nothing").string());
   EXPECT_EQ(none.code, 1) << none.output;
   EXPECT_NE(none.output.find("no such recording folder"), std::string::npos) << none.output;
+}
+
+// The whole robot from the config, no twin (issue 12): the twin's youBot served over DDS by `projbot
+// sim-base` in a second process is driven to the demo tour's first stop on its odometry, the emulated
+// PTU-D46 aims at the Duck, and the Kinect (fakenect, the twin's frames from that stop) shows it: it is
+// found and lit.
+TEST_F(DevicesCli, RunDrivesAConfiguredRobotWithNoTwin) {
+  const int domain = 150 + static_cast<int>(::getpid() % 50);
+  const auto scene = projbot::config::load_scene(std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml");
+  projbot::engine::Renderer renderer{projbot::engine::RendererOptions{}};
+  projbot::twin::Twin twin{scene, {}, renderer};
+  // Where the camera stands once a drift-free base has reached the Duck's stop and aimed at it.
+  const std::size_t duck = twin.target_index("duck");
+  const Eigen::Vector3d& stop = *scene.targets[static_cast<std::size_t>(scene.target_index("duck"))].stop;
+  const projbot::robot::Pose2D goal{stop.x(), stop.y(), stop.z()};
+  const auto aim = projbot::robot::aim_at(goal, twin.surveyed_middle(duck), scene.pan_tilt);
+  const Eigen::Matrix4d T_world_camera = projbot::robot::head_poses(goal, aim.angles, scene.pan_tilt).T_world_camera.matrix();
+  projbot::alignment::write_fakenect_dump(dir_ / "dump", twin_frames(twin, T_world_camera, 10, 100, 0.0).frames());
+  std::string once;
+  {
+    std::ifstream in(dir_ / "dump" / "INDEX.txt");
+    once.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  {
+    std::ofstream out(dir_ / "dump" / "INDEX.txt");  // 60 s at 30 Hz: the drive, then the dwell
+    for (int i = 0; i < 180; ++i) out << once;
+  }
+  const projbot::robot::PtuD46Emulator ptu;
+  const fs::path site_yaml = site("  camera: {driver: freenect, registered: false}\n  pan_tilt: {port: " + ptu.port() +
+                                  "}\n  base: {domain: " + std::to_string(domain) + "}\n");
+  const fs::path log = dir_ / "sim-base.txt";
+  ASSERT_EQ(std::system(("timeout -s KILL 90 " + std::string(PROJBOT_EXE) + " sim-base --config " + site_yaml.string() +
+                         " --seconds 40 > " + log.string() + " 2>&1 &")
+                            .c_str()),
+            0);
+  ::setenv("LD_LIBRARY_PATH", PROJBOT_FAKENECT_DIR, 1);
+  ::setenv("FAKENECT_PATH", (dir_ / "dump").c_str(), 1);
+  const CliRun r = run_projbot("run --headless --visits 1 --dwell 2 --config " + site_yaml.string(), 120);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("the configured base, pan-tilt and camera serve the session: no twin"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("twin's"), std::string::npos) << r.output;
+  // Arrived where it was sent, on odometry (drift-free here): within the controller's 1 cm.
+  EXPECT_NE(r.output.find("visit 1: duck, drove "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("(not arrived)"), std::string::npos) << r.output;
+  const std::string visit = r.output.substr(r.output.find("visit 1: duck"));
+  EXPECT_NEAR(number_after(visit, ", believed at x "), stop.x(), 0.011) << r.output;
+  EXPECT_NEAR(number_after(visit, " m, y "), stop.y(), 0.011) << r.output;
+  // The pan-tilt was turned towards the Duck, and the Duck was found and lit for most of the dwell.
+  EXPECT_NEAR(static_cast<double>(ptu.pan_steps()) * scene.pan_tilt.step_rad, aim.angles.pan_rad, 0.01);
+  EXPECT_GT(number_after(r.output, "pose age at display (depth capture to expected display), "), 60.0) << r.output;
+  EXPECT_NE(r.output.find("error at display: not measured (the configured robot"), std::string::npos) << r.output;
 }

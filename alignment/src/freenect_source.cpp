@@ -63,14 +63,20 @@ struct FreenectSource::Impl {
 
   void on_depth(const void* data, std::uint32_t timestamp) {
     DepthImage& d = pending.depth;
+    d.capture_time_s = steady_now_s();  // its arrival, before the conversion below: that counts in a pose's age
     d.width = kWidth;
     d.height = kHeight;
     d.depth_m.resize(static_cast<std::size_t>(kWidth) * kHeight);
     const auto* raw = static_cast<const std::uint16_t*>(data);
-    for (std::size_t i = 0; i < d.depth_m.size(); ++i)
-      d.depth_m[i] =
-          options.registered ? (raw[i] == 0 ? 0.0F : 0.001F * static_cast<float>(raw[i])) : kinect_raw_to_metres(raw[i]);
-    d.capture_time_s = steady_now_s();
+    static const std::vector<float> metres = [] {  // kinect_raw_to_metres() of every 11-bit value, once
+      std::vector<float> t(2048);
+      for (std::size_t v = 0; v < t.size(); ++v) t[v] = kinect_raw_to_metres(static_cast<std::uint16_t>(v));
+      return t;
+    }();
+    if (options.registered)
+      for (std::size_t i = 0; i < d.depth_m.size(); ++i) d.depth_m[i] = 0.001F * static_cast<float>(raw[i]);
+    else
+      for (std::size_t i = 0; i < d.depth_m.size(); ++i) d.depth_m[i] = raw[i] < 2048 ? metres[raw[i]] : 0.0F;
     pending.depth_timestamp = timestamp;
     have_depth = true;
     have_colour = false;  // the colour that belongs to it comes after it
@@ -159,7 +165,7 @@ RgbdFrame FreenectSource::next() {
       throw AlignmentError(who + ": stopped delivering frames (unplugged, or the end of a fakenect dump)");
   }
   ++m.frames_read;
-  return m.pending;
+  return std::move(m.pending);  // handed over, not copied: the next frame refills it
 }
 
 int FreenectSource::frames_read() const { return impl_->frames_read; }

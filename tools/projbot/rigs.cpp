@@ -65,6 +65,37 @@ session::Dwell TwinRig::dwell(double dwell_s, bool lockstep) {
   return d;
 }
 
+bool configured_robot(const config::DevicesConfig& d) {
+  if (d.laser)
+    throw DeviceError(
+        "devices.laser is configured, but no session localises on a real laser yet (the configured base closes the loop on "
+        "its odometry): leave it out of `devices:` (projbot devices still checks it)");
+  if (!d.base && !d.pan_tilt) return false;
+  std::string missing;
+  for (const auto& [name, there] : {std::pair<const char*, bool>{"base", d.base.has_value()},
+                                    {"pan_tilt", d.pan_tilt.has_value()},
+                                    {"camera", d.camera.has_value()}})
+    if (!there) missing += std::string(missing.empty() ? "" : " and ") + "devices." + name;
+  if (!missing.empty())
+    throw DeviceError("a real robot needs its base, pan_tilt and camera configured together, and " + missing +
+                      (missing.find(" and ") != std::string::npos ? " are" : " is") +
+                      " not (the twin cannot stand in for part of a real robot); configure it, or run the twin with --sim");
+  return true;
+}
+
+DeviceRig::DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, Devices& devices)
+    : navigator_(*devices.base, {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()}),
+      camera_(*devices.camera),
+      session_(scene, targets, navigator_, *devices.pan_tilt) {}
+
+session::Dwell DeviceRig::dwell(double dwell_s, bool lockstep) {
+  session::Dwell d;
+  d.camera = [this](const session::Stop&, double) -> alignment::RgbdCamera& { return camera_; };
+  d.over = [dwell_s](const session::Stop&, int, double elapsed_s) { return elapsed_s >= dwell_s; };
+  d.lockstep = lockstep;
+  return d;
+}
+
 ReplayRig::ReplayRig(const config::Scene& scene, const config::Recording& recording, const std::vector<session::Target>& targets)
     : recording_(recording), session_(std::make_unique<session::Session>(scene, targets, *this, *this)) {}
 

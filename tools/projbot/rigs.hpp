@@ -12,6 +12,7 @@
 #include <tuple>
 #include <vector>
 
+#include "devices.hpp"
 #include "projbot/alignment/freenect_source.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/config/recording.hpp"
@@ -53,6 +54,28 @@ class TwinRig {
   twin::Twin twin_;
   twin::TwinCamera twin_camera_;
   alignment::RgbdCamera* configured_;
+  session::Session session_;
+};
+
+/// Whether the config's devices make up the whole robot: a base, a pan-tilt and a camera, configured
+/// together (the session then drives them, and no twin). False when none of the base and pan-tilt is
+/// configured (the twin serves the robot). Throws DeviceError naming what is missing for part of a robot
+/// (the twin's camera cannot see where a real base went), and for a laser, which no session drives yet.
+bool configured_robot(const config::DevicesConfig& devices);
+
+/// The configured devices serving the whole session: the base over ROS 2 topics (closing the loop on its
+/// odometry, started at the scene's robot.start), the PTU-D46 and the camera. No twin, so no truth.
+class DeviceRig {
+ public:
+  /// `devices` (base, pan_tilt and camera opened) outlive the rig. Throws RobotError when the base sends
+  /// no odometry.
+  DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, Devices& devices);
+  session::Session& session() { return session_; }
+  session::Dwell dwell(double dwell_s, bool lockstep);
+
+ private:
+  robot::Ros2Navigator navigator_;
+  alignment::RgbdCamera& camera_;
   session::Session session_;
 };
 

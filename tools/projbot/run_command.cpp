@@ -114,13 +114,24 @@ struct RunOptions {
 
 // What the robot thread tells the render thread at each step of the session, with the twin's truth when
 // the twin serves the robot; in a replay, each lockstep frame's poses are also checked against the recording's.
+// Per live frame: from the camera's capture stamp, and from its next() returning, to the frame handed to
+// every lit worker (ms).
+struct Handoffs {
+  std::vector<double> from_capture_ms, in_session_ms;
+};
+
 class RunObserver final : public session::StopObserver {
  public:
-  RunObserver(const config::Scene& scene, alignment::LatestValue<RobotState>& state, std::vector<double>& handoff_ms,
-              twin::Twin* twin, PoseCheck* check)
-      : scene_(scene), state_(state), handoff_ms_(handoff_ms), twin_(twin), check_(check) {}
+  RunObserver(const config::Scene& scene, alignment::LatestValue<RobotState>& state, Handoffs& handoffs, twin::Twin* twin,
+              PoseCheck* check)
+      : scene_(scene), state_(state), handoffs_(handoffs), twin_(twin), check_(check) {}
   void driving(int visit) override { state_.publish({.lit = {}, .since_s = now_s(), .visit = visit + 1}); }
   void lit(const session::Stop& stop, double since_s) override {
+    std::cout << "visit " << stop.visit + 1 << ": " << scene_.targets[static_cast<std::size_t>(stop.target)].name << ", drove "
+              << std::fixed << std::setprecision(1) << stop.drive.drive_seconds << " s"
+              << (stop.drive.arrived ? "" : " (not arrived)") << ", believed at x " << std::setprecision(3)
+              << stop.drive.estimate.x_m << " m, y " << stop.drive.estimate.y_m << " m, heading " << std::setprecision(1)
+              << stop.drive.estimate.theta_rad * 180.0 / M_PI << " deg; lit " << stop.lit.size() << " target(s)" << std::endl;
     std::vector<LitTarget> lit;
     for (const session::LitTarget& l : stop.lit)
       lit.push_back({l.target, l.target == stop.target ? stop.target_visit : 0,
@@ -131,7 +142,11 @@ class RunObserver final : public session::StopObserver {
   }
   void frame(const session::Stop& stop, int k, const alignment::RgbdFrame& f,
              const std::vector<std::optional<alignment::PoseSample>>& samples) override {
-    if (samples.empty()) handoff_ms_.push_back(1000.0 * (now_s() - f.depth.capture_time_s));  // live: at the hand-off
+    if (samples.empty()) {  // live: at the hand-off
+      const double now = now_s();
+      handoffs_.from_capture_ms.push_back(1000.0 * (now - f.depth.capture_time_s));
+      handoffs_.in_session_ms.push_back(1000.0 * (now - f.delivered_s));
+    }
     if (check_) check_->compare(scene_, stop, k, samples);
     ++frames;
   }
@@ -144,7 +159,7 @@ class RunObserver final : public session::StopObserver {
   std::size_t twin_index(int target) const { return twin_->target_index(scene_.targets[static_cast<std::size_t>(target)].name); }
   const config::Scene& scene_;
   alignment::LatestValue<RobotState>& state_;
-  std::vector<double>& handoff_ms_;
+  Handoffs& handoffs_;
   twin::Twin* twin_;
   PoseCheck* check_;
 };
@@ -152,19 +167,23 @@ class RunObserver final : public session::StopObserver {
 // The robot thread: the session at each stop of the tour (the twin's robot, the configured camera or the
 // twin's), or at each stop of a recording (`replay`, in lockstep, checked by `check`).
 void drive(const config::Scene& scene, const RunOptions& o, SceneTrackers& trackers, alignment::LatestValue<RobotState>& state,
-           std::vector<double>& handoff_ms, const std::stop_token& stop, alignment::RgbdCamera* configured,
-           const config::Recording* replay, PoseCheck* check) {
-  if (replay) {
+           Handoffs& handoffs, const std::stop_token& stop, Devices& devices, const config::Recording* replay, PoseCheck* check) {
+  const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
+  if (devices.base) {  // the configured robot: no twin
+    DeviceRig rig(scene, trackers.targets, devices);
+    RunObserver observer(scene, state, handoffs, nullptr, nullptr);
+    const session::Dwell dwell = rig.dwell(o.dwell_s, false);
+    for (int v = 0; v < visits && !stop.stop_requested(); ++v) rig.session().visit(v, trackers.workers, dwell, observer, stop);
+  } else if (replay) {
     ReplayRig rig(scene, *replay, trackers.targets);
-    RunObserver observer(scene, state, handoff_ms, nullptr, check);
+    RunObserver observer(scene, state, handoffs, nullptr, check);
     const session::Dwell dwell = rig.dwell();
     for (int v = 0; v < static_cast<int>(replay->stops.size()) && !stop.stop_requested(); ++v)
       rig.session().visit(v, trackers.workers, dwell, observer, stop);
   } else {
-    TwinRig rig(scene, trackers.targets, o.seed, configured);
-    RunObserver observer(scene, state, handoff_ms, &rig.twin(), nullptr);
+    TwinRig rig(scene, trackers.targets, o.seed, devices.camera.get());
+    RunObserver observer(scene, state, handoffs, &rig.twin(), nullptr);
     const session::Dwell dwell = rig.dwell(o.dwell_s, false);
-    const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
     for (int v = 0; v < visits && !stop.stop_requested(); ++v) rig.session().visit(v, trackers.workers, dwell, observer, stop);
   }
   RobotState last;
@@ -191,22 +210,23 @@ Devices open_configured(const config::Scene& scene, bool headless) {
   std::vector<DeviceCheck> checks;
   Devices devices = open_devices(wanted, checks, true);  // throws DeviceError at the first that fails
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
-  if (scene.devices.pan_tilt || scene.devices.laser || scene.devices.base)
-    throw DeviceError(
-        "every configured device answered, but run drives only a real camera and projector so far: the robot "
-        "(pan_tilt, laser, base) stays the twin's until the session drives real ones (issue 12); leave them out "
-        "of `devices:` or run the twin with --sim");
-  std::cout << "the twin serves the robot" << (scene.devices.camera ? "" : " and the camera") << std::endl;
+  const bool robot = configured_robot(wanted);  // part of a robot, or a laser: refused, saying what
+  if (robot)
+    std::cout << "the configured base, pan-tilt and camera serve the session: no twin (nothing is measured against a truth)"
+              << std::endl;
+  else
+    std::cout << "the twin serves the robot" << (scene.devices.camera ? "" : " and the camera") << std::endl;
   return devices;
 }
 
-void print_robot(std::ostream& out, const RobotState& robot, bool configured_camera, const std::vector<double>& capture_ms,
-                 std::size_t tracked) {
+void print_robot(std::ostream& out, const RobotState& robot, bool configured_camera, const Handoffs& h, std::size_t tracked) {
   out << "robot: " << robot.visit << " visit(s); " << (configured_camera ? "the configured" : "the twin's")
-      << " camera delivered " << capture_ms.size() << " frames (capture to hand-off to the workers p50 "
-      << engine::percentile(capture_ms, 0.5) << " ms, p95 " << engine::percentile(capture_ms, 0.95) << " ms"
-      << (configured_camera ? ")" : ": the twin's render and Kinect noise)") << "; the tracker workers processed " << tracked
-      << "\n";
+      << " camera delivered " << h.from_capture_ms.size() << " frames (capture to hand-off to the workers p50 "
+      << engine::percentile(h.from_capture_ms, 0.5) << " ms, p95 " << engine::percentile(h.from_capture_ms, 0.95) << " ms"
+      << (configured_camera ? "" : ": the twin's render and Kinect noise")
+      << "; of that, from the camera's next() to the hand-off p50 " << std::setprecision(3)
+      << engine::percentile(h.in_session_ms, 0.5) << " ms, p95 " << engine::percentile(h.in_session_ms, 0.95)
+      << " ms); the tracker workers processed " << tracked << "\n";
 }
 
 // --replay DIR: the recording, read before anything else starts (and the options it rules out refused).
@@ -241,9 +261,11 @@ const Command kRun{
     "Devices come from the config's `devices:` section (projbot devices --help shows it): each one configured\n"
     "is opened and read once at start, and one that is absent stops the run with a message naming it.\n"
     "A configured camera replaces the twin's (its frames at its own rate, its colour on arrival) and a\n"
-    "configured projector sets the window's monitor and fullscreen; the robot (pan_tilt, laser, base) is still\n"
-    "the twin's, and configuring one of them stops the run saying so. With none configured, or with --sim,\n"
-    "the digital twin serves every device. A device that fails while projecting blanks the projector at\n"
+    "configured projector sets the window's monitor and fullscreen. A configured base, pan_tilt and camera\n"
+    "(together) make the whole robot: the base is driven to each stop over its ROS 2 topics on its odometry\n"
+    "(placed in the map at robot.start), the pan-tilt aims, and no twin runs (so no error is measured). Part\n"
+    "of a robot, or a laser (not localised on yet), stops the run saying so. With none configured, or with\n"
+    "--sim, the digital twin serves every device. A device that fails while projecting blanks the projector at\n"
     "once; what was measured until then is printed and written, and the failure is reported (exit 1).\n"
     "With --replay DIR the session runs from a recording (projbot record): the base and pan-tilt answer\n"
     "what they answered then, each stop's frames play at their recorded pace and are tracked in lockstep,\n"
@@ -272,7 +294,7 @@ const Command kRun{
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
       std::optional<PoseCheck> check;
       if (recording) check.emplace(recording->folder() / "poses.csv");
-      const Devices devices = args.flag("sim") || recording ? Devices{} : open_configured(scene, args.flag("headless"));
+      Devices devices = args.flag("sim") || recording ? Devices{} : open_configured(scene, args.flag("headless"));
       RunOptions o;
       o.visits = args.get_int("visits", 0, 1, 1000);
       o.dwell_s = args.get_double("dwell", 4.0);
@@ -312,11 +334,10 @@ const Command kRun{
       alignment::LatestValue<RobotState> state;
       std::exception_ptr robot_error;
       std::atomic<bool> robot_done{false};
-      std::vector<double> capture_ms;  // capture to hand-off per frame: the robot thread's until it is joined
+      Handoffs handoffs;  // the robot thread's until it is joined
       std::jthread robot_thread([&](std::stop_token stop) {
         try {
-          drive(scene, o, trackers, state, capture_ms, stop, devices.camera.get(), recording ? &*recording : nullptr,
-                check ? &*check : nullptr);
+          drive(scene, o, trackers, state, handoffs, stop, devices, recording ? &*recording : nullptr, check ? &*check : nullptr);
         } catch (...) {
           robot_error = std::current_exception();
         }
@@ -430,8 +451,11 @@ const Command kRun{
                   << " compared, largest difference " << std::setprecision(4) << check->max_mm << " mm, " << check->max_deg
                   << " deg; " << check->mismatched << " found or lost in one and not the other\n";
       } else {
-        errors.print(std::cout);
-        print_robot(std::cout, robot, devices.camera != nullptr, capture_ms, tracked);
+        if (devices.base)
+          std::cout << "error at display: not measured (the configured robot: no truth to measure against)\n";
+        else
+          errors.print(std::cout);
+        print_robot(std::cout, robot, devices.camera != nullptr, handoffs, tracked);
       }
       if (const auto csv = args.get("profile")) {
         std::ostringstream f;

@@ -130,6 +130,7 @@ Stop Session::visit(int visit, const std::vector<alignment::TrackerWorker*>& wor
   alignment::RgbdCamera& camera = dwell.camera(at, since);
   // The first frame's colour, taken before anything is lit, guides each lit target's acquisition.
   auto frame = std::make_shared<alignment::RgbdFrame>(camera.next());
+  frame->delivered_s = now_s();
   std::shared_ptr<const assets::Image> colour;
   if (!frame->colour.rgba.empty()) colour = std::shared_ptr<const assets::Image>(frame, &frame->colour);
   for (std::size_t k = 0; k < at.lit.size(); ++k)
@@ -147,6 +148,7 @@ Stop Session::visit(int visit, const std::vector<alignment::TrackerWorker*>& wor
     observer.frame(at, k, *frame, samples);
     if (stop.stop_requested() || dwell.over(at, k + 1, now_s() - since)) break;
     frame = std::make_shared<alignment::RgbdFrame>(camera.next());
+    frame->delivered_s = now_s();
   }
   observer.left(at);
   return at;

@@ -15,6 +15,7 @@ struct RgbdFrame {
   assets::Image colour;               ///< RGBA; empty when the camera has no colour
   std::uint32_t depth_timestamp = 0;  ///< the device's own counters (0 where it has none)
   std::uint32_t colour_timestamp = 0;
+  double delivered_s = 0.0;  ///< when next() handed it over (host steady clock), stamped by the session
 };
 
 class RgbdCamera {

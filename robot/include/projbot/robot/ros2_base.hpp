@@ -12,7 +12,9 @@
 #include <vector>
 
 #include "projbot/config/devices.hpp"
+#include "projbot/robot/base.hpp"
 #include "projbot/robot/error.hpp"
+#include "projbot/robot/navigator.hpp"
 #include "projbot/robot/pose2d.hpp"
 #include "projbot/robot/sim_base.hpp"
 #include "projbot/robot/youbot.hpp"
@@ -47,6 +49,29 @@ class Ros2Base {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+/// The base over ROS 2 topics as the session's Navigator: drives to a stop under the stop controller,
+/// closing the loop on the base's odometry in real time, placed in the map where the config says the
+/// robot starts (the odometry frame's pose is fixed at the first message: a driver whose odometry starts at
+/// zero and one that publishes map poses both work). Wheel odometry only: it drifts as the paper's did.
+class Ros2Navigator final : public Navigator {
+ public:
+  /// `base` outlives the navigator. Reads the first odometry (RobotError naming the base when none comes).
+  Ros2Navigator(Ros2Base& base, const Pose2D& start_in_map, const ControllerConfig& controller = {}, double rate_hz = 20.0,
+                double timeout_s = 120.0);
+  /// Drives until the controller says arrived (or timeout_s passes: arrived false), stops the base and
+  /// lets it settle. Throws RobotError naming the base when its odometry stops for a second.
+  StopReport drive_to(const Pose2D& goal, int index) override;
+  Pose2D believed_pose() const override { return compose(T_map_odom_, last_.pose); }
+
+ private:
+  Odometry2D fresh(double& last_change_s);
+  Ros2Base& base_;
+  BaseController controller_;
+  double rate_hz_, timeout_s_;
+  Pose2D T_map_odom_;
+  Odometry2D last_;
 };
 
 /// The twin's side: a simulated youBot (SimulatedBase, wheel odometry) that follows the newest cmd_vel
