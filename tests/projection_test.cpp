@@ -29,7 +29,7 @@ TEST(ProjectionTest, PixelCentreConventionWithOffCentrePrincipalPoint) {
   p.near_m = 0.2;
   p.far_m = 8.0;
   for (const Eigen::Vector3d& x : {Eigen::Vector3d(0.1, -0.2, 1.3), Eigen::Vector3d(-0.4, 0.3, 2.7), Eigen::Vector3d(0, 0, 5)}) {
-    const Eigen::Vector2d uv = projbot::engine::project_to_pixel(p, x);
+    const Eigen::Vector2d uv = p.project(x);
     EXPECT_NEAR(uv.x(), 900 * x.x() / x.z() + 350.25, 1e-9);
     EXPECT_NEAR(uv.y(), 700 * x.y() / x.z() + 280.75, 1e-9);
     // Pixel (i, j) has its centre at u = i: framebuffer coordinate i + 0.5.
@@ -59,4 +59,24 @@ TEST(ProjectionTest, GpuMatrixIsColumnMajor) {
   EXPECT_FLOAT_EQ(g[1], 4.0F);  // column 0, row 1
   EXPECT_FLOAT_EQ(g[4], 1.0F);  // column 1, row 0
   EXPECT_FLOAT_EQ(g[15], 15.0F);
+}
+
+// The one pinhole type (issue 12): project and back-project are inverse, the projector's model is one, and
+// a depth camera's intrinsics are the same type.
+TEST(PinholeTest, ProjectAndBackProjectAreInverse) {
+  const projbot::config::Pinhole k{640, 480, 520.0, 530.0, 318.2, 241.7};
+  const Eigen::Vector3d p(0.12, -0.34, 1.7);
+  const Eigen::Vector2d x = k.project(p);
+  EXPECT_NEAR(x.x(), 520.0 * 0.12 / 1.7 + 318.2, 1e-12);
+  EXPECT_NEAR(x.y(), 530.0 * -0.34 / 1.7 + 241.7, 1e-12);
+  EXPECT_LT((k.back_project(x.x(), x.y(), 1.7) - p).norm(), 1e-12);
+  int u = 0, v = 0;
+  EXPECT_TRUE(k.nearest_pixel(p, u, v));
+  EXPECT_EQ(u, static_cast<int>(std::lround(x.x())));
+  EXPECT_FALSE(k.contains({640.0, 10.0}));
+  EXPECT_TRUE(k.contains({639.9, 479.9}));
+  const ProjectorConfig projector;  // 1280x800, f 1400: a Pinhole too
+  EXPECT_NEAR(projector.project({0.0, 0.0, 2.0}).x(), 639.5, 1e-12);
+  const projbot::config::Pinhole& as_pinhole = projector;
+  EXPECT_EQ(as_pinhole.width_px, 1280);
 }

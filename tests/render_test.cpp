@@ -83,8 +83,7 @@ std::vector<bool> cpu_silhouette(const Model& m, const Eigen::Matrix4d& T, const
     for (std::size_t t = 0; t < prim.indices.size(); t += 3) {
       Eigen::Vector2d q[3];
       for (int k = 0; k < 3; ++k)
-        q[k] = projbot::engine::project_to_pixel(
-            p, (T * pos(prim.vertices[prim.indices[t + static_cast<std::size_t>(k)]]).homogeneous()).head<3>());
+        q[k] = p.project((T * pos(prim.vertices[prim.indices[t + static_cast<std::size_t>(k)]]).homogeneous()).head<3>());
       const double area = (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
       if (std::abs(area) < 1e-12) continue;
       const int x0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}))));
@@ -194,7 +193,7 @@ TEST_F(RenderTest, ProjectedVertexPositionsWithinHalfPixel) {
     std::vector<Eigen::Vector2d> centres;
     for (std::size_t v = 0; v < verts.size() && centres.size() < 40; v += 7) {
       const Eigen::Vector3d c = (T * pos(verts[v]).homogeneous()).head<3>();  // projector frame
-      const Eigen::Vector2d uv = projbot::engine::project_to_pixel(p, c);
+      const Eigen::Vector2d uv = p.project(c);
       if (uv.x() < 20 || uv.y() < 20 || uv.x() > p.width_px - 20 || uv.y() > p.height_px - 20) continue;
       if (std::any_of(centres.begin(), centres.end(), [&](const Eigen::Vector2d& o) { return (o - uv).norm() < 40; })) continue;
       centres.push_back(uv);
@@ -223,7 +222,7 @@ TEST_F(RenderTest, ProjectedVertexPositionsWithinHalfPixel) {
     for (std::size_t k = 0; k < tris.size(); ++k) {
       ASSERT_GT(sums[k].z(), 150) << "marker " << k << " is not fully visible";
       Eigen::Vector2d expected = Eigen::Vector2d::Zero();
-      for (const auto& x : tris[k]) expected += projbot::engine::project_to_pixel(p, (T * x.homogeneous()).head<3>()) / 3.0;
+      for (const auto& x : tris[k]) expected += p.project((T * x.homogeneous()).head<3>()) / 3.0;
       const Eigen::Vector2d measured = sums[k].head<2>() / sums[k].z();
       worst = std::max(worst, (measured - expected).norm());
       ++seen;
@@ -261,13 +260,12 @@ TEST_F(RenderTest, TextureColourLandsWhereCpuPredicts) {
     const Eigen::Vector3d xp = (T * x.homogeneous()).head<3>();
     const Eigen::Vector3d n = T.topLeftCorner<3, 3>() * (pos(b) - pos(a)).cross(pos(c) - pos(a));
     if (n.dot(xp) >= -0.3 * n.norm() * xp.norm()) continue;  // keep faces that clearly face the projector
-    const Eigen::Vector2d uv_px = projbot::engine::project_to_pixel(p, xp);
+    const Eigen::Vector2d uv_px = p.project(xp);
     const int i = static_cast<int>(std::lround(uv_px.x())), j = static_cast<int>(std::lround(uv_px.y()));
     // Stay 3 px inside the triangle so the pixel centre belongs to this face.
     Eigen::Vector2d q[3];
     for (int k = 0; k < 3; ++k)
-      q[k] = projbot::engine::project_to_pixel(
-          p, (T * pos(prim.vertices[prim.indices[t + static_cast<std::size_t>(k)]]).homogeneous()).head<3>());
+      q[k] = p.project((T * pos(prim.vertices[prim.indices[t + static_cast<std::size_t>(k)]]).homogeneous()).head<3>());
     bool inside = true;
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector2d e = q[(k + 1) % 3] - q[k];

@@ -21,12 +21,7 @@ namespace {
 
 const fs::path kDuck = fs::path(PROJBOT_SHARED_DATA) / "gltf" / "Duck" / "glTF-Binary" / "Duck.glb";
 
-projbot::config::ProjectorConfig as_pinhole(const CameraIntrinsics& k) {
-  projbot::config::ProjectorConfig p;
-  p.width_px = k.width_px, p.height_px = k.height_px, p.fx_px = k.fx_px, p.fy_px = k.fy_px, p.cx_px = k.cx_px, p.cy_px = k.cy_px;
-  p.near_m = 0.1, p.far_m = 10.0;
-  return p;
-}
+projbot::config::ProjectorConfig as_pinhole(const CameraIntrinsics& k) { return {k, 0.1, 10.0}; }
 
 Eigen::Matrix4d perturb(const Eigen::Matrix4d& T, double angle_deg, double shift_m, std::mt19937& rng) {
   std::normal_distribution<double> g;

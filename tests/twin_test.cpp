@@ -33,7 +33,7 @@ Eigen::Matrix4d translation(double x, double y, double z) {
 // slab whose near face (model z = 0) stands 1 m in front of it.
 class MarkerErrorTest : public ::testing::Test {
  protected:
-  projbot::config::ProjectorConfig k_{1000, 1000, 1000.0, 1000.0, 500.0, 500.0, 0.1, 10.0};
+  projbot::config::ProjectorConfig k_{{1000, 1000, 1000.0, 1000.0, 500.0, 500.0}, 0.1, 10.0};
   MeshRaycaster slab_{projbot::assets::make_box({-0.5, -0.5, 0.0}, {0.5, 0.5, 0.02}, {1, 1, 1, 1})};
   Eigen::Matrix4d T_true_ = translation(0, 0, 1.0);
   Eigen::Vector3d marker_{0.1, 0.0, 0.0};

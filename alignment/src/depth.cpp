@@ -137,7 +137,7 @@ PointCloud depth_to_cloud(const DepthImage& depth, const CameraIntrinsics& k, do
         p = {nan, nan, nan};
         continue;
       }
-      p = {static_cast<float>((x - k.cx_px) * z / k.fx_px), static_cast<float>((y - k.cy_px) * z / k.fy_px), z};
+      p = k.back_project(x, y, z).cast<float>();
     }
   return c;
 }

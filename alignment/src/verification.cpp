@@ -268,7 +268,8 @@ double correlation(const ColourSamples& s, const assets::Image& im, const Camera
   double n = 0, sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
   for (std::size_t i = 0; i < s.points.size(); ++i) {
     const Eigen::Vector3d p = s.points[i] + shift;
-    const double b = image_luminance(im, k.fx_px * p.x() / p.z() + k.cx_px, k.fy_px * p.y() / p.z() + k.cy_px);
+    const Eigen::Vector2d x = k.project(p);
+    const double b = image_luminance(im, x.x(), x.y());
     if (!std::isfinite(b)) continue;
     const double a = s.luminance[i];
     n += 1, sa += a, sb += b, saa += a * a, sbb += b * b, sab += a * b;

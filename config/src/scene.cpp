@@ -18,7 +18,7 @@ namespace {
 // A pinhole section (`projector:`, `camera:`): every intrinsic required unless defaults are given.
 ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std::optional<ProjectorConfig>& defaults) {
   YAML::Node node = root.child(key, !defaults);
-  ProjectorConfig p = defaults.value_or(ProjectorConfig{0, 0, 0.0, 0.0, 0.0, 0.0});
+  ProjectorConfig p = defaults.value_or(ProjectorConfig{Pinhole{0, 0, 0.0, 0.0, 0.0, 0.0}, 0.1, 20.0});
   if (!node) return p;
   MapReader r(node, key, root.file());
   const bool required = !defaults;

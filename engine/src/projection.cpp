@@ -17,10 +17,6 @@ Eigen::Matrix4d clip_from_projector(const config::ProjectorConfig& p) {
   return m;
 }
 
-Eigen::Vector2d project_to_pixel(const config::ProjectorConfig& p, const Eigen::Vector3d& x) {
-  return {p.fx_px * x.x() / x.z() + p.cx_px, p.fy_px * x.y() / x.z() + p.cy_px};
-}
-
 std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m) {
   std::array<float, 16> out{};
   for (int c = 0; c < 4; ++c)

@@ -59,9 +59,7 @@ const Command kBenchTrack{
       const std::size_t id = renderer.add_model(duck);
       const alignment::ModelCloud model = alignment::model_cloud_from(duck, 50000);
       const alignment::CameraIntrinsics k = alignment::CameraIntrinsics::kinect_v1();
-      config::ProjectorConfig pinhole;
-      pinhole.width_px = k.width_px, pinhole.height_px = k.height_px, pinhole.fx_px = k.fx_px, pinhole.fy_px = k.fy_px;
-      pinhole.cx_px = k.cx_px, pinhole.cy_px = k.cy_px, pinhole.near_m = 0.1, pinhole.far_m = 10.0;
+      const config::ProjectorConfig pinhole(k, 0.1, 10.0);
       auto camera = renderer.make_depth_camera(k.width_px, k.height_px);
 
       std::printf("rendering %d frames at %.1f m...\n", frames, distance);

@@ -24,7 +24,7 @@ SceneTrackers make_trackers(const config::Scene& scene, const alignment::WorkerC
   t.clouds.resize(n);
   t.owned.resize(n);
   t.workers.assign(n, nullptr);
-  const alignment::CameraIntrinsics k = session::depth_intrinsics(scene);
+  const alignment::CameraIntrinsics& k = scene.depth_camera;
   for (std::size_t i = 0; i < n; ++i) {
     const config::TargetConfig& c = scene.targets[i];
     if (!c.T_world_target && !c.T_map_target) continue;

@@ -4,15 +4,9 @@
 #include <chrono>
 
 #include "projbot/alignment/equations.hpp"
-#include "projbot/engine/projection.hpp"
 #include "projbot/robot/error.hpp"
 
 namespace projbot::session {
-
-alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene) {
-  const config::ProjectorConfig& k = scene.depth_camera;
-  return {k.width_px, k.height_px, k.fx_px, k.fy_px, k.cx_px, k.cy_px};
-}
 
 Eigen::Matrix4d surveyed_pose(const config::TargetConfig& target) {
   if (target.T_map_target) return *target.T_map_target;
@@ -80,10 +74,8 @@ LitTarget Session::plan(int target, const robot::HeadPoses& believed) const {
 std::vector<LitTarget> Session::neighbours(int visited, const robot::HeadPoses& believed) const {
   const Eigen::Matrix4d T_camera_world = alignment::rigid_inverse(believed.T_world_camera.matrix());
   const Eigen::Matrix4d T_projector_world = alignment::rigid_inverse(believed.T_world_projector.matrix());
-  const auto inside = [](const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
-    if (p.z() < 0.3 || p.z() > 5.0) return false;
-    const Eigen::Vector2d x = engine::project_to_pixel(k, p);
-    return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < k.width_px && x.y() < k.height_px;
+  const auto inside = [](const config::Pinhole& k, const Eigen::Vector3d& p) {
+    return p.z() >= 0.3 && p.z() <= 5.0 && k.contains(k.project(p));
   };
   std::vector<std::pair<double, int>> in_view;  // range, scene index
   for (const Target& t : targets_) {

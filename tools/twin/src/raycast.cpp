@@ -113,7 +113,7 @@ MarkerError measure_marker(const config::ProjectorConfig& k, const Eigen::Matrix
   // Eq. 3: x = A_p X, the content's pixel, then the centre of the pixel that shows it.
   Eigen::Vector3d ray = drawn;
   if (drawn.z() > 0.0) {
-    e.pixel = engine::project_to_pixel(k, drawn).array().round();
+    e.pixel = k.project(drawn).array().round();
     e.in_image = e.pixel.x() >= 0 && e.pixel.y() >= 0 && e.pixel.x() < k.width_px && e.pixel.y() < k.height_px;
     ray = {(e.pixel.x() - k.cx_px) / k.fx_px, (e.pixel.y() - k.cy_px) / k.fy_px, 1.0};
   }

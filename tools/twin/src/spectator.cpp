@@ -72,7 +72,7 @@ assets::Image SpectatorView::draw(Twin& twin, const Eigen::Matrix4d& T_world_spe
         const Eigen::Vector4d p(z * (u - pinhole_.cx_px) / pinhole_.fx_px, z * (v - pinhole_.cy_px) / pinhole_.fy_px, z, 1.0);
         const Eigen::Vector3d q = (T_projector_spectator * p).head<3>();
         // Eq. 3: the projector pixel that reaches this point, if nothing nearer the projector blocks it.
-        const Eigen::Vector2d x = q.z() > k.near_m ? engine::project_to_pixel(k, q) : Eigen::Vector2d(-1.0, -1.0);
+        const Eigen::Vector2d x = q.z() > k.near_m ? k.project(q) : Eigen::Vector2d(-1.0, -1.0);
         const long pu = std::lround(x.x()), pv = std::lround(x.y());
         if (pu >= 0 && pv >= 0 && pu < k.width_px && pv < k.height_px) {
           const float seen = lit_depth.z_m[static_cast<std::size_t>(pv) * k.width_px + pu];

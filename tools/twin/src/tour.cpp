@@ -33,7 +33,7 @@ struct Errors {
 // Whether a point in the projector frame falls inside the projector's image (Eq. 3).
 bool lit_by(const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
   if (p.z() <= 0.0) return false;
-  const Eigen::Vector2d x = engine::project_to_pixel(k, p);
+  const Eigen::Vector2d x = k.project(p);
   return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < k.width_px && x.y() < k.height_px;
 }
 

@@ -74,11 +74,7 @@ robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource 
 }
 
 Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Renderer& renderer)
-    : scene_(scene),
-      options_(options),
-      renderer_(renderer),
-      pan_tilt_(scene.pan_tilt),
-      camera_(session::depth_intrinsics(scene)) {
+    : scene_(scene), options_(options), renderer_(renderer), pan_tilt_(scene.pan_tilt), camera_(scene.depth_camera) {
   const std::string where = scene.source.empty() ? std::string("<scene>") : scene.source.string();
   if (scene.visits.empty()) throw TwinError(where + ": the twin needs a 'tour: {visits: [...]}' section");
   const assets::Model room = room_model(scene);

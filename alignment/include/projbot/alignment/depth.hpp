@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "projbot/config/pinhole.hpp"
+
 namespace projbot::alignment {
 
 /// A bad depth file, cloud or request: the message names the file and what is wrong.
@@ -16,27 +18,8 @@ class AlignmentError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Pinhole intrinsics of a depth camera, OpenCV convention (x right, y down, z forward), pixels.
-struct CameraIntrinsics {
-  int width_px = 640;
-  int height_px = 480;
-  double fx_px = 525.0;
-  double fy_px = 525.0;
-  double cx_px = 319.5;
-  double cy_px = 239.5;
-
-  /// Kinect v1 / PrimeSense depth camera defaults: 640x480, f = 525 px, principal point at the image
-  /// centre (the TUM RGB-D and Open3D defaults; PCL's OpenNI grabber reports cx 320, cy 240).
-  static CameraIntrinsics kinect_v1() { return {}; }
-
-  /// The pixel whose centre is nearest to where camera-frame point p (z > 0) projects; false when it
-  /// falls outside the image.
-  bool nearest_pixel(const Eigen::Vector3d& p, int& u, int& v) const {
-    u = static_cast<int>(std::lround(fx_px * p.x() / p.z() + cx_px));
-    v = static_cast<int>(std::lround(fy_px * p.y() / p.z() + cy_px));
-    return u >= 0 && v >= 0 && u < width_px && v < height_px;
-  }
-};
+/// A depth camera's intrinsics: the one pinhole type (config::Pinhole), Kinect v1 by default.
+using CameraIntrinsics = config::Pinhole;
 
 /// A depth image in metres, row-major, top row first; 0 or NaN marks a missing measurement.
 struct DepthImage {

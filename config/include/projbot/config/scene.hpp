@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "projbot/config/devices.hpp"
+#include "projbot/config/pinhole.hpp"
 #include "projbot/config/robot.hpp"
 
 namespace projbot::config {
@@ -21,18 +22,13 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Projector pinhole model, OpenCV convention: x right, y down, z forward; a point (X, Y, Z) in the
-/// projector frame lands at u = fx X/Z + cx, v = fy Y/Z + cy, and pixel (i, j) has its centre at
-/// u = i, v = j (Eq. 3 of the paper, x = A_p X).
-struct ProjectorConfig {
-  int width_px = 1280;    ///< image width, pixels (> 0)
-  int height_px = 800;    ///< image height, pixels (> 0)
-  double fx_px = 1400.0;  ///< focal length along x, pixels (> 0)
-  double fy_px = 1400.0;  ///< focal length along y, pixels (> 0)
-  double cx_px = 639.5;   ///< principal point x, pixels
-  double cy_px = 399.5;   ///< principal point y, pixels
-  double near_m = 0.1;    ///< near clipping distance along z, metres (> 0)
-  double far_m = 20.0;    ///< far clipping distance along z, metres (> near_m)
+/// The projector as a scene gives it (`projector:`), and a depth camera's pinhole with its clip range
+/// (`camera:`): the pinhole (A_p, Eq. 3) plus what drawing needs.
+struct ProjectorConfig : Pinhole {
+  ProjectorConfig() : Pinhole{1280, 800, 1400.0, 1400.0, 639.5, 399.5} {}
+  ProjectorConfig(const Pinhole& pinhole, double near, double far) : Pinhole(pinhole), near_m(near), far_m(far) {}
+  double near_m = 0.1;  ///< near clipping distance along z, metres (> 0)
+  double far_m = 20.0;  ///< far clipping distance along z, metres (> near_m)
   // The projector only (`projector:`), for the time a frame reaches the object (issue 14):
   double refresh_hz = 60.0;   ///< frames per second it shows (1..1000)
   double input_lag_ms = 0.0;  ///< its own delay from a frame's arrival to light (0..1000 ms)
@@ -158,7 +154,7 @@ struct Scene {
   DevicesConfig devices;                                    ///< `devices:` real devices (none: the twin)
 
   /// Kinect v1 depth: 640x480, fx = fy = 525 px, 0.5-4.5 m.
-  static ProjectorConfig kinect_v1_depth_camera() { return {640, 480, 525.0, 525.0, 319.5, 239.5, 0.5, 4.5}; }
+  static ProjectorConfig kinect_v1_depth_camera() { return {Pinhole::kinect_v1(), 0.5, 4.5}; }
   /// Index of the target named `name`, or -1.
   int target_index(std::string_view name) const;
 };

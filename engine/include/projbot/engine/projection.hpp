@@ -14,8 +14,7 @@ namespace projbot::engine {
 /// its centre at u = i, v = j. Depth maps near..far to 0..1.
 Eigen::Matrix4d clip_from_projector(const config::ProjectorConfig& projector);
 
-/// CPU reference of Eq. 3: pixel coordinates (u, v) of a projector-frame point (Z > 0).
-Eigen::Vector2d project_to_pixel(const config::ProjectorConfig& projector, const Eigen::Vector3d& p_projector);
+// The CPU side of Eq. 3 is config::Pinhole::project (ProjectorConfig is a Pinhole).
 
 /// Converts a host transform to the column-major float matrix the GPU gets (the one Eigen -> GPU conversion).
 std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m);

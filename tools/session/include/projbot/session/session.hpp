@@ -32,9 +32,6 @@ class SessionError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The scene's depth camera as the estimator's intrinsics.
-alignment::CameraIntrinsics depth_intrinsics(const config::Scene& scene);
-
 /// Where the map says a target stands: its surveyed map_pose, else its world_pose.
 Eigen::Matrix4d surveyed_pose(const config::TargetConfig& target);
 
