@@ -385,6 +385,26 @@ TEST_F(CliTest, TourInterruptedKeepsTheFinishedVisits) {
   EXPECT_NE(tour.output().find("interrupted"), std::string::npos);
 }
 
+// Ctrl-C while recording: the stop in progress ends there and every stop is kept, marked interrupted; the
+// recording replays as it is; exit 130.
+TEST_F(CliTest, RecordInterruptedKeepsTheStopsAndReplays) {
+  const fs::path rec = dir_ / "rec";
+  Background record({"record", "--out", rec.string(), "--visits", "6", "--dwell", "3"}, dir_ / "record.log");
+  ASSERT_GT(record.pid, 0);
+  ASSERT_TRUE(record.wait_for_output("stop 1: duck, ", std::chrono::seconds(120))) << record.output();
+  const auto [code, seconds] = record.signal_and_wait(SIGINT, std::chrono::seconds(60));
+  EXPECT_EQ(code, 130) << record.output();
+  std::ifstream in(rec / "recording.yaml");
+  std::stringstream yaml;
+  yaml << in.rdbuf();
+  EXPECT_NE(yaml.str().find("interrupted: true"), std::string::npos) << yaml.str();
+  EXPECT_NE(yaml.str().find("frames: \"stop02\""), std::string::npos) << yaml.str();  // the stop in progress, cut short
+  EXPECT_EQ(yaml.str().find("frames: \"stop04\""), std::string::npos) << yaml.str();
+  const CliRun replay = run_projbot("run --headless --replay " + rec.string(), 120);
+  EXPECT_EQ(replay.code, 0) << replay.output;
+  EXPECT_NE(replay.output.find(" deg; 0 found or lost in one and not the other"), std::string::npos) << replay.output;
+}
+
 // Ctrl-C in ICP-SLAM: the scans done so far are mapped and their trajectory written; exit 130.
 TEST_F(CliTest, SlamInterruptedKeepsTheScansDone) {
   const std::string rawlog = std::string(PROJBOT_SHARED_DATA) + "/mrpt/range_030_bearing_015.rawlog";  // 1460 scans, ~2.5 s

@@ -68,6 +68,8 @@ class RecordObserver final : public session::StopObserver {
   void left(const session::Stop&) override {
     rec_.stops.push_back(current_);
     save();
+    std::cout << "stop " << rec_.stops.size() << ": " << current_.target << ", " << current_.frame_count << " frames recorded"
+              << std::endl;
   }
   void save() const {
     config::write_file_atomically(out_ / "poses.csv", poses_.text());
@@ -103,8 +105,9 @@ const Command kRecord{
     "`projbot run --replay DIR` runs the same session from them with no device and no twin, and compares\n"
     "its poses with poses.csv frame for frame. A stop's dump also replays through the real Kinect driver:\n"
     "  fakenect DIR/stop01 projbot run --config site.yaml   (camera: {driver: freenect, registered: false})\n"
-    "The camera is the config's `devices.camera` (or, with none or with --sim, the twin's); the robot is\n"
-    "the twin's. Depth is kept to the Kinect's disparity steps, for the trackers too. The laser scans and\n"
+    "The devices are the config's, as for run: a base, pan-tilt and camera together drive the robot with no\n"
+    "twin; a camera alone is read with the twin's robot; none, or --sim, is the twin's. Depth is kept to the Kinect's disparity "
+    "steps, for the trackers too. The laser scans and\n"
     "wheel odometry behind the robot's belief are not recorded (the belief is). Ctrl-C ends the stop in\n"
     "progress and keeps every stop recorded.\n",
     {{"out", "DIR", "the recording's folder (new or empty)"},
@@ -133,22 +136,32 @@ const Command kRecord{
       Devices devices;
       config::Recording rec;
       rec.camera = "the twin's camera";
-      if (scene.devices.camera && !args.flag("sim")) {
-        config::DevicesConfig camera_only;
-        camera_only.camera = scene.devices.camera;
+      bool robot = false;
+      if (!args.flag("sim")) {
+        config::DevicesConfig wanted = scene.devices;
+        wanted.projector.reset();  // nothing is projected while recording
         std::vector<DeviceCheck> checks;
-        devices = open_devices(camera_only, checks, true);
-        rec.camera = checks.front().config;
+        if (wanted.any()) devices = open_devices(wanted, checks, true);  // each checked once; the first absent one named
+        robot = configured_robot(wanted);
+        for (const auto& c : checks)
+          if (c.role == "camera") rec.camera = c.config;
       }
       rec.scene = fs::absolute(scene.source);
       rec.seed = seed;
       rec.dwell_s = dwell_s;
       SceneTrackers trackers = make_trackers(scene, worker_config(true, true));
-      TwinRig rig(scene, trackers.targets, seed, devices.camera.get(), true);
+      // The robot: the configured base, pan-tilt and camera together, or the twin's (with the configured camera, if any).
+      std::unique_ptr<DeviceRig> device_rig;
+      std::unique_ptr<TwinRig> twin_rig;
+      if (robot)
+        device_rig = std::make_unique<DeviceRig>(scene, trackers.targets, devices);
+      else
+        twin_rig = std::make_unique<TwinRig>(scene, trackers.targets, seed, devices.camera.get(), true);
+      session::Session& session = robot ? device_rig->session() : twin_rig->session();
+      session::Dwell dwell = robot ? device_rig->dwell(dwell_s, true) : twin_rig->dwell(dwell_s, true);
       catch_interrupts();  // Ctrl-C: end the stop in progress, keep every stop recorded
       Progress progress("frame", static_cast<int>(std::ceil(visits * dwell_s * 30.0)));
       RecordObserver observer(scene, rec, *out, progress);
-      session::Dwell dwell = rig.dwell(dwell_s, true);
       QuantisedCamera quantised;
       dwell.camera = [&, camera = dwell.camera](const session::Stop& stop, double since_s) -> alignment::RgbdCamera& {
         quantised.inner = &camera(stop, since_s);
@@ -158,8 +171,7 @@ const Command kRecord{
         return interrupted() || over(stop, frames, elapsed_s);
       };
       const std::stop_source never;
-      for (int v = 0; v < visits && !interrupted(); ++v)
-        rig.session().visit(v, trackers.workers, dwell, observer, never.get_token());
+      for (int v = 0; v < visits && !interrupted(); ++v) session.visit(v, trackers.workers, dwell, observer, never.get_token());
       rec.interrupted = interrupted();
       observer.save();
       std::cout << "recorded " << rec.stops.size() << " stop(s), " << observer.frames << " frames from " << rec.camera << " to "
