@@ -244,6 +244,16 @@ TEST_F(DevicesCli, RecordThenReplayAStopThroughTheKinectDriver) {
   for (std::string line; std::getline(index, line);) files += fs::exists(rec / "stop01" / line) ? 1 : 0;
   EXPECT_EQ(files, 2 * static_cast<int>(frames));  // a depth and a colour file per frame, each there
   EXPECT_EQ(run_projbot("record --out " + rec.string() + " --dwell 1", 60).code, 2);  // never over a recording
+  // The twin robot's laser and odometry on the way there, as an MRPT rawlog that ICP-SLAM maps.
+  const CliRun slam = run_projbot("slam --rawlog " + (rec / "laser.rawlog").string() + " --out-map " + (dir_ / "map").string() +
+                                      " --out-trajectory " + (dir_ / "slam.txt").string(),
+                                  120);
+  EXPECT_EQ(slam.code, 0) << slam.output;
+  EXPECT_TRUE(fs::exists(dir_ / "map" / "grid.png")) << slam.output;
+  std::ifstream trajectory(dir_ / "slam.txt");
+  int poses = 0;
+  for (std::string line; std::getline(trajectory, line);) ++poses;
+  EXPECT_GT(poses, 20) << slam.output;  // a scan every 0.1 s of a drive of several seconds, and the settling
   ::setenv("LD_LIBRARY_PATH", PROJBOT_FAKENECT_DIR, 1);
   ::setenv("FAKENECT_PATH", (rec / "stop01").c_str(), 1);
   const CliRun r = run_projbot(

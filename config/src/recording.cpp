@@ -51,7 +51,9 @@ std::string recording_yaml(const Recording& r) {
   out << std::setprecision(17);
   out << "# projbot record: one fakenect dump per stop (stopNN/), the poses tracked in each frame (poses.csv)\n"
       << "format: 1\nscene: " << quoted(r.scene.string()) << "\ncamera: " << quoted(r.camera) << "\nseed: " << r.seed
-      << "\ndwell_s: " << r.dwell_s << "\ninterrupted: " << (r.interrupted ? "true" : "false") << "\nstops:\n";
+      << "\ndwell_s: " << r.dwell_s << "\ninterrupted: " << (r.interrupted ? "true" : "false") << "\n";
+  if (!r.laser.empty()) out << "laser: " << quoted(r.laser) << "\n";
+  out << "stops:\n";
   if (r.stops.empty()) out << "  []\n";
   for (const RecordedStop& s : r.stops)
     out << "  - {visit: " << s.visit << ", target: " << quoted(s.target) << ", goal: " << triple(s.goal)
@@ -83,6 +85,7 @@ Recording load_recording(const std::filesystem::path& folder) {
   rec.seed = static_cast<std::uint64_t>(r.get<long long>("seed", 0, true));
   rec.dwell_s = r.get<double>("dwell_s", 0.0, true);
   rec.interrupted = r.get<bool>("interrupted", false, true);
+  rec.laser = r.get<std::string>("laser", "");
   const YAML::Node stops = r.child("stops", true);
   if (!stops.IsSequence()) r.fail(stops, "stops", "expected a list of stops");
   for (std::size_t k = 0; k < stops.size(); ++k)

@@ -56,6 +56,7 @@ StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
   const auto scan_and_correct = [&] {
     LaserScan scan = map_.simulate_scan(base_.true_pose(), c_.laser, rng_);
     scan.timestamp_s = time_s_;
+    if (on_scan_) on_scan_(scan, odometry_.pose());
     const auto t0 = std::chrono::steady_clock::now();
     const LocalizationUpdate u = localizer_.correct(scan);
     ms_total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -80,7 +81,10 @@ StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
   base_.set_wheel_speeds({});
   r.arrived = controller_.arrived();
   if (c_.source == PoseSource::localized)
-    for (int k = 0; k < c_.settle_scans; ++k) scan_and_correct();
+    for (int k = 0; k < c_.settle_scans; ++k) {  // at rest, one scan per laser period (the control period)
+      time_s_ += c_.control_dt_s;
+      scan_and_correct();
+    }
   r.drive_seconds = time_s_ - t_start;
   r.truth = base_.true_pose();
   r.odometry = odometry_.pose();

@@ -45,6 +45,8 @@ void print_help() {
                "  projbot tour --mode odometry --report r.json      the paper's set-up, with a JSON report\n"
                "  projbot run --sim --fullscreen                    the live engine against the twin\n"
                "  projbot devices --config site.yaml                what this machine has; do the scene's devices work?\n"
+               "  projbot record --out rec/ --config site.yaml      the session through the tour, recorded\n"
+               "  projbot run --replay rec/ --headless              the same session again from the recording\n"
                "  projbot bench render\n";
 }
 

@@ -14,6 +14,7 @@
 #include "progress.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/config/recording.hpp"
+#include "projbot/robot/localization.hpp"
 #include "rigs.hpp"
 #include "scene_setup.hpp"
 
@@ -72,10 +73,16 @@ class RecordObserver final : public session::StopObserver {
               << std::endl;
   }
   void save() const {
+    if (!scans.empty()) {  // written whole, then renamed: a reader never sees half a rawlog
+      robot::write_rawlog(out_ / "laser.rawlog.tmp", scans);
+      fs::rename(out_ / "laser.rawlog.tmp", out_ / "laser.rawlog");
+      rec_.laser = "laser.rawlog";
+    }
     config::write_file_atomically(out_ / "poses.csv", poses_.text());
     config::write_file_atomically(out_ / "recording.yaml", config::recording_yaml(rec_));
   }
   int frames = 0;
+  std::vector<robot::RawlogStep> scans;  // the twin robot's laser and odometry so far
 
  private:
   const config::Scene& scene_;
@@ -102,14 +109,15 @@ const Command kRecord{
     "  recording.yaml  the scene, and per stop what the session asked and the devices answered: the stop\n"
     "                  driven to, where the robot then believed it stood, the pan-tilt's angles\n"
     "  poses.csv       the pose each lit target's tracker gave for every frame (the session's decisions)\n"
+    "  laser.rawlog    the twin robot's laser scans and wheel odometry while driving and settling, as an MRPT\n"
+    "                  rawlog (projbot slam and MRPT's own tools read it)\n"
     "`projbot run --replay DIR` runs the same session from them with no device and no twin, and compares\n"
     "its poses with poses.csv frame for frame. A stop's dump also replays through the real Kinect driver:\n"
     "  fakenect DIR/stop01 projbot run --config site.yaml   (camera: {driver: freenect, registered: false})\n"
     "The devices are the config's, as for run: a base, pan-tilt and camera together drive the robot with no\n"
     "twin; a camera alone is read with the twin's robot; none, or --sim, is the twin's. Depth is kept to the Kinect's disparity "
-    "steps, for the trackers too. The laser scans and\n"
-    "wheel odometry behind the robot's belief are not recorded (the belief is). Ctrl-C ends the stop in\n"
-    "progress and keeps every stop recorded.\n",
+    "steps, for the trackers too. A configured robot's laser and odometry are not recorded yet (its\n"
+    "belief at each stop is). Ctrl-C ends the stop in progress and keeps every stop recorded.\n",
     {{"out", "DIR", "the recording's folder (new or empty)"},
      {"config", "FILE", "scene (default: assets/scenes/tour.yaml)"},
      {"sim", "", "record the twin's camera whatever `devices:` configures"},
@@ -162,6 +170,17 @@ const Command kRecord{
       catch_interrupts();  // Ctrl-C: end the stop in progress, keep every stop recorded
       Progress progress("frame", static_cast<int>(std::ceil(visits * dwell_s * 30.0)));
       RecordObserver observer(scene, rec, *out, progress);
+      if (twin_rig) {  // the twin's laser scans and wheel odometry, as an MRPT rawlog
+        twin_rig->twin().robot().on_scan([&observer, last = std::optional<robot::Pose2D>()](
+                                             const robot::LaserScan& scan, const robot::Pose2D& odometry) mutable {
+          robot::RawlogStep step;
+          step.timestamp_s = scan.timestamp_s;
+          if (last) step.odometry_increment = robot::between(*last, odometry);
+          step.scan = scan;
+          observer.scans.push_back(std::move(step));
+          last = odometry;
+        });
+      }
       QuantisedCamera quantised;
       dwell.camera = [&, camera = dwell.camera](const session::Stop& stop, double since_s) -> alignment::RgbdCamera& {
         quantised.inner = &camera(stop, since_s);

@@ -32,6 +32,9 @@ struct Recording {
   std::uint64_t seed = 0;
   double dwell_s = 0.0;
   bool interrupted = false;  ///< cut short: the stops listed are those recorded
+  /// The robot's laser scans and wheel odometry as an MRPT rawlog, relative to the folder (empty: none;
+  /// a configured robot's laser is not recorded yet).
+  std::string laser;
   std::vector<RecordedStop> stops;
   /// The folder the recording's relative paths start from.
   std::filesystem::path folder() const { return source.parent_path(); }

@@ -50,6 +50,9 @@ class SimRobot final : public Navigator {
   Pose2D true_pose() const { return base_.true_pose(); }
   Pose2D odometry_pose() const { return odometry_.pose(); }
   const OccupancyMap& map() const { return map_; }
+  /// Called with every laser scan the robot takes (while driving and settling; localized mode) and the
+  /// wheel odometry at that instant: what a recording keeps as its rawlog.
+  void on_scan(std::function<void(const LaserScan&, const Pose2D& odometry)> listener) { on_scan_ = std::move(listener); }
   double time_s() const { return time_s_; }
 
  private:
@@ -61,6 +64,7 @@ class SimRobot final : public Navigator {
   WheelOdometry odometry_;
   BaseController controller_;
   double time_s_ = 0.0;
+  std::function<void(const LaserScan&, const Pose2D&)> on_scan_;
 };
 
 /// Runs the tour. Deterministic for a given config (all noise is seeded). `stop_requested`, asked before
