@@ -214,6 +214,33 @@ TEST_F(DevicesCli, RunTracksThroughAConfiguredKinect) {
   EXPECT_GT(number_after(r.output, "pose age at display (depth capture to expected display), "), 90.0) << r.output;
   EXPECT_LT(number_after(r.output, "still mean "), 1.0) << r.output;
 
+  // The camera goes quiet for 1.5 s in the middle of the dwell (the dump's next frame is 1.5 s later):
+  // within 100 ms the projection is blanked, and it is lit again when frames come back.
+  const TwinFrames later = twin_frames(twin, T_world_camera, 10, 100, 10.0 / 30.0 + 1.5);
+  projbot::alignment::write_fakenect_dump(dir_ / "later", later.frames());
+  std::string after;
+  {
+    std::ifstream in(dir_ / "later" / "INDEX.txt");
+    after.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  for (const auto& f : fs::directory_iterator(dir_ / "later"))
+    if (f.path().filename() != "INDEX.txt") fs::copy_file(f.path(), dir_ / "dump" / f.path().filename());
+  {
+    std::ofstream out(dir_ / "dump" / "INDEX.txt");
+    out << once << after;
+    for (int i = 0; i < 6; ++i) out << once;  // back in time: played without waiting
+  }
+  const CliRun quiet = run_projbot("run --headless --visits 1 --dwell 3 --config " + (dir_ / "site.yaml").string(), 120);
+  ASSERT_EQ(quiet.code, 0) << quiet.output;
+  const std::size_t at = quiet.output.find(" frames blanked because the camera had handed over no frame for 100 ms");
+  ASSERT_NE(at, std::string::npos) << quiet.output;
+  const std::size_t from = quiet.output.rfind("; ", at) + 2;
+  const double silent = std::stod(quiet.output.substr(from, at - from));
+  EXPECT_GT(silent, 60.0) << quiet.output;  // 1.5 s at 60 Hz, less the first 100 ms
+  EXPECT_LT(silent, 100.0) << quiet.output;
+  const std::string ages = quiet.output.substr(quiet.output.find("pose age at display"));
+  EXPECT_LT(number_after(ages, ", max "), 250.0) << quiet.output;  // no lit frame drew a pose 1.5 s old
+
   // The camera stops in the middle of the dwell (the dump ends after 30 frames, 1 s): the projection is
   // blanked, what was measured is printed and written, and the failure is reported with exit status 1.
   play_times(3);

@@ -118,7 +118,12 @@ struct RunOptions {
 // every lit worker (ms).
 struct Handoffs {
   std::vector<double> from_capture_ms, in_session_ms;
+  std::atomic<double> last_s{0.0};  // the newest live hand-off (steady clock), read by the render thread
 };
+
+// A live camera silent this long (no frame handed to the workers) blanks the projection: what was last
+// seen may no longer be there (issue 12: a camera that stops, lit no longer than this).
+constexpr double kSilentCameraS = 0.1;
 
 class RunObserver final : public session::StopObserver {
  public:
@@ -146,6 +151,7 @@ class RunObserver final : public session::StopObserver {
       const double now = now_s();
       handoffs_.from_capture_ms.push_back(1000.0 * (now - f.depth.capture_time_s));
       handoffs_.in_session_ms.push_back(1000.0 * (now - f.delivered_s));
+      handoffs_.last_s = now;
     }
     if (check_) check_->compare(scene_, stop, k, samples);
     ++frames;
@@ -265,7 +271,8 @@ const Command kRun{
     "(together) make the whole robot: the base is driven to each stop over its ROS 2 topics on its odometry\n"
     "(placed in the map at robot.start), the pan-tilt aims, and no twin runs (so no error is measured). Part\n"
     "of a robot, or a laser (not localised on yet), stops the run saying so. With none configured, or with\n"
-    "--sim, the digital twin serves every device. A device that fails while projecting blanks the projector at\n"
+    "--sim, the digital twin serves every device. A live camera that hands over no frame for 100 ms blanks the\n"
+    "projection until its frames come back. A device that fails while projecting blanks the projector at\n"
     "once; what was measured until then is printed and written, and the failure is reported (exit 1).\n"
     "With --replay DIR the session runs from a recording (projbot record): the base and pan-tilt answer\n"
     "what they answered then, each stop's frames play at their recorded pace and are tracked in lockstep,\n"
@@ -359,7 +366,8 @@ const Command kRun{
       };
       RobotState robot;
       const double t0 = now_s();
-      std::size_t blank = 0, frames_with_neighbours = 0;
+      std::size_t blank = 0, frames_with_neighbours = 0, silent = 0;
+      double stale_before_s = 0.0;  // poses captured before the camera last went quiet are not drawn
       auto next_frame = Clock::now();
       while (!interrupted() && !target->poll_close() && !robot_done && (seconds == 0.0 || now_s() - t0 < seconds)) {
         state.read(robot);
@@ -371,10 +379,16 @@ const Command kRun{
           // presents at the next vblank; the period as measured) plus the projector's input lag (issue 14).
           const double display_s =
               now_s() + cadence.period_s(1.0 / scene.projector.refresh_hz) + 1e-3 * scene.projector.input_lag_ms;
+          if (!recording && !robot.lit.empty() && now_s() - handoffs.last_s > kSilentCameraS) {
+            ++silent;                  // the camera has gone quiet: blank rather than show what it saw last...
+            stale_before_s = now_s();  // ...and, once it is back, only what it sees from then on
+            return;
+          }
           for (const LitTarget& lit : robot.lit) {
             alignment::PoseSample pose;
             auto& worker = *workers[static_cast<std::size_t>(lit.target)];
-            if (!worker.latest(pose) || pose.lost || pose.capture_time_s < robot.since_s) continue;  // blanked on its own
+            if (!worker.latest(pose) || pose.lost || pose.capture_time_s < std::max(robot.since_s, stale_before_s))
+              continue;  // blanked on its own
             const Eigen::Matrix4d T_camera_target =
                 predict ? alignment::predict_pose(pose.motion, display_s) : pose.T_camera_target;
             out.push_back({items[static_cast<std::size_t>(lit.target)].model,
@@ -441,6 +455,9 @@ const Command kRun{
                 << engine::percentile(ages_ms, 0.95) << " ms, p99 " << engine::percentile(ages_ms, 0.99) << " ms, max "
                 << engine::percentile(ages_ms, 1.0) << " ms; " << blank << " frames blank (driving, acquiring or lost)";
       if (frames_with_neighbours > 0) std::cout << "; " << frames_with_neighbours << " frames lit a neighbour too";
+      if (silent > 0)
+        std::cout << "; " << silent << " frames blanked because the camera had handed over no frame for "
+                  << std::lround(1000.0 * kSilentCameraS) << " ms";
       std::cout << "\n";
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
