@@ -6,7 +6,9 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include <vector>
 
+#include "kinect_frames.hpp"
 #include "projbot/alignment/freenect_source.hpp"
 
 namespace projbot::alignment {
@@ -55,10 +57,31 @@ std::string read_pnm(const std::filesystem::path& path, const char* magic, int m
 
 }  // namespace
 
-DepthImage kinect_quantised(const DepthImage& depth) {
-  DepthImage out = depth;
-  for (float& z : out.depth_m) z = kinect_raw_to_metres(kinect_metres_to_raw(z));
-  return out;
+void kinect_depth_from_raw(const std::uint16_t* raw, DepthImage& out) {
+  static const std::vector<float> metres = [] {  // kinect_raw_to_metres() of every 11-bit value, once
+    std::vector<float> t(2048);
+    for (std::size_t v = 0; v < t.size(); ++v) t[v] = kinect_raw_to_metres(static_cast<std::uint16_t>(v));
+    return t;
+  }();
+  out.width = 640;
+  out.height = 480;
+  out.depth_m.resize(640 * 480);
+  for (std::size_t i = 0; i < out.depth_m.size(); ++i) out.depth_m[i] = raw[i] < 2048 ? metres[raw[i]] : 0.0F;
+}
+
+void kinect_colour_from_rgb(const std::uint8_t* rgb, assets::Image& out) {
+  out.width = 640;
+  out.height = 480;
+  out.rgba.resize(640 * 480 * 4);
+  for (std::size_t i = 0; i < 640 * 480; ++i) {
+    std::memcpy(&out.rgba[i * 4], rgb + i * 3, 3);
+    out.rgba[i * 4 + 3] = 255;
+  }
+}
+
+DepthImage kinect_quantised(DepthImage depth) {
+  for (float& z : depth.depth_m) z = kinect_raw_to_metres(kinect_metres_to_raw(z));
+  return depth;
 }
 
 FakenectDumpReader::FakenectDumpReader(const std::filesystem::path& folder, bool realtime)
@@ -95,23 +118,11 @@ RgbdFrame FakenectDumpReader::next() {
     throw AlignmentError(folder_.string() + ": the recording ends after " + std::to_string(frames()) + " frames");
   const Entry& e = entries_[static_cast<std::size_t>(next_)];
   RgbdFrame f;
-  const std::string raw = read_pnm(folder_ / e.depth, "P5", 65535, 2);
-  f.depth.width = 640;
-  f.depth.height = 480;
-  f.depth.depth_m.resize(640 * 480);
-  for (std::size_t i = 0; i < f.depth.depth_m.size(); ++i) {
-    std::uint16_t v = 0;
-    std::memcpy(&v, &raw[i * 2], 2);  // as fakenect hands it to the driver: the host's byte order
-    f.depth.depth_m[i] = kinect_raw_to_metres(v);
-  }
-  const std::string rgb = read_pnm(folder_ / e.colour, "P6", 255, 3);
-  f.colour.width = 640;
-  f.colour.height = 480;
-  f.colour.rgba.resize(640 * 480 * 4);
-  for (std::size_t i = 0; i < 640 * 480; ++i) {
-    std::memcpy(&f.colour.rgba[i * 4], &rgb[i * 3], 3);
-    f.colour.rgba[i * 4 + 3] = 255;
-  }
+  const std::string bytes = read_pnm(folder_ / e.depth, "P5", 65535, 2);
+  std::vector<std::uint16_t> raw(640 * 480);
+  std::memcpy(raw.data(), bytes.data(), bytes.size());  // as fakenect hands it to the driver: the host's byte order
+  kinect_depth_from_raw(raw.data(), f.depth);
+  kinect_colour_from_rgb(reinterpret_cast<const std::uint8_t*>(read_pnm(folder_ / e.colour, "P6", 255, 3).data()), f.colour);
   if (next_ == 0) offset_s_ = steady_now_s() - e.time_s;
   f.depth.capture_time_s = e.time_s + offset_s_;
   if (realtime_) {

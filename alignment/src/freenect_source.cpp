@@ -11,6 +11,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "kinect_frames.hpp"
 #include "projbot/config/output_file.hpp"
 
 namespace projbot::alignment {
@@ -64,19 +65,15 @@ struct FreenectSource::Impl {
   void on_depth(const void* data, std::uint32_t timestamp) {
     DepthImage& d = pending.depth;
     d.capture_time_s = steady_now_s();  // its arrival, before the conversion below: that counts in a pose's age
-    d.width = kWidth;
-    d.height = kHeight;
-    d.depth_m.resize(static_cast<std::size_t>(kWidth) * kHeight);
     const auto* raw = static_cast<const std::uint16_t*>(data);
-    static const std::vector<float> metres = [] {  // kinect_raw_to_metres() of every 11-bit value, once
-      std::vector<float> t(2048);
-      for (std::size_t v = 0; v < t.size(); ++v) t[v] = kinect_raw_to_metres(static_cast<std::uint16_t>(v));
-      return t;
-    }();
-    if (options.registered)
+    if (options.registered) {
+      d.width = kWidth;
+      d.height = kHeight;
+      d.depth_m.resize(static_cast<std::size_t>(kWidth) * kHeight);
       for (std::size_t i = 0; i < d.depth_m.size(); ++i) d.depth_m[i] = 0.001F * static_cast<float>(raw[i]);
-    else
-      for (std::size_t i = 0; i < d.depth_m.size(); ++i) d.depth_m[i] = raw[i] < 2048 ? metres[raw[i]] : 0.0F;
+    } else {
+      kinect_depth_from_raw(raw, d);
+    }
     pending.depth_timestamp = timestamp;
     have_depth = true;
     have_colour = false;  // the colour that belongs to it comes after it
@@ -84,15 +81,7 @@ struct FreenectSource::Impl {
 
   void on_colour(const void* data, std::uint32_t timestamp) {
     if (!have_depth) return;
-    assets::Image& c = pending.colour;
-    c.width = kWidth;
-    c.height = kHeight;
-    c.rgba.resize(static_cast<std::size_t>(kWidth) * kHeight * 4);
-    const auto* rgb = static_cast<const std::uint8_t*>(data);
-    for (std::size_t i = 0; i < static_cast<std::size_t>(kWidth) * kHeight; ++i) {
-      std::memcpy(&c.rgba[i * 4], rgb + i * 3, 3);
-      c.rgba[i * 4 + 3] = 255;
-    }
+    kinect_colour_from_rgb(static_cast<const std::uint8_t*>(data), pending.colour);
     pending.colour_timestamp = timestamp;
     have_colour = true;
   }

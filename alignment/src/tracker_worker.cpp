@@ -316,20 +316,22 @@ TrackerWorker::~TrackerWorker() {
   wake_.notify_all();
 }  // jthread joins
 
-void TrackerWorker::submit(std::shared_ptr<const DepthImage> frame) {
+std::uint64_t TrackerWorker::post(std::shared_ptr<const DepthImage> frame) {
+  std::uint64_t ticket = 0;
   {
     std::lock_guard lock(mutex_);
     inbox_ = std::move(frame);  // a frame not yet taken is dropped: only the newest matters
-    ++submitted_;
+    ticket = ++submitted_;
   }
   wake_.notify_one();
+  return ticket;
 }
 
+void TrackerWorker::submit(std::shared_ptr<const DepthImage> frame) { post(std::move(frame)); }
+
 std::optional<PoseSample> TrackerWorker::track(std::shared_ptr<const DepthImage> frame) {
+  const std::uint64_t ticket = post(std::move(frame));
   std::unique_lock lock(mutex_);
-  inbox_ = std::move(frame);
-  const std::uint64_t ticket = ++submitted_;
-  wake_.notify_one();
   done_.wait(lock, [&] { return finished_ >= ticket || error_; });
   if (error_) std::rethrow_exception(error_);
   return finished_sample_;

@@ -1,7 +1,6 @@
 #include "projbot/config/recording.hpp"
 
 #include <iomanip>
-#include <limits>
 
 #include "map_reader.hpp"
 

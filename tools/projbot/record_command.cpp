@@ -32,7 +32,7 @@ class QuantisedCamera final : public alignment::RgbdCamera {
     alignment::RgbdFrame f = inner->next();
     if (f.colour.rgba.empty())
       throw DeviceError("the camera delivers no colour, and a fakenect dump holds depth and colour together");
-    for (float& z : f.depth.depth_m) z = alignment::kinect_raw_to_metres(alignment::kinect_metres_to_raw(z));
+    f.depth = alignment::kinect_quantised(std::move(f.depth));
     return f;
   }
 };
@@ -149,8 +149,7 @@ const Command kRecord{
         config::DevicesConfig wanted = scene.devices;
         wanted.projector.reset();  // nothing is projected while recording
         std::vector<DeviceCheck> checks;
-        if (wanted.any()) devices = open_devices(wanted, checks, true);  // each checked once; the first absent one named
-        robot = configured_robot(wanted);
+        devices = open_session_devices(wanted, checks, robot);
         for (const auto& c : checks)
           if (c.role == "camera") rec.camera = c.config;
       }

@@ -83,6 +83,14 @@ bool configured_robot(const config::DevicesConfig& d) {
   return true;
 }
 
+Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot) {
+  robot = false;
+  if (!wanted.any()) return {};
+  Devices devices = open_devices(wanted, checks, true);
+  robot = configured_robot(wanted);  // after opening: an absent device is named before a missing one
+  return devices;
+}
+
 DeviceRig::DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, Devices& devices)
     : navigator_(*devices.base, {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()}),
       camera_(*devices.camera),

@@ -63,6 +63,11 @@ class TwinRig {
 /// (the twin's camera cannot see where a real base went), and for a laser, which no session drives yet.
 bool configured_robot(const config::DevicesConfig& devices);
 
+/// The config's devices for a session, each opened and read once (the first that fails a DeviceError
+/// naming it), then checked to make a whole robot or a camera alone (configured_robot): `robot` says which.
+/// None configured: no device, `robot` false.
+Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot);
+
 /// The configured devices serving the whole session: the base over ROS 2 topics (closing the loop on its
 /// odometry, started at the scene's robot.start), the PTU-D46 and the camera. No twin, so no truth.
 class DeviceRig {

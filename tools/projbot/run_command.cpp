@@ -112,8 +112,6 @@ struct RunOptions {
   std::uint64_t seed = 1;
 };
 
-// What the robot thread tells the render thread at each step of the session, with the twin's truth when
-// the twin serves the robot; in a replay, each lockstep frame's poses are also checked against the recording's.
 // Per live frame: from the camera's capture stamp, and from its next() returning, to the frame handed to
 // every lit worker (ms).
 struct Handoffs {
@@ -125,6 +123,8 @@ struct Handoffs {
 // seen may no longer be there (issue 12: a camera that stops, lit no longer than this).
 constexpr double kSilentCameraS = 0.1;
 
+// What the robot thread tells the render thread at each step of the session, with the twin's truth when
+// the twin serves the robot; in a replay, each lockstep frame's poses are also checked against the recording's.
 class RunObserver final : public session::StopObserver {
  public:
   RunObserver(const config::Scene& scene, alignment::LatestValue<RobotState>& state, Handoffs& handoffs, twin::Twin* twin,
@@ -154,12 +154,10 @@ class RunObserver final : public session::StopObserver {
       handoffs_.last_s = now;
     }
     if (check_) check_->compare(scene_, stop, k, samples);
-    ++frames;
   }
   void left(const session::Stop& stop) override {
     if (twin_) twin_->end_visit(twin_index(stop.target), stop.target_visit);  // back home, or left where it was moved
   }
-  int frames = 0;
 
  private:
   std::size_t twin_index(int target) const { return twin_->target_index(scene_.targets[static_cast<std::size_t>(target)].name); }
@@ -174,23 +172,20 @@ class RunObserver final : public session::StopObserver {
 // twin's), or at each stop of a recording (`replay`, in lockstep, checked by `check`).
 void drive(const config::Scene& scene, const RunOptions& o, SceneTrackers& trackers, alignment::LatestValue<RobotState>& state,
            Handoffs& handoffs, const std::stop_token& stop, Devices& devices, const config::Recording* replay, PoseCheck* check) {
+  const auto tour = [&](session::Session& session, const session::Dwell& dwell, twin::Twin* twin, int visits) {
+    RunObserver observer(scene, state, handoffs, twin, check);
+    for (int v = 0; v < visits && !stop.stop_requested(); ++v) session.visit(v, trackers.workers, dwell, observer, stop);
+  };
   const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
   if (devices.base) {  // the configured robot: no twin
     DeviceRig rig(scene, trackers.targets, devices);
-    RunObserver observer(scene, state, handoffs, nullptr, nullptr);
-    const session::Dwell dwell = rig.dwell(o.dwell_s, false);
-    for (int v = 0; v < visits && !stop.stop_requested(); ++v) rig.session().visit(v, trackers.workers, dwell, observer, stop);
+    tour(rig.session(), rig.dwell(o.dwell_s, false), nullptr, visits);
   } else if (replay) {
     ReplayRig rig(scene, *replay, trackers.targets);
-    RunObserver observer(scene, state, handoffs, nullptr, check);
-    const session::Dwell dwell = rig.dwell();
-    for (int v = 0; v < static_cast<int>(replay->stops.size()) && !stop.stop_requested(); ++v)
-      rig.session().visit(v, trackers.workers, dwell, observer, stop);
+    tour(rig.session(), rig.dwell(), nullptr, static_cast<int>(replay->stops.size()));
   } else {
     TwinRig rig(scene, trackers.targets, o.seed, devices.camera.get());
-    RunObserver observer(scene, state, handoffs, &rig.twin(), nullptr);
-    const session::Dwell dwell = rig.dwell(o.dwell_s, false);
-    for (int v = 0; v < visits && !stop.stop_requested(); ++v) rig.session().visit(v, trackers.workers, dwell, observer, stop);
+    tour(rig.session(), rig.dwell(o.dwell_s, false), &rig.twin(), visits);
   }
   RobotState last;
   state.read(last);
@@ -214,9 +209,9 @@ Devices open_configured(const config::Scene& scene, bool headless) {
     return {};
   }
   std::vector<DeviceCheck> checks;
-  Devices devices = open_devices(wanted, checks, true);  // throws DeviceError at the first that fails
+  bool robot = false;
+  Devices devices = open_session_devices(wanted, checks, robot);  // an absent device, part of a robot or a laser: refused
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
-  const bool robot = configured_robot(wanted);  // part of a robot, or a laser: refused, saying what
   if (robot)
     std::cout << "the configured base, pan-tilt and camera serve the session: no twin (nothing is measured against a truth)"
               << std::endl;

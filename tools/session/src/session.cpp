@@ -120,9 +120,13 @@ Stop Session::visit(int visit, const std::vector<alignment::TrackerWorker*>& wor
   const auto now_s = [] { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); };
   const double since = now_s();
   alignment::RgbdCamera& camera = dwell.camera(at, since);
+  const auto read = [&] {
+    auto f = std::make_shared<alignment::RgbdFrame>(camera.next());
+    f->delivered_s = now_s();
+    return f;
+  };
   // The first frame's colour, taken before anything is lit, guides each lit target's acquisition.
-  auto frame = std::make_shared<alignment::RgbdFrame>(camera.next());
-  frame->delivered_s = now_s();
+  auto frame = read();
   std::shared_ptr<const assets::Image> colour;
   if (!frame->colour.rgba.empty()) colour = std::shared_ptr<const assets::Image>(frame, &frame->colour);
   for (std::size_t k = 0; k < at.lit.size(); ++k)
@@ -139,8 +143,7 @@ Stop Session::visit(int visit, const std::vector<alignment::TrackerWorker*>& wor
         w->submit(depth);
     observer.frame(at, k, *frame, samples);
     if (stop.stop_requested() || dwell.over(at, k + 1, now_s() - since)) break;
-    frame = std::make_shared<alignment::RgbdFrame>(camera.next());
-    frame->delivered_s = now_s();
+    frame = read();
   }
   observer.left(at);
   return at;

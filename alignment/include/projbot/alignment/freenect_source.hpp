@@ -87,7 +87,7 @@ void write_fakenect_dump(const std::filesystem::path& folder, const std::vector<
 /// Depth as a fakenect dump gives it back: each value through the Kinect's raw 11-bit disparity and back
 /// (kinect_metres_to_raw, then kinect_raw_to_metres). What a recording's tracker sees, so a replay of the
 /// dump sees the same.
-DepthImage kinect_quantised(const DepthImage& depth);
+DepthImage kinect_quantised(DepthImage depth);
 
 /// A fakenect dump read back frame by frame without libfreenect (`projbot run --replay` plays one per
 /// stop): depth through kinect_raw_to_metres() as the Kinect driver converts raw disparity, colour as

@@ -253,6 +253,8 @@ class TrackerWorker {
 
  private:
   void run(std::stop_token stop);
+  // Puts `frame` in the inbox (replacing one not yet taken) and wakes the worker; returns its ticket.
+  std::uint64_t post(std::shared_ptr<const DepthImage> frame);
 
   TargetFollower follower_;  // used by the worker thread only
   LatestValue<PoseSample> poses_;

@@ -1,7 +1,7 @@
 #pragma once
 // The mobile base as the projection session drives it (issue 12): to a stop under closed-loop control,
 // then where the robot believes it is. The twin's simulated robot is one implementation; a real base
-// (the youBot over ROS 2 topics, localised on its laser) is another.
+// over ROS 2 topics, on its odometry (Ros2Navigator), is another.
 
 #include "projbot/robot/pose2d.hpp"
 
@@ -15,7 +15,7 @@ struct StopReport {
   double odometry_error_m = 0.0, odometry_error_rad = 0.0;  ///< raw wheel odometry vs truth
   double arrival_error_m = 0.0;                             ///< truth vs goal
   bool arrived = false;
-  double drive_seconds = 0.0;  ///< simulated time to reach the stop
+  double drive_seconds = 0.0;  ///< time to reach the stop and settle (simulated in the twin, real on a base)
   int corrections = 0, rejected = 0;
   double correct_ms_mean = 0.0;  ///< wall time per localisation update
 };
