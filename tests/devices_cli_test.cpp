@@ -293,13 +293,14 @@ TEST_F(DevicesCli, RecordThenReplayAStopThroughTheKinectDriver) {
 namespace {
 
 // The display's two targets, recorded at 2 stops by `projbot record` into dir/rec.
-fs::path record_display(const fs::path& dir) {
+// Returns the folder and the frames recorded, as record reports them.
+std::pair<fs::path, int> record_display(const fs::path& dir) {
   const fs::path rec = dir / "rec";
   const CliRun r = run_projbot("record --out " + rec.string() + " --visits 2 --dwell 1 --config " +
                                    std::string(PROJBOT_ASSET_DIR) + "/scenes/display.yaml",
                                120);
   EXPECT_EQ(r.code, 0) << r.output;
-  return rec;
+  return {rec, static_cast<int>(number_after(r.output, "recorded 2 stop(s), "))};
 }
 
 int data_rows(const fs::path& csv) {
@@ -315,9 +316,12 @@ int data_rows(const fs::path& csv) {
 // pan-tilt answer what they answered, each stop's dump plays) and its trackers give the recording's poses
 // frame for frame (measured: every pose identical, 0.0000 mm).
 TEST_F(DevicesCli, RunReplaysARecordingFrameForFrame) {
-  const fs::path rec = record_display(dir_);
+  const auto [rec, frames] = record_display(dir_);
   const int poses = data_rows(rec / "poses.csv");
-  EXPECT_GE(poses, 2 * 2 * 8);  // 2 stops, 2 lit targets each (the neighbour too), >= 8 frames a stop
+  // 2 stops with a frame or more each (how many a second holds depends on how fast this machine tracks in
+  // lockstep), and a pose per frame for each of the 2 lit targets (the neighbour too).
+  EXPECT_GE(frames, 2);
+  EXPECT_EQ(poses, 2 * frames);
   const CliRun r = run_projbot("run --headless --replay " + rec.string(), 120);
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output.find("no devices configured"), std::string::npos) << r.output;  // nor the twin
@@ -341,6 +345,12 @@ TEST_F(DevicesCli, RunReplaysARecordingFrameForFrame) {
   EXPECT_EQ(gone.code, 1) << gone.output;
   EXPECT_NE(gone.output.find((rec / "stop02" / first).string() + ": cannot open"), std::string::npos) << gone.output;
   EXPECT_NE(gone.output.find("(the projection was blanked"), std::string::npos) << gone.output;
+  fs::copy_file(rec / "poses.csv", dir_ / "poses.csv");
+  std::ofstream(rec / "poses.csv", std::ios::trunc).flush();  // emptied
+  const CliRun empty = run_projbot("run --headless --replay " + rec.string());
+  EXPECT_EQ(empty.code, 1) << empty.output;
+  EXPECT_NE(empty.output.find("poses.csv:1: not the poses of a recording"), std::string::npos) << empty.output;
+  fs::copy_file(dir_ / "poses.csv", rec / "poses.csv", fs::copy_options::overwrite_existing);
   std::ofstream(rec / "recording.yaml", std::ios::app) << "extra: 1\n";
   const CliRun bad = run_projbot("run --headless --replay " + rec.string());
   EXPECT_EQ(bad.code, 1) << bad.output;

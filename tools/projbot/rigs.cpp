@@ -178,7 +178,9 @@ PoseCheck::PoseCheck(const std::filesystem::path& csv) {
   std::ifstream in(csv);
   if (!in) throw config::ConfigError(csv.string() + ": cannot read the recording's poses");
   std::string line;
-  std::getline(in, line);  // the header
+  if (!std::getline(in, line) || line != PoseLog::kHeader)
+    throw config::ConfigError(csv.string() +
+                              ":1: not the poses of a recording (its first line is the header projbot record writes)");
   for (int n = 2; std::getline(in, line); ++n) {
     std::istringstream fields(line);
     std::string visit, frame, target, cell;

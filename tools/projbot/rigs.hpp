@@ -108,13 +108,15 @@ class ReplayRig final : public robot::Navigator, public robot::PanTilt {
 /// poses.csv: what each lit target's worker published for every frame of a lockstep session.
 class PoseLog {
  public:
+  /// The file's first line: what PoseCheck checks before it reads one.
+  static constexpr const char* kHeader = "visit,frame,target,published,lost,r00,r01,r02,tx,r10,r11,r12,ty,r20,r21,r22,tz";
   /// One row per lit target of a frame (stop.lit's order). Appended to the text.
   void add(const config::Scene& scene, const session::Stop& stop, int frame,
            const std::vector<std::optional<alignment::PoseSample>>& samples);
   const std::string& text() const { return text_; }
 
  private:
-  std::string text_ = "visit,frame,target,published,lost,r00,r01,r02,tx,r10,r11,r12,ty,r20,r21,r22,tz\n";
+  std::string text_ = std::string(kHeader) + "\n";
 };
 
 /// A replay's poses against the recording's, frame for frame.
