@@ -706,3 +706,47 @@ TEST_F(CliTest, BenchAcquireReportsEveryTargetAndMethod) {
   EXPECT_EQ(run_projbot("bench acquire --guess-error 5").code, 2);
   EXPECT_EQ(run_projbot("bench acquire --trials 0").code, 2);
 }
+
+// The calibration as a user runs it: the twin's capture, solved, its truth compared, and the file a
+// scene takes as `calibration:`; a folder from another tool needs the projector and board named.
+TEST_F(CliTest, CalibrateSimulateThenSolveFeedsAScene) {
+  const fs::path cap = dir_ / "cap";
+  CliRun r = run_projbot("calibrate simulate --poses 4 --out " + cap.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("wrote 4 board poses (44 images each, 640x480)"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(cap / "pose_03" / "43.png"));
+  const fs::path calib = dir_ / "calib.yaml";
+  r = run_projbot("calibrate solve " + cap.string() + " --out " + calib.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("against the truth:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("warning: only 4 usable views"), std::string::npos) << r.output;
+  double rms_camera = -1, rms_projector = -1;
+  const std::size_t at = r.output.find("reprojection RMS: camera ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + at, "reprojection RMS: camera %lf px, projector %lf px", &rms_camera, &rms_projector),
+            2);
+  EXPECT_GT(rms_camera, 0.0);
+  EXPECT_LT(rms_camera, 0.3);
+  EXPECT_GT(rms_projector, 0.0);
+  EXPECT_LT(rms_projector, 0.5);
+  // A scene takes the file: render through the calibrated projector.
+  write("scene.yaml", "calibration: calib.yaml\ntargets:\n  - {name: duck, model: " + kDuck +
+                          ", scale: 1, pose: {translation: [0, 0, 1.2]}}\n");
+  r = run_projbot("render --scene " + (dir_ / "scene.yaml").string() + " --out " + (dir_ / "f.png").string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  const projbot::assets::Image f = projbot::assets::read_image(dir_ / "f.png");
+  EXPECT_EQ(f.width, 1280);
+  fs::remove(cap / "capture.yaml");
+  r = run_projbot("calibrate solve " + cap.string() + " --out " + calib.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("has no capture.yaml: give the projector's size and the board (--projector WxH --board SPEC)"),
+            std::string::npos)
+      << r.output;
+  r = run_projbot("calibrate solve " + cap.string() + " --out " + calib.string() +
+                  " --projector 1280x800 --board charuco:10x7:0.06:0.045");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(run_projbot("calibrate solve --out " + calib.string()).code, 2);
+  EXPECT_EQ(run_projbot("calibrate solve " + cap.string() + " --out " + calib.string() + " --projector 1280by800").code, 2);
+  EXPECT_EQ(run_projbot("calibrate capture").code, 2);
+  EXPECT_EQ(run_projbot("calibrate simulate --out " + cap.string()).code, 1);  // not empty
+}

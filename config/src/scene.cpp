@@ -392,6 +392,9 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
     m.get<double>("projector", 0.0);
     m.reject_unknown();
   }
+  // What `projbot calibrate solve` also reports: the colour camera's own lens (the depth camera is the
+  // scene's `camera:`), the projector area covered, the views and warnings. Informational here.
+  for (const char* key : {"camera", "projector_coverage", "views", "warnings", "board_poses"}) r.child(key, false);
   r.reject_unknown();
 }
 

@@ -32,5 +32,7 @@ extern const Command kRun;
 extern const Command kDevices;
 extern const Command kSimBase;
 extern const Command kRecord;
+extern const Command kCalibrateSimulate;
+extern const Command kCalibrateSolve;
 
 }  // namespace projbot::tools

@@ -2,6 +2,7 @@
 
 #include <malloc.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -15,11 +16,15 @@ namespace {
 using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
-  static const std::vector<const Command*> all{
-      &projbot::tools::kRender,     &projbot::tools::kShow,          &projbot::tools::kBenchRender,  &projbot::tools::kAlign,
-      &projbot::tools::kBenchTrack, &projbot::tools::kBenchMotion,   &projbot::tools::kBenchAcquire, &projbot::tools::kSlam,
-      &projbot::tools::kLocalize,   &projbot::tools::kBenchLocalize, &projbot::tools::kTour,         &projbot::tools::kRun,
-      &projbot::tools::kDevices,    &projbot::tools::kSimBase,       &projbot::tools::kRecord};
+  static const std::vector<const Command*> all{&projbot::tools::kRender,        &projbot::tools::kShow,
+                                               &projbot::tools::kBenchRender,   &projbot::tools::kAlign,
+                                               &projbot::tools::kBenchTrack,    &projbot::tools::kBenchMotion,
+                                               &projbot::tools::kBenchAcquire,  &projbot::tools::kSlam,
+                                               &projbot::tools::kLocalize,      &projbot::tools::kBenchLocalize,
+                                               &projbot::tools::kTour,          &projbot::tools::kRun,
+                                               &projbot::tools::kDevices,       &projbot::tools::kSimBase,
+                                               &projbot::tools::kRecord,        &projbot::tools::kCalibrateSimulate,
+                                               &projbot::tools::kCalibrateSolve};
   return all;
 }
 
@@ -31,7 +36,7 @@ void print_help() {
                "       projbot --version\n\nCommands:\n";
   for (const auto* c : commands()) {
     std::string name = "  " + c->name;
-    name.resize(18, ' ');
+    name.resize(std::max<std::size_t>(22, name.size() + 2), ' ');
     std::cout << name << c->summary << '\n';
   }
   std::cout << "\nExamples:\n"
@@ -47,6 +52,8 @@ void print_help() {
                "  projbot devices --config site.yaml                what this machine has; do the scene's devices work?\n"
                "  projbot record --out rec/ --config site.yaml      the session through the tour, recorded\n"
                "  projbot run --replay rec/ --headless              the same session again from the recording\n"
+               "  projbot calibrate simulate --out cap/                the twin's projector-camera calibration session\n"
+               "  projbot calibrate solve cap/ --out calib.yaml        A_p, R_cp, T_cp from Gray-code captures\n"
                "  projbot bench render\n";
 }
 
@@ -88,6 +95,16 @@ static int dispatch(int argc, char** argv, std::string& name) {
     name = std::string("bench ") + argv[2];
     first = 3;
   }
+  if (name == "calibrate") {  // "calibrate simulate", "calibrate solve": the projector-camera calibration's steps
+    const std::string what = argc < 3 ? std::string() : argv[2];
+    if (what != "simulate" && what != "solve") {
+      std::cerr << "projbot calibrate: " << (argc < 3 ? std::string("say which step") : "no step '" + what + "'")
+                << ": projbot calibrate simulate | solve\n";
+      return 2;
+    }
+    name = "calibrate " + what;
+    first = 3;
+  }
   const Command* cmd = nullptr;
   for (const auto* c : commands())
     if (c->name == name) cmd = c;
@@ -102,7 +119,9 @@ static int dispatch(int argc, char** argv, std::string& name) {
     }
   try {
     const projbot::cli::Args args(cmd->options, argc, argv, first);
-    if (!args.positional().empty()) throw projbot::cli::UsageError("unexpected argument '" + args.positional().front() + "'");
+    // Only `calibrate solve DIR` takes an argument that is not an option, as the issue gives it.
+    if (args.positional().size() > (cmd == &projbot::tools::kCalibrateSolve ? 1U : 0U))
+      throw projbot::cli::UsageError("unexpected argument '" + args.positional().back() + "'");
     return cmd->run(args);
   } catch (const std::bad_alloc&) {
     std::cerr << "projbot " << name << ": out of memory: an input is larger than this machine can hold\n";

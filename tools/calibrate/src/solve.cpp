@@ -1,0 +1,171 @@
+// `solve`: corners in the camera (the white image), their projector positions through the decoded Gray
+// code, then OpenCV's calibrateCamera for each device and stereoCalibrate for R_cp, T_cp.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "capture_io.hpp"
+#include "projbot/calibrate/procam.hpp"
+
+namespace projbot::calibrate {
+namespace {
+
+struct ViewPoints {
+  std::vector<cv::Point3f> object;  // every corner the camera found
+  std::vector<cv::Point2f> camera;
+  std::vector<cv::Point3f> shared_object;  // those also mapped to the projector
+  std::vector<cv::Point2f> shared_camera, projector;
+};
+
+ViewResult measure_view(const CaptureManifest& m, const cv::Mat& white, const std::vector<cv::Mat>& images, const SolveOptions& o,
+                        ViewPoints& points) {
+  ViewResult r;
+  const BoardView board = detect_board(m.board, white);
+  r.corners = static_cast<int>(board.image.size());
+  if (r.corners < o.min_corners) {
+    r.refused =
+        r.corners == 0 ? "no board found in the white image" : "only " + std::to_string(r.corners) + " board corners found";
+    return r;
+  }
+  const cv::Mat decoded = decode_gray_code(images, m.projector_width, m.projector_height);
+  points.object = board.object;
+  points.camera = board.image;
+  for (std::size_t k = 0; k < board.image.size(); ++k)
+    if (const auto p = corner_to_projector(decoded, board.image[k])) {
+      points.shared_object.push_back(board.object[k]);
+      points.shared_camera.push_back(board.image[k]);
+      points.projector.emplace_back(static_cast<float>(p->x), static_cast<float>(p->y));
+    }
+  r.projector_corners = static_cast<int>(points.projector.size());
+  if (r.projector_corners < o.min_corners)
+    r.refused = "only " + std::to_string(r.projector_corners) + " of " + std::to_string(r.corners) +
+                " corners lit by decodable patterns (is the board inside the projector's image?)";
+  return r;
+}
+
+Lens lens_from(const cv::Mat& K, const cv::Mat& D, cv::Size size) {
+  Lens l;
+  l.pinhole =
+      config::Pinhole{size.width, size.height, K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2), K.at<double>(1, 2)};
+  for (int i = 0; i < 5 && i < static_cast<int>(D.total()); ++i) l.distortion[static_cast<std::size_t>(i)] = D.at<double>(i);
+  return l;
+}
+
+double coverage(const std::vector<std::vector<cv::Point2f>>& projector, cv::Size size) {
+  std::vector<cv::Point2f> all, hull;
+  for (const auto& v : projector) all.insert(all.end(), v.begin(), v.end());
+  if (all.size() < 3) return 0.0;
+  cv::convexHull(all, hull);
+  return cv::contourArea(hull) / (static_cast<double>(size.width) * size.height);
+}
+
+void add_warnings(Calibration& c, int used, int total) {
+  auto fixed = [](double v, int digits) {
+    std::ostringstream s;
+    s.setf(std::ios::fixed);
+    s.precision(digits);
+    s << v;
+    return s.str();
+  };
+  if (used < 8)
+    c.warnings.push_back("only " + std::to_string(used) + " usable views: take 8 or more for a calibration you can trust");
+  if (used < total)
+    c.warnings.push_back(std::to_string(total - used) + " of " + std::to_string(total) + " views refused (see views)");
+  if (c.projector_coverage < 0.3)
+    c.warnings.push_back("the corners covered " + fixed(100.0 * c.projector_coverage, 0) +
+                         " % of the projector's image: hold the board near its edges and corners too");
+  if (c.projector_rms_px > 0.5)
+    c.warnings.push_back("projector reprojection RMS " + fixed(c.projector_rms_px, 2) + " px is high (> 0.5)");
+  if (c.camera_rms_px > 0.3) c.warnings.push_back("camera reprojection RMS " + fixed(c.camera_rms_px, 2) + " px is high (> 0.3)");
+}
+
+}  // namespace
+
+Calibration solve(const std::filesystem::path& dir, const SolveOptions& o,
+                  const std::function<void(int, int, const ViewResult&)>& progress) {
+  const CaptureManifest m = read_manifest(dir, o);
+  const auto expected = static_cast<std::size_t>(images_per_pose(m.projector_width, m.projector_height));
+  const cv::Size projector_size(m.projector_width, m.projector_height);
+  Calibration c;
+  cv::Size camera_size;
+  std::vector<ViewPoints> used;
+  for (std::size_t i = 0; i < m.folders.size(); ++i) {
+    const std::vector<cv::Mat> images = read_pose(dir / m.folders[i], expected);
+    if (i == 0) camera_size = images.front().size();
+    if (images.front().size() != camera_size)
+      throw CalibrationError("'" + (dir / m.folders[i]).string() + "': its images are " + std::to_string(images.front().cols) +
+                             "x" + std::to_string(images.front().rows) + ", the first pose's " +
+                             std::to_string(camera_size.width) + "x" + std::to_string(camera_size.height));
+    ViewPoints points;
+    ViewResult r = measure_view(m, lit_image(images), images, o, points);
+    r.folder = m.folders[i];
+    if (r.refused.empty()) used.push_back(std::move(points));
+    c.views.push_back(r);
+    if (progress) progress(static_cast<int>(i + 1), static_cast<int>(m.folders.size()), r);
+  }
+  if (used.size() < 3) {
+    std::string why;
+    for (const ViewResult& v : c.views)
+      if (!v.refused.empty()) why += "; " + v.folder + ": " + v.refused;
+    throw CalibrationError("'" + dir.string() + "': " + std::to_string(used.size()) + " usable views of " +
+                           std::to_string(m.folders.size()) + ", 3 is the least a calibration needs" + why);
+  }
+  std::vector<std::vector<cv::Point3f>> obj, shared_obj;
+  std::vector<std::vector<cv::Point2f>> cam, shared_cam, proj;
+  for (const ViewPoints& v : used) {
+    obj.push_back(v.object);
+    cam.push_back(v.camera);
+    shared_obj.push_back(v.shared_object);
+    shared_cam.push_back(v.shared_camera);
+    proj.push_back(v.projector);
+  }
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 200, 1e-12);
+  cv::Mat Kc, Dc, Kp, Dp;
+  std::vector<cv::Mat> rv, tv;
+  cv::calibrateCamera(obj, cam, camera_size, Kc, Dc, rv, tv, cv::CALIB_FIX_K3, criteria);
+  const int projector_flags =
+      cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3 | (o.projector_distortion ? 0 : cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2);
+  cv::calibrateCamera(shared_obj, proj, projector_size, Kp, Dp, rv, tv, projector_flags, criteria);
+  // The camera's lens is fixed from its own calibration, its corners undistorted to ideal pixels, so
+  // the joint fit below refines both focal lengths and principal points with the board poses shared.
+  std::vector<std::vector<cv::Point2f>> ideal(shared_cam.size());
+  for (std::size_t i = 0; i < shared_cam.size(); ++i) cv::undistortPoints(shared_cam[i], ideal[i], Kc, Dc, cv::noArray(), Kc);
+  cv::Mat R, T, E, F, per_view, zero = cv::Mat::zeros(5, 1, CV_64F), Dp_fixed = Dp.clone();
+  const int joint =
+      cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3;
+  if (o.projector_distortion) {
+    cv::stereoCalibrate(shared_obj, shared_cam, proj, Kc, Dc, Kp, Dp, camera_size, R, T, E, F, per_view, cv::CALIB_FIX_INTRINSIC,
+                        criteria);
+  } else {
+    cv::stereoCalibrate(shared_obj, ideal, proj, Kc, zero, Kp, Dp_fixed, camera_size, R, T, E, F, per_view, joint, criteria);
+  }
+  c.camera = lens_from(Kc, Dc, camera_size);
+  c.projector = lens_from(Kp, Dp, projector_size);
+  c.T_projector_camera = Eigen::Matrix4d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) c.T_projector_camera(r, k) = R.at<double>(r, k);
+    c.T_projector_camera(r, 3) = T.at<double>(r);
+  }
+  double sum_c = 0.0, sum_p = 0.0, n = 0.0;
+  std::size_t u = 0;
+  for (ViewResult& v : c.views) {
+    if (!v.refused.empty()) continue;
+    v.camera_rms_px = per_view.at<double>(static_cast<int>(u), 0);
+    v.projector_rms_px = per_view.at<double>(static_cast<int>(u), 1);
+    const double count = static_cast<double>(proj[u].size());
+    sum_c += count * v.camera_rms_px * v.camera_rms_px;
+    sum_p += count * v.projector_rms_px * v.projector_rms_px;
+    n += count;
+    ++u;
+  }
+  c.camera_rms_px = std::sqrt(sum_c / n);
+  c.projector_rms_px = std::sqrt(sum_p / n);
+  c.projector_coverage = coverage(proj, projector_size);
+  add_warnings(c, static_cast<int>(used.size()), static_cast<int>(c.views.size()));
+  return c;
+}
+
+}  // namespace projbot::calibrate

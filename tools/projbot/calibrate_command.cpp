@@ -1,0 +1,177 @@
+// projbot calibrate simulate | solve: the projector-camera calibration (issue 13) in the twin and from
+// capture folders, checked against the truth when the folder has one.
+
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "progress.hpp"
+#include "projbot/calibrate/calibrate.hpp"
+#include "projbot/config/scene.hpp"
+#include "scene_setup.hpp"
+
+namespace projbot::tools {
+namespace {
+
+constexpr const char* kDefaultBoard = "charuco:10x7:0.06:0.045:DICT_4X4_50";
+
+// The twin's colour camera lens: the Kinect v1 depth camera's pinhole (colour registered to it) with a
+// moderate barrel distortion of a webcam-class lens, so the solve has one to find.
+calibrate::Lens twin_colour_lens(const config::Scene& scene) {
+  calibrate::Lens l;
+  l.pinhole = scene.depth_camera;
+  l.distortion = {0.10, -0.20, 0.0005, -0.0005, 0.0};
+  return l;
+}
+
+int run_simulate(const cli::Args& args) {
+  const auto out = args.get("out");
+  if (!out) throw cli::UsageError("--out DIR is required");
+  args.check_output_folders({"out"});
+  const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
+  const config::Scene scene = config::load_scene(scene_path);
+  calibrate::SimulationConfig c;
+  c.poses = args.get_int("poses", 10, 1, 100);
+  c.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
+  c.board = calibrate::Board::parse(args.get_or("board", kDefaultBoard));
+  c.camera = twin_colour_lens(scene);
+  c.projector = scene.projector;
+  c.T_projector_camera = scene.pan_tilt.T_projector_camera;
+  c.noise_sigma = args.get_double("noise", c.noise_sigma);
+  if (!(c.noise_sigma >= 0.0 && c.noise_sigma <= 50.0)) throw cli::UsageError("--noise must be 0..50 grey levels");
+  Progress progress("pose", c.poses);
+  calibrate::simulate(c, *out, [&](int done, int) { progress.step(done); });
+  std::cout << "wrote " << c.poses << " board poses (" << calibrate::images_per_pose(c.projector.width_px, c.projector.height_px)
+            << " images each, " << c.camera.pinhole.width_px << "x" << c.camera.pinhole.height_px << ") and the truth to " << *out
+            << "\nnext: projbot calibrate solve " << *out << " --out calib.yaml\n";
+  return 0;
+}
+
+std::pair<int, int> parse_size(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 8 || h < 8 || w > 16384 || h > 16384)
+    throw cli::UsageError("--projector '" + text + "': expected WIDTHxHEIGHT in pixels, e.g. 1280x800");
+  return {w, h};
+}
+
+void print_result(const calibrate::Calibration& c) {
+  std::cout << std::fixed << std::setprecision(3);
+  for (const auto& v : c.views) {
+    std::cout << "  " << std::left << std::setw(12) << v.folder << std::right << std::setw(4) << v.corners << " corners, "
+              << std::setw(3) << v.projector_corners << " in the projector";
+    if (v.refused.empty())
+      std::cout << ", RMS camera " << v.camera_rms_px << " px, projector " << v.projector_rms_px << " px\n";
+    else
+      std::cout << ", refused: " << v.refused << '\n';
+  }
+  const auto& p = c.projector.pinhole;
+  const auto& k = c.camera.pinhole;
+  std::cout << "projector " << p.width_px << "x" << p.height_px << ": fx " << p.fx_px << " fy " << p.fy_px << " cx " << p.cx_px
+            << " cy " << p.cy_px << "\ncamera " << k.width_px << "x" << k.height_px << ": fx " << k.fx_px << " fy " << k.fy_px
+            << " cx " << k.cx_px << " cy " << k.cy_px << ", k1 " << c.camera.distortion[0] << " k2 " << c.camera.distortion[1]
+            << "\nT_cp (mm): " << std::setprecision(2) << 1000 * c.T_projector_camera(0, 3) << ", "
+            << 1000 * c.T_projector_camera(1, 3) << ", " << 1000 * c.T_projector_camera(2, 3) << std::setprecision(3)
+            << "\nreprojection RMS: camera " << c.camera_rms_px << " px, projector " << c.projector_rms_px
+            << " px; corners cover " << std::setprecision(0) << 100 * c.projector_coverage << " % of the projector's image\n";
+  for (const auto& w : c.warnings) std::cout << "warning: " << w << '\n';
+}
+
+// The solve beside the truth a simulated capture carries.
+void print_truth(const calibrate::Calibration& c, const calibrate::Calibration& t) {
+  const auto pct = [](double a, double b) { return 100.0 * std::abs(a - b) / b; };
+  const auto& p = c.projector.pinhole;
+  const auto& q = t.projector.pinhole;
+  const auto& k = c.camera.pinhole;
+  const auto& l = t.camera.pinhole;
+  const Eigen::Matrix3d dR = c.T_projector_camera.block<3, 3>(0, 0) * t.T_projector_camera.block<3, 3>(0, 0).transpose();
+  const double angle_deg = std::acos(std::clamp((dR.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
+  const double dt_mm = 1000.0 * (c.T_projector_camera.block<3, 1>(0, 3) - t.T_projector_camera.block<3, 1>(0, 3)).norm();
+  std::cout << std::fixed << std::setprecision(3) << "against the truth:\n  projector fx " << pct(p.fx_px, q.fx_px) << " %, fy "
+            << pct(p.fy_px, q.fy_px) << " %, principal point " << std::hypot(p.cx_px - q.cx_px, p.cy_px - q.cy_px)
+            << " px\n  camera fx " << pct(k.fx_px, l.fx_px) << " %, fy " << pct(k.fy_px, l.fy_px) << " %, principal point "
+            << std::hypot(k.cx_px - l.cx_px, k.cy_px - l.cy_px) << " px\n  T_cp " << dt_mm << " mm, R_cp " << angle_deg
+            << " deg\n";
+}
+
+int run_solve(const cli::Args& args) {
+  if (args.positional().size() != 1)
+    throw cli::UsageError("give one capture folder: projbot calibrate solve DIR --out calib.yaml");
+  const std::filesystem::path dir = args.positional().front();
+  const auto out = args.get("out");
+  if (!out) throw cli::UsageError("--out FILE is required");
+  args.check_output_files({"out"});
+  calibrate::SolveOptions o;
+  if (const auto s = args.get("projector")) o.projector_size = parse_size(*s);
+  if (const auto b = args.get("board")) o.board = calibrate::Board::parse(*b);
+  o.projector_distortion = args.flag("projector-distortion");
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<Progress> progress;
+  const calibrate::Calibration c = calibrate::solve(dir, o, [&](int done, int total, const calibrate::ViewResult&) {
+    if (!progress) progress = std::make_unique<Progress>("view", total);
+    progress->step(done);
+  });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  calibrate::write_calibration(c, *out, "solved from " + dir.string());
+  print_result(c);
+  const std::filesystem::path truth = args.get_or("truth", (dir / "truth.yaml").string());
+  std::error_code ec;
+  if (std::filesystem::exists(truth, ec))
+    print_truth(c, calibrate::read_calibration(truth));
+  else if (args.get("truth"))
+    throw cli::UsageError("--truth '" + truth.string() + "': no such file");
+  std::cout << std::setprecision(1) << "solved in " << seconds << " s; wrote " << *out
+            << " (a scene takes it as `calibration: " << std::filesystem::path(*out).filename().string() << "`)\n";
+  return 0;
+}
+
+}  // namespace
+
+const Command kCalibrateSimulate{
+    "calibrate simulate",
+    "the twin's calibration session: a ChArUco board at N poses under the projector's Gray codes",
+    "projbot calibrate simulate --out DIR [--scene FILE] [--poses N] [--board SPEC] [--seed K] [--noise LEVELS]\n\n"
+    "Holds a printed board at N poses in front of the twin's colour camera and projector (the scene's\n"
+    "projector intrinsics and robot.pan_tilt.projector_from_camera are the truth), projects OpenCV's\n"
+    "Gray-code patterns of both axes with their inverses, then white and black, and writes what the\n"
+    "camera sees (640x480 grey PNGs: its lens distortion, blur, noise, the projector's falloff):\n"
+    "  DIR/capture.yaml   projector size, board, the pose folders\n"
+    "  DIR/pose_NN/       the images, in GrayCodePattern::generate() order, then white, then black\n"
+    "  DIR/truth.yaml     the values the images were made with, in calib.yaml's format\n"
+    "Then: projbot calibrate solve DIR --out calib.yaml (it compares itself with truth.yaml).\n",
+    {{"out", "DIR", "the capture folder to write (new or empty)"},
+     {"scene", "FILE", "scene giving the projector and camera (default: assets/scenes/shop.yaml)"},
+     {"poses", "N", "board poses (default 10)"},
+     {"board", "SPEC", std::string("board (default ") + kDefaultBoard + "; or checkerboard:9x7:0.05)"},
+     {"seed", "K", "seed of the poses' jitter and the noise (default 1)"},
+     {"noise", "LEVELS", "camera noise sigma, grey levels (default 1.5)"}},
+    run_simulate};
+
+const Command kCalibrateSolve{
+    "calibrate solve",
+    "projector intrinsics A_p and camera-to-projector R_cp, T_cp from a Gray-code capture folder",
+    "projbot calibrate solve DIR --out calib.yaml [--projector WxH --board SPEC] [--projector-distortion]\n\n"
+    "DIR holds one folder per board pose, each with the Gray-code images in the order OpenCV's\n"
+    "GrayCodePattern::generate() gives them (each bit's pattern then its inverse, columns then rows), then\n"
+    "a white and a black image. With a capture.yaml (projbot calibrate simulate writes one) nothing else is\n"
+    "needed; captures from other tools give the projector size and the board:\n"
+    "  --projector 1024x768 --board checkerboard:9x7:0.025     (9 x 7 inner corners, 25 mm squares)\n"
+    "  --board charuco:10x7:0.06:0.045:DICT_4X4_50             (10 x 7 squares of 60 mm, 45 mm markers)\n"
+    "Per pose: the board's corners in the white image, each pixel's projector position decoded from the\n"
+    "patterns, each corner's projector position from a robust local fit of the decoded pixels around it;\n"
+    "then OpenCV's calibrateCamera for camera and projector and a joint stereoCalibrate. Writes A_p,\n"
+    "R_cp, T_cp (Eq. 2), the camera's intrinsics and distortion, the reprojection RMS per view and in all,\n"
+    "the projector area the corners covered, and warnings. A scene uses it as `calibration: calib.yaml`.\n"
+    "The projector is fitted as a pinhole (the renderer draws one) unless --projector-distortion.\n",
+    {{"out", "FILE", "the calibration to write (YAML)"},
+     {"projector", "WxH", "projector size in pixels (for a folder without capture.yaml)"},
+     {"board", "SPEC", "the board (for a folder without capture.yaml)"},
+     {"projector-distortion", "",
+      "also fit the projector's radial distortion k1, k2 (a scene refuses it until the renderer pre-distorts)"},
+     {"truth", "FILE", "compare with this calibration (default: DIR/truth.yaml when present)"}},
+    run_solve};
+
+}  // namespace projbot::tools
