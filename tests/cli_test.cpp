@@ -750,3 +750,31 @@ TEST_F(CliTest, CalibrateSimulateThenSolveFeedsAScene) {
   EXPECT_EQ(run_projbot("calibrate capture").code, 2);
   EXPECT_EQ(run_projbot("calibrate simulate --out " + cap.string()).code, 1);  // not empty
 }
+
+// tour --calibration: the session projects with the calibration's A_p while the twin's light keeps the
+// scene's. The truth as a calibration changes nothing; a principal point 5 px off (at fx 1400 and about
+// 1.5 m, some 5 mm) shows at the markers.
+TEST_F(CliTest, TourWithACalibrationPaysForItsError) {
+  const std::string pose = "projector_from_camera: {translation: [0, 0.08, 0]}\n";
+  write("truth.yaml", "projector: {width: 1280, height: 800, fx: 1400, fy: 1400, cx: 639.5, cy: 399.5}\n" + pose);
+  write("off.yaml", "projector: {width: 1280, height: 800, fx: 1400, fy: 1400, cx: 644.5, cy: 399.5}\n" + pose);
+  const auto mean_of_visit = [](const std::string& out) {
+    double mean = -1.0;
+    const std::size_t at = out.find("lit at arrival, mean ");
+    if (at != std::string::npos) std::sscanf(out.c_str() + at, "lit at arrival, mean %lf", &mean);
+    return mean;
+  };
+  CliRun r = run_projbot("tour --visits 1 --mode localized --calibration " + (dir_ / "truth.yaml").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("projecting with the calibration"), std::string::npos) << r.output;
+  EXPECT_GT(mean_of_visit(r.output), 0.0) << r.output;
+  EXPECT_LT(mean_of_visit(r.output), 2.5) << r.output;
+  r = run_projbot("tour --visits 1 --mode localized --calibration " + (dir_ / "off.yaml").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_GT(mean_of_visit(r.output), 3.0) << r.output;
+  EXPECT_LT(mean_of_visit(r.output), 9.0) << r.output;
+  write("small.yaml", "projector: {width: 1024, height: 768, fx: 1400, fy: 1400, cx: 511.5, cy: 383.5}\n" + pose);
+  r = run_projbot("tour --visits 1 --calibration " + (dir_ / "small.yaml").string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("a 1024x768 projector, the scene's is 1280x800"), std::string::npos) << r.output;
+}

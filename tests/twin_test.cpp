@@ -40,9 +40,20 @@ class MarkerErrorTest : public ::testing::Test {
   std::vector<PlacedMesh> scene_{{&slab_, T_true_}};
 
   projbot::twin::MarkerError measure(const Eigen::Matrix4d& T_est) const {
-    return projbot::twin::measure_marker(k_, T_est, T_true_, marker_, scene_);
+    return projbot::twin::measure_marker(k_, k_, T_est, T_true_, marker_, scene_);
   }
 };
+
+// A calibration that put the principal point 4 px right of the truth: the content is drawn 4 px right of
+// where the lens sends the marker's ray, so at 1 m with f = 1000 px it lands 4 mm off.
+TEST_F(MarkerErrorTest, MiscalibratedPrincipalPointShiftsTheLight) {
+  projbot::config::ProjectorConfig believed = k_;
+  believed.cx_px += 4.0;
+  const auto e = projbot::twin::measure_marker(believed, k_, T_true_, T_true_, marker_, scene_);
+  EXPECT_DOUBLE_EQ(e.pixel.x(), 604.0);
+  EXPECT_TRUE(e.landed);
+  EXPECT_NEAR(e.error_mm, 4.0, 1e-6);
+}
 
 TEST_F(MarkerErrorTest, ExactPoseLandsOnTheMarker) {
   const auto e = measure(T_true_);

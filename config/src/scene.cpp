@@ -348,8 +348,22 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
     root.fail(node, "calibration", "cannot open '" + path.string() + "': not a file");
   if (std::filesystem::file_size(path, ec) > (1U << 20))
     root.fail(node, "calibration", "'" + path.string() + "' is larger than 1 MB: not a calibration file");
+  std::ifstream probe(path, std::ios::binary);
+  if (!probe) root.fail(node, "calibration", "cannot open '" + path.string() + "'");
+  const ProjectorCalibration c = load_calibration(path);
+  static_cast<Pinhole&>(scene.projector) = c.projector;
+  scene.pan_tilt.T_projector_camera = c.T_projector_camera;
+}
+
+}  // namespace
+
+ProjectorCalibration load_calibration(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw ConfigError(path.string() + ": not a file");
+  if (std::filesystem::file_size(path, ec) > (1U << 20))
+    throw ConfigError(path.string() + ": larger than 1 MB: not a calibration file");
   std::ifstream in(path, std::ios::binary);
-  if (!in) root.fail(node, "calibration", "cannot open '" + path.string() + "'");
+  if (!in) throw ConfigError(path.string() + ": cannot open");
   std::ostringstream text;
   text << in.rdbuf();
   const std::string file = path.string();
@@ -362,7 +376,8 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
   if (!c || c.IsNull()) throw ConfigError(file + ": the calibration file is empty");
   MapReader r(c, "", file);
   MapReader p(r.child("projector", true), "projector", file);
-  ProjectorConfig& k = scene.projector;
+  ProjectorCalibration out;
+  ProjectorConfig k;
   k.width_px = p.get<int>("width", 0, true);
   k.height_px = p.get<int>("height", 0, true);
   k.fx_px = p.get<double>("fx", 0.0, true);
@@ -384,7 +399,8 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
   } catch (const ConfigError& e) {
     r.fail(c["projector"], "", e.what());
   }
-  scene.pan_tilt.T_projector_camera = read_pose(r, "projector_from_camera", "projector_from_camera");
+  out.projector = k;
+  out.T_projector_camera = read_pose(r, "projector_from_camera", "projector_from_camera");
   if (!c["projector_from_camera"]) r.fail(c, "projector_from_camera", "missing required key");
   if (YAML::Node rms = r.child("reprojection_rms_px", false)) {  // what the calibration measured: informational here
     MapReader m(rms, "reprojection_rms_px", file);
@@ -396,9 +412,8 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
   // scene's `camera:`), the projector area covered, the views and warnings. Informational here.
   for (const char* key : {"camera", "projector_coverage", "views", "warnings", "board_poses"}) r.child(key, false);
   r.reject_unknown();
+  return out;
 }
-
-}  // namespace
 
 std::vector<std::string> DevicesConfig::describe() const {
   std::vector<std::string> out;

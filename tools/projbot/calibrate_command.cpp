@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "progress.hpp"
 #include "projbot/calibrate/calibrate.hpp"
 #include "projbot/config/scene.hpp"
@@ -43,11 +44,18 @@ int run_simulate(const cli::Args& args) {
   c.noise_sigma = args.get_double("noise", c.noise_sigma);
   if (!(c.noise_sigma >= 0.0 && c.noise_sigma <= 50.0)) throw cli::UsageError("--noise must be 0..50 grey levels");
   Progress progress("pose", c.poses);
-  calibrate::simulate(c, *out, [&](int done, int) { progress.step(done); });
-  std::cout << "wrote " << c.poses << " board poses (" << calibrate::images_per_pose(c.projector.width_px, c.projector.height_px)
+  catch_interrupts();  // Ctrl-C: the poses rendered so far are written as the capture
+  const int written = calibrate::simulate(
+      c, *out, [&](int done, int) { progress.step(done); }, [] { return interrupted(); });
+  if (written == 0) {
+    std::cerr << "projbot calibrate simulate: interrupted before the first pose; nothing written\n";
+    return interrupt_exit_code();
+  }
+  std::cout << "wrote " << written << " board poses (" << calibrate::images_per_pose(c.projector.width_px, c.projector.height_px)
             << " images each, " << c.camera.pinhole.width_px << "x" << c.camera.pinhole.height_px << ") and the truth to " << *out
             << "\nnext: projbot calibrate solve " << *out << " --out calib.yaml\n";
-  return 0;
+  if (written < c.poses) std::cout << "interrupted after " << written << " of " << c.poses << " poses\n";
+  return interrupted() ? interrupt_exit_code() : 0;
 }
 
 std::pair<int, int> parse_size(const std::string& text) {
@@ -141,7 +149,8 @@ const Command kCalibrateSimulate{
     "  DIR/capture.yaml   projector size, board, the pose folders\n"
     "  DIR/pose_NN/       the images, in GrayCodePattern::generate() order, then white, then black\n"
     "  DIR/truth.yaml     the values the images were made with, in calib.yaml's format\n"
-    "Then: projbot calibrate solve DIR --out calib.yaml (it compares itself with truth.yaml).\n",
+    "Then: projbot calibrate solve DIR --out calib.yaml (it compares itself with truth.yaml).\n"
+    "Ctrl-C writes the poses rendered so far as the capture and exits 130.\n",
     {{"out", "DIR", "the capture folder to write (new or empty)"},
      {"scene", "FILE", "scene giving the projector and camera (default: assets/scenes/shop.yaml)"},
      {"poses", "N", "board poses (default 10)"},

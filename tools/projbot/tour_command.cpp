@@ -68,7 +68,10 @@ const Command kTour{
       "_spectator_end.png after a move)"},
      {"dwell", "S", "simulated seconds of projection per visit in tracking mode or while a target moves (default 3)"},
      {"no-noise", "", "depth without the Kinect v1 noise model"},
-     {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"}},
+     {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"},
+     {"calibration", "FILE",
+      "project with a calibration's A_p and R_cp, T_cp (projbot calibrate solve) while the twin's projector keeps the "
+      "scene's: what the calibration's error costs at the markers"}},
     [](const cli::Args& args) {
       twin::TourOptions o;
       const std::string mode = args.get_or("mode", "tracking");
@@ -91,7 +94,16 @@ const Command kTour{
       args.check_output_folders({"frames"});
       const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
       const auto scene = config::load_scene(scene_path);
-      std::cout << "Tour of " << scene_path << " in " << mode << " mode" << kModeHints.at(mode) << std::endl;
+      if (const auto calibration = args.get("calibration")) {
+        o.calibration = config::load_calibration(*calibration);
+        if (o.calibration->projector.width_px != scene.projector.width_px ||
+            o.calibration->projector.height_px != scene.projector.height_px)
+          throw config::ConfigError(*calibration + ": a " + std::to_string(o.calibration->projector.width_px) + "x" +
+                                    std::to_string(o.calibration->projector.height_px) + " projector, the scene's is " +
+                                    std::to_string(scene.projector.width_px) + "x" + std::to_string(scene.projector.height_px));
+      }
+      std::cout << "Tour of " << scene_path << " in " << mode << " mode" << kModeHints.at(mode)
+                << (o.calibration ? ", projecting with the calibration " + *args.get("calibration") : std::string()) << std::endl;
       catch_interrupts();  // Ctrl-C: stop after the visit in progress, keep the finished ones
       o.stop_requested = [] { return interrupted(); };
       Progress progress("visit", o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size()));

@@ -103,6 +103,12 @@ Board Board::parse(const std::string& spec) {
     if (!dictionaries().contains(b.dictionary))
       throw CalibrationError("board '" + spec + "': unknown ArUco dictionary '" + b.dictionary +
                              "' (DICT_4X4_50 ... DICT_7X7_1000)");
+    // A ChArUco board carries a marker in every other square, each a different one of the dictionary's.
+    const int markers = b.squares_x * b.squares_y / 2;
+    const int available = cv::aruco::getPredefinedDictionary(dictionaries().at(b.dictionary))->bytesList.rows;
+    if (markers > available)
+      throw CalibrationError("board '" + spec + "': " + std::to_string(markers) + " markers, " + b.dictionary + " has " +
+                             std::to_string(available) + "; name a larger dictionary (DICT_4X4_1000)");
   }
   return b;
 }

@@ -219,7 +219,8 @@ static std::vector<Eigen::Matrix4d> board_poses(const SimulationConfig& c, const
   return poses;
 }
 
-void simulate(const SimulationConfig& c, const std::filesystem::path& out, const std::function<void(int, int)>& progress) {
+int simulate(const SimulationConfig& c, const std::filesystem::path& out, const std::function<void(int, int)>& progress,
+             const std::function<bool()>& stop) {
   if (c.poses < 1 || c.poses > 100) throw CalibrationError("simulate: poses must be 1..100");
   const Geometry g = board_geometry(c.board);
   const std::vector<Eigen::Matrix4d> poses = board_poses(c, g);
@@ -227,7 +228,7 @@ void simulate(const SimulationConfig& c, const std::filesystem::path& out, const
   const std::vector<cv::Point2d> rays = sample_rays(c.camera);
   CaptureWriter writer(out);
   CaptureManifest manifest{c.projector.width_px, c.projector.height_px, c.board, {}};
-  for (int i = 0; i < c.poses; ++i) {
+  for (int i = 0; i < c.poses && !(stop && stop()); ++i) {
     const std::vector<Sample> samples = trace(c, g, rays, poses[static_cast<std::size_t>(i)]);
     std::mt19937_64 rng(c.seed * 1000003u + static_cast<std::uint64_t>(i));
     std::vector<cv::Mat> images;
@@ -235,12 +236,15 @@ void simulate(const SimulationConfig& c, const std::filesystem::path& out, const
     manifest.folders.push_back(writer.write_pose(i, images));
     if (progress) progress(i + 1, c.poses);
   }
+  const int written = static_cast<int>(manifest.folders.size());
+  if (written == 0) return 0;  // stopped before the first pose: the writer removes its folder
   Calibration truth;
   truth.camera = c.camera;
   truth.projector = Lens{c.projector, {}};
   truth.T_projector_camera = c.T_projector_camera;
-  truth.T_camera_board = poses;
+  truth.T_camera_board.assign(poses.begin(), poses.begin() + written);
   writer.finish(manifest, truth);
+  return written;
 }
 
 }  // namespace projbot::calibrate

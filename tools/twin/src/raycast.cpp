@@ -104,8 +104,9 @@ std::optional<Eigen::Vector3d> cast_ray(std::span<const PlacedMesh> scene, const
   return Eigen::Vector3d(origin + best * direction);
 }
 
-MarkerError measure_marker(const config::ProjectorConfig& k, const Eigen::Matrix4d& T_est, const Eigen::Matrix4d& T_true,
-                           const Eigen::Vector3d& marker_m, std::span<const PlacedMesh> true_scene) {
+MarkerError measure_marker(const config::Pinhole& k, const config::Pinhole& light, const Eigen::Matrix4d& T_est,
+                           const Eigen::Matrix4d& T_true, const Eigen::Vector3d& marker_m,
+                           std::span<const PlacedMesh> true_scene) {
   MarkerError e;
   e.marker_m = marker_m;
   const Eigen::Vector3d truth = (T_true * marker_m.homogeneous()).head<3>();
@@ -115,7 +116,7 @@ MarkerError measure_marker(const config::ProjectorConfig& k, const Eigen::Matrix
   if (drawn.z() > 0.0) {
     e.pixel = k.project(drawn).array().round();
     e.in_image = e.pixel.x() >= 0 && e.pixel.y() >= 0 && e.pixel.x() < k.width_px && e.pixel.y() < k.height_px;
-    ray = {(e.pixel.x() - k.cx_px) / k.fx_px, (e.pixel.y() - k.cy_px) / k.fy_px, 1.0};
+    ray = light.back_project(e.pixel.x(), e.pixel.y(), 1.0);
   }
   const Eigen::Vector3d d = ray.normalized();
   if (e.in_image) {

@@ -37,11 +37,23 @@ bool lit_by(const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
   return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < k.width_px && x.y() < k.height_px;
 }
 
+// The projector as the twin's light follows it (the scene's: the truth) and as the session believes it
+// (a calibration's A_p and R_cp, T_cp when the tour is given one; else the truth): Eq. 2 and the
+// drawing use what the session believes.
+struct ProjectorModels {
+  config::ProjectorConfig truth, believed;
+  Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();  // believed R_cp, T_cp
+  Eigen::Matrix4d projector_from_target(const Eigen::Matrix4d& T_camera_target) const {
+    return alignment::projector_from_target(T_projector_camera, T_camera_target);  // Eq. 2
+  }
+};
+
 // The error at the target's markers. A marker the projector cannot light (outside its image, turned
 // away, or hidden by the target itself or something in front) has no error to measure and is left out; mean and max are
 // NaN when no marker is visible (such frames are left out of the visit's statistics).
-Errors marker_errors(const Twin& twin, std::size_t target, const config::ProjectorConfig& projector,
-                     const Eigen::Matrix4d& T_world_projector, const Eigen::Matrix4d& T_projector_target_estimated) {
+Errors marker_errors(const Twin& twin, std::size_t target, const ProjectorModels& projector,
+                     const Eigen::Matrix4d& T_world_projector, const Eigen::Matrix4d& T_camera_target_estimated) {
+  const Eigen::Matrix4d T_projector_target_estimated = projector.projector_from_target(T_camera_target_estimated);
   const Eigen::Matrix4d T_projector_world = alignment::rigid_inverse(T_world_projector);
   const auto scene = twin.true_scene(T_projector_world);
   const TwinTarget& t = twin.targets()[target];
@@ -50,10 +62,10 @@ Errors marker_errors(const Twin& twin, std::size_t target, const config::Project
   int visible = 0;
   for (const auto& m : t.config.markers_m) {
     const Eigen::Vector3d truth = (T_true * m.homogeneous()).head<3>();
-    if (!lit_by(projector, truth)) continue;  // outside the projector's image: it cannot be lit
+    if (!lit_by(projector.truth, truth)) continue;  // outside the projector's image: it cannot be lit
     const auto first = cast_ray(scene, Eigen::Vector3d::Zero(), truth.normalized());
     if (!first || (*first - truth).norm() > 0.002) continue;
-    e.markers.push_back(measure_marker(projector, T_projector_target_estimated, T_true, m, scene));
+    e.markers.push_back(measure_marker(projector.believed, projector.truth, T_projector_target_estimated, T_true, m, scene));
     e.mean_mm += e.markers.back().error_mm;
     e.max_mm = std::max(e.max_mm, e.markers.back().error_mm);
     ++visible;
@@ -143,6 +155,7 @@ struct DwellContext {
   Twin& twin;
   std::size_t target;
   const config::ProjectorConfig& projector;
+  const ProjectorModels& models;
   const robot::HeadPoses& truth;
   const TourOptions& options;
   std::uint32_t noise_seed;
@@ -239,9 +252,7 @@ TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double
   s.age_ms = 1000.0 * (display_s - drawn.capture_time_s);
   s.in_world = target.in_world;
   const Eigen::Matrix4d T_camera_target = predict ? alignment::predict_pose(drawn.motion, display_s) : drawn.T_camera_target;
-  const Eigen::Matrix4d& T_projector_camera = c.twin.scene().pan_tilt.T_projector_camera;
-  const Errors e = marker_errors(c.twin, c.target, c.projector, c.truth.T_world_projector.matrix(),
-                                 alignment::projector_from_target(T_projector_camera, T_camera_target));
+  const Errors e = marker_errors(c.twin, c.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
   s.mean_mm = e.mean_mm;
   s.max_mm = e.max_mm;
   return s;
@@ -253,8 +264,7 @@ void measure_neighbour(const DwellContext& c, NeighbourLight& n, double display_
   if (!n.shown) return count_frame(n, std::nan(""));
   const Eigen::Matrix4d T_camera_target =
       c.options.predict ? alignment::predict_pose(n.drawn.motion, display_s) : n.drawn.T_camera_target;
-  const Errors e = marker_errors(c.twin, n.target, c.projector, c.truth.T_world_projector.matrix(),
-                                 alignment::projector_from_target(c.twin.scene().pan_tilt.T_projector_camera, T_camera_target));
+  const Errors e = marker_errors(c.twin, n.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
   count_frame(n, e.mean_mm);
 }
 
@@ -365,7 +375,7 @@ bool dwell(const DwellContext& c, const std::vector<alignment::TargetFollower*>&
 // the visited target is, and its error at the markers measured.
 NeighbourLight acquire_neighbour(TourMode mode, const Twin& twin, alignment::TargetFollower& follower, std::size_t target,
                                  const session::LitTarget& n, const robot::HeadPoses& truth, const alignment::DepthImage& depth,
-                                 const std::optional<assets::Image>& colour) {
+                                 const std::optional<assets::Image>& colour, const ProjectorModels& models) {
   const TwinTarget& t = twin.targets()[target];
   VisitReport scratch;
   acquire(mode, follower, twin, depth, n.T_camera_target_guess, n.footing, colour ? &*colour : nullptr, scratch);
@@ -378,9 +388,7 @@ NeighbourLight acquire_neighbour(TourMode mode, const Twin& twin, alignment::Tar
   r.projected = scratch.projected;
   r.align_ms = scratch.align_ms;
   std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth, t, n.T_camera_target_guess);
-  const Errors e =
-      marker_errors(twin, target, twin.scene().projector, truth.T_world_projector.matrix(),
-                    alignment::projector_from_target(twin.scene().pan_tilt.T_projector_camera, scratch.icp.T_scan_model));
+  const Errors e = marker_errors(twin, target, models, truth.T_world_projector.matrix(), scratch.icp.T_scan_model);
   r.mean_mm = e.mean_mm;
   r.max_mm = e.max_mm;
   count_frame(l, e.mean_mm);  // the arrival's frame
@@ -424,7 +432,11 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   twin_options.depth_noise = options.depth_noise;
   Twin twin(scene, twin_options, renderer);
   auto& targets = twin.targets();
-  const config::PanTiltConfig& rig = scene.pan_tilt;
+  ProjectorModels models{scene.projector, scene.projector, scene.pan_tilt.T_projector_camera};
+  if (options.calibration) {
+    static_cast<config::Pinhole&>(models.believed) = options.calibration->projector;
+    models.T_projector_camera = options.calibration->T_projector_camera;
+  }
 
   // The paper aligned once per stop with plain ICP from the initial guess; ours is point-to-plane, coarse
   // to fine, rejects correspondences whose normals disagree, and adds local restarts, FPFH
@@ -489,10 +501,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
       std::vector<engine::DrawItem> items;
       if (lit) items.push_back({twin.target_model_ids()[i], T_projector_target});
       for (const NeighbourLight& n : lights)
-        if (n.shown)
-          items.push_back({twin.target_model_ids()[n.target],
-                           alignment::projector_from_target(rig.T_projector_camera, n.drawn.T_camera_target)});
-      renderer.draw_frame(*projector_frame, scene.projector, items);
+        if (n.shown) items.push_back({twin.target_model_ids()[n.target], models.projector_from_target(n.drawn.T_camera_target)});
+      renderer.draw_frame(*projector_frame, models.believed, items);
       return projector_frame->read_back();
     };
     const auto spectator_at = [&](const TwinTarget& t) {
@@ -516,16 +526,16 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     acquire(options.mode, followers[i], twin, depth, T_init, visited.footing, colour ? &*colour : nullptr, r);
     const Eigen::Matrix4d T_world_projector = truth.T_world_projector.matrix();
     r.view = alignment::view_constraints(target.cloud, r.icp.T_scan_model, twin.camera());
-    r.T_projector_target_estimated = alignment::projector_from_target(rig.T_projector_camera, r.icp.T_scan_model);
+    r.T_projector_target_estimated = models.projector_from_target(r.icp.T_scan_model);
     r.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;
-    Errors e = marker_errors(twin, i, scene.projector, T_world_projector, r.T_projector_target_estimated);
+    Errors e = marker_errors(twin, i, models, T_world_projector, r.icp.T_scan_model);
     r.markers = e.markers;
     r.mean_mm = e.mean_mm;
     r.max_mm = e.max_mm;
     for (std::size_t k = 1; k < arrival.lit.size(); ++k) {
       const session::LitTarget& n = arrival.lit[k];
       const std::size_t j = twin.target_index(scene.targets[static_cast<std::size_t>(n.target)].name);
-      lights.push_back(acquire_neighbour(options.mode, twin, followers[j], j, n, truth, depth, colour));
+      lights.push_back(acquire_neighbour(options.mode, twin, followers[j], j, n, truth, depth, colour, models));
     }
 
     if (projector_frame) {
@@ -547,14 +557,13 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     if (options.mode == TourMode::tracking || r.moved) {
       std::vector<alignment::TargetFollower*> lanes{&followers[i]};
       for (const NeighbourLight& n : lights) lanes.push_back(&followers[n.target]);
-      report.interrupted = !dwell(DwellContext{twin, i, scene.projector, truth, options, noise_seed, lights}, lanes, r);
+      report.interrupted = !dwell(DwellContext{twin, i, scene.projector, models, truth, options, noise_seed, lights}, lanes, r);
     }
     for (const NeighbourLight& l : lights) r.neighbours.push_back(finished(l));
     if (spectator && r.moved && !report.interrupted) {
       // A moved target: what the visitor sees at the end of the dwell, where the target went and where
       // the light went (followed, or left where the target was).
-      const auto image =
-          projector_image(r.shown_at_end, alignment::projector_from_target(rig.T_projector_camera, r.T_camera_target_at_end));
+      const auto image = projector_image(r.shown_at_end, models.projector_from_target(r.T_camera_target_at_end));
       assets::write_png(frame_path(options, r, "_spectator_end"),
                         spectator->draw(twin, spectator_at(target), T_world_projector, image));
     }

@@ -162,6 +162,15 @@ struct Scene {
 /// Reads and validates a scene file. Throws ConfigError naming file:line and the key path.
 Scene load_scene(const std::filesystem::path& path);
 
+/// What a calibration file (`projbot calibrate solve`'s calib.yaml) gives: the projector's pinhole A_p
+/// and the camera-to-projector pose R_cp, T_cp (X_p = R_cp X_c + T_cp, Eq. 2).
+struct ProjectorCalibration {
+  Pinhole projector;
+  Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();
+};
+/// Reads and validates one (a scene's `calibration:` reads it so). Throws ConfigError naming file:line.
+ProjectorCalibration load_calibration(const std::filesystem::path& path);
+
 /// Parses scene YAML text; `source` names it in errors and resolves relative model paths.
 Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& source);
 

@@ -73,9 +73,10 @@ struct SimulationConfig {
 };
 
 /// Writes a capture folder (capture.yaml, pose_NN/NN.png, truth.yaml with the values it was made
-/// with). `progress(pose)` is called after each pose. Throws CalibrationError.
-void simulate(const SimulationConfig& config, const std::filesystem::path& out,
-              const std::function<void(int pose, int poses)>& progress = {});
+/// with); returns the poses written. `progress(pose)` is called after each pose; when `stop()` says so
+/// the poses finished so far are written as the capture (none: nothing is). Throws CalibrationError.
+int simulate(const SimulationConfig& config, const std::filesystem::path& out,
+             const std::function<void(int pose, int poses)>& progress = {}, const std::function<bool()>& stop = {});
 
 /// What `solve` needs beyond the folder: given on the command line for captures made with other
 /// tools (no capture.yaml), else read from capture.yaml.

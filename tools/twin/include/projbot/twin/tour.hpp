@@ -48,6 +48,10 @@ struct TourOptions {
   std::function<bool()> stop_requested;
   /// Called with each visit as it finishes (progress for a person watching).
   std::function<void(const VisitReport&)> on_visit;
+  /// The session's projector from a calibration (issue 13): Eq. 2 and the drawing use its A_p and R_cp,
+  /// T_cp while the twin's light keeps the scene's, the truth, so the markers show what the calibration's
+  /// error costs. Unset: the session knows the truth.
+  std::optional<config::ProjectorCalibration> calibration;
 };
 
 /// The projection error of one projector frame while projecting, at its display time.
