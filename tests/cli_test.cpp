@@ -778,3 +778,28 @@ TEST_F(CliTest, TourWithACalibrationPaysForItsError) {
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("a 1024x768 projector, the scene's is 1280x800"), std::string::npos) << r.output;
 }
+
+// Ctrl-C in calibrate simulate: the poses rendered so far become the capture, nothing half-written stays.
+TEST_F(CliTest, CalibrateSimulateKeepsTheFinishedPosesOnCtrlC) {
+  const fs::path cap = dir_ / "cap";
+  Background sim({"calibrate", "simulate", "--poses", "30", "--out", cap.string()}, dir_ / "sim.log");
+  ASSERT_GT(sim.pid, 0);
+  const fs::path second = dir_ / (".cap.partial-" + std::to_string(sim.pid)) / "pose_01";
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(second) && std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(fs::exists(second)) << sim.output();
+  const auto [code, seconds] = sim.signal_and_wait(SIGINT, std::chrono::seconds(60));
+  EXPECT_EQ(code, 130) << sim.output();
+  EXPECT_NE(sim.output().find("interrupted after"), std::string::npos) << sim.output();
+  std::ifstream manifest(cap / "capture.yaml");
+  std::string text((std::istreambuf_iterator<char>(manifest)), std::istreambuf_iterator<char>());
+  int poses = 0;
+  for (std::size_t at = 0; (at = text.find("  - pose_", at)) != std::string::npos; ++at) ++poses;
+  EXPECT_GE(poses, 1) << text;
+  EXPECT_LT(poses, 30) << text;
+  for (int i = 0; i < poses; ++i)
+    EXPECT_TRUE(fs::exists(cap / ((i < 10 ? "pose_0" : "pose_") + std::to_string(i)) / "43.png")) << i;
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find(".cap.partial"), std::string::npos) << e.path();
+}
