@@ -266,3 +266,34 @@ TEST(Solve, NamesMissingAndMismatchedImages) {
   EXPECT_NE(error_of([&] { simulate(twin_config(1), dir); }).find("exists and is not an empty folder"), std::string::npos);
   fs::remove_all(root);
 }
+
+// A person's script gives the poses: they are used as given (the truth has them), and one that takes the
+// board out of the views is refused by its number.
+TEST(Simulate, HoldsTheBoardWhereAScriptSays) {
+  const fs::path root = temp_dir("script");
+  std::ofstream(root / "poses.yaml")
+      << "poses:\n  - {centre: [0.0, -0.05, 1.1], tilt_deg: [15, -20, 5]}\n  - {centre: [0.05, -0.02, 0.9]}\n";
+  const std::vector<BoardPose> script = read_board_poses(root / "poses.yaml");
+  ASSERT_EQ(script.size(), 2u);
+  SimulationConfig c = twin_config(10);
+  c.scripted = script;
+  EXPECT_EQ(simulate(c, root / "capture"), 2);
+  const Calibration truth = read_calibration(root / "capture" / "truth.yaml");
+  ASSERT_EQ(truth.T_camera_board.size(), 2u);
+  // Pose 2 faces the camera: its rotation is the board frame's face-on one, tilted by nothing.
+  const Eigen::Matrix3d R = truth.T_camera_board[1].block<3, 3>(0, 0);
+  EXPECT_NEAR(std::abs(R(0, 0)), 1.0, 1e-9);
+  EXPECT_NEAR(std::abs(R(2, 2)), 1.0, 1e-9);
+  // The middle of the squares is where the script put it.
+  const Board& b = c.board;
+  const Eigen::Vector4d middle_board = truth.T_camera_board[1].inverse() * Eigen::Vector4d(0.05, -0.02, 0.9, 1.0);
+  EXPECT_NEAR(std::abs(middle_board.z()), 0.0, 1e-9);
+  EXPECT_NEAR(std::abs(middle_board.x()), b.width_m() / 2, 0.002);
+  std::ofstream(root / "far.yaml") << "poses:\n  - {centre: [0, 0, 1]}\n  - {centre: [0.9, 0, 1]}\n";
+  c.scripted = read_board_poses(root / "far.yaml");
+  EXPECT_NE(error_of([&] { simulate(c, root / "capture2"); }).find("board pose 2 of 2"), std::string::npos);
+  EXPECT_FALSE(fs::exists(root / "capture2"));
+  std::ofstream(root / "bad.yaml") << "poses:\n  - {centre: [0, 0]}\n";
+  EXPECT_NE(error_of([&] { read_board_poses(root / "bad.yaml"); }).find("centre: expected 3 numbers"), std::string::npos);
+  fs::remove_all(root);
+}

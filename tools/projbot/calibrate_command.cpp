@@ -36,6 +36,11 @@ int run_simulate(const cli::Args& args) {
   const config::Scene scene = config::load_scene(scene_path);
   calibrate::SimulationConfig c;
   c.poses = args.get_int("poses", 10, 1, 100);
+  if (const auto file = args.get("poses-file")) {
+    if (args.get("poses")) throw cli::UsageError("give --poses or --poses-file, not both");
+    c.scripted = calibrate::read_board_poses(*file);
+    c.poses = static_cast<int>(c.scripted.size());
+  }
   c.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
   c.board = calibrate::Board::parse(args.get_or("board", kDefaultBoard));
   c.camera = twin_colour_lens(scene);
@@ -141,7 +146,7 @@ int run_solve(const cli::Args& args) {
 const Command kCalibrateSimulate{
     "calibrate simulate",
     "the twin's calibration session: a ChArUco board at N poses under the projector's Gray codes",
-    "projbot calibrate simulate --out DIR [--scene FILE] [--poses N] [--board SPEC] [--seed K] [--noise LEVELS]\n\n"
+    "projbot calibrate simulate --out DIR [--scene FILE] [--poses N | --poses-file FILE] [--board SPEC] [--seed K]\n\n"
     "Holds a printed board at N poses in front of the twin's colour camera and projector (the scene's\n"
     "projector intrinsics and robot.pan_tilt.projector_from_camera are the truth), projects OpenCV's\n"
     "Gray-code patterns of both axes with their inverses, then white and black, and writes what the\n"
@@ -153,7 +158,9 @@ const Command kCalibrateSimulate{
     "Ctrl-C writes the poses rendered so far as the capture and exits 130.\n",
     {{"out", "DIR", "the capture folder to write (new or empty)"},
      {"scene", "FILE", "scene giving the projector and camera (default: assets/scenes/shop.yaml)"},
-     {"poses", "N", "board poses (default 10)"},
+     {"poses", "N", "board poses (default 10), spread over the projector's image, 0.8-1.3 m, tilted up to 30 degrees"},
+     {"poses-file", "FILE",
+      "the board's poses from a script: poses: [{centre: [x, y, z], tilt_deg: [a, b, c]}, ...] (camera frame)"},
      {"board", "SPEC", std::string("board (default ") + kDefaultBoard + "; or checkerboard:9x7:0.05)"},
      {"seed", "K", "seed of the poses' jitter and the noise (default 1)"},
      {"noise", "LEVELS", "camera noise sigma, grey levels (default 1.5)"}},

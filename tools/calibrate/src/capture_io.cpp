@@ -172,6 +172,34 @@ CaptureManifest read_manifest(const fs::path& dir, const SolveOptions& options) 
   return m;
 }
 
+std::vector<BoardPose> read_board_poses(const fs::path& path) {
+  std::vector<BoardPose> out;
+  try {
+    const YAML::Node y = YAML::LoadFile(path.string());
+    if (!y.IsMap() || !y["poses"] || !y["poses"].IsSequence() || y["poses"].size() == 0)
+      throw CalibrationError(path.string() + ": expected 'poses: [{centre: [x, y, z], tilt_deg: [a, b, c]}, ...]'");
+    for (const auto& p : y["poses"]) {
+      BoardPose b;
+      const auto vec = [&](const char* key, Eigen::Vector3d& v) {
+        const YAML::Node n = p[key];
+        if (!n.IsSequence() || n.size() != 3)
+          throw CalibrationError(path.string() + ":" + std::to_string(p.Mark().line + 1) + ": " + key + ": expected 3 numbers");
+        for (std::size_t k = 0; k < 3; ++k) v[static_cast<Eigen::Index>(k)] = n[k].as<double>();
+        if (!v.allFinite()) throw CalibrationError(path.string() + ": " + key + " is not finite");
+      };
+      vec("centre", b.centre_m);
+      if (p["tilt_deg"]) vec("tilt_deg", b.tilt_deg);
+      if (b.centre_m.z() <= 0.1)
+        throw CalibrationError(path.string() + ":" + std::to_string(p.Mark().line + 1) +
+                               ": centre must lie in front of the camera (z > 0.1 m)");
+      out.push_back(b);
+    }
+  } catch (const YAML::Exception& e) {
+    throw CalibrationError(path.string() + ": " + e.what());
+  }
+  return out;
+}
+
 std::vector<cv::Mat> read_pose(const fs::path& folder, std::size_t expected) {
   const std::vector<fs::path> files = images_in(folder);
   if (files.size() != expected)

@@ -7,6 +7,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <random>
 
 #include "capture_io.hpp"
@@ -78,36 +79,52 @@ float board_albedo(const Geometry& g, const Eigen::Vector2d& p) {
   return static_cast<float>(0.05 + 0.80 * v / 255.0);
 }
 
-std::vector<Sample> trace(const SimulationConfig& c, const Geometry& g, const std::vector<cv::Point2d>& rays,
-                          const Eigen::Matrix4d& T_camera_board) {
+// Where the segment from `from` along `dir` (scaled: 0 < s < max_s) meets the board's paper, in
+// drawing pixels; empty when it does not.
+std::optional<Eigen::Vector2d> hit_paper(const Geometry& g, const Eigen::Matrix4d& T_camera_board, const Eigen::Vector3d& from,
+                                         const Eigen::Vector3d& dir, double max_s, double& s_hit) {
   const Eigen::Matrix3d R = T_camera_board.block<3, 3>(0, 0);
   const Eigen::Vector3d t = T_camera_board.block<3, 1>(0, 3), n = R.col(2);
+  const double along = n.dot(dir);
+  if (std::abs(along) < 1e-12) return std::nullopt;
+  s_hit = n.dot(t - from) / along;
+  if (!(s_hit > 1e-9 && s_hit < max_s)) return std::nullopt;
+  const Eigen::Vector3d b = R.transpose() * (from + dir * s_hit - t);
   const cv::Matx23d& A = g.board.board_to_pixel;
+  const Eigen::Vector2d px(A(0, 0) * b.x() + A(0, 1) * b.y() + A(0, 2), A(1, 0) * b.x() + A(1, 1) * b.y() + A(1, 2));
+  if (!((px.array() >= g.paper_min.array()).all() && (px.array() <= g.paper_max.array()).all())) return std::nullopt;
+  return px;
+}
+
+std::vector<Sample> trace(const SimulationConfig& c, const Geometry& g, const std::vector<cv::Point2d>& rays,
+                          const Eigen::Matrix4d& T_camera_board) {
+  const Eigen::Vector3d n = T_camera_board.block<3, 1>(0, 2);
   const Eigen::Matrix3d R_pc = c.T_projector_camera.block<3, 3>(0, 0);
   const Eigen::Vector3d t_pc = c.T_projector_camera.block<3, 1>(0, 3);
+  const Eigen::Vector3d projector_centre = R_pc.transpose() * (-t_pc);
   std::vector<Sample> out(rays.size());
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const Eigen::Vector3d d(rays[i].x, rays[i].y, 1.0);
     Sample& s = out[i];
     Eigen::Vector3d P = d * kWallZ, normal(0, 0, -1);
     s.albedo = 0.5f;
-    const double s_board = n.dot(t) / n.dot(d);
-    if (s_board > 0.0 && s_board < kWallZ) {
-      const Eigen::Vector3d b = R.transpose() * (d * s_board - t);
-      const Eigen::Vector2d px(A(0, 0) * b.x() + A(0, 1) * b.y() + A(0, 2), A(1, 0) * b.x() + A(1, 1) * b.y() + A(1, 2));
-      if ((px.array() >= g.paper_min.array()).all() && (px.array() <= g.paper_max.array()).all()) {
-        P = d * s_board;
-        normal = n;
-        const bool printed =
-            px.x() >= -0.5 && px.y() >= -0.5 && px.x() <= g.board.image.cols - 0.5 && px.y() <= g.board.image.rows - 0.5;
-        s.albedo = printed ? board_albedo(g, px) : 0.85f;
-      }
+    double s_board = 0.0;
+    bool on_board = false;
+    if (const auto px = hit_paper(g, T_camera_board, Eigen::Vector3d::Zero(), d, kWallZ, s_board)) {
+      P = d * s_board;
+      normal = n;
+      on_board = true;
+      const bool printed =
+          px->x() >= -0.5 && px->y() >= -0.5 && px->x() <= g.board.image.cols - 0.5 && px->y() <= g.board.image.rows - 0.5;
+      s.albedo = printed ? board_albedo(g, *px) : 0.85f;
     }
     const Eigen::Vector3d Pp = R_pc * P + t_pc;
     if (Pp.z() <= 0.0) continue;
     int u = 0, v = 0;
     if (!c.projector.nearest_pixel(Pp, u, v)) continue;
-    const Eigen::Vector3d to_projector = (R_pc.transpose() * (-t_pc) - P).normalized();
+    double s_shadow = 0.0;  // the board's shadow on the wall: the light to this point passes through the paper
+    if (!on_board && hit_paper(g, T_camera_board, P, projector_centre - P, 1.0, s_shadow)) continue;
+    const Eigen::Vector3d to_projector = (projector_centre - P).normalized();
     s.falloff = static_cast<float>(std::abs(normal.dot(to_projector)) / Pp.squaredNorm());
     s.projector_index = v * c.projector.width_px + u;
   }
@@ -189,6 +206,17 @@ static std::vector<Eigen::Matrix4d> board_poses(const SimulationConfig& c, const
   std::mt19937_64 rng(c.seed);
   std::uniform_real_distribution<double> jitter(-1.0, 1.0);
   std::vector<Eigen::Matrix4d> poses;
+  for (std::size_t i = 0; i < c.scripted.size(); ++i) {
+    const BoardPose& p = c.scripted[i];
+    Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+    T.block<3, 3>(0, 0) = tilt(p.tilt_deg.x(), p.tilt_deg.y(), p.tilt_deg.z()) * g.R0;
+    T.block<3, 1>(0, 3) = p.centre_m - T.block<3, 3>(0, 0) * Eigen::Vector3d(g.centre.x(), g.centre.y(), 0.0);
+    if (!pose_fits(c, g, T))
+      throw CalibrationError("board pose " + std::to_string(i + 1) + " of " + std::to_string(c.scripted.size()) + ": the board " +
+                             c.board.spec() + " is not wholly inside both the camera's and the projector's views");
+    poses.push_back(T);
+  }
+  if (!c.scripted.empty()) return poses;
   for (int i = 0; i < c.poses; ++i) {
     const double* s = kSpread[i % 9];
     double z = 0.8 + 0.5 * ((i * 7) % 10) / 9.0;
@@ -221,20 +249,22 @@ static std::vector<Eigen::Matrix4d> board_poses(const SimulationConfig& c, const
 
 int simulate(const SimulationConfig& c, const std::filesystem::path& out, const std::function<void(int, int)>& progress,
              const std::function<bool()>& stop) {
-  if (c.poses < 1 || c.poses > 100) throw CalibrationError("simulate: poses must be 1..100");
+  if (c.scripted.empty() && (c.poses < 1 || c.poses > 100)) throw CalibrationError("simulate: poses must be 1..100");
+  if (c.scripted.size() > 100) throw CalibrationError("simulate: at most 100 board poses");
   const Geometry g = board_geometry(c.board);
   const std::vector<Eigen::Matrix4d> poses = board_poses(c, g);
+  const int count = static_cast<int>(poses.size());
   const std::vector<cv::Mat> patterns = gray_code_images(c.projector.width_px, c.projector.height_px);
   const std::vector<cv::Point2d> rays = sample_rays(c.camera);
   CaptureWriter writer(out);
   CaptureManifest manifest{c.projector.width_px, c.projector.height_px, c.board, {}};
-  for (int i = 0; i < c.poses && !(stop && stop()); ++i) {
+  for (int i = 0; i < count && !(stop && stop()); ++i) {
     const std::vector<Sample> samples = trace(c, g, rays, poses[static_cast<std::size_t>(i)]);
     std::mt19937_64 rng(c.seed * 1000003u + static_cast<std::uint64_t>(i));
     std::vector<cv::Mat> images;
     for (const cv::Mat& pattern : patterns) images.push_back(expose(c, samples, pattern, rng));
     manifest.folders.push_back(writer.write_pose(i, images));
-    if (progress) progress(i + 1, c.poses);
+    if (progress) progress(i + 1, count);
   }
   const int written = static_cast<int>(manifest.folders.size());
   if (written == 0) return 0;  // stopped before the first pose: the writer removes its folder

@@ -56,12 +56,23 @@ struct Lens {
 /// and black.
 int images_per_pose(int projector_width, int projector_height);
 
+/// A board pose a person's script gives: the middle of the board's squares in the colour camera's frame
+/// (x right, y down, z forward; metres) and its tilt away from facing the camera, degrees about the
+/// camera's x, y and z axes (R = Rx Ry Rz).
+struct BoardPose {
+  Eigen::Vector3d centre_m = Eigen::Vector3d(0, 0, 1);
+  Eigen::Vector3d tilt_deg = Eigen::Vector3d::Zero();
+};
+/// Reads `poses: [{centre: [x, y, z], tilt_deg: [a, b, c]}, ...]`. Throws CalibrationError naming the file.
+std::vector<BoardPose> read_board_poses(const std::filesystem::path& path);
+
 /// The twin's calibration session: a board held at `poses` poses in front of the camera and projector
 /// (a deterministic spread over the projector's image, 0.8-1.3 m, tilted up to 30 degrees), the
 /// projector's patterns falling on it (inverse-square and incidence falloff over room light), seen by
 /// the colour camera through its lens distortion, with blur and sensor noise.
 struct SimulationConfig {
   int poses = 10;
+  std::vector<BoardPose> scripted;  ///< when given, the board is held at these (and `poses` is ignored)
   std::uint64_t seed = 1;
   Board board;
   Lens camera;                                                       ///< the colour camera's truth (pinhole + distortion)
