@@ -729,6 +729,11 @@ TEST_F(CliTest, CalibrateSimulateThenSolveFeedsAScene) {
   EXPECT_LT(rms_camera, 0.3);
   EXPECT_GT(rms_projector, 0.0);
   EXPECT_LT(rms_projector, 0.5);
+  // A full disk: the error names the file, and a device is written in place, never replaced by a file.
+  r = run_projbot("calibrate solve " + cap.string() + " --out /dev/full");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("/dev/full: cannot write"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::is_character_file("/dev/full"));
   // A scene takes the file: render through the calibrated projector.
   write("scene.yaml", "calibration: calib.yaml\ntargets:\n  - {name: duck, model: " + kDuck +
                           ", scale: 1, pose: {translation: [0, 0, 1.2]}}\n");

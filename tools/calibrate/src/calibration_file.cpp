@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "projbot/calibrate/calibrate.hpp"
+#include "projbot/config/output_file.hpp"
 
 namespace projbot::calibrate {
 namespace {
@@ -73,22 +74,7 @@ void write_calibration(const Calibration& c, const std::filesystem::path& path, 
   y << "warnings: [";
   for (std::size_t i = 0; i < c.warnings.size(); ++i) y << (i ? ", " : "") << quoted(c.warnings[i]);
   y << "]\n";
-  const std::filesystem::path temp = path.string() + ".tmp-" + std::to_string(::getpid());
-  std::error_code ec;
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    out << y.str();
-    out.flush();
-    if (!out) {
-      std::filesystem::remove(temp, ec);
-      throw CalibrationError("cannot write '" + path.string() + "'");
-    }
-  }
-  std::filesystem::rename(temp, path, ec);
-  if (ec) {
-    std::filesystem::remove(temp, ec);
-    throw CalibrationError("cannot write '" + path.string() + "': " + ec.message());
-  }
+  config::write_file_atomically(path, y.str());  // a device or FIFO is written in place, never replaced
 }
 
 Calibration read_calibration(const std::filesystem::path& path) {

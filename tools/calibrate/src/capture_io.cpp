@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "projbot/calibrate/procam.hpp"
+#include "projbot/config/output_file.hpp"
 
 namespace projbot::calibrate {
 namespace fs = std::filesystem;
@@ -57,26 +58,6 @@ std::vector<fs::path> images_in(const fs::path& folder) {
   std::sort(out.begin(), out.end(),
             [](const fs::path& a, const fs::path& b) { return natural_less(a.filename().string(), b.filename().string()); });
   return out;
-}
-
-void write_text_atomically(const fs::path& path, const std::string& text) {
-  const fs::path temp = path.string() + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(temp, ec);
-      throw CalibrationError("cannot write '" + path.string() + "'");
-    }
-  }
-  std::error_code ec;
-  fs::rename(temp, path, ec);
-  if (ec) {
-    fs::remove(temp, ec);
-    throw CalibrationError("cannot write '" + path.string() + "': " + ec.message());
-  }
 }
 
 }  // namespace
@@ -125,7 +106,7 @@ void CaptureWriter::finish(const CaptureManifest& m, const std::optional<Calibra
     << "images_per_pose: " << images_per_pose(m.projector_width, m.projector_height) << "\n"
     << "poses:\n";
   for (const std::string& f : m.folders) y << "  - " << f << "\n";
-  write_text_atomically(temp_ / "capture.yaml", y.str());
+  config::write_file_atomically(temp_ / "capture.yaml", y.str());
   if (truth) write_calibration(*truth, temp_ / "truth.yaml", "the truth this capture was simulated with");
   std::error_code ec;
   if (fs::exists(out_, ec)) fs::remove(out_, ec);  // an empty folder, checked at the start
