@@ -1,5 +1,5 @@
-// `solve`: corners in the camera (the white image), their projector positions through the decoded Gray
-// code, then OpenCV's calibrateCamera for each device and stereoCalibrate for R_cp, T_cp.
+// `solve`: corners in the camera (the mean of the pattern images), their projector positions through the
+// decoded Gray code, then OpenCV's calibrateCamera for each device and stereoCalibrate for R_cp, T_cp.
 
 #include <Eigen/Core>
 #include <cmath>
@@ -13,17 +13,19 @@
 namespace projbot::calibrate {
 namespace {
 
-struct ViewPoints {
-  std::vector<cv::Point3f> object;  // every corner the camera found
-  std::vector<cv::Point2f> camera;
-  std::vector<cv::Point3f> shared_object;  // those also mapped to the projector
-  std::vector<cv::Point2f> shared_camera, projector;
+// The used views' correspondences, one entry per view in each list, as OpenCV's calibration takes them.
+struct Correspondences {
+  std::vector<std::vector<cv::Point3f>> object;  // every corner the camera found
+  std::vector<std::vector<cv::Point2f>> camera;
+  std::vector<std::vector<cv::Point3f>> shared_object;  // those also mapped to the projector
+  std::vector<std::vector<cv::Point2f>> shared_camera, projector;
 };
 
-ViewResult measure_view(const CaptureManifest& m, const cv::Mat& white, const std::vector<cv::Mat>& images, const SolveOptions& o,
-                        ViewPoints& points) {
+// One view: its corners found in `lit` and mapped into the projector. Appended to `points` when used.
+ViewResult measure_view(const CaptureManifest& m, const cv::Mat& lit, const std::vector<cv::Mat>& images, const SolveOptions& o,
+                        Correspondences& points) {
   ViewResult r;
-  const BoardView board = detect_board(m.board, white);
+  const BoardView board = detect_board(m.board, lit);
   r.corners = static_cast<int>(board.image.size());
   if (r.corners < o.min_corners) {
     r.refused =
@@ -31,18 +33,25 @@ ViewResult measure_view(const CaptureManifest& m, const cv::Mat& white, const st
     return r;
   }
   const cv::Mat decoded = decode_gray_code(images, m.projector_width, m.projector_height);
-  points.object = board.object;
-  points.camera = board.image;
+  std::vector<cv::Point3f> shared_object;
+  std::vector<cv::Point2f> shared_camera, projector;
   for (std::size_t k = 0; k < board.image.size(); ++k)
     if (const auto p = corner_to_projector(decoded, board.image[k])) {
-      points.shared_object.push_back(board.object[k]);
-      points.shared_camera.push_back(board.image[k]);
-      points.projector.emplace_back(static_cast<float>(p->x), static_cast<float>(p->y));
+      shared_object.push_back(board.object[k]);
+      shared_camera.push_back(board.image[k]);
+      projector.emplace_back(static_cast<float>(p->x), static_cast<float>(p->y));
     }
-  r.projector_corners = static_cast<int>(points.projector.size());
-  if (r.projector_corners < o.min_corners)
+  r.projector_corners = static_cast<int>(projector.size());
+  if (r.projector_corners < o.min_corners) {
     r.refused = "only " + std::to_string(r.projector_corners) + " of " + std::to_string(r.corners) +
                 " corners lit by decodable patterns (is the board inside the projector's image?)";
+    return r;
+  }
+  points.object.push_back(board.object);
+  points.camera.push_back(board.image);
+  points.shared_object.push_back(std::move(shared_object));
+  points.shared_camera.push_back(std::move(shared_camera));
+  points.projector.push_back(std::move(projector));
   return r;
 }
 
@@ -82,65 +91,31 @@ void add_warnings(Calibration& c, int used, int total) {
   if (c.camera_rms_px > 0.3) c.warnings.push_back("camera reprojection RMS " + fixed(c.camera_rms_px, 2) + " px is high (> 0.3)");
 }
 
-}  // namespace
-
-Calibration solve(const std::filesystem::path& dir, const SolveOptions& o,
-                  const std::function<void(int, int, const ViewResult&)>& progress) {
-  const CaptureManifest m = read_manifest(dir, o);
-  const auto expected = static_cast<std::size_t>(images_per_pose(m.projector_width, m.projector_height));
-  const cv::Size projector_size(m.projector_width, m.projector_height);
-  Calibration c;
-  cv::Size camera_size;
-  std::vector<ViewPoints> used;
-  for (std::size_t i = 0; i < m.folders.size(); ++i) {
-    const std::vector<cv::Mat> images = read_pose(dir / m.folders[i], expected);
-    if (i == 0) camera_size = images.front().size();
-    if (images.front().size() != camera_size)
-      throw CalibrationError("'" + (dir / m.folders[i]).string() + "': its images are " + std::to_string(images.front().cols) +
-                             "x" + std::to_string(images.front().rows) + ", the first pose's " +
-                             std::to_string(camera_size.width) + "x" + std::to_string(camera_size.height));
-    ViewPoints points;
-    ViewResult r = measure_view(m, lit_image(images), images, o, points);
-    r.folder = m.folders[i];
-    if (r.refused.empty()) used.push_back(std::move(points));
-    c.views.push_back(r);
-    if (progress) progress(static_cast<int>(i + 1), static_cast<int>(m.folders.size()), r);
-  }
-  if (used.size() < 3) {
-    std::string why;
-    for (const ViewResult& v : c.views)
-      if (!v.refused.empty()) why += "; " + v.folder + ": " + v.refused;
-    throw CalibrationError("'" + dir.string() + "': " + std::to_string(used.size()) + " usable views of " +
-                           std::to_string(m.folders.size()) + ", 3 is the least a calibration needs" + why);
-  }
-  std::vector<std::vector<cv::Point3f>> obj, shared_obj;
-  std::vector<std::vector<cv::Point2f>> cam, shared_cam, proj;
-  for (const ViewPoints& v : used) {
-    obj.push_back(v.object);
-    cam.push_back(v.camera);
-    shared_obj.push_back(v.shared_object);
-    shared_cam.push_back(v.shared_camera);
-    proj.push_back(v.projector);
-  }
+// Both devices' intrinsics and R_cp, T_cp from the used views; per-view and total RMS into `c`.
+void calibrate_devices(const Correspondences& p, cv::Size camera_size, cv::Size projector_size, bool projector_distortion,
+                       Calibration& c) {
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 200, 1e-12);
   cv::Mat Kc, Dc, Kp, Dp;
   std::vector<cv::Mat> rv, tv;
-  cv::calibrateCamera(obj, cam, camera_size, Kc, Dc, rv, tv, cv::CALIB_FIX_K3, criteria);
+  cv::calibrateCamera(p.object, p.camera, camera_size, Kc, Dc, rv, tv, cv::CALIB_FIX_K3, criteria);
   const int projector_flags =
-      cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3 | (o.projector_distortion ? 0 : cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2);
-  cv::calibrateCamera(shared_obj, proj, projector_size, Kp, Dp, rv, tv, projector_flags, criteria);
-  // The camera's lens is fixed from its own calibration, its corners undistorted to ideal pixels, so
-  // the joint fit below refines both focal lengths and principal points with the board poses shared.
-  std::vector<std::vector<cv::Point2f>> ideal(shared_cam.size());
-  for (std::size_t i = 0; i < shared_cam.size(); ++i) cv::undistortPoints(shared_cam[i], ideal[i], Kc, Dc, cv::noArray(), Kc);
-  cv::Mat R, T, E, F, per_view, zero = cv::Mat::zeros(5, 1, CV_64F), Dp_fixed = Dp.clone();
-  const int joint =
-      cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3;
-  if (o.projector_distortion) {
-    cv::stereoCalibrate(shared_obj, shared_cam, proj, Kc, Dc, Kp, Dp, camera_size, R, T, E, F, per_view, cv::CALIB_FIX_INTRINSIC,
-                        criteria);
+      cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3 | (projector_distortion ? 0 : cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2);
+  cv::calibrateCamera(p.shared_object, p.projector, projector_size, Kp, Dp, rv, tv, projector_flags, criteria);
+  cv::Mat R, T, E, F, per_view;
+  if (projector_distortion) {
+    cv::stereoCalibrate(p.shared_object, p.shared_camera, p.projector, Kc, Dc, Kp, Dp, camera_size, R, T, E, F, per_view,
+                        cv::CALIB_FIX_INTRINSIC, criteria);
   } else {
-    cv::stereoCalibrate(shared_obj, ideal, proj, Kc, zero, Kp, Dp_fixed, camera_size, R, T, E, F, per_view, joint, criteria);
+    // The camera's lens is fixed from its own calibration, its corners undistorted to ideal pixels, so
+    // the joint fit refines both focal lengths and principal points with the board poses shared (the
+    // projector's distortion is zero and stays so).
+    std::vector<std::vector<cv::Point2f>> ideal(p.shared_camera.size());
+    for (std::size_t i = 0; i < ideal.size(); ++i) cv::undistortPoints(p.shared_camera[i], ideal[i], Kc, Dc, cv::noArray(), Kc);
+    const int joint =
+        cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3;
+    cv::Mat no_lens = cv::Mat::zeros(5, 1, CV_64F);
+    cv::stereoCalibrate(p.shared_object, ideal, p.projector, Kc, no_lens, Kp, Dp, camera_size, R, T, E, F, per_view, joint,
+                        criteria);
   }
   c.camera = lens_from(Kc, Dc, camera_size);
   c.projector = lens_from(Kp, Dp, projector_size);
@@ -155,7 +130,7 @@ Calibration solve(const std::filesystem::path& dir, const SolveOptions& o,
     if (!v.refused.empty()) continue;
     v.camera_rms_px = per_view.at<double>(static_cast<int>(u), 0);
     v.projector_rms_px = per_view.at<double>(static_cast<int>(u), 1);
-    const double count = static_cast<double>(proj[u].size());
+    const double count = static_cast<double>(p.projector[u].size());
     sum_c += count * v.camera_rms_px * v.camera_rms_px;
     sum_p += count * v.projector_rms_px * v.projector_rms_px;
     n += count;
@@ -163,8 +138,40 @@ Calibration solve(const std::filesystem::path& dir, const SolveOptions& o,
   }
   c.camera_rms_px = std::sqrt(sum_c / n);
   c.projector_rms_px = std::sqrt(sum_p / n);
-  c.projector_coverage = coverage(proj, projector_size);
-  add_warnings(c, static_cast<int>(used.size()), static_cast<int>(c.views.size()));
+}
+
+}  // namespace
+
+Calibration solve(const std::filesystem::path& dir, const SolveOptions& o,
+                  const std::function<void(int, int, const ViewResult&)>& progress) {
+  const CaptureManifest m = read_manifest(dir, o);
+  const auto expected = static_cast<std::size_t>(images_per_pose(m.projector_width, m.projector_height));
+  const cv::Size projector_size(m.projector_width, m.projector_height);
+  Calibration c;
+  cv::Size camera_size;
+  Correspondences used;
+  for (std::size_t i = 0; i < m.folders.size(); ++i) {
+    const std::vector<cv::Mat> images = read_pose(dir / m.folders[i], expected);
+    if (i == 0) camera_size = images.front().size();
+    if (images.front().size() != camera_size)
+      throw CalibrationError("'" + (dir / m.folders[i]).string() + "': its images are " + std::to_string(images.front().cols) +
+                             "x" + std::to_string(images.front().rows) + ", the first pose's " +
+                             std::to_string(camera_size.width) + "x" + std::to_string(camera_size.height));
+    ViewResult r = measure_view(m, lit_image(images), images, o, used);
+    r.folder = m.folders[i];
+    c.views.push_back(r);
+    if (progress) progress(static_cast<int>(i + 1), static_cast<int>(m.folders.size()), r);
+  }
+  if (used.projector.size() < 3) {
+    std::string why;
+    for (const ViewResult& v : c.views)
+      if (!v.refused.empty()) why += "; " + v.folder + ": " + v.refused;
+    throw CalibrationError("'" + dir.string() + "': " + std::to_string(used.projector.size()) + " usable views of " +
+                           std::to_string(m.folders.size()) + ", 3 is the least a calibration needs" + why);
+  }
+  calibrate_devices(used, camera_size, projector_size, o.projector_distortion, c);
+  c.projector_coverage = coverage(used.projector, projector_size);
+  add_warnings(c, static_cast<int>(used.projector.size()), static_cast<int>(c.views.size()));
   return c;
 }
 

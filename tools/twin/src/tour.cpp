@@ -154,7 +154,6 @@ std::pair<double, double> guess_error(const robot::HeadPoses& truth, const TwinT
 struct DwellContext {
   Twin& twin;
   std::size_t target;
-  const config::ProjectorConfig& projector;
   const ProjectorModels& models;
   const robot::HeadPoses& truth;
   const TourOptions& options;
@@ -311,8 +310,8 @@ void summarise_timeline(VisitReport& r) {
 bool dwell(const DwellContext& c, const std::vector<alignment::TargetFollower*>& followers, VisitReport& r) {
   const TwinTarget& target = c.twin.targets()[c.target];
   const bool tracking = c.options.mode == TourMode::tracking;
-  const double period_s = 1.0 / c.projector.refresh_hz;
-  const double display_delay_s = period_s + 1e-3 * c.projector.input_lag_ms;
+  const double period_s = 1.0 / c.models.truth.refresh_hz;
+  const double display_delay_s = period_s + 1e-3 * c.models.truth.input_lag_ms;
   alignment::PoseSample drawn;  // the newest result: at first the arrival's estimate
   drawn.T_camera_target = drawn.motion.T = r.icp.T_scan_model;
   bool shown = r.projected;
@@ -322,7 +321,7 @@ bool dwell(const DwellContext& c, const std::vector<alignment::TargetFollower*>&
   const double motion_end_s = motion ? motion->end_s() : 0.0;
   double back_under = -1.0;  // when the error went back under the goal for good, -1 while it is not
   bool ever_over = false;
-  const int frames = static_cast<int>(std::lround(c.options.dwell_s * c.projector.refresh_hz));
+  const int frames = static_cast<int>(std::lround(c.options.dwell_s * c.models.truth.refresh_hz));
   for (int j = 1; j <= frames; ++j) {
     if (c.options.stop_requested && c.options.stop_requested()) return false;
     const double start_s = j * period_s;
@@ -557,7 +556,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     if (options.mode == TourMode::tracking || r.moved) {
       std::vector<alignment::TargetFollower*> lanes{&followers[i]};
       for (const NeighbourLight& n : lights) lanes.push_back(&followers[n.target]);
-      report.interrupted = !dwell(DwellContext{twin, i, scene.projector, models, truth, options, noise_seed, lights}, lanes, r);
+      report.interrupted = !dwell(DwellContext{twin, i, models, truth, options, noise_seed, lights}, lanes, r);
     }
     for (const NeighbourLight& l : lights) r.neighbours.push_back(finished(l));
     if (spectator && r.moved && !report.interrupted) {
