@@ -96,6 +96,17 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, BadSceneTest,
     ::testing::Values(
         BadCase{"unknown_top_key", kProj + "targets: []\nprojecter: 3\n", {"s.yaml:3:", "projecter", "unknown key"}},
+        BadCase{
+            "projector_distortion_too_long",
+            "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240, distortion: [0, 0, 0, 0, 0, 0, 0, 0, 0]}\n"
+            "targets: []\n",
+            {"s.yaml:1:", "projector.distortion", "up to 5 coefficients"}},
+        BadCase{"projector_distortion_not_finite",
+                "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240, distortion: [.nan]}\ntargets: []\n",
+                {"s.yaml:1:", "projector.distortion", "finite"}},
+        BadCase{"projector_lens_too_strong",
+                "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240, distortion: [-0.6]}\ntargets: []\n",
+                {"s.yaml:1:", "projector", "distortion folds the image over at panel position"}},
         BadCase{"unknown_projector_key",
                 "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240, fz: 1}\ntargets: []\n",
                 {"s.yaml:1:", "projector.fz", "unknown key"}},
@@ -344,11 +355,26 @@ TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
     return "";
   };
   const std::string good_pose = "projector_from_camera: {translation: [0, 0, 0]}\n";
+  // The projector's lens comes with the calibration (the renderer pre-distorts by it); OpenCV's rational
+  // terms k4..k6 are accepted only as zeros, and a lens that folds the image over is refused.
+  EXPECT_EQ(error("calibration: calib2.yaml\n",
+                  "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512, cy: 384, "
+                  "distortion: [0.1, -0.05, 0.001, 0, 0.01, 0, 0, 0]}\n" +
+                      good_pose),
+            "");
+  EXPECT_EQ(projbot::config::load_scene(dir / "scene2.yaml").projector.distortion,
+            (projbot::config::Distortion{0.1, -0.05, 0.001, 0, 0.01}));
   EXPECT_NE(error("calibration: calib2.yaml\n",
                   "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512, cy: 384, "
-                  "distortion: [0.1, 0, 0, 0, 0]}\n" +
+                  "distortion: [0.1, 0, 0, 0, 0, 0.2]}\n" +
                       good_pose)
-                .find("calib2.yaml:1: projector.distortion: the renderer does not pre-distort"),
+                .find("calib2.yaml:1: projector.distortion: only OpenCV's 5-term lens"),
+            std::string::npos);
+  EXPECT_NE(error("calibration: calib2.yaml\n",
+                  "projector: {width: 1024, height: 768, fx: 500, fy: 500, cx: 512, cy: 384, "
+                  "distortion: [-0.5, 0, 0, 0, 0]}\n" +
+                      good_pose)
+                .find("calib2.yaml:1: projector: distortion folds the image over at panel position (-1, -1)"),
             std::string::npos);
   EXPECT_NE(
       error("calibration: calib2.yaml\n", "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512}\n" + good_pose)
@@ -363,4 +389,35 @@ TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
             std::string::npos);
   EXPECT_NE(error("calibration: none.yaml\n", "").find("scene2.yaml:1: calibration: cannot open"), std::string::npos);
   std::filesystem::remove_all(dir);
+}
+
+// OpenCV's lens model: undistort inverts distort, and the Jacobian is distort's derivative.
+TEST(LensTest, UndistortInvertsDistortAndTheJacobianIsItsDerivative) {
+  const projbot::config::Distortion k{-0.22, 0.06, 0.002, -0.0015, 0.01};
+  for (double x = -0.6; x <= 0.6; x += 0.15)
+    for (double y = -0.45; y <= 0.45; y += 0.15) {
+      const Eigen::Vector2d p(x, y);
+      const Eigen::Vector2d d = projbot::config::distort(k, p);
+      const auto back = projbot::config::undistort(k, d);
+      ASSERT_TRUE(back) << p.transpose();
+      EXPECT_LT((*back - p).norm(), 1e-10) << p.transpose();
+      const double h = 1e-6;
+      for (int c = 0; c < 2; ++c) {
+        Eigen::Vector2d e = Eigen::Vector2d::Zero();
+        e[c] = h;
+        const Eigen::Vector2d numeric = (projbot::config::distort(k, p + e) - projbot::config::distort(k, p - e)) / (2 * h);
+        EXPECT_LT((projbot::config::distort_jacobian(k, p).col(c) - numeric).norm(), 1e-8);
+      }
+    }
+  // r (1 + k1 r^2) has its largest value 0.54 at r = 0.82 with k1 = -0.5: nothing reaches radius 0.6.
+  EXPECT_FALSE(projbot::config::undistort({-0.5, 0, 0, 0, 0}, {0.6, 0.0}));
+  // The projector's lens: the panel pixel lighting a point and the ray a panel pixel sends are inverses.
+  projbot::config::ProjectorConfig p;
+  p.distortion = k;
+  const Eigen::Vector3d X(0.31, -0.2, 1.4);
+  const Eigen::Vector2d px = p.project_lit(X);
+  EXPECT_GT((px - p.project(X)).norm(), 5.0);
+  const auto ray = p.panel_ray(px.x(), px.y());
+  ASSERT_TRUE(ray);
+  EXPECT_LT((*ray * X.z() - X).norm(), 1e-9);
 }

@@ -449,3 +449,70 @@ TEST_F(RenderTest, BadRequestsAreErrors) {
   empty.source = "empty";
   EXPECT_THROW(renderer_->add_model(empty), projbot::engine::EngineError);
 }
+
+// The lens pass (issue 13): with the projector's distortion, content drawn for a ray lands on the panel
+// pixel the lens sends along that ray (config::ProjectorConfig::project_lit). Small white squares over the
+// whole image, corners included, on the rays of known panel pixels: the weighted centroid of each one's
+// pixels against that panel pixel, tens of pixels from where a pinhole would draw it near the corners. Each
+// frame is drawn 25 times, the squares moved by a fifth of a pixel each way, so that the rasteriser's pixel
+// quantisation averages out and a systematic offset (a half-pixel convention, a wrong canvas margin) shows.
+TEST_F(RenderTest, LensPassPutsContentWhereTheLensSendsIt) {
+  ProjectorConfig p = projector(640, 480, 600, 600, 319.5, 239.5);
+  p.distortion = {-0.22, 0.06, 0.002, -0.0015, 0.0};
+  const double half = 0.006;  // a 12 mm square at 1 m: about 7 px
+  const std::size_t id = renderer_->add_model(
+      quad({Eigen::Vector3d(-half, -half, 0), {half, -half, 0}, {half, half, 0}, {-half, half, 0}}, {1, 1, 1, 1}));
+  std::vector<Eigen::Vector2d> panel;
+  for (const double v : {20.0, 240.0, 460.0})
+    for (const double u : {20.0, 180.0, 320.0, 460.0, 620.0}) panel.emplace_back(u, v);
+  std::vector<Eigen::Vector2d> offset(panel.size(), Eigen::Vector2d::Zero());
+  double largest_shift = 0.0;
+  constexpr double kSteps[] = {-0.37, -0.17, 0.03, 0.23, 0.43};  // off the half pixels, where rasterisers break ties
+  for (const double du : kSteps)
+    for (const double dv : kSteps) {
+      std::vector<DrawItem> items;
+      for (const Eigen::Vector2d& x : panel) {
+        const auto ray = p.panel_ray(x.x() + du, x.y() + dv);
+        ASSERT_TRUE(ray);
+        items.push_back({id, pose(ray->x(), ray->y(), 1.0, 0, 0, 0)});
+        largest_shift = std::max(largest_shift, (p.project(*ray) - x).norm());
+      }
+      const Image img = render(p, items);
+      std::vector<Eigen::Vector3d> sums(panel.size(), Eigen::Vector3d::Zero());
+      for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+          if (img.pixel(x, y)[0] == 0) continue;
+          std::size_t k = 0;  // the nearest square's (they are 140 px apart or more)
+          for (std::size_t j = 1; j < panel.size(); ++j)
+            if ((panel[j] - Eigen::Vector2d(x, y)).norm() < (panel[k] - Eigen::Vector2d(x, y)).norm()) k = j;
+          sums[k] += img.pixel(x, y)[0] / 255.0 * Eigen::Vector3d(x, y, 1);
+        }
+      for (std::size_t k = 0; k < panel.size(); ++k) {
+        ASSERT_GT(sums[k].z(), 25.0) << "square at " << panel[k].transpose() << " not drawn";
+        offset[k] += (sums[k].head<2>() / sums[k].z() - panel[k] - Eigen::Vector2d(du, dv)) / 25.0;
+      }
+    }
+  double worst = 0.0;
+  for (const auto& o : offset) worst = std::max(worst, o.norm());
+  std::cout << "lens pass: worst mean centroid offset " << worst << " px; the lens moves content up to " << largest_shift
+            << " px\n";
+  EXPECT_LT(worst, 0.15);  // a pinhole projector (no lens pass) draws these squares to 0.099 px by the same measure
+  EXPECT_GT(largest_shift, 30.0) << "the case must have a lens worth correcting";
+}
+
+// A barrel lens throws the panel's corners' light outside the pinhole's image: the canvas holds those rays,
+// so a surface filling the whole view lights every panel pixel (none left black at the corners).
+TEST_F(RenderTest, LensPassFillsThePanelOutToTheCorners) {
+  ProjectorConfig p = projector(320, 200, 300, 300, 159.5, 99.5);
+  p.distortion = {-0.3, 0.08, 0.0, 0.0, 0.0};
+  const auto corner = p.panel_ray(-0.5, -0.5);
+  ASSERT_TRUE(corner);
+  ASSERT_LT(p.fx_px * corner->x() + p.cx_px, -5.0) << "the corner's ray must leave the pinhole's image";
+  const double s = 2.0;  // a 4 m wall 1 m away: wider than every ray
+  const std::size_t id =
+      renderer_->add_model(quad({Eigen::Vector3d(-s, -s, 0), {s, -s, 0}, {s, s, 0}, {-s, s, 0}}, {0.5F, 1, 1, 1}));
+  const Image img = render(p, {{id, pose(0, 0, 1.0, 0, 0, 0)}});
+  std::size_t dark = 0;
+  for (std::size_t i = 0; i < img.rgba.size(); i += 4) dark += img.rgba[i + 1] != 255 ? 1 : 0;
+  EXPECT_EQ(dark, 0U) << "panel pixels left unlit";
+}

@@ -55,6 +55,24 @@ TEST_F(MarkerErrorTest, MiscalibratedPrincipalPointShiftsTheLight) {
   EXPECT_NEAR(e.error_mm, 4.0, 1e-6);
 }
 
+// A projector with a barrel lens (k1 -0.2): drawn through the same lens (the renderer's pre-distortion),
+// the marker's light lands within the pixel's rounding; drawn as a pinhole, the lens throws it 2-3 cm off
+// near the image's corner (the marker 0.5 m off the axis at 1 m: the lens pulls its ray in by 5 %).
+TEST_F(MarkerErrorTest, TheProjectorsLensMustBeDrawnToLandOnTheMarker) {
+  projbot::config::ProjectorConfig lens = k_;
+  lens.distortion = {-0.2, 0.0, 0.0, 0.0, 0.0};
+  const Eigen::Vector3d corner(0.4, 0.3, 0.0);
+  const auto drawn = projbot::twin::measure_marker(lens, lens, T_true_, T_true_, corner, scene_);
+  EXPECT_TRUE(drawn.landed);
+  EXPECT_LT(drawn.error_mm, 0.75);  // half a pixel's diagonal at 1 m, f = 1000 px
+  const Eigen::Vector2d expected = lens.project_lit((T_true_ * corner.homogeneous()).head<3>());
+  EXPECT_LE((drawn.pixel - expected).cwiseAbs().maxCoeff(), 0.5);
+  const auto pinhole = projbot::twin::measure_marker(k_, lens, T_true_, T_true_, corner, scene_);
+  EXPECT_TRUE(pinhole.landed);
+  EXPECT_GT(pinhole.error_mm, 20.0);
+  EXPECT_LT(pinhole.error_mm, 30.0);
+}
+
 TEST_F(MarkerErrorTest, ExactPoseLandsOnTheMarker) {
   const auto e = measure(T_true_);
   EXPECT_TRUE(e.in_image);

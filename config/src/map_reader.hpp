@@ -28,7 +28,9 @@ class MapReader {
     std::ostringstream msg;
     msg << file_;
     if (mark.line >= 0) msg << ':' << mark.line + 1;
-    msg << ": " << (key_path.empty() ? "<root>" : key_path) << ": " << why;
+    msg << ": ";
+    if (!key_path.empty()) msg << key_path << ": ";  // empty: `why` names what it is about
+    msg << why;
     throw ConfigError(msg.str());
   }
 

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/LU>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -14,6 +15,23 @@
 
 namespace projbot::config {
 namespace {
+
+// `distortion: [k1, k2, p1, p2, k3]` (OpenCV's order; fewer is the rest zero). A calibration file may
+// list OpenCV's rational terms k4..k6 too, as long as they are zero: the renderer draws the 5-term lens.
+Distortion read_distortion(const MapReader& r, const YAML::Node& d, const std::string& path) {
+  if (!d.IsSequence() || d.size() == 0 || d.size() > 8)
+    r.fail(d, path, "expected a list of up to 5 coefficients k1, k2, p1, p2, k3");
+  const std::vector<double> v = r.numbers(d, path, d.size());
+  Distortion k{};
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(v[i])) r.fail(d, path, "coefficients must be finite");
+    if (i < k.size())
+      k[i] = v[i];
+    else if (v[i] != 0.0)
+      r.fail(d, path, "only OpenCV's 5-term lens (k1, k2, p1, p2, k3) is drawn; the rational terms k4..k6 must be zero");
+  }
+  return k;
+}
 
 // A pinhole section (`projector:`, `camera:`): every intrinsic required unless defaults are given.
 ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std::optional<ProjectorConfig>& defaults) {
@@ -37,6 +55,7 @@ ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std:
       r.fail(node["refresh_hz"], r.key_path("refresh_hz"), "must be 1..1000 Hz");
     if (!(p.input_lag_ms >= 0.0 && p.input_lag_ms <= 1000.0))
       r.fail(node["input_lag_ms"], r.key_path("input_lag_ms"), "must be 0..1000 ms");
+    if (YAML::Node d = r.child("distortion", false)) p.distortion = read_distortion(r, d, r.key_path("distortion"));
   }
   r.reject_unknown();
   try {
@@ -352,6 +371,7 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
   if (!probe) root.fail(node, "calibration", "cannot open '" + path.string() + "'");
   const ProjectorCalibration c = load_calibration(path);
   static_cast<Pinhole&>(scene.projector) = c.projector;
+  scene.projector.distortion = c.distortion;
   scene.pan_tilt.T_projector_camera = c.T_projector_camera;
 }
 
@@ -384,15 +404,7 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
   k.fy_px = p.get<double>("fy", 0.0, true);
   k.cx_px = p.get<double>("cx", 0.0, true);
   k.cy_px = p.get<double>("cy", 0.0, true);
-  if (YAML::Node d = p.child("distortion", false)) {
-    if (!d.IsSequence() || d.size() == 0 || d.size() > 8)
-      p.fail(d, "projector.distortion", "expected a list of up to 8 coefficients");
-    for (const double v : p.numbers(d, "projector.distortion", d.size()))
-      if (v != 0.0)
-        p.fail(d, "projector.distortion",
-               "the renderer does not pre-distort its image yet, so a projector with lens distortion would be drawn "
-               "wrong; only zeros are accepted");
-  }
+  if (YAML::Node d = p.child("distortion", false)) k.distortion = read_distortion(p, d, "projector.distortion");
   p.reject_unknown();
   try {
     validate_projector(k, "projector");
@@ -400,6 +412,7 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
     r.fail(c["projector"], "", e.what());
   }
   out.projector = k;
+  out.distortion = k.distortion;
   out.T_projector_camera = read_pose(r, "projector_from_camera", "projector_from_camera");
   if (!c["projector_from_camera"]) r.fail(c, "projector_from_camera", "missing required key");
   if (YAML::Node rms = r.child("reprojection_rms_px", false)) {  // what the calibration measured: informational here
@@ -433,6 +446,34 @@ std::vector<std::string> DevicesConfig::describe() const {
   return out;
 }
 
+namespace {
+
+// A lens the renderer can pre-distort for: over a 33 x 33 grid of the panel (its edges included) every
+// position sends its light along one ray, neighbours along neighbouring rays (the lens does not fold the
+// image over), and the rays fit in an undistorted image at most twice the panel's size each way.
+template <typename Fail>
+void validate_lens(const ProjectorConfig& p, const Fail& fail) {
+  for (const double c : p.distortion)
+    if (!std::isfinite(c)) fail("distortion coefficients must be finite");
+  if (!has_distortion(p.distortion)) return;
+  constexpr int kSteps = 32;
+  for (int j = 0; j <= kSteps; ++j)
+    for (int i = 0; i <= kSteps; ++i) {
+      const double u = -0.5 + p.width_px * i / double(kSteps), v = -0.5 + p.height_px * j / double(kSteps);
+      const auto ray = p.panel_ray(u, v);
+      const auto where = " at panel position (" + std::to_string(std::lround(u)) + ", " + std::to_string(std::lround(v)) + ")";
+      if (!ray || !(distort_jacobian(p.distortion, ray->head<2>()).determinant() > 0.0))
+        fail("distortion folds the image over" + where + ": no lens the renderer can pre-distort for (check the calibration)");
+      const double iu = p.fx_px * ray->x() + p.cx_px, iv = p.fy_px * ray->y() + p.cy_px;
+      if (std::abs(iu - p.cx_px) > p.width_px || std::abs(iv - p.cy_px) > p.height_px)
+        fail("distortion throws the light of the panel" + where +
+             " more than an image's width or height from the centre: "
+             "too strong to pre-distort for (check the calibration)");
+    }
+}
+
+}  // namespace
+
 void validate_projector(const ProjectorConfig& p, std::string_view where) {
   const auto fail = [&](const std::string& why) { throw ConfigError(std::string(where) + ": " + why); };
   if (p.width_px <= 0 || p.height_px <= 0 || p.width_px > 16384 || p.height_px > 16384)
@@ -442,6 +483,7 @@ void validate_projector(const ProjectorConfig& p, std::string_view where) {
   if (!std::isfinite(p.cx_px) || !std::isfinite(p.cy_px)) fail("cx and cy must be finite");
   if (!(p.near_m > 0.0) || !std::isfinite(p.far_m) || !(p.near_m < p.far_m))
     fail("need 0 < near < far (near " + std::to_string(p.near_m) + ", far " + std::to_string(p.far_m) + ")");
+  validate_lens(p, fail);
 }
 
 namespace {

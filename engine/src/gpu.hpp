@@ -85,6 +85,15 @@ struct FrameSlot {
   FrameProfiler* profiler = nullptr;
 };
 
+/// The lens pass's undistorted canvas (renderer.cpp): made on a target's first frame for a projector
+/// with distortion, remade when the target's size or the projector changes.
+struct LensCanvasImages {
+  Image color;  ///< the target's format, drawn then sampled
+  Image depth;
+  vk::raii::DescriptorPool pool{nullptr};
+  vk::raii::DescriptorSet set{nullptr};
+};
+
 /// An offscreen image or a swapchain. Created and used by the render thread.
 class TargetBackend {
  public:
@@ -98,6 +107,7 @@ class TargetBackend {
   std::vector<FrameSlot> slots;
   std::size_t next_slot = 0;
   vk::raii::QueryPool timestamps{nullptr};
+  std::optional<LensCanvasImages> canvas;
 
   virtual vk::Extent2D extent() const = 0;
   virtual vk::Format color_format() const = 0;

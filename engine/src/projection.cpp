@@ -1,5 +1,8 @@
 #include "projbot/engine/projection.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace projbot::engine {
 
 Eigen::Matrix4d clip_from_projector(const config::ProjectorConfig& p) {
@@ -15,6 +18,34 @@ Eigen::Matrix4d clip_from_projector(const config::ProjectorConfig& p) {
   m(2, 3) = -f * n / (f - n);
   m(3, 2) = 1.0;
   return m;
+}
+
+LensCanvas lens_canvas(const config::ProjectorConfig& p) {
+  // The rays of the panel's edges (its outermost pixel edges, -0.5 and size - 0.5), as pinhole pixels.
+  double u0 = 0.0, v0 = 0.0, u1 = p.width_px - 1.0, v1 = p.height_px - 1.0;
+  constexpr int kSteps = 256;
+  for (int i = 0; i <= kSteps; ++i) {
+    const double s = static_cast<double>(i) / kSteps;
+    const double us[] = {-0.5 + s * p.width_px, -0.5, p.width_px - 0.5};
+    const double vs[] = {-0.5 + s * p.height_px, -0.5, p.height_px - 0.5};
+    const std::pair<double, double> edges[] = {{us[0], vs[1]}, {us[0], vs[2]}, {us[1], vs[0]}, {us[2], vs[0]}};
+    for (const auto& [u, v] : edges) {
+      const auto ray = p.panel_ray(u, v);
+      if (!ray) continue;  // validate_projector refuses such lenses; the canvas then only holds the panel
+      const double iu = p.fx_px * ray->x() + p.cx_px, iv = p.fy_px * ray->y() + p.cy_px;
+      u0 = std::min(u0, iu), u1 = std::max(u1, iu), v0 = std::min(v0, iv), v1 = std::max(v1, iv);
+    }
+  }
+  LensCanvas c;
+  c.left_px = static_cast<int>(std::ceil(-u0)) + 1;  // a pixel more: bilinear sampling reads the neighbour
+  c.top_px = static_cast<int>(std::ceil(-v0)) + 1;
+  c.pinhole = p;
+  c.pinhole.distortion = {};
+  c.pinhole.width_px = c.left_px + static_cast<int>(std::ceil(u1)) + 2;
+  c.pinhole.height_px = c.top_px + static_cast<int>(std::ceil(v1)) + 2;
+  c.pinhole.cx_px = p.cx_px + c.left_px;
+  c.pinhole.cy_px = p.cy_px + c.top_px;
+  return c;
 }
 
 std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m) {

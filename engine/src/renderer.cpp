@@ -3,6 +3,8 @@
 #include "projbot/engine/renderer.hpp"
 
 #include <projbot/shaders/depth.frag.spv.h>
+#include <projbot/shaders/lens.frag.spv.h>
+#include <projbot/shaders/lens.vert.spv.h>
 #include <projbot/shaders/mesh.frag.spv.h>
 #include <projbot/shaders/mesh.vert.spv.h>
 
@@ -12,6 +14,7 @@
 #include <map>
 
 #include "gpu.hpp"
+#include "projbot/config/lens.hpp"
 #include "projbot/engine/projection.hpp"
 
 namespace projbot::engine {
@@ -29,6 +32,21 @@ struct DrawConstants {
   float alpha_cutoff;
 };
 static_assert(sizeof(DrawConstants) == 84);
+
+/// Push constants of lens.frag (std430: 64 bytes).
+struct LensConstants {
+  std::array<float, 4> intrinsics;  // fx, fy, cx, cy
+  std::array<float, 4> k;           // k1, k2, p1, p2
+  std::array<float, 4> k3_scale;    // k3, projector pixels per target pixel x, y, unused
+  std::array<float, 4> place;       // canvas margins left, top; 1 / canvas width, 1 / canvas height
+};
+static_assert(sizeof(LensConstants) == 64);
+
+/// Whether two projectors draw the same lens canvas.
+bool same_lens(const config::ProjectorConfig& a, const config::ProjectorConfig& b) {
+  return a.width_px == b.width_px && a.height_px == b.height_px && a.fx_px == b.fx_px && a.fy_px == b.fy_px &&
+         a.cx_px == b.cx_px && a.cy_px == b.cy_px && a.distortion == b.distortion;
+}
 
 /// The fragment shader's kAlphaMode specialisation constant.
 std::int32_t alpha_mode_id(assets::AlphaMode mode) {
@@ -94,7 +112,14 @@ struct Renderer::Impl {
   vk::raii::ShaderModule depth_frag{nullptr};
   // (format, cull back, alpha mode, depth camera)
   std::map<std::tuple<vk::Format, bool, std::int32_t, bool>, vk::raii::Pipeline> pipelines;
-  detail::Image white;  // bound where a material has no texture
+  // The lens pass (a projector with distortion): one full-target triangle sampling the canvas.
+  vk::raii::PipelineLayout lens_layout{nullptr};
+  vk::raii::ShaderModule lens_vert{nullptr};
+  vk::raii::ShaderModule lens_frag{nullptr};
+  vk::raii::Sampler lens_sampler{nullptr};
+  std::map<vk::Format, vk::raii::Pipeline> lens_pipelines;
+  std::optional<std::pair<config::ProjectorConfig, LensCanvas>> last_canvas;  // lens_canvas() of the last projector
+  detail::Image white;                                                        // bound where a material has no texture
   std::vector<GpuModel> models;
   std::vector<DrawItem> items;
   std::uint64_t frame_index = 0;
@@ -108,6 +133,14 @@ struct Renderer::Impl {
     vert = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_vert_spv), k_mesh_vert_spv));
     frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_frag_spv), k_mesh_frag_spv));
     depth_frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_depth_frag_spv), k_depth_frag_spv));
+    vk::PushConstantRange lens_push(vk::ShaderStageFlagBits::eFragment, 0, sizeof(LensConstants));
+    lens_layout = vk::raii::PipelineLayout(gpu->device, vk::PipelineLayoutCreateInfo({}, layouts, lens_push));
+    lens_vert = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_lens_vert_spv), k_lens_vert_spv));
+    lens_frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_lens_frag_spv), k_lens_frag_spv));
+    lens_sampler = vk::raii::Sampler(
+        gpu->device, vk::SamplerCreateInfo({}, vk::Filter::eLinear, vk::Filter::eLinear, vk::SamplerMipmapMode::eNearest,
+                                           vk::SamplerAddressMode::eClampToEdge, vk::SamplerAddressMode::eClampToEdge,
+                                           vk::SamplerAddressMode::eClampToEdge));
     assets::Image w;
     w.width = w.height = 1;
     w.rgba = {255, 255, 255, 255};
@@ -182,6 +215,63 @@ struct Renderer::Impl {
                                         &blending, &dynamic, *pipeline_layout);
     info.pNext = &rendering;
     return pipelines.emplace(key, vk::raii::Pipeline(gpu->device, nullptr, info)).first->second;
+  }
+
+  const vk::raii::Pipeline& lens_pipeline(vk::Format format) {
+    if (auto it = lens_pipelines.find(format); it != lens_pipelines.end()) return it->second;
+    const vk::PipelineShaderStageCreateInfo stages[] = {{{}, vk::ShaderStageFlagBits::eVertex, *lens_vert, "main"},
+                                                        {{}, vk::ShaderStageFlagBits::eFragment, *lens_frag, "main"}};
+    vk::PipelineVertexInputStateCreateInfo vertex_input;
+    vk::PipelineInputAssemblyStateCreateInfo assembly({}, vk::PrimitiveTopology::eTriangleList);
+    vk::PipelineViewportStateCreateInfo viewport({}, 1, nullptr, 1, nullptr);
+    vk::PipelineRasterizationStateCreateInfo raster({}, VK_FALSE, VK_FALSE, vk::PolygonMode::eFill, vk::CullModeFlagBits::eNone,
+                                                    vk::FrontFace::eCounterClockwise, VK_FALSE, 0, 0, 0, 1.0F);
+    vk::PipelineMultisampleStateCreateInfo multisample({}, vk::SampleCountFlagBits::e1);
+    vk::PipelineColorBlendAttachmentState attachment;
+    attachment.colorWriteMask = vk::ColorComponentFlagBits::eR | vk::ColorComponentFlagBits::eG | vk::ColorComponentFlagBits::eB |
+                                vk::ColorComponentFlagBits::eA;
+    vk::PipelineColorBlendStateCreateInfo blending({}, VK_FALSE, vk::LogicOp::eCopy, attachment);
+    const vk::DynamicState dynamic_states[] = {vk::DynamicState::eViewport, vk::DynamicState::eScissor};
+    vk::PipelineDynamicStateCreateInfo dynamic({}, dynamic_states);
+    vk::PipelineRenderingCreateInfo rendering(0, format);
+    vk::GraphicsPipelineCreateInfo info({}, stages, &vertex_input, &assembly, nullptr, &viewport, &raster, &multisample, nullptr,
+                                        &blending, &dynamic, *lens_layout);
+    info.pNext = &rendering;
+    return lens_pipelines.emplace(format, vk::raii::Pipeline(gpu->device, nullptr, info)).first->second;
+  }
+
+  const LensCanvas& canvas_for(const config::ProjectorConfig& projector) {
+    if (!last_canvas || !same_lens(last_canvas->first, projector)) last_canvas.emplace(projector, lens_canvas(projector));
+    return last_canvas->second;
+  }
+
+  // The target's canvas at the pixel density of the target, (re)made when its size or format changes.
+  detail::LensCanvasImages& ensure_canvas(detail::TargetBackend& t, const LensCanvas& lc, const config::ProjectorConfig& p) {
+    const vk::Extent2D e = t.extent();
+    const vk::Extent2D size(
+        static_cast<std::uint32_t>(std::ceil(e.width * static_cast<double>(lc.pinhole.width_px) / p.width_px)),
+        static_cast<std::uint32_t>(std::ceil(e.height * static_cast<double>(lc.pinhole.height_px) / p.height_px)));
+    if (t.canvas && t.canvas->color.extent == size && t.canvas->color.format == t.color_format()) return *t.canvas;
+    if (size.width > 16384 || size.height > 16384)
+      throw EngineError("the projector's lens needs an undistorted canvas of " + std::to_string(size.width) + "x" +
+                        std::to_string(size.height) + " pixels, more than 16384 each way");
+    if (t.canvas) gpu->device.waitIdle();  // frames in flight may still sample the old one
+    t.canvas.reset();
+    detail::LensCanvasImages c;
+    c.color = gpu->make_image(size, t.color_format(), vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eSampled,
+                              vk::ImageAspectFlagBits::eColor);
+    c.depth = gpu->make_image(size, detail::kDepthFormat, vk::ImageUsageFlagBits::eDepthStencilAttachment,
+                              vk::ImageAspectFlagBits::eDepth);
+    vk::DescriptorPoolSize pool_size(vk::DescriptorType::eCombinedImageSampler, 1);
+    c.pool = vk::raii::DescriptorPool(
+        gpu->device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, pool_size));
+    vk::raii::DescriptorSets sets(gpu->device, vk::DescriptorSetAllocateInfo(*c.pool, *set_layout));
+    c.set = std::move(sets[0]);
+    vk::DescriptorImageInfo image_info(*lens_sampler, *c.color.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+    gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*c.set, 0, 0, vk::DescriptorType::eCombinedImageSampler, image_info),
+                                     {});
+    t.canvas = std::move(c);
+    return *t.canvas;
   }
 
   std::size_t add_model(const assets::Model& model) {
@@ -292,6 +382,65 @@ struct Renderer::Impl {
       }
   }
 
+  static void transition_depth(const vk::raii::CommandBuffer& cmd, vk::Image depth) {
+    detail::transition(cmd, depth, vk::ImageAspectFlagBits::eDepth, vk::ImageLayout::eUndefined,
+                       vk::ImageLayout::eDepthAttachmentOptimal, vk::PipelineStageFlagBits2::eLateFragmentTests,
+                       vk::AccessFlagBits2::eDepthStencilAttachmentWrite, vk::PipelineStageFlagBits2::eEarlyFragmentTests,
+                       vk::AccessFlagBits2::eDepthStencilAttachmentWrite | vk::AccessFlagBits2::eDepthStencilAttachmentRead);
+  }
+
+  // Dynamic rendering into `color` (and `depth`, when given) over the whole of `extent`, cleared to black.
+  static void begin_pass(const vk::raii::CommandBuffer& cmd, vk::ImageView color, vk::ImageView depth, vk::Extent2D extent,
+                         float clear_alpha) {
+    vk::RenderingAttachmentInfo color_att(color, vk::ImageLayout::eColorAttachmentOptimal, {}, {}, {},
+                                          vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eStore,
+                                          vk::ClearColorValue(std::array<float, 4>{0.0F, 0.0F, 0.0F, clear_alpha}));
+    vk::RenderingAttachmentInfo depth_att(depth, vk::ImageLayout::eDepthAttachmentOptimal, {}, {}, {},
+                                          vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eDontCare,
+                                          vk::ClearDepthStencilValue(1.0F, 0));
+    cmd.beginRendering(vk::RenderingInfo({}, vk::Rect2D({0, 0}, extent), 1, 0, color_att, depth ? &depth_att : nullptr));
+    cmd.setViewport(0, vk::Viewport(0.0F, 0.0F, static_cast<float>(extent.width), static_cast<float>(extent.height), 0.0F, 1.0F));
+    cmd.setScissor(0, vk::Rect2D({0, 0}, extent));
+  }
+
+  // The lens pass's first half: the models through the canvas's pinhole, left ready to sample. One canvas
+  // serves both frames in flight: the barriers order this frame's drawing after the last frame's sampling.
+  void record_canvas(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, const config::ProjectorConfig& projector) {
+    const LensCanvas& lc = canvas_for(projector);
+    detail::LensCanvasImages& c = *t.canvas;  // made by draw_frame before the fence was reset
+    detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
+                       vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eFragmentShader,
+                       vk::AccessFlagBits2::eShaderSampledRead, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
+                       vk::AccessFlagBits2::eColorAttachmentWrite);
+    transition_depth(cmd, *c.depth.image);
+    begin_pass(cmd, *c.color.view, *c.depth.view, c.color.extent, 1.0F);
+    record_draws(cmd, t.color_format(), lc.pinhole, false);
+    cmd.endRendering();
+    detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eColorAttachmentOptimal,
+                       vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
+                       vk::AccessFlagBits2::eColorAttachmentWrite, vk::PipelineStageFlagBits2::eFragmentShader,
+                       vk::AccessFlagBits2::eShaderSampledRead);
+  }
+
+  // The lens pass's second half: every target pixel takes the canvas at its panel position's ray.
+  void record_lens(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, vk::ImageView color,
+                   const config::ProjectorConfig& p) {
+    const LensCanvas& lc = canvas_for(p);
+    const vk::Extent2D e = t.extent();
+    const auto f = [](double v) { return static_cast<float>(v); };
+    LensConstants c{
+        {f(p.fx_px), f(p.fy_px), f(p.cx_px), f(p.cy_px)},
+        {f(p.distortion[0]), f(p.distortion[1]), f(p.distortion[2]), f(p.distortion[3])},
+        {f(p.distortion[4]), f(static_cast<double>(p.width_px) / e.width), f(static_cast<double>(p.height_px) / e.height), 0.0F},
+        {f(lc.left_px), f(lc.top_px), f(1.0 / lc.pinhole.width_px), f(1.0 / lc.pinhole.height_px)}};
+    begin_pass(cmd, color, nullptr, e, 1.0F);
+    cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *lens_pipeline(t.color_format()));
+    cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *lens_layout, 0, *t.canvas->set, {});
+    cmd.pushConstants<LensConstants>(*lens_layout, vk::ShaderStageFlagBits::eFragment, 0, c);
+    cmd.draw(3, 1, 0, 0);
+    cmd.endRendering();
+  }
+
   bool draw_frame(detail::TargetBackend& t, const config::ProjectorConfig& projector, const PoseReader& read_poses,
                   FrameProfiler* profiler) {
     ensure_slots(t);
@@ -313,6 +462,9 @@ struct Renderer::Impl {
         throw EngineError("draw item refers to model " + std::to_string(item.model) + ", but " + std::to_string(models.size()) +
                           " are uploaded");
 
+    const bool lens = !t.depth_output() && config::has_distortion(projector.distortion);
+    if (lens) ensure_canvas(t, canvas_for(projector), projector);
+
     gpu->device.resetFences(*slot.fence);
     const vk::raii::CommandBuffer& cmd = slot.cmd;
     cmd.reset();
@@ -322,29 +474,20 @@ struct Renderer::Impl {
       cmd.resetQueryPool(*t.timestamps, q0, 2);
       cmd.writeTimestamp2(vk::PipelineStageFlagBits2::eTopOfPipe, *t.timestamps, q0);
     }
-    const vk::Extent2D extent = t.extent();
-    const vk::Image depth = *t.depth().image;
+    if (lens) record_canvas(cmd, t, projector);
     detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                        vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
                        vk::AccessFlagBits2::eNone, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
                        vk::AccessFlagBits2::eColorAttachmentWrite);
-    detail::transition(cmd, depth, vk::ImageAspectFlagBits::eDepth, vk::ImageLayout::eUndefined,
-                       vk::ImageLayout::eDepthAttachmentOptimal, vk::PipelineStageFlagBits2::eLateFragmentTests,
-                       vk::AccessFlagBits2::eDepthStencilAttachmentWrite, vk::PipelineStageFlagBits2::eEarlyFragmentTests,
-                       vk::AccessFlagBits2::eDepthStencilAttachmentWrite | vk::AccessFlagBits2::eDepthStencilAttachmentRead);
-    vk::RenderingAttachmentInfo color_att(
-        frame->color_view, vk::ImageLayout::eColorAttachmentOptimal, {}, {}, {}, vk::AttachmentLoadOp::eClear,
-        vk::AttachmentStoreOp::eStore,
-        vk::ClearColorValue(std::array<float, 4>{0.0F, 0.0F, 0.0F, t.depth_output() ? 0.0F : 1.0F}));
-    vk::RenderingAttachmentInfo depth_att(*t.depth().view, vk::ImageLayout::eDepthAttachmentOptimal, {}, {}, {},
-                                          vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eDontCare,
-                                          vk::ClearDepthStencilValue(1.0F, 0));
-    cmd.beginRendering(vk::RenderingInfo({}, vk::Rect2D({0, 0}, extent), 1, 0, color_att, &depth_att));
-    // The projector image (width x height of the intrinsics) is stretched onto the target.
-    cmd.setViewport(0, vk::Viewport(0.0F, 0.0F, static_cast<float>(extent.width), static_cast<float>(extent.height), 0.0F, 1.0F));
-    cmd.setScissor(0, vk::Rect2D({0, 0}, extent));
-    record_draws(cmd, t.color_format(), projector, t.depth_output());
-    cmd.endRendering();
+    if (lens) {
+      record_lens(cmd, t, frame->color_view, projector);
+    } else {
+      transition_depth(cmd, *t.depth().image);
+      begin_pass(cmd, frame->color_view, *t.depth().view, t.extent(), t.depth_output() ? 0.0F : 1.0F);
+      // The projector image (width x height of the intrinsics) is stretched onto the target.
+      record_draws(cmd, t.color_format(), projector, t.depth_output());
+      cmd.endRendering();
+    }
     const bool to_present = frame->color_final_layout == vk::ImageLayout::ePresentSrcKHR;
     detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eColorAttachmentOptimal,
                        frame->color_final_layout, vk::PipelineStageFlagBits2::eColorAttachmentOutput,

@@ -181,12 +181,13 @@ const Command kCalibrateSolve{
     "then OpenCV's calibrateCamera for camera and projector and a joint stereoCalibrate. Writes A_p,\n"
     "R_cp, T_cp (Eq. 2), the camera's intrinsics and distortion, the reprojection RMS per view and in all,\n"
     "the projector area the corners covered, and warnings. A scene uses it as `calibration: calib.yaml`.\n"
-    "The projector is fitted as a pinhole (the renderer draws one) unless --projector-distortion.\n",
+    "The projector is fitted as a pinhole unless --projector-distortion; with it, the renderer pre-distorts its\n"
+    "image by the lens found, so that straight content lands straight.\n",
     {{"out", "FILE", "the calibration to write (YAML)"},
      {"projector", "WxH", "projector size in pixels (for a folder without capture.yaml)"},
      {"board", "SPEC", "the board (for a folder without capture.yaml)"},
      {"projector-distortion", "",
-      "also fit the projector's radial distortion k1, k2 (a scene refuses it until the renderer pre-distorts)"},
+      "also fit the projector's radial distortion k1, k2 (for a projector lens that bends straight lines)"},
      {"truth", "FILE", "compare with this calibration (default: DIR/truth.yaml when present)"}},
     run_solve};
 

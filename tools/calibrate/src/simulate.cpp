@@ -120,8 +120,9 @@ std::vector<Sample> trace(const SimulationConfig& c, const Geometry& g, const st
     }
     const Eigen::Vector3d Pp = R_pc * P + t_pc;
     if (Pp.z() <= 0.0) continue;
-    int u = 0, v = 0;
-    if (!c.projector.nearest_pixel(Pp, u, v)) continue;
+    const Eigen::Vector2d x = c.projector.project_lit(Pp);  // through the projector's lens
+    const int u = static_cast<int>(std::lround(x.x())), v = static_cast<int>(std::lround(x.y()));
+    if (u < 0 || v < 0 || u >= c.projector.width_px || v >= c.projector.height_px) continue;
     double s_shadow = 0.0;  // the board's shadow on the wall: the light to this point passes through the paper
     if (!on_board && hit_paper(g, T_camera_board, P, projector_centre - P, 1.0, s_shadow)) continue;
     const Eigen::Vector3d to_projector = (projector_centre - P).normalized();
@@ -190,7 +191,7 @@ bool pose_fits(const SimulationConfig& c, const Geometry& g, const Eigen::Matrix
           return false;
       } else {
         const Eigen::Vector3d Pp = (c.T_projector_camera * P.homogeneous()).head<3>();
-        if (Pp.z() <= 0.2 || !c.projector.contains(c.projector.project(Pp))) return false;
+        if (Pp.z() <= 0.2 || !c.projector.contains(c.projector.project_lit(Pp))) return false;
       }
     }
   }
@@ -270,7 +271,7 @@ int simulate(const SimulationConfig& c, const std::filesystem::path& out, const 
   if (written == 0) return 0;  // stopped before the first pose: the writer removes its folder
   Calibration truth;
   truth.camera = c.camera;
-  truth.projector = Lens{c.projector, {}};
+  truth.projector = Lens{c.projector, c.projector.distortion};
   truth.T_projector_camera = c.T_projector_camera;
   truth.T_camera_board.assign(poses.begin(), poses.begin() + written);
   writer.finish(manifest, truth);

@@ -104,19 +104,22 @@ std::optional<Eigen::Vector3d> cast_ray(std::span<const PlacedMesh> scene, const
   return Eigen::Vector3d(origin + best * direction);
 }
 
-MarkerError measure_marker(const config::Pinhole& k, const config::Pinhole& light, const Eigen::Matrix4d& T_est,
+MarkerError measure_marker(const config::ProjectorConfig& k, const config::ProjectorConfig& light, const Eigen::Matrix4d& T_est,
                            const Eigen::Matrix4d& T_true, const Eigen::Vector3d& marker_m,
                            std::span<const PlacedMesh> true_scene) {
   MarkerError e;
   e.marker_m = marker_m;
   const Eigen::Vector3d truth = (T_true * marker_m.homogeneous()).head<3>();
   const Eigen::Vector3d drawn = (T_est * marker_m.homogeneous()).head<3>();
-  // Eq. 3: x = A_p X, the content's pixel, then the centre of the pixel that shows it.
+  // Eq. 3: x = A_p X through the believed lens, the content's pixel, then the centre of the pixel that shows it.
   Eigen::Vector3d ray = drawn;
   if (drawn.z() > 0.0) {
-    e.pixel = k.project(drawn).array().round();
+    e.pixel = k.project_lit(drawn).array().round();
     e.in_image = e.pixel.x() >= 0 && e.pixel.y() >= 0 && e.pixel.x() < k.width_px && e.pixel.y() < k.height_px;
-    ray = light.back_project(e.pixel.x(), e.pixel.y(), 1.0);
+    if (const auto r = light.panel_ray(e.pixel.x(), e.pixel.y()))
+      ray = *r;
+    else
+      e.in_image = false;  // a lens validate_projector refuses; measured as the distance to the drawn ray
   }
   const Eigen::Vector3d d = ray.normalized();
   if (e.in_image) {

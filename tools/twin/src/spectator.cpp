@@ -71,11 +71,15 @@ assets::Image SpectatorView::draw(Twin& twin, const Eigen::Matrix4d& T_world_spe
       if (z > 0.0F) {
         const Eigen::Vector4d p(z * (u - pinhole_.cx_px) / pinhole_.fx_px, z * (v - pinhole_.cy_px) / pinhole_.fy_px, z, 1.0);
         const Eigen::Vector3d q = (T_projector_spectator * p).head<3>();
-        // Eq. 3: the projector pixel that reaches this point, if nothing nearer the projector blocks it.
-        const Eigen::Vector2d x = q.z() > k.near_m ? k.project(q) : Eigen::Vector2d(-1.0, -1.0);
-        const long pu = std::lround(x.x()), pv = std::lround(x.y());
-        if (pu >= 0 && pv >= 0 && pu < k.width_px && pv < k.height_px) {
-          const float seen = lit_depth.z_m[static_cast<std::size_t>(pv) * k.width_px + pu];
+        // Eq. 3: the projector pixel that reaches this point through its lens, if nothing nearer the
+        // projector blocks it (the projector's depth image is a pinhole's: looked up along the ray).
+        const bool ahead = q.z() > k.near_m;
+        const Eigen::Vector2d x = ahead ? k.project_lit(q) : Eigen::Vector2d(-1.0, -1.0);
+        const Eigen::Vector2d ray = ahead ? k.project(q) : Eigen::Vector2d(-1.0, -1.0);
+        const long pu = std::lround(x.x()), pv = std::lround(x.y()), ru = std::lround(ray.x()), rv = std::lround(ray.y());
+        if (pu >= 0 && pv >= 0 && pu < k.width_px && pv < k.height_px && ru >= 0 && rv >= 0 && ru < k.width_px &&
+            rv < k.height_px) {
+          const float seen = lit_depth.z_m[static_cast<std::size_t>(rv) * k.width_px + ru];
           if (seen > 0.0F && std::abs(seen - q.z()) < 0.01 + 0.01 * q.z()) {
             const std::uint8_t* c = projector_frame.pixel(static_cast<int>(pu), static_cast<int>(pv));
             for (int ch = 0; ch < 3; ++ch) light[ch] += c[ch] / 255.0;

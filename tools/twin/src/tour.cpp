@@ -33,7 +33,7 @@ struct Errors {
 // Whether a point in the projector frame falls inside the projector's image (Eq. 3).
 bool lit_by(const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
   if (p.z() <= 0.0) return false;
-  const Eigen::Vector2d x = k.project(p);
+  const Eigen::Vector2d x = k.project_lit(p);
   return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < k.width_px && x.y() < k.height_px;
 }
 
@@ -434,6 +434,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   ProjectorModels models{scene.projector, scene.projector, scene.pan_tilt.T_projector_camera};
   if (options.calibration) {
     static_cast<config::Pinhole&>(models.believed) = options.calibration->projector;
+    models.believed.distortion = options.calibration->distortion;
     models.T_projector_camera = options.calibration->T_projector_camera;
   }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "projbot/config/devices.hpp"
+#include "projbot/config/lens.hpp"
 #include "projbot/config/pinhole.hpp"
 #include "projbot/config/robot.hpp"
 
@@ -32,6 +33,16 @@ struct ProjectorConfig : Pinhole {
   // The projector only (`projector:`), for the time a frame reaches the object (issue 14):
   double refresh_hz = 60.0;   ///< frames per second it shows (1..1000)
   double input_lag_ms = 0.0;  ///< its own delay from a frame's arrival to light (0..1000 ms)
+  /// Its lens (`projector.distortion`, or a calibration's): k1, k2, p1, p2, k3. Zero for a pinhole and
+  /// for every depth camera. The renderer pre-distorts the projector's image by it.
+  Distortion distortion{};
+
+  /// The panel pixel whose light reaches projector-frame point p (z > 0): A_p after the lens. Equals
+  /// project(p) without distortion.
+  Eigen::Vector2d project_lit(const Eigen::Vector3d& p) const;
+  /// The direction (x, y, 1) of the light panel position (u, v) sends out: the lens undone. Empty where
+  /// the distortion cannot be inverted (validate_projector refuses such lenses over the image).
+  std::optional<Eigen::Vector3d> panel_ray(double u, double v) const;
 };
 
 /// How a scripted move runs through its duration: `smooth` eases in and out (no jump in speed);
@@ -166,6 +177,7 @@ Scene load_scene(const std::filesystem::path& path);
 /// and the camera-to-projector pose R_cp, T_cp (X_p = R_cp X_c + T_cp, Eq. 2).
 struct ProjectorCalibration {
   Pinhole projector;
+  Distortion distortion{};  ///< the projector's lens, k1 k2 p1 p2 k3
   Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();
 };
 /// Reads and validates one (a scene's `calibration:` reads it so). Throws ConfigError naming file:line.

@@ -16,6 +16,18 @@ Eigen::Matrix4d clip_from_projector(const config::ProjectorConfig& projector);
 
 // The CPU side of Eq. 3 is config::Pinhole::project (ProjectorConfig is a Pinhole).
 
+/// A projector with lens distortion is drawn in two passes: the models through a pinhole onto an
+/// undistorted canvas, then each panel pixel takes the canvas at the ray its light leaves along (the lens
+/// undone), so content drawn for a ray lands on that ray. The canvas is the projector's pinhole (same
+/// focal lengths, no distortion) widened by margins that hold every panel pixel's ray.
+struct LensCanvas {
+  config::ProjectorConfig pinhole;  ///< the canvas's projector: size width + left + right margins, principal point shifted
+  int left_px = 0;                  ///< margin left of and above the panel's image, projector pixels
+  int top_px = 0;
+};
+/// The canvas for `projector` (whose lens validate_projector accepted).
+LensCanvas lens_canvas(const config::ProjectorConfig& projector);
+
 /// Converts a host transform to the column-major float matrix the GPU gets (the one Eigen -> GPU conversion).
 std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m);
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "projbot/config/pinhole.hpp"
+#include "projbot/config/scene.hpp"
 
 namespace projbot::calibrate {
 
@@ -76,7 +76,7 @@ struct SimulationConfig {
   std::uint64_t seed = 1;
   Board board;
   Lens camera;                                                       ///< the colour camera's truth (pinhole + distortion)
-  config::Pinhole projector;                                         ///< A_p's truth
+  config::ProjectorConfig projector;                                 ///< A_p's truth, with its lens
   Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();  ///< R_cp, T_cp's truth
   double ambient = 0.10;       ///< room light, as a fraction of the projector's white at 1 m
   double blur_sigma_px = 0.7;  ///< the camera's optical blur (Gaussian), pixels

@@ -50,11 +50,11 @@ struct MarkerError {
   double error_mm = 0.0;
 };
 
-/// Eq. 3 with the estimated pose and the drawing's pinhole (`drawn`: what the session believes A_p is)
-/// gives the pixel that carries the marker (rounded to the pixel centre, as content is drawn in
-/// pixels); that pixel's ray through the true lens (`light`) is cast into `true_scene` (projector frame,
-/// true poses) and compared with the marker under the true pose.
-MarkerError measure_marker(const config::Pinhole& drawn, const config::Pinhole& light,
+/// Eq. 3 with the estimated pose and the drawing's projector (`drawn`: what the session believes A_p and
+/// its lens are; the renderer pre-distorts by that lens) gives the pixel that carries the marker (rounded
+/// to the pixel centre, as content is drawn in pixels); that pixel's ray through the true lens (`light`)
+/// is cast into `true_scene` (projector frame, true poses) and compared with the marker under the true pose.
+MarkerError measure_marker(const config::ProjectorConfig& drawn, const config::ProjectorConfig& light,
                            const Eigen::Matrix4d& T_projector_target_estimated, const Eigen::Matrix4d& T_projector_target_true,
                            const Eigen::Vector3d& marker_m, std::span<const PlacedMesh> true_scene);
 
