@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <Eigen/Core>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -144,6 +145,54 @@ TEST_F(CliTest, RendersTheDemoSceneToAPng) {
   std::size_t lit = 0;
   for (std::size_t i = 0; i < img.rgba.size(); i += 4) lit += img.rgba[i] > 0 ? 1 : 0;
   EXPECT_GT(lit, 50000U);
+}
+
+// A projector with a lens (`projector.distortion`): the frame is drawn pre-distorted, validation-clean, the
+// Duck where the lens's forward model moves the pinhole frame's Duck; a lens that folds the image over
+// is refused naming the file, the key and where.
+TEST_F(CliTest, RendersThroughTheProjectorsLens) {
+  const auto scene = [&](const std::string& name, const std::string& lens) {
+    return write(name, "projector: {width: 320, height: 200, fx: 300, fy: 300, cx: 159.5, cy: 99.5" + lens +
+                           "}\ntargets:\n  - {name: duck, model: " + kDuck +
+                           ", scale: 0.25, recenter: true, pose: {translation: [0.25, 0.12, 1.0], rpy_deg: [180, 0, 0]}}\n")
+        .string();
+  };
+  const fs::path pin = dir_ / "pin.png", lens = dir_ / "lens.png";
+  ASSERT_EQ(run_projbot("render --scene " + scene("pin.yaml", "") + " --out " + pin.string()).code, 0);
+  const CliRun r =
+      run_projbot("render --validation --scene " + scene("lens.yaml", ", distortion: [-0.3, 0.08]") + " --out " + lens.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("validation: 0 errors, 0 warnings"), std::string::npos) << r.output;
+  // Where the lens frame's lit pixels should be: every lit pixel of the pinhole frame moved to the panel
+  // position that lights its ray (x -> x (1 + k1 r^2 + k2 r^4), normalised), weighted by the area it then
+  // covers; against the centroid of the lens frame's lit pixels.
+  const auto panel = [](const Eigen::Vector2d& px) {
+    const Eigen::Vector2d x = (px - Eigen::Vector2d(159.5, 99.5)) / 300.0;
+    const double r2 = x.squaredNorm();
+    return Eigen::Vector2d(Eigen::Vector2d(159.5, 99.5) + 300.0 * x * (1.0 - 0.3 * r2 + 0.08 * r2 * r2));
+  };
+  const auto pin_img = projbot::assets::read_image(pin), lens_img = projbot::assets::read_image(lens);
+  Eigen::Vector3d expected = Eigen::Vector3d::Zero(), measured = Eigen::Vector3d::Zero();
+  double moved = 0.0;
+  for (int y = 0; y < pin_img.height; ++y)
+    for (int x = 0; x < pin_img.width; ++x) {
+      if (lens_img.pixel(x, y)[0] > 0) measured += Eigen::Vector3d(x, y, 1);
+      if (pin_img.pixel(x, y)[0] == 0) continue;
+      const Eigen::Vector2d p(x, y), q = panel(p), dx = panel(p + Eigen::Vector2d(0.5, 0)) - panel(p - Eigen::Vector2d(0.5, 0)),
+                                     dy = panel(p + Eigen::Vector2d(0, 0.5)) - panel(p - Eigen::Vector2d(0, 0.5));
+      const double area = dx.x() * dy.y() - dx.y() * dy.x();
+      expected += area * Eigen::Vector3d(q.x(), q.y(), 1.0);
+      moved = std::max(moved, (q - p).norm());
+    }
+  ASSERT_GT(measured.z(), 300.0);
+  EXPECT_GT(moved, 10.0) << "px: the lens must move the duck enough to tell";
+  EXPECT_LT((measured.head<2>() / measured.z() - expected.head<2>() / expected.z()).norm(), 0.5);
+  // The canvas is resampled bilinearly: the silhouette's edge pixels catch some light (3.3 % more lit here).
+  EXPECT_NEAR(measured.z() / expected.z(), 1.0, 0.05) << "lit area";
+  const CliRun fold = run_projbot("render --scene " + scene("fold.yaml", ", distortion: [-0.9]") + " --out " + lens.string());
+  EXPECT_EQ(fold.code, 1);
+  EXPECT_NE(fold.output.find("fold.yaml:1: projector: distortion folds the image over at panel position"), std::string::npos)
+      << fold.output;
 }
 
 TEST_F(CliTest, OverridesAndProfile) {

@@ -84,13 +84,29 @@ void print_result(const calibrate::Calibration& c) {
   const auto& p = c.projector.pinhole;
   const auto& k = c.camera.pinhole;
   std::cout << "projector " << p.width_px << "x" << p.height_px << ": fx " << p.fx_px << " fy " << p.fy_px << " cx " << p.cx_px
-            << " cy " << p.cy_px << "\ncamera " << k.width_px << "x" << k.height_px << ": fx " << k.fx_px << " fy " << k.fy_px
-            << " cx " << k.cx_px << " cy " << k.cy_px << ", k1 " << c.camera.distortion[0] << " k2 " << c.camera.distortion[1]
+            << " cy " << p.cy_px;
+  if (config::has_distortion(c.projector.distortion))
+    std::cout << ", k1 " << c.projector.distortion[0] << " k2 " << c.projector.distortion[1];
+  std::cout << "\ncamera " << k.width_px << "x" << k.height_px << ": fx " << k.fx_px << " fy " << k.fy_px << " cx " << k.cx_px
+            << " cy " << k.cy_px << ", k1 " << c.camera.distortion[0] << " k2 " << c.camera.distortion[1]
             << "\nT_cp (mm): " << std::setprecision(2) << 1000 * c.T_projector_camera(0, 3) << ", "
             << 1000 * c.T_projector_camera(1, 3) << ", " << 1000 * c.T_projector_camera(2, 3) << std::setprecision(3)
             << "\nreprojection RMS: camera " << c.camera_rms_px << " px, projector " << c.projector_rms_px
             << " px; corners cover " << std::setprecision(0) << 100 * c.projector_coverage << " % of the projector's image\n";
   for (const auto& w : c.warnings) std::cout << "warning: " << w << '\n';
+}
+
+// How far apart two lenses put the same ray on the panel, at most over the image (in the truth's pixels).
+double lens_difference_px(const calibrate::Lens& fit, const calibrate::Lens& truth) {
+  const config::Pinhole& k = truth.pinhole;
+  double worst = 0.0;
+  for (int j = 0; j <= 20; ++j)
+    for (int i = 0; i <= 20; ++i) {
+      const Eigen::Vector2d x((k.width_px * i / 20.0 - k.cx_px) / k.fx_px, (k.height_px * j / 20.0 - k.cy_px) / k.fy_px);
+      const Eigen::Vector2d d = config::distort(fit.distortion, x) - config::distort(truth.distortion, x);
+      worst = std::max(worst, std::hypot(k.fx_px * d.x(), k.fy_px * d.y()));
+    }
+  return worst;
 }
 
 // The solve beside the truth a simulated capture carries.
@@ -108,6 +124,10 @@ void print_truth(const calibrate::Calibration& c, const calibrate::Calibration& 
             << " px\n  camera fx " << pct(k.fx_px, l.fx_px) << " %, fy " << pct(k.fy_px, l.fy_px) << " %, principal point "
             << std::hypot(k.cx_px - l.cx_px, k.cy_px - l.cy_px) << " px\n  T_cp " << dt_mm << " mm, R_cp " << angle_deg
             << " deg\n";
+  if (config::has_distortion(c.projector.distortion) || config::has_distortion(t.projector.distortion))
+    std::cout << "  projector lens k1 " << c.projector.distortion[0] << " (truth " << t.projector.distortion[0] << "), k2 "
+              << c.projector.distortion[1] << " (truth " << t.projector.distortion[1] << "): the two lenses place a ray "
+              << lens_difference_px(c.projector, t.projector) << " px apart at most over the image\n";
 }
 
 int run_solve(const cli::Args& args) {

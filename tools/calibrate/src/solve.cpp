@@ -101,22 +101,18 @@ void calibrate_devices(const Correspondences& p, cv::Size camera_size, cv::Size 
   const int projector_flags =
       cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3 | (projector_distortion ? 0 : cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2);
   cv::calibrateCamera(p.shared_object, p.projector, projector_size, Kp, Dp, rv, tv, projector_flags, criteria);
+  // The camera's lens is fixed from its own calibration, its corners undistorted to ideal pixels, so the
+  // joint fit refines both focal lengths and principal points (and the projector's k1, k2 when fitted)
+  // with the board poses shared. The flags are both devices': the camera's ideal corners keep its k1, k2
+  // near zero.
+  std::vector<std::vector<cv::Point2f>> ideal(p.shared_camera.size());
+  for (std::size_t i = 0; i < ideal.size(); ++i) cv::undistortPoints(p.shared_camera[i], ideal[i], Kc, Dc, cv::noArray(), Kc);
+  const int joint = cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3 |
+                    (projector_distortion ? 0 : cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2);
+  cv::Mat no_lens = cv::Mat::zeros(5, 1, CV_64F);
   cv::Mat R, T, E, F, per_view;
-  if (projector_distortion) {
-    cv::stereoCalibrate(p.shared_object, p.shared_camera, p.projector, Kc, Dc, Kp, Dp, camera_size, R, T, E, F, per_view,
-                        cv::CALIB_FIX_INTRINSIC, criteria);
-  } else {
-    // The camera's lens is fixed from its own calibration, its corners undistorted to ideal pixels, so
-    // the joint fit refines both focal lengths and principal points with the board poses shared (the
-    // projector's distortion is zero and stays so).
-    std::vector<std::vector<cv::Point2f>> ideal(p.shared_camera.size());
-    for (std::size_t i = 0; i < ideal.size(); ++i) cv::undistortPoints(p.shared_camera[i], ideal[i], Kc, Dc, cv::noArray(), Kc);
-    const int joint =
-        cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3;
-    cv::Mat no_lens = cv::Mat::zeros(5, 1, CV_64F);
-    cv::stereoCalibrate(p.shared_object, ideal, p.projector, Kc, no_lens, Kp, Dp, camera_size, R, T, E, F, per_view, joint,
-                        criteria);
-  }
+  cv::stereoCalibrate(p.shared_object, ideal, p.projector, Kc, no_lens, Kp, Dp, camera_size, R, T, E, F, per_view, joint,
+                      criteria);
   c.camera = lens_from(Kc, Dc, camera_size);
   c.projector = lens_from(Kp, Dp, projector_size);
   c.T_projector_camera = Eigen::Matrix4d::Identity();
