@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "projbot/calibrate/capture.hpp"
 #include "projbot/calibrate/procam.hpp"
 #include "projbot/config/scene.hpp"
 
@@ -326,5 +327,45 @@ TEST(Simulate, HoldsTheBoardWhereAScriptSays) {
   EXPECT_FALSE(fs::exists(root / "capture2"));
   std::ofstream(root / "bad.yaml") << "poses:\n  - {centre: [0, 0]}\n";
   EXPECT_NE(error_of([&] { read_board_poses(root / "bad.yaml"); }).find("centre: expected 3 numbers"), std::string::npos);
+  fs::remove_all(root);
+}
+
+// The capture session on the twin's rig: a pose held out of the camera's view is refused on the spot and
+// the session goes on; the poses kept are written with their truth, and `solve` reads them; a rig that
+// hands back no image is an error naming the pattern, and the unfinished folder is not left behind.
+TEST(Capture, RefusesABadPoseOnTheSpotAndKeepsTheRest) {
+  const fs::path root = temp_dir("capture");
+  SimulationConfig c = twin_config(3);
+  c.scripted = {{Eigen::Vector3d(0.0, 0.05, 1.0), Eigen::Vector3d(10, -15, 0)},
+                {Eigen::Vector3d(0.9, 0.05, 1.0), Eigen::Vector3d::Zero()},
+                {Eigen::Vector3d(0.05, 0.1, 1.1), Eigen::Vector3d(-20, 10, 5)}};
+  CaptureOptions o;
+  o.board = c.board;
+  o.poses = 3;
+  std::vector<std::string> said;
+  auto rig = make_twin_rig(c);
+  const CaptureSummary s = capture(*rig, o, root / "cap", [&](const std::string& line) { said.push_back(line); });
+  EXPECT_EQ(s.kept, 2);
+  EXPECT_EQ(s.refused, 1);
+  ASSERT_EQ(said.size(), 3u);
+  EXPECT_EQ(said[1].rfind("pose 2 refused: no board found in the white image", 0), 0u) << said[1];
+  const Calibration truth = read_calibration(root / "cap" / "truth.yaml");
+  ASSERT_EQ(truth.T_camera_board.size(), 2u);
+  EXPECT_NEAR(truth.T_camera_board[1](2, 3), 1.1, 0.2);  // the third scripted pose, kept second
+  SolveOptions so;
+  so.min_corners = 6;
+  EXPECT_NE(error_of([&] { solve(root / "cap", so); }).find("views"), std::string::npos)
+      << "two views are too few to calibrate, and solve says so";
+
+  class Blind final : public CaptureRig {
+   public:
+    bool ready(int, int) override { return true; }
+    cv::Mat show_and_capture(std::size_t, const cv::Mat&) override { return {}; }
+  } blind;
+  EXPECT_NE(error_of([&] {
+              capture(blind, o, root / "cap2", [](const std::string&) {});
+            }).find("the camera gave no 8-bit grey image for pattern 0"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(root / "cap2"));
   fs::remove_all(root);
 }

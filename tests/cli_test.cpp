@@ -765,6 +765,35 @@ TEST_F(CliTest, BenchAcquireReportsEveryTargetAndMethod) {
 
 // The calibration as a user runs it: the twin's capture, solved, its truth compared, and the file a
 // scene takes as `calibration:`; a folder from another tool needs the projector and board named.
+// calibrate capture: the session. --sim: the engine draws each pattern (checked pixel for pixel against
+// it), the twin's board takes it; a pose the person holds out of view is refused on the spot, the rest
+// kept, and the folder solves. Without --sim, a config with no camera says what is missing.
+TEST_F(CliTest, CalibrateCaptureRefusesABadPoseAndWritesWhatSolveReads) {
+  const fs::path poses = write("poses.yaml",
+                               "poses:\n  - {centre: [0.0, 0.05, 1.0], tilt_deg: [10, -15, 0]}\n"
+                               "  - {centre: [0.9, 0.05, 1.0]}\n"
+                               "  - {centre: [0.05, 0.1, 1.1], tilt_deg: [-20, 10, 5]}\n"
+                               "  - {centre: [-0.1, -0.05, 0.9], tilt_deg: [5, 25, -5]}\n");
+  const fs::path cap = dir_ / "cap";
+  CliRun r = run_projbot("calibrate capture --sim --poses-file " + poses.string() + " --out " + cap.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("pose 2 refused: no board found in the white image; hold the board again"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("kept 3 board poses (1 refused)"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(cap / "pose_02" / "43.png"));
+  EXPECT_FALSE(fs::exists(cap / "pose_03"));
+  r = run_projbot("calibrate solve " + cap.string() + " --out " + (dir_ / "calib.yaml").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("warning: only 3 usable views"), std::string::npos) << r.output;
+  r = run_projbot("calibrate capture --out " + (dir_ / "cap2").string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("shop.yaml configures no camera (devices.camera)"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "cap2"));
+  r = run_projbot("calibrate capture --sim --out " + cap.string());  // refused before any pattern is shown
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("cap' exists and is not an empty folder; name a new one"), std::string::npos) << r.output;
+}
+
 TEST_F(CliTest, CalibrateSimulateThenSolveFeedsAScene) {
   const fs::path cap = dir_ / "cap";
   CliRun r = run_projbot("calibrate simulate --poses 4 --out " + cap.string());

@@ -7,10 +7,13 @@
 #include <iostream>
 #include <sstream>
 
+#include "calibrate_capture.hpp"
 #include "commands.hpp"
+#include "devices.hpp"
 #include "interrupt.hpp"
 #include "progress.hpp"
 #include "projbot/calibrate/calibrate.hpp"
+#include "projbot/calibrate/capture.hpp"
 #include "projbot/config/scene.hpp"
 #include "scene_setup.hpp"
 
@@ -28,12 +31,9 @@ calibrate::Lens twin_colour_lens(const config::Scene& scene) {
   return l;
 }
 
-int run_simulate(const cli::Args& args) {
-  const auto out = args.get("out");
-  if (!out) throw cli::UsageError("--out DIR is required");
-  args.check_output_folders({"out"});
-  const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
-  const config::Scene scene = config::load_scene(scene_path);
+// The twin's session from the command line: poses (spread or scripted), board, seed and noise, with the
+// scene's projector and R_cp, T_cp as the truth.
+calibrate::SimulationConfig simulation_config(const cli::Args& args, const config::Scene& scene) {
   calibrate::SimulationConfig c;
   c.poses = args.get_int("poses", 10, 1, 100);
   if (const auto file = args.get("poses-file")) {
@@ -48,6 +48,16 @@ int run_simulate(const cli::Args& args) {
   c.T_projector_camera = scene.pan_tilt.T_projector_camera;
   c.noise_sigma = args.get_double("noise", c.noise_sigma);
   if (!(c.noise_sigma >= 0.0 && c.noise_sigma <= 50.0)) throw cli::UsageError("--noise must be 0..50 grey levels");
+  return c;
+}
+
+int run_simulate(const cli::Args& args) {
+  const auto out = args.get("out");
+  if (!out) throw cli::UsageError("--out DIR is required");
+  args.check_output_folders({"out"});
+  const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
+  const config::Scene scene = config::load_scene(scene_path);
+  const calibrate::SimulationConfig c = simulation_config(args, scene);
   Progress progress("pose", c.poses);
   catch_interrupts();  // Ctrl-C: the poses rendered so far are written as the capture
   const int written = calibrate::simulate(
@@ -161,7 +171,109 @@ int run_solve(const cli::Args& args) {
   return 0;
 }
 
+// The session on the configured projector and colour camera (the projector's window, the camera's
+// colour frames after each pattern settles), or the twin's with --sim: the patterns the engine draws
+// fall on the twin's board.
+calibrate::CaptureSummary capture_on_devices(const cli::Args& args, const config::Scene& scene, engine::Renderer& renderer,
+                                             PatternScreen& screen, const calibrate::CaptureOptions& o,
+                                             const std::filesystem::path& out) {
+  config::DevicesConfig wanted;
+  wanted.camera = scene.devices.camera;
+  wanted.projector = scene.devices.projector;
+  std::vector<DeviceCheck> checks;
+  Devices devices = open_devices(wanted, checks, true);  // an absent device: an error naming it, before anything is shown
+  for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
+  engine::WindowOptions wo = window_options(args, scene.projector, "projbot calibrate capture");
+  if (scene.devices.projector) {
+    wo.fullscreen = args.flag("fullscreen") || scene.devices.projector->fullscreen;
+    if (!args.get("monitor")) wo.monitor = scene.devices.projector->monitor;
+  }
+  auto window = open_window(renderer, wo, scene.projector);
+  const double settle_ms = args.get_double("settle-ms", 150.0);
+  if (!(settle_ms >= 0.0 && settle_ms <= 5000.0)) throw cli::UsageError("--settle-ms must be 0..5000");
+  auto rig = make_device_rig(screen, renderer, *window, *devices.camera, settle_ms, scene.projector.input_lag_ms);
+  return calibrate::capture(
+      *rig, o, out, [](const std::string& line) { std::cout << line << std::endl; }, interrupted);
+}
+
+int run_capture(const cli::Args& args) {
+  const auto out = args.get("out");
+  if (!out) throw cli::UsageError("--out DIR is required");
+  args.check_output_folders({"out"});
+  const std::string scene_path = args.get_or("config", (asset_dir() / "scenes" / "shop.yaml").string());
+  const config::Scene scene = config::load_scene(scene_path);
+  const bool sim = args.flag("sim");
+  if (!sim && !scene.devices.camera)
+    throw cli::UsageError(scene_path +
+                          " configures no camera (devices.camera): the session needs the projector and a colour "
+                          "camera; --sim runs it in the twin");
+  calibrate::CaptureOptions o;
+  o.projector_width = scene.projector.width_px;
+  o.projector_height = scene.projector.height_px;
+  o.board = calibrate::Board::parse(args.get_or("board", kDefaultBoard));
+  o.poses = args.get_int("poses", 10, 1, 100);
+  engine::RendererOptions ro;
+  ro.windowing = !sim;
+  engine::Renderer renderer(ro);
+  PatternScreen screen(renderer, scene.projector);
+  catch_interrupts();  // Ctrl-C: the poses kept so far are written as the capture
+  calibrate::CaptureSummary s;
+  if (sim) {
+    const calibrate::SimulationConfig c = simulation_config(args, scene);
+    o.poses = c.poses;
+    // The twin takes what the engine drew, checked pixel for pixel against the pattern it was given.
+    auto rig = calibrate::make_twin_rig(c, [&](std::size_t index, const cv::Mat& pattern) {
+      cv::Mat shown = screen.render(index);
+      const int differ = cv::countNonZero(shown != pattern);
+      if (differ != 0)
+        throw calibrate::CalibrationError("the engine drew pattern " + std::to_string(index) + " with " + std::to_string(differ) +
+                                          " pixels unlike the pattern's");
+      return shown;
+    });
+    s = calibrate::capture(
+        *rig, o, *out, [](const std::string& line) { std::cout << line << std::endl; }, interrupted);
+  } else {
+    s = capture_on_devices(args, scene, renderer, screen, o, *out);
+  }
+  if (s.kept == 0) {
+    std::cerr << "projbot calibrate capture: no pose kept (" << s.refused << " refused); nothing written\n";
+    return interrupted() ? interrupt_exit_code() : 1;
+  }
+  std::cout << "kept " << s.kept << " board poses (" << s.refused << " refused) in " << *out << "\nnext: projbot calibrate solve "
+            << *out << " --out calib.yaml" << std::endl;
+  return interrupted() ? interrupt_exit_code() : 0;
+}
+
 }  // namespace
+
+const Command kCalibrateCapture{
+    "calibrate capture",
+    "the calibration session: the projector shows Gray codes on a held board, the colour camera takes them",
+    "projbot calibrate capture --out DIR [--config site.yaml | --sim] [--poses N] [--board SPEC] [--settle-ms MS]\n\n"
+    "For each pose of a printed board (ChArUco by default; print it flat, measure its squares): the projector\n"
+    "shows white while you hold the board in its light, wholly in the camera's view; press Enter and it shows\n"
+    "OpenCV's Gray-code patterns of both axes with their inverses, then white and black, taking a colour image\n"
+    "of each once the light has settled. A pose with too little board or too few decoded corners is refused on\n"
+    "the spot and asked for again; q and Enter finishes with the poses kept. Vary the distance (0.8-1.5 m), the\n"
+    "tilt (up to 30 degrees) and the place in the projector's image. Writes the folder `solve` reads:\n"
+    "  DIR/capture.yaml   projector size, board, the pose folders\n"
+    "  DIR/pose_NN/       the images, in GrayCodePattern::generate() order, then white, then black\n"
+    "The projector and camera are the config's `devices.projector` and `devices.camera`; --sim runs the session\n"
+    "in the twin (the engine draws each pattern, the twin's board and camera take it; DIR/truth.yaml beside).\n"
+    "Ctrl-C writes the poses kept so far as the capture and exits 130.\n",
+    {{"out", "DIR", "the capture folder to write (new or empty)"},
+     {"config", "FILE", "site or scene file with devices.camera and devices.projector (default: assets/scenes/shop.yaml)"},
+     {"sim", "", "the twin's board, projector and camera"},
+     {"poses", "N", "board poses to keep (default 10)"},
+     {"poses-file", "FILE", "--sim: the board's poses from a script, as calibrate simulate takes them"},
+     {"board", "SPEC", std::string("board (default ") + kDefaultBoard + "; or checkerboard:9x7:0.05)"},
+     {"seed", "K", "--sim: seed of the poses' jitter and the noise (default 1)"},
+     {"noise", "LEVELS", "--sim: camera noise sigma, grey levels (default 1.5)"},
+     {"settle-ms", "MS", "wait after a pattern is presented before taking the image (default 150; plus projector.input_lag_ms)"},
+     {"fullscreen", "", "full screen on the projector (the config's devices.projector says so too)"},
+     {"monitor", "N", "the projector's monitor index (default: devices.projector.monitor)"},
+     {"present-mode", "MODE", "fifo (default), mailbox or immediate"}},
+    run_capture};
 
 const Command kCalibrateSimulate{
     "calibrate simulate",

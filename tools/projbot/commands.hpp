@@ -34,5 +34,6 @@ extern const Command kSimBase;
 extern const Command kRecord;
 extern const Command kCalibrateSimulate;
 extern const Command kCalibrateSolve;
+extern const Command kCalibrateCapture;
 
 }  // namespace projbot::tools

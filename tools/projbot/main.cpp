@@ -16,15 +16,15 @@ namespace {
 using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
-  static const std::vector<const Command*> all{&projbot::tools::kRender,        &projbot::tools::kShow,
-                                               &projbot::tools::kBenchRender,   &projbot::tools::kAlign,
-                                               &projbot::tools::kBenchTrack,    &projbot::tools::kBenchMotion,
-                                               &projbot::tools::kBenchAcquire,  &projbot::tools::kSlam,
-                                               &projbot::tools::kLocalize,      &projbot::tools::kBenchLocalize,
-                                               &projbot::tools::kTour,          &projbot::tools::kRun,
-                                               &projbot::tools::kDevices,       &projbot::tools::kSimBase,
-                                               &projbot::tools::kRecord,        &projbot::tools::kCalibrateSimulate,
-                                               &projbot::tools::kCalibrateSolve};
+  static const std::vector<const Command*> all{&projbot::tools::kRender,         &projbot::tools::kShow,
+                                               &projbot::tools::kBenchRender,    &projbot::tools::kAlign,
+                                               &projbot::tools::kBenchTrack,     &projbot::tools::kBenchMotion,
+                                               &projbot::tools::kBenchAcquire,   &projbot::tools::kSlam,
+                                               &projbot::tools::kLocalize,       &projbot::tools::kBenchLocalize,
+                                               &projbot::tools::kTour,           &projbot::tools::kRun,
+                                               &projbot::tools::kDevices,        &projbot::tools::kSimBase,
+                                               &projbot::tools::kRecord,         &projbot::tools::kCalibrateSimulate,
+                                               &projbot::tools::kCalibrateSolve, &projbot::tools::kCalibrateCapture};
   return all;
 }
 
@@ -39,22 +39,24 @@ void print_help() {
     name.resize(std::max<std::size_t>(22, name.size() + 2), ' ');
     std::cout << name << c->summary << '\n';
   }
-  std::cout << "\nExamples:\n"
-               "  projbot render --out frame.png                    the demo scene, headless\n"
-               "  projbot render --model duck.glb --out duck.png    one model, framed in view\n"
-               "  projbot show --scene my.yaml --fullscreen --monitor 1\n"
-               "  projbot align --model bun0.pcd --scan bun4.pcd --init \"0 0 0 0 -30 0\" --json\n"
-               "  projbot slam --rawlog run.rawlog --out-map map --out-trajectory slam.txt\n"
-               "  projbot localize --map map --rawlog run2.rawlog --out-trajectory loc.txt\n"
-               "  projbot tour                                      the demo tour in the digital twin (Table 1)\n"
-               "  projbot tour --mode odometry --report r.json      the paper's set-up, with a JSON report\n"
-               "  projbot run --sim --fullscreen                    the live engine against the twin\n"
-               "  projbot devices --config site.yaml                what this machine has; do the scene's devices work?\n"
-               "  projbot record --out rec/ --config site.yaml      the session through the tour, recorded\n"
-               "  projbot run --replay rec/ --headless              the same session again from the recording\n"
-               "  projbot calibrate simulate --out cap/                the twin's projector-camera calibration session\n"
-               "  projbot calibrate solve cap/ --out calib.yaml        A_p, R_cp, T_cp from Gray-code captures\n"
-               "  projbot bench render\n";
+  std::cout
+      << "\nExamples:\n"
+         "  projbot render --out frame.png                    the demo scene, headless\n"
+         "  projbot render --model duck.glb --out duck.png    one model, framed in view\n"
+         "  projbot show --scene my.yaml --fullscreen --monitor 1\n"
+         "  projbot align --model bun0.pcd --scan bun4.pcd --init \"0 0 0 0 -30 0\" --json\n"
+         "  projbot slam --rawlog run.rawlog --out-map map --out-trajectory slam.txt\n"
+         "  projbot localize --map map --rawlog run2.rawlog --out-trajectory loc.txt\n"
+         "  projbot tour                                      the demo tour in the digital twin (Table 1)\n"
+         "  projbot tour --mode odometry --report r.json      the paper's set-up, with a JSON report\n"
+         "  projbot run --sim --fullscreen                    the live engine against the twin\n"
+         "  projbot devices --config site.yaml                what this machine has; do the scene's devices work?\n"
+         "  projbot record --out rec/ --config site.yaml      the session through the tour, recorded\n"
+         "  projbot run --replay rec/ --headless              the same session again from the recording\n"
+         "  projbot calibrate capture --out cap/                 the projector-camera calibration session (--sim: the twin's)\n"
+         "  projbot calibrate simulate --out cap/                the twin's session, rendered without the engine\n"
+         "  projbot calibrate solve cap/ --out calib.yaml        A_p, R_cp, T_cp from Gray-code captures\n"
+         "  projbot bench render\n";
 }
 
 }  // namespace
@@ -95,11 +97,11 @@ static int dispatch(int argc, char** argv, std::string& name) {
     name = std::string("bench ") + argv[2];
     first = 3;
   }
-  if (name == "calibrate") {  // "calibrate simulate", "calibrate solve": the projector-camera calibration's steps
+  if (name == "calibrate") {  // "calibrate capture", "simulate", "solve": the projector-camera calibration's steps
     const std::string what = argc < 3 ? std::string() : argv[2];
-    if (what != "simulate" && what != "solve") {
+    if (what != "capture" && what != "simulate" && what != "solve") {
       std::cerr << "projbot calibrate: " << (argc < 3 ? std::string("say which step") : "no step '" + what + "'")
-                << ": projbot calibrate simulate | solve\n";
+                << ": projbot calibrate capture | simulate | solve\n";
       return 2;
     }
     name = "calibrate " + what;

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "capture_io.hpp"
+#include "projbot/calibrate/capture.hpp"
 #include "projbot/calibrate/procam.hpp"
 
 namespace projbot::calibrate {
@@ -202,7 +203,9 @@ bool pose_fits(const SimulationConfig& c, const Geometry& g, const Eigen::Matrix
 
 // Pose i of n: the board's centre over a 3 x 3 spread of the projector's image at 0.8-1.3 m, tilted
 // up to 30 degrees about varied axes; pulled nearer face-on and further away until it fits both views.
-static std::vector<Eigen::Matrix4d> board_poses(const SimulationConfig& c, const Geometry& g) {
+// A scripted pose that does not fit is refused by its number, unless `as_held` (the capture session's
+// twin: a person may hold the board badly, and the session refuses the pose on the spot).
+static std::vector<Eigen::Matrix4d> board_poses(const SimulationConfig& c, const Geometry& g, bool as_held = false) {
   static constexpr double kSpread[9][2] = {{0, 0}, {-1, -1}, {1, 1}, {1, -1}, {-1, 1}, {0, -1}, {0, 1}, {-1, 0}, {1, 0}};
   std::mt19937_64 rng(c.seed);
   std::uniform_real_distribution<double> jitter(-1.0, 1.0);
@@ -212,7 +215,7 @@ static std::vector<Eigen::Matrix4d> board_poses(const SimulationConfig& c, const
     Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
     T.block<3, 3>(0, 0) = tilt(p.tilt_deg.x(), p.tilt_deg.y(), p.tilt_deg.z()) * g.R0;
     T.block<3, 1>(0, 3) = p.centre_m - T.block<3, 3>(0, 0) * Eigen::Vector3d(g.centre.x(), g.centre.y(), 0.0);
-    if (!pose_fits(c, g, T))
+    if (!as_held && !pose_fits(c, g, T))
       throw CalibrationError("board pose " + std::to_string(i + 1) + " of " + std::to_string(c.scripted.size()) + ": the board " +
                              c.board.spec() + " is not wholly inside both the camera's and the projector's views");
     poses.push_back(T);
@@ -276,6 +279,60 @@ int simulate(const SimulationConfig& c, const std::filesystem::path& out, const 
   truth.T_camera_board.assign(poses.begin(), poses.begin() + written);
   writer.finish(manifest, truth);
   return written;
+}
+
+namespace {
+
+class TwinRig final : public CaptureRig {
+ public:
+  TwinRig(const SimulationConfig& c, PatternDisplay display)
+      : c_(c),
+        g_(board_geometry(c.board)),
+        poses_(board_poses(c, g_, true)),
+        rays_(sample_rays(c.camera)),
+        display_(std::move(display)) {}
+
+  bool ready(int, int) override {
+    if (next_ >= poses_.size()) return false;
+    current_ = next_++;
+    samples_ = trace(c_, g_, rays_, poses_[current_]);
+    rng_.seed(c_.seed * 1000003u + current_);
+    return true;
+  }
+  cv::Mat show_and_capture(std::size_t index, const cv::Mat& pattern) override {
+    if (samples_.empty()) throw CalibrationError("twin rig: a pattern shown before the board was held");
+    const cv::Mat shown = display_ ? display_(index, pattern) : pattern;
+    if (shown.size() != cv::Size(c_.projector.width_px, c_.projector.height_px) || shown.type() != CV_8UC1)
+      throw CalibrationError("twin rig: the projector's output is not a " + std::to_string(c_.projector.width_px) + "x" +
+                             std::to_string(c_.projector.height_px) + " grey image");
+    return expose(c_, samples_, shown.isContinuous() ? shown : shown.clone(), rng_);
+  }
+  void accepted() override { kept_.push_back(poses_[current_]); }
+  std::optional<Calibration> truth() const override {
+    Calibration t;
+    t.camera = c_.camera;
+    t.projector = Lens{c_.projector, c_.projector.distortion};
+    t.T_projector_camera = c_.T_projector_camera;
+    t.T_camera_board = kept_;
+    return t;
+  }
+
+ private:
+  SimulationConfig c_;
+  Geometry g_;
+  std::vector<Eigen::Matrix4d> poses_;
+  std::vector<cv::Point2d> rays_;
+  PatternDisplay display_;
+  std::vector<Sample> samples_;
+  std::mt19937_64 rng_;
+  std::size_t next_ = 0, current_ = 0;
+  std::vector<Eigen::Matrix4d> kept_;
+};
+
+}  // namespace
+
+std::unique_ptr<CaptureRig> make_twin_rig(const SimulationConfig& config, PatternDisplay display) {
+  return std::make_unique<TwinRig>(config, std::move(display));
 }
 
 }  // namespace projbot::calibrate

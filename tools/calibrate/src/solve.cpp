@@ -9,17 +9,9 @@
 
 #include "capture_io.hpp"
 #include "projbot/calibrate/procam.hpp"
+#include "solve_views.hpp"
 
 namespace projbot::calibrate {
-namespace {
-
-// The used views' correspondences, one entry per view in each list, as OpenCV's calibration takes them.
-struct Correspondences {
-  std::vector<std::vector<cv::Point3f>> object;  // every corner the camera found
-  std::vector<std::vector<cv::Point2f>> camera;
-  std::vector<std::vector<cv::Point3f>> shared_object;  // those also mapped to the projector
-  std::vector<std::vector<cv::Point2f>> shared_camera, projector;
-};
 
 // One view: its corners found in `lit` and mapped into the projector. Appended to `points` when used.
 ViewResult measure_view(const CaptureManifest& m, const cv::Mat& lit, const std::vector<cv::Mat>& images, const SolveOptions& o,
@@ -54,6 +46,8 @@ ViewResult measure_view(const CaptureManifest& m, const cv::Mat& lit, const std:
   points.projector.push_back(std::move(projector));
   return r;
 }
+
+namespace {
 
 Lens lens_from(const cv::Mat& K, const cv::Mat& D, cv::Size size) {
   Lens l;

@@ -1,0 +1,144 @@
+#include "calibrate_capture.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <string>
+#include <thread>
+
+#include "projbot/calibrate/procam.hpp"
+
+namespace projbot::tools {
+namespace {
+
+// A quad at 1 m whose corners are the projector image's outer pixel edges, its texture the pattern.
+assets::Model pattern_quad(const config::ProjectorConfig& p, const cv::Mat& pattern) {
+  assets::Model m;
+  m.source = "gray-code pattern";
+  assets::Image img;
+  img.width = pattern.cols;
+  img.height = pattern.rows;
+  img.rgba.resize(static_cast<std::size_t>(img.width) * img.height * 4);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      std::uint8_t* px = img.pixel(x, y);
+      px[0] = px[1] = px[2] = pattern.at<std::uint8_t>(y, x);
+      px[3] = 255;
+    }
+  m.images.push_back(std::move(img));
+  assets::Material mat;
+  mat.base_color_image = 0;
+  mat.double_sided = true;
+  mat.sampler = {assets::Wrap::kClampToEdge, assets::Wrap::kClampToEdge, assets::Filter::kNearest, assets::Filter::kNearest};
+  m.materials.push_back(mat);
+  assets::Primitive q;
+  const double u[2] = {-0.5, p.width_px - 0.5}, v[2] = {-0.5, p.height_px - 0.5};
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      assets::Vertex vx;
+      vx.position = {static_cast<float>((u[i] - p.cx_px) / p.fx_px), static_cast<float>((v[j] - p.cy_px) / p.fy_px), 1.0F};
+      vx.uv = {static_cast<float>(i), static_cast<float>(j)};
+      q.vertices.push_back(vx);
+    }
+  q.indices = {0, 1, 3, 0, 3, 2};
+  m.primitives.push_back(std::move(q));
+  return m;
+}
+
+// Luma of an RGBA camera image (Rec. 601 weights, as OpenCV's RGB2GRAY).
+cv::Mat grey_of(const assets::Image& colour) {
+  cv::Mat out(colour.height, colour.width, CV_8UC1);
+  for (int y = 0; y < colour.height; ++y)
+    for (int x = 0; x < colour.width; ++x) {
+      const std::uint8_t* c = colour.pixel(x, y);
+      out.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(std::lround(0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2]));
+    }
+  return out;
+}
+
+double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+class DeviceRig final : public calibrate::CaptureRig {
+ public:
+  DeviceRig(PatternScreen& screen, engine::Renderer& renderer, engine::RenderTarget& window, alignment::RgbdCamera& camera,
+            double settle_ms, double lag_ms)
+      : screen_(screen),
+        renderer_(renderer),
+        window_(window),
+        camera_(camera),
+        settle_s_(settle_ms / 1000.0),
+        lag_s_(lag_ms / 1000.0) {}
+
+  bool ready(int pose, int poses) override {
+    show(screen_.white_index());
+    std::cout << "pose " << pose << " of " << poses
+              << ": hold the board in the projector's white light, wholly in the camera's view, and press Enter (q and "
+                 "Enter: finish with the poses kept)"
+              << std::endl;
+    std::string line;
+    if (!std::getline(std::cin, line)) return false;
+    return line != "q" && line != "Q";
+  }
+
+  cv::Mat show_and_capture(std::size_t index, const cv::Mat& /*pattern*/) override {
+    show(index);
+    const double shown = now_s();
+    std::this_thread::sleep_for(std::chrono::duration<double>(settle_s_ + lag_s_));
+    for (int tries = 0; tries < 100; ++tries) {  // frames taken before the light changed are dropped
+      alignment::RgbdFrame f = camera_.next();
+      if (f.colour.rgba.empty())
+        throw calibrate::CalibrationError("the configured camera delivers no colour image; calibrate capture needs one");
+      if (f.depth.capture_time_s >= shown + lag_s_) return grey_of(f.colour);
+    }
+    throw calibrate::CalibrationError(
+        "the camera delivered 100 frames all taken before the pattern was shown: are its "
+        "timestamps on the host's steady clock?");
+  }
+
+ private:
+  void show(std::size_t index) {
+    for (int k = 0; k < 2; ++k) screen_.draw(window_, index);  // both swapchain images hold it
+    renderer_.finish(window_);
+    window_.poll_close();
+  }
+
+  PatternScreen& screen_;
+  engine::Renderer& renderer_;
+  engine::RenderTarget& window_;
+  alignment::RgbdCamera& camera_;
+  double settle_s_, lag_s_;
+};
+
+}  // namespace
+
+PatternScreen::PatternScreen(engine::Renderer& renderer, const config::ProjectorConfig& projector)
+    : renderer_(renderer), pinhole_(projector) {
+  pinhole_.distortion = {};
+  pinhole_.near_m = 0.1;
+  pinhole_.far_m = 10.0;
+  for (const cv::Mat& pattern : calibrate::gray_code_images(projector.width_px, projector.height_px))
+    models_.push_back(renderer_.add_model(pattern_quad(pinhole_, pattern)));
+}
+
+void PatternScreen::draw(engine::RenderTarget& target, std::size_t index) {
+  const std::vector<engine::DrawItem> items{{models_.at(index), Eigen::Matrix4d::Identity()}};
+  renderer_.draw_frame(target, pinhole_, items);
+}
+
+cv::Mat PatternScreen::render(std::size_t index) {
+  if (!offscreen_) offscreen_ = renderer_.make_offscreen(pinhole_.width_px, pinhole_.height_px);
+  draw(*offscreen_, index);
+  const assets::Image img = offscreen_->read_back();
+  cv::Mat out(img.height, img.width, CV_8UC1);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) out.at<std::uint8_t>(y, x) = img.pixel(x, y)[0];
+  return out;
+}
+
+std::unique_ptr<calibrate::CaptureRig> make_device_rig(PatternScreen& screen, engine::Renderer& renderer,
+                                                       engine::RenderTarget& window, alignment::RgbdCamera& camera,
+                                                       double settle_ms, double input_lag_ms) {
+  return std::make_unique<DeviceRig>(screen, renderer, window, camera, settle_ms, input_lag_ms);
+}
+
+}  // namespace projbot::tools

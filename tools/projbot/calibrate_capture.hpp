@@ -1,0 +1,40 @@
+#pragma once
+// `calibrate capture`'s rigs on the engine: the patterns drawn by the renderer (offscreen for the twin,
+// full screen on the projector for the real devices) and the configured colour camera.
+
+#include <memory>
+
+#include "projbot/alignment/rgbd_camera.hpp"
+#include "projbot/calibrate/capture.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/engine/renderer.hpp"
+
+namespace projbot::tools {
+
+/// The Gray-code patterns uploaded once, each a quad that fills the projector's image texel for pixel
+/// (nearest sampling, no lens: a pattern's pixels are the panel's own).
+class PatternScreen {
+ public:
+  PatternScreen(engine::Renderer& renderer, const config::ProjectorConfig& projector);
+  /// Draws pattern `index` into `target` (the projector window, or an offscreen image of its size).
+  void draw(engine::RenderTarget& target, std::size_t index);
+  /// Draws it offscreen and reads it back as 8-bit grey: the projector's output as the engine makes it.
+  cv::Mat render(std::size_t index);
+  /// The white pattern's index (gray_code_images(): the codes, then white, then black).
+  std::size_t white_index() const { return models_.size() - 2; }
+
+ private:
+  engine::Renderer& renderer_;
+  config::ProjectorConfig pinhole_;
+  std::vector<std::size_t> models_;
+  std::unique_ptr<engine::RenderTarget> offscreen_;
+};
+
+/// The real rig: `screen` drawn into `window` (the projector, full screen), `camera`'s colour images
+/// taken `settle_ms` plus the projector's input lag after each pattern is presented; ready() asks the
+/// person on the terminal to hold the board and press Enter (q: finish).
+std::unique_ptr<calibrate::CaptureRig> make_device_rig(PatternScreen& screen, engine::Renderer& renderer,
+                                                       engine::RenderTarget& window, alignment::RgbdCamera& camera,
+                                                       double settle_ms, double input_lag_ms);
+
+}  // namespace projbot::tools
