@@ -7,10 +7,14 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <future>
+#include <sstream>
 #include <string>
 #include <thread>
 
+#include "projbot/alignment/freenect_source.hpp"
 #include "x11_screenshot.hpp"
 
 namespace {
@@ -54,6 +58,75 @@ TEST(RunWindowTest, FullscreenTwinRunLightsTheTargets) {
   EXPECT_GT(best, 0.005) << output;
   EXPECT_LT(best, 0.6);
   if (best_image.width > 0) projbot::assets::write_png(::testing::TempDir() + "run_window.png", best_image);
+}
+
+// `calibrate capture` on configured devices: a Kinect v1 (libfreenect, played by fakenect from a dump of a
+// grey wall) and the projector window full screen on Xvfb. The person is asked to hold the board (Enter
+// on stdin), the window shows the Gray-code patterns (a screenshot half white, half black: a stripe
+// pattern), the camera's colour frames are taken, and the pose is refused on the spot (no board on a
+// bare wall); q ends the session with nothing written.
+TEST(RunWindowTest, CalibrateCaptureOnAKinectAndTheProjectorWindow) {
+  namespace fs = std::filesystem;
+  projbot::testing::X11Display x11;
+  ASSERT_TRUE(x11.ok()) << "no X display (run under xvfb-run)";
+  const fs::path dir = fs::temp_directory_path() / ("projbot_capture_window_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  projbot::alignment::DepthImage depth;
+  depth.width = 640, depth.height = 480;
+  depth.depth_m.assign(640 * 480, 1.5F);
+  projbot::assets::Image colour;
+  colour.width = 640, colour.height = 480;
+  colour.rgba.assign(640 * 480 * 4, 128);
+  projbot::alignment::write_fakenect_dump(dir / "dump", {{&depth, &colour, 10.0}, {&depth, &colour, 10.0 + 1.0 / 30.0}});
+  std::string once;
+  {
+    std::ifstream in(dir / "dump" / "INDEX.txt");
+    once.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  {
+    std::ofstream out(dir / "dump" / "INDEX.txt");  // fakenect plays the list once: 600 frames, 20 s at 30 Hz
+    for (int i = 0; i < 300; ++i) out << once;
+  }
+  std::ifstream shop(std::string(PROJBOT_ASSET_DIR) + "/scenes/shop.yaml");
+  std::ostringstream text;
+  text << shop.rdbuf();
+  std::string yaml = text.str();
+  for (std::size_t at = 0; (at = yaml.find("model: ../", at)) != std::string::npos; at += 7)
+    yaml.insert(at + 7, std::string(PROJBOT_ASSET_DIR) + "/scenes/");
+  std::ofstream(dir / "site.yaml") << yaml
+                                   << "devices:\n  camera: {driver: freenect, registered: false}\n"
+                                      "  projector: {monitor: 0, fullscreen: true}\n";
+  std::ofstream(dir / "answers.txt") << "\nq\n";
+  const std::string cmd = "env LD_LIBRARY_PATH=" PROJBOT_FAKENECT_DIR " FAKENECT_PATH=" + (dir / "dump").string() +
+                          " timeout 120 " + std::string(PROJBOT_EXE) + " calibrate capture --settle-ms 60 --config " +
+                          (dir / "site.yaml").string() + " --out " + (dir / "cap").string() + " <" +
+                          (dir / "answers.txt").string() + " 2>&1";
+  auto run = std::async(std::launch::async, [&] {
+    FILE* pipe = popen(cmd.c_str(), "r");
+    std::string out;
+    std::array<char, 512> buf{};
+    while (pipe != nullptr && fgets(buf.data(), buf.size(), pipe) != nullptr) out += buf.data();
+    const int status = pipe != nullptr ? pclose(pipe) : -1;
+    return std::pair{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+  });
+  bool stripes = false;
+  std::string shares;  // what the screenshots showed, for the message
+  while (run.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready)
+    if (!stripes) {
+      const double share = lit_share(x11.screenshot(x11.root_window(), x11.screen_width(), x11.screen_height()));
+      stripes = share > 0.3 && share < 0.7;
+      shares += std::to_string(share).substr(0, 4) + " ";
+    }
+  const auto [code, output] = run.get();
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_NE(output.find("opened camera: freenect #0"), std::string::npos) << output;
+  EXPECT_NE(output.find("pose 1 of 10: hold the board in the projector's white light"), std::string::npos) << output;
+  EXPECT_NE(output.find("pose 1 refused: no board found in the white image"), std::string::npos) << output;
+  EXPECT_NE(output.find("no pose kept (1 refused); nothing written"), std::string::npos) << output;
+  EXPECT_TRUE(stripes) << "no screenshot showed a stripe pattern; lit shares: " << shares;
+  EXPECT_FALSE(fs::exists(dir / "cap"));
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -174,15 +174,18 @@ int run_solve(const cli::Args& args) {
 // The session on the configured projector and colour camera (the projector's window, the camera's
 // colour frames after each pattern settles), or the twin's with --sim: the patterns the engine draws
 // fall on the twin's board.
-calibrate::CaptureSummary capture_on_devices(const cli::Args& args, const config::Scene& scene, engine::Renderer& renderer,
-                                             PatternScreen& screen, const calibrate::CaptureOptions& o,
-                                             const std::filesystem::path& out) {
+calibrate::CaptureSummary capture_on_devices(const cli::Args& args, const config::Scene& scene,
+                                             const calibrate::CaptureOptions& o, const std::filesystem::path& out) {
   config::DevicesConfig wanted;
   wanted.camera = scene.devices.camera;
   wanted.projector = scene.devices.projector;
   std::vector<DeviceCheck> checks;
   Devices devices = open_devices(wanted, checks, true);  // an absent device: an error naming it, before anything is shown
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
+  engine::RendererOptions ro;  // after the monitors were checked: that check starts and stops GLFW
+  ro.windowing = true;
+  engine::Renderer renderer(ro);
+  PatternScreen screen(renderer, scene.projector);
   engine::WindowOptions wo = window_options(args, scene.projector, "projbot calibrate capture");
   if (scene.devices.projector) {
     wo.fullscreen = args.flag("fullscreen") || scene.devices.projector->fullscreen;
@@ -212,13 +215,11 @@ int run_capture(const cli::Args& args) {
   o.projector_height = scene.projector.height_px;
   o.board = calibrate::Board::parse(args.get_or("board", kDefaultBoard));
   o.poses = args.get_int("poses", 10, 1, 100);
-  engine::RendererOptions ro;
-  ro.windowing = !sim;
-  engine::Renderer renderer(ro);
-  PatternScreen screen(renderer, scene.projector);
   catch_interrupts();  // Ctrl-C: the poses kept so far are written as the capture
   calibrate::CaptureSummary s;
   if (sim) {
+    engine::Renderer renderer(engine::RendererOptions{});
+    PatternScreen screen(renderer, scene.projector);
     const calibrate::SimulationConfig c = simulation_config(args, scene);
     o.poses = c.poses;
     // The twin takes what the engine drew, checked pixel for pixel against the pattern it was given.
@@ -233,7 +234,7 @@ int run_capture(const cli::Args& args) {
     s = calibrate::capture(
         *rig, o, *out, [](const std::string& line) { std::cout << line << std::endl; }, interrupted);
   } else {
-    s = capture_on_devices(args, scene, renderer, screen, o, *out);
+    s = capture_on_devices(args, scene, o, *out);
   }
   if (s.kept == 0) {
     std::cerr << "projbot calibrate capture: no pose kept (" << s.refused << " refused); nothing written\n";
