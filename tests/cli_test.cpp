@@ -191,7 +191,7 @@ TEST_F(CliTest, RendersThroughTheProjectorsLens) {
   EXPECT_NEAR(measured.z() / expected.z(), 1.0, 0.05) << "lit area";
   const CliRun fold = run_projbot("render --scene " + scene("fold.yaml", ", distortion: [-0.9]") + " --out " + lens.string());
   EXPECT_EQ(fold.code, 1);
-  EXPECT_NE(fold.output.find("fold.yaml:1: projector: distortion folds the image over at panel position"), std::string::npos)
+  EXPECT_NE(fold.output.find("fold.yaml:1: projector: distortion folds the image over at panel pixel"), std::string::npos)
       << fold.output;
 }
 

@@ -106,7 +106,7 @@ INSTANTIATE_TEST_SUITE_P(
                 {"s.yaml:1:", "projector.distortion", "finite"}},
         BadCase{"projector_lens_too_strong",
                 "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240, distortion: [-0.6]}\ntargets: []\n",
-                {"s.yaml:1:", "projector", "distortion folds the image over at panel position"}},
+                {"s.yaml:1:", "projector", "distortion folds the image over at panel pixel"}},
         BadCase{"unknown_projector_key",
                 "projector: {width: 640, height: 480, fx: 500, fy: 500, cx: 320, cy: 240, fz: 1}\ntargets: []\n",
                 {"s.yaml:1:", "projector.fz", "unknown key"}},
@@ -374,7 +374,7 @@ TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
                   "projector: {width: 1024, height: 768, fx: 500, fy: 500, cx: 512, cy: 384, "
                   "distortion: [-0.5, 0, 0, 0, 0]}\n" +
                       good_pose)
-                .find("calib2.yaml:1: projector: distortion folds the image over at panel position (-1, -1)"),
+                .find("calib2.yaml:1: projector: distortion folds the image over at panel pixel (0, 0)"),
             std::string::npos);
   EXPECT_NE(
       error("calibration: calib2.yaml\n", "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512}\n" + good_pose)

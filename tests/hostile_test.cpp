@@ -571,14 +571,14 @@ const std::vector<Hostile> kArgumentCases{
             {{"bad.yaml", "calibration: /dev/zero\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}},
             1,
             {"bad.yaml:1: calibration", "/dev/zero", "not a file"}},
-    Hostile{"calibration_with_distortion",
+    Hostile{"calibration_lens_folds",
             "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
             {{"calib.yaml",
-              "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24, distortion: [0.2]}\n"
+              "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24, distortion: [-2.0]}\n"
               "projector_from_camera: {translation: [0, 0, 0]}\n"},
              {"bad.yaml", "calibration: calib.yaml\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}},
             1,
-            {"calib.yaml:1: projector.distortion", "pre-distort"}},
+            {"calib.yaml:1: projector: distortion folds the image over at panel pixel (0, 0)"}},
     Hostile{"devices_unknown_camera_driver",
             "run --headless --config {dir}/bad.yaml --profile {dir}/prev.csv",
             {{"bad.yaml", kTour + "devices: {camera: {driver: kinect2}}\n"}},
@@ -779,7 +779,7 @@ std::vector<Hostile> all_cases() {
               {"needs a 'tour: {visits: [...]}' section"}},
       Hostile{"run_bad_dwell", "run --headless --dwell 0", "", 2, {"--dwell"}},
       // The calibration: a capture folder that is not one, bad boards and sizes, outputs that cannot be written.
-      Hostile{"calibrate_no_step", "calibrate", "", 2, {"say which step: projbot calibrate simulate | solve"}},
+      Hostile{"calibrate_no_step", "calibrate", "", 2, {"say which step: projbot calibrate capture | simulate | solve"}},
       Hostile{"calibrate_solve_missing_folder",
               "calibrate solve {dir}/nothing --out {dir}/c.yaml",
               "",

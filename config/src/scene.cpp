@@ -461,7 +461,10 @@ void validate_lens(const ProjectorConfig& p, const Fail& fail) {
     for (int i = 0; i <= kSteps; ++i) {
       const double u = -0.5 + p.width_px * i / double(kSteps), v = -0.5 + p.height_px * j / double(kSteps);
       const auto ray = p.panel_ray(u, v);
-      const auto where = " at panel position (" + std::to_string(std::lround(u)) + ", " + std::to_string(std::lround(v)) + ")";
+      const auto pixel = [](double x, int size) {
+        return std::to_string(std::clamp(std::lround(std::floor(x + 0.5)), 0L, size - 1L));
+      };
+      const auto where = " at panel pixel (" + pixel(u, p.width_px) + ", " + pixel(v, p.height_px) + ")";
       if (!ray || !(distort_jacobian(p.distortion, ray->head<2>()).determinant() > 0.0))
         fail("distortion folds the image over" + where + ": no lens the renderer can pre-distort for (check the calibration)");
       const double iu = p.fx_px * ray->x() + p.cx_px, iv = p.fy_px * ray->y() + p.cy_px;
