@@ -202,7 +202,7 @@ void TargetFollower::by_colour(const DepthImage& frame, const Known& known, cons
   // Colour may move the pose only where depth does not object: on the duck, which depth pins, colour's
   // best agreement lay 2.7-3.3 mm off in 2 of 20 captures, and the depth RMSE grew 45-65 % there; along
   // the face-on box's face it changed by under 2 %.
-  if (c.shift_m.norm() > 0.0) {
+  if (c.moved()) {
     const PointCloud tight = depth_to_cloud(near_guess(frame, r.T_scan_model, known, cfg_.recrop_m), k_);
     const AlignmentResult before = aligner_.score(tight, r.T_scan_model), after = aligner_.score(tight, c.T_camera_model);
     if (after.rmse_mm <= before.rmse_mm * (1.0 + cfg_.colour_max_rmse_growth) &&

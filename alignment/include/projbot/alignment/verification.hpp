@@ -91,14 +91,20 @@ struct ColourRefinement {
   Eigen::Matrix4d T_camera_model = Eigen::Matrix4d::Identity();
   double agreement_before = 0.0;                      ///< colour_agreement at the pose given (NaN: colour says nothing)
   double agreement_after = 0.0;                       ///< ...and at the result
-  Eigen::Vector3d shift_m = Eigen::Vector3d::Zero();  ///< the move, camera frame
+  Eigen::Vector3d shift_m = Eigen::Vector3d::Zero();  ///< the move of the seen surface's centre, camera frame
+  double turn_deg = 0.0;                              ///< the turn about its weakest rotation, degrees
+  bool moved() const { return shift_m.norm() > 0.0 || turn_deg > 0.0; }
 };
+/// How far colour_refined turns a pose about its weakest rotation at most (degrees).
+inline constexpr double kColourTurnReachDeg = 2.0;
 
 /// Depth pins a box seen face-on only loosely along its face: the Kinect's edges are noisy and the
 /// shop's box came out 1.7-2.9 mm off sideways. Its texture does not slide. The pose is moved within
 /// +-reach_m in the plane of the two weakest slides of view_constraints (their translations, made
 /// orthonormal) to where colour_agreement is highest: a grid of 2 step_m, then finer ones of step_m / 2
-/// and step_m / 4 around the best. The pose is kept when colour says nothing (NaN) or no move gains at least min_gain.
+/// and step_m / 4 around the best; then turned about the view's weakest rotation (through the seen
+/// surface's centre, within kColourTurnReachDeg) and slid once more. The pose is kept when colour says
+/// nothing (NaN) or no move gains at least min_gain.
 ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
                                 const assets::Image& colour, const CameraIntrinsics& k, double reach_m = 0.008,
                                 double step_m = 0.001, double min_gain = 0.005);
