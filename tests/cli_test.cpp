@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -193,6 +194,26 @@ TEST_F(CliTest, RendersThroughTheProjectorsLens) {
   EXPECT_EQ(fold.code, 1);
   EXPECT_NE(fold.output.find("fold.yaml:1: projector: distortion folds the image over at panel pixel"), std::string::npos)
       << fold.output;
+}
+
+// bench render --lens: every run made through the pinhole and through the lens, a row each.
+TEST_F(CliTest, BenchRenderMeasuresTheLensPassBesideThePinhole) {
+  const CliRun r = run_projbot("bench render --offscreen-only --sizes 64x48 --frames 5 --lens -0.12,0.05");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::istringstream lines(r.output);
+  std::map<std::string, int> rows;  // lens column -> rows
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream cells(line);
+    std::string model, tris, size, target, lens;
+    double fps = 0.0, p50 = 0.0, p95 = 0.0, p99 = 0.0, max = 0.0, gpu = 0.0;
+    if (!(cells >> model >> tris >> size >> target >> fps >> p50 >> p95 >> p99 >> max >> gpu >> lens) || size != "64x48")
+      continue;
+    EXPECT_GT(fps, 0.0) << line;
+    EXPECT_GT(p50, 0.0) << line;
+    ++rows[lens];
+  }
+  EXPECT_EQ(rows["pinhole"], 2) << r.output;  // duck and sphere
+  EXPECT_EQ(rows["k1=-0.12,k2=0.05"], 2) << r.output;
 }
 
 TEST_F(CliTest, OverridesAndProfile) {

@@ -1,8 +1,10 @@
 // projbot bench render: frame rate and frame-time percentiles of the projector pass.
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 
 #include "commands.hpp"
 #include "interrupt.hpp"
@@ -45,23 +47,78 @@ std::vector<std::pair<int, int>> parse_sizes(const std::string& text) {
   return out;
 }
 
+// The pinhole, and with --lens K1,K2 a projector lens with those radial terms, validated at every size
+// as a scene's lens would be.
+std::vector<std::optional<config::Distortion>> lenses_to_measure(const std::optional<std::string>& text,
+                                                                 const std::vector<std::pair<int, int>>& sizes) {
+  std::vector<std::optional<config::Distortion>> lenses{std::nullopt};
+  if (!text) return lenses;
+  double k1 = 0.0, k2 = 0.0;
+  char extra = 0;
+  if (std::sscanf(text->c_str(), "%lf,%lf%c", &k1, &k2, &extra) != 2 || !std::isfinite(k1) || !std::isfinite(k2))
+    throw cli::UsageError("--lens must be K1,K2 (two radial terms, e.g. -0.12,0.05), not '" + *text + "'");
+  lenses.push_back(config::Distortion{k1, k2, 0.0, 0.0, 0.0});
+  for (const auto& [w, h] : sizes) {
+    auto p = projector_for(w, h);
+    p.distortion = *lenses.back();
+    try {
+      config::validate_projector(p, "--lens " + *text + " at " + std::to_string(w) + "x" + std::to_string(h));
+    } catch (const config::ConfigError& e) {
+      throw cli::UsageError(e.what());
+    }
+  }
+  return lenses;
+}
+
+// One run: 20 warm-up frames, then `frames` measured ones (fewer when interrupted).
+engine::FrameSummary measure(engine::Renderer& renderer, const config::ProjectorConfig& projector,
+                             const std::vector<engine::DrawItem>& items, bool windowed, int frames) {
+  std::unique_ptr<engine::RenderTarget> target;
+  if (windowed) {
+    engine::WindowOptions wo;
+    wo.width_px = projector.width_px;
+    wo.height_px = projector.height_px;
+    wo.title = "projbot bench";
+    wo.present_mode = engine::PresentMode::kImmediate;
+    target = renderer.make_window(wo);
+  } else {
+    target = renderer.make_offscreen(projector.width_px, projector.height_px);
+  }
+  for (int i = 0; i < 20 && !interrupted(); ++i) {
+    target->poll_close();
+    renderer.draw_frame(*target, projector, items);
+  }
+  renderer.finish(*target);
+  engine::FrameProfiler profiler;
+  for (int i = 0; i < frames && !interrupted(); ++i) {
+    target->poll_close();
+    renderer.draw_frame(*target, projector, items, &profiler);
+  }
+  renderer.finish(*target);
+  return profiler.summary();
+}
+
 }  // namespace
 
 const Command kBenchRender{
     "bench render",
     "benchmark the projector pass (frame rate, frame-time percentiles)",
-    "projbot bench render [--frames N] [--sizes WxH,...] [--offscreen-only | --windowed-only]\n\n"
+    "projbot bench render [--frames N] [--sizes WxH,...] [--lens K1,K2] [--offscreen-only | --windowed-only]\n\n"
     "Draws the Duck (4212 triangles) and a 100k-triangle textured sphere at each size, offscreen and\n"
     "(when a display is there, e.g. under xvfb-run) in a window, and prints one row per run. Frame time\n"
-    "is start-to-start of consecutive frames; windowed runs use the IMMEDIATE present mode where offered.\n",
+    "is start-to-start of consecutive frames; windowed runs use the IMMEDIATE present mode where offered.\n"
+    "With --lens every run is made twice, through a pinhole and through a projector lens with those\n"
+    "radial terms (the lens pass: the models drawn onto an undistorted canvas, then warped per pixel).\n",
     {{"frames", "N", "measured frames per run, after 20 warm-up frames (default 300)"},
      {"sizes", "WxH,...", "target sizes (default 1280x800,1920x1080)"},
+     {"lens", "K1,K2", "also measure each run through a projector lens with these radial terms"},
      {"offscreen-only", "", "skip the windowed runs"},
      {"windowed-only", "", "skip the offscreen runs"},
      {"device", "N", "Vulkan physical device index"}},
     [](const cli::Args& args) {
       const int frames = args.get_int("frames", 300, 1, 1000000);
       const auto sizes = parse_sizes(args.get_or("sizes", "1280x800,1920x1080"));
+      const auto lenses = lenses_to_measure(args.get("lens"), sizes);
       if (args.flag("offscreen-only") && args.flag("windowed-only"))
         throw cli::UsageError("--offscreen-only and --windowed-only together leave nothing to measure: give one");
       const bool want_offscreen = !args.flag("windowed-only");
@@ -82,49 +139,30 @@ const Command kBenchRender{
       engine::Renderer renderer(ro);
       catch_interrupts();  // Ctrl-C: the rows printed are whole; the run under way is dropped; exit 130
       std::cout << "device: " << renderer.device_info().name << " (" << renderer.device_info().driver << ")\n";
-      std::printf("%-11s %8s %10s %-9s %8s %8s %8s %8s %8s %8s\n", "model", "tris", "size", "target", "fps", "p50_ms", "p95_ms",
-                  "p99_ms", "max_ms", "gpu_p50");
+      std::printf("%-11s %8s %10s %-9s %8s %8s %8s %8s %8s %8s  %s\n", "model", "tris", "size", "target", "fps", "p50_ms",
+                  "p95_ms", "p99_ms", "max_ms", "gpu_p50", "lens");
       for (const auto& m : models) {
         const std::size_t id = renderer.add_model(m.model);
         const double radius = 0.5 * m.model.bounds().diagonal().norm();
-        for (const auto& [w, h] : sizes) {
-          const auto projector = projector_for(w, h);
-          const std::vector<engine::DrawItem> items{{id, framing_pose(projector, radius)}};
-          for (const bool windowed : {false, true}) {
-            if ((windowed && !want_window) || (!windowed && !want_offscreen)) continue;
-            std::unique_ptr<engine::RenderTarget> target;
-            if (windowed) {
-              engine::WindowOptions wo;
-              wo.width_px = w;
-              wo.height_px = h;
-              wo.title = "projbot bench";
-              wo.present_mode = engine::PresentMode::kImmediate;
-              target = renderer.make_window(wo);
-            } else {
-              target = renderer.make_offscreen(w, h);
+        for (const auto& [w, h] : sizes)
+          for (const auto& lens : lenses)
+            for (const bool windowed : {false, true}) {
+              auto projector = projector_for(w, h);
+              if (lens) projector.distortion = *lens;
+              const std::vector<engine::DrawItem> items{{id, framing_pose(projector, radius)}};
+              if ((windowed && !want_window) || (!windowed && !want_offscreen)) continue;
+              const engine::FrameSummary s = measure(renderer, projector, items, windowed, frames);
+              if (interrupted())
+                return benchmark_interrupted("after " + std::to_string(s.frames) + " of " + std::to_string(frames) +
+                                             " frames of this run (not reported)");
+              char size[32], lens_text[48] = "pinhole";
+              std::snprintf(size, sizeof size, "%dx%d", w, h);
+              if (lens) std::snprintf(lens_text, sizeof lens_text, "k1=%g,k2=%g", (*lens)[0], (*lens)[1]);
+              std::printf("%-11s %8zu %10s %-9s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f  %s\n", m.name.c_str(),
+                          m.model.triangle_count(), size, windowed ? "window" : "offscreen", s.fps, s.p50_ms, s.p95_ms, s.p99_ms,
+                          s.max_ms, s.gpu_p50_ms, lens_text);
+              std::fflush(stdout);
             }
-            for (int i = 0; i < 20 && !interrupted(); ++i) {
-              target->poll_close();
-              renderer.draw_frame(*target, projector, items);
-            }
-            renderer.finish(*target);
-            engine::FrameProfiler profiler;
-            for (int i = 0; i < frames && !interrupted(); ++i) {
-              target->poll_close();
-              renderer.draw_frame(*target, projector, items, &profiler);
-            }
-            renderer.finish(*target);
-            const auto s = profiler.summary();
-            if (interrupted())
-              return benchmark_interrupted("after " + std::to_string(s.frames) + " of " + std::to_string(frames) +
-                                           " frames of this run (not reported)");
-            char size[32];
-            std::snprintf(size, sizeof size, "%dx%d", w, h);
-            std::printf("%-11s %8zu %10s %-9s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f\n", m.name.c_str(), m.model.triangle_count(),
-                        size, windowed ? "window" : "offscreen", s.fps, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms, s.gpu_p50_ms);
-            std::fflush(stdout);
-          }
-        }
       }
       return 0;
     }};
