@@ -502,6 +502,31 @@ TEST_F(RenderTest, LensPassPutsContentWhereTheLensSendsIt) {
 
 // A barrel lens throws the panel's corners' light outside the pinhole's image: the canvas holds those rays,
 // so a surface filling the whole view lights every panel pixel (none left black at the corners).
+// The lens pass's map of rays is made once per target and lens: a target drawn through one lens and
+// then another shows the second lens, pixel for pixel as a new target does, and not the first.
+TEST_F(RenderTest, LensPassFollowsALensChangeOnTheSameTarget) {
+  ProjectorConfig a = projector(160, 100, 150, 150, 79.5, 49.5), b = a;
+  // Mirror images in y: their canvases have one size (the margins above and below trade places), so
+  // only the lens itself tells that the map must be made again.
+  a.distortion = {-0.3, 0.08, 0.004, 0.0, 0.0};
+  b.distortion = {-0.3, 0.08, -0.004, 0.0, 0.0};
+  const auto ca = projbot::engine::lens_canvas(a), cb = projbot::engine::lens_canvas(b);
+  ASSERT_EQ(ca.pinhole.width_px, cb.pinhole.width_px);
+  ASSERT_EQ(ca.pinhole.height_px, cb.pinhole.height_px);
+  const std::size_t id = renderer_->add_model(
+      quad({Eigen::Vector3d(-0.2, -0.15, 0), {0.25, -0.15, 0}, {0.25, 0.1, 0}, {-0.2, 0.1, 0}}, {1, 0.5F, 0.25F, 1}));
+  const std::vector<DrawItem> items{{id, pose(0, 0, 1.0, 0, 0, 0)}};
+  auto target = renderer_->make_offscreen(a.width_px, a.height_px);
+  ASSERT_TRUE(renderer_->draw_frame(*target, a, items));
+  const Image through_a = target->read_back();
+  ASSERT_TRUE(renderer_->draw_frame(*target, b, items));
+  const Image through_b = target->read_back();
+  EXPECT_EQ(through_b.rgba, render(b, items).rgba);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < through_a.rgba.size(); ++i) differ += through_a.rgba[i] != through_b.rgba[i] ? 1 : 0;
+  EXPECT_GT(differ, 400U) << "the two lenses must place the quad differently";
+}
+
 TEST_F(RenderTest, LensPassFillsThePanelOutToTheCorners) {
   ProjectorConfig p = projector(320, 200, 300, 300, 159.5, 99.5);
   p.distortion = {-0.3, 0.08, 0.0, 0.0, 0.0};

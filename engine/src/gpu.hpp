@@ -90,6 +90,8 @@ struct FrameSlot {
 struct LensCanvasImages {
   Image color;  ///< the target's format, drawn then sampled
   Image depth;
+  Image warp;                         ///< engine::lens_warp at the target's size: the canvas position per pixel
+  config::ProjectorConfig projector;  ///< the projector (lens) it was made for
   vk::raii::DescriptorPool pool{nullptr};
   vk::raii::DescriptorSet set{nullptr};
 };

@@ -48,6 +48,21 @@ LensCanvas lens_canvas(const config::ProjectorConfig& p) {
   return c;
 }
 
+std::vector<float> lens_warp(const config::ProjectorConfig& p, const LensCanvas& c, int width, int height) {
+  std::vector<float> uv(2 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height), -1.0F);
+  const double sx = static_cast<double>(p.width_px) / width, sy = static_cast<double>(p.height_px) / height;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      // The panel position of the target pixel's centre (pixel centres at integers).
+      const auto ray = p.panel_ray((x + 0.5) * sx - 0.5, (y + 0.5) * sy - 0.5);
+      if (!ray) continue;
+      const std::size_t i = 2 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x));
+      uv[i] = static_cast<float>((p.fx_px * ray->x() + p.cx_px + c.left_px + 0.5) / c.pinhole.width_px);
+      uv[i + 1] = static_cast<float>((p.fy_px * ray->y() + p.cy_px + c.top_px + 0.5) / c.pinhole.height_px);
+    }
+  return uv;
+}
+
 std::array<float, 16> to_gpu_matrix(const Eigen::Matrix4d& m) {
   std::array<float, 16> out{};
   for (int c = 0; c < 4; ++c)

@@ -33,15 +33,6 @@ struct DrawConstants {
 };
 static_assert(sizeof(DrawConstants) == 84);
 
-/// Push constants of lens.frag (std430: 64 bytes).
-struct LensConstants {
-  std::array<float, 4> intrinsics;  // fx, fy, cx, cy
-  std::array<float, 4> k;           // k1, k2, p1, p2
-  std::array<float, 4> k3_scale;    // k3, projector pixels per target pixel x, y, unused
-  std::array<float, 4> place;       // canvas margins left, top; 1 / canvas width, 1 / canvas height
-};
-static_assert(sizeof(LensConstants) == 64);
-
 /// Whether two projectors draw the same lens canvas.
 bool same_lens(const config::ProjectorConfig& a, const config::ProjectorConfig& b) {
   return a.width_px == b.width_px && a.height_px == b.height_px && a.fx_px == b.fx_px && a.fy_px == b.fy_px &&
@@ -117,6 +108,8 @@ struct Renderer::Impl {
   vk::raii::ShaderModule lens_vert{nullptr};
   vk::raii::ShaderModule lens_frag{nullptr};
   vk::raii::Sampler lens_sampler{nullptr};
+  vk::raii::Sampler warp_sampler{nullptr};                 // nearest: the warp map is read texel for texel
+  vk::raii::DescriptorSetLayout lens_set_layout{nullptr};  // the canvas and the warp map
   std::map<vk::Format, vk::raii::Pipeline> lens_pipelines;
   std::optional<std::pair<config::ProjectorConfig, LensCanvas>> last_canvas;  // lens_canvas() of the last projector
   detail::Image white;                                                        // bound where a material has no texture
@@ -133,12 +126,20 @@ struct Renderer::Impl {
     vert = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_vert_spv), k_mesh_vert_spv));
     frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_frag_spv), k_mesh_frag_spv));
     depth_frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_depth_frag_spv), k_depth_frag_spv));
-    vk::PushConstantRange lens_push(vk::ShaderStageFlagBits::eFragment, 0, sizeof(LensConstants));
-    lens_layout = vk::raii::PipelineLayout(gpu->device, vk::PipelineLayoutCreateInfo({}, layouts, lens_push));
+    const vk::DescriptorSetLayoutBinding lens_bindings[] = {
+        {0, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment},
+        {1, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment}};
+    lens_set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, lens_bindings));
+    const vk::DescriptorSetLayout lens_layouts[] = {*lens_set_layout};
+    lens_layout = vk::raii::PipelineLayout(gpu->device, vk::PipelineLayoutCreateInfo({}, lens_layouts, {}));
     lens_vert = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_lens_vert_spv), k_lens_vert_spv));
     lens_frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_lens_frag_spv), k_lens_frag_spv));
     lens_sampler = vk::raii::Sampler(
         gpu->device, vk::SamplerCreateInfo({}, vk::Filter::eLinear, vk::Filter::eLinear, vk::SamplerMipmapMode::eNearest,
+                                           vk::SamplerAddressMode::eClampToEdge, vk::SamplerAddressMode::eClampToEdge,
+                                           vk::SamplerAddressMode::eClampToEdge));
+    warp_sampler = vk::raii::Sampler(
+        gpu->device, vk::SamplerCreateInfo({}, vk::Filter::eNearest, vk::Filter::eNearest, vk::SamplerMipmapMode::eNearest,
                                            vk::SamplerAddressMode::eClampToEdge, vk::SamplerAddressMode::eClampToEdge,
                                            vk::SamplerAddressMode::eClampToEdge));
     assets::Image w;
@@ -152,14 +153,18 @@ struct Renderer::Impl {
   }
 
   detail::Image upload_texture(const assets::Image& img) {
-    const vk::Extent2D extent(static_cast<std::uint32_t>(img.width), static_cast<std::uint32_t>(img.height));
     // UNORM, not SRGB: texels reach the target exactly as stored in the file.
-    detail::Image tex =
-        gpu->make_image(extent, vk::Format::eR8G8B8A8Unorm,
-                        vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst, vk::ImageAspectFlagBits::eColor);
-    Buffer staging = gpu->make_buffer(img.rgba.size(), vk::BufferUsageFlagBits::eTransferSrc,
+    return upload_image(vk::Extent2D(static_cast<std::uint32_t>(img.width), static_cast<std::uint32_t>(img.height)),
+                        vk::Format::eR8G8B8A8Unorm, img.rgba.data(), img.rgba.size());
+  }
+
+  // A sampled image of `format` holding `bytes`, ready for fragment shaders to read.
+  detail::Image upload_image(vk::Extent2D extent, vk::Format format, const void* bytes, std::size_t size) {
+    detail::Image tex = gpu->make_image(extent, format, vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst,
+                                        vk::ImageAspectFlagBits::eColor);
+    Buffer staging = gpu->make_buffer(size, vk::BufferUsageFlagBits::eTransferSrc,
                                       vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
-    std::memcpy(staging.mapped, img.rgba.data(), img.rgba.size());
+    std::memcpy(staging.mapped, bytes, size);
     gpu->one_shot([&](vk::raii::CommandBuffer& cmd) {
       detail::transition(cmd, *tex.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                          vk::ImageLayout::eTransferDstOptimal, vk::PipelineStageFlagBits2::eNone, vk::AccessFlagBits2::eNone,
@@ -251,7 +256,9 @@ struct Renderer::Impl {
     const vk::Extent2D size(
         static_cast<std::uint32_t>(std::ceil(e.width * static_cast<double>(lc.pinhole.width_px) / p.width_px)),
         static_cast<std::uint32_t>(std::ceil(e.height * static_cast<double>(lc.pinhole.height_px) / p.height_px)));
-    if (t.canvas && t.canvas->color.extent == size && t.canvas->color.format == t.color_format()) return *t.canvas;
+    if (t.canvas && t.canvas->color.extent == size && t.canvas->color.format == t.color_format() && t.canvas->warp.extent == e &&
+        same_lens(t.canvas->projector, p))
+      return *t.canvas;
     if (size.width > 16384 || size.height > 16384)
       throw EngineError("the projector's lens needs an undistorted canvas of " + std::to_string(size.width) + "x" +
                         std::to_string(size.height) + " pixels, more than 16384 each way");
@@ -262,14 +269,20 @@ struct Renderer::Impl {
                               vk::ImageAspectFlagBits::eColor);
     c.depth = gpu->make_image(size, detail::kDepthFormat, vk::ImageUsageFlagBits::eDepthStencilAttachment,
                               vk::ImageAspectFlagBits::eDepth);
-    vk::DescriptorPoolSize pool_size(vk::DescriptorType::eCombinedImageSampler, 1);
+    const std::vector<float> warp = lens_warp(p, lc, static_cast<int>(e.width), static_cast<int>(e.height));
+    c.warp = upload_image(e, vk::Format::eR32G32Sfloat, warp.data(), warp.size() * sizeof(float));
+    c.projector = p;
+    vk::DescriptorPoolSize pool_size(vk::DescriptorType::eCombinedImageSampler, 2);
     c.pool = vk::raii::DescriptorPool(
         gpu->device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, pool_size));
-    vk::raii::DescriptorSets sets(gpu->device, vk::DescriptorSetAllocateInfo(*c.pool, *set_layout));
+    vk::raii::DescriptorSets sets(gpu->device, vk::DescriptorSetAllocateInfo(*c.pool, *lens_set_layout));
     c.set = std::move(sets[0]);
-    vk::DescriptorImageInfo image_info(*lens_sampler, *c.color.view, vk::ImageLayout::eShaderReadOnlyOptimal);
-    gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*c.set, 0, 0, vk::DescriptorType::eCombinedImageSampler, image_info),
-                                     {});
+    const vk::DescriptorImageInfo canvas_info(*lens_sampler, *c.color.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+    const vk::DescriptorImageInfo warp_info(*warp_sampler, *c.warp.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+    gpu->device.updateDescriptorSets(
+        {vk::WriteDescriptorSet(*c.set, 0, 0, vk::DescriptorType::eCombinedImageSampler, canvas_info),
+         vk::WriteDescriptorSet(*c.set, 1, 0, vk::DescriptorType::eCombinedImageSampler, warp_info)},
+        {});
     t.canvas = std::move(c);
     return *t.canvas;
   }
@@ -423,20 +436,11 @@ struct Renderer::Impl {
   }
 
   // The lens pass's second half: every target pixel takes the canvas at its panel position's ray.
-  void record_lens(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, vk::ImageView color,
-                   const config::ProjectorConfig& p) {
-    const LensCanvas& lc = canvas_for(p);
-    const vk::Extent2D e = t.extent();
-    const auto f = [](double v) { return static_cast<float>(v); };
-    LensConstants c{
-        {f(p.fx_px), f(p.fy_px), f(p.cx_px), f(p.cy_px)},
-        {f(p.distortion[0]), f(p.distortion[1]), f(p.distortion[2]), f(p.distortion[3])},
-        {f(p.distortion[4]), f(static_cast<double>(p.width_px) / e.width), f(static_cast<double>(p.height_px) / e.height), 0.0F},
-        {f(lc.left_px), f(lc.top_px), f(1.0 / lc.pinhole.width_px), f(1.0 / lc.pinhole.height_px)}};
-    begin_pass(cmd, color, nullptr, e, 1.0F);
+  // (ensure_canvas made its warp map for this projector and target size.)
+  void record_lens(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, vk::ImageView color) {
+    begin_pass(cmd, color, nullptr, t.extent(), 1.0F);
     cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *lens_pipeline(t.color_format()));
     cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *lens_layout, 0, *t.canvas->set, {});
-    cmd.pushConstants<LensConstants>(*lens_layout, vk::ShaderStageFlagBits::eFragment, 0, c);
     cmd.draw(3, 1, 0, 0);
     cmd.endRendering();
   }
@@ -480,7 +484,7 @@ struct Renderer::Impl {
                        vk::AccessFlagBits2::eNone, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
                        vk::AccessFlagBits2::eColorAttachmentWrite);
     if (lens) {
-      record_lens(cmd, t, frame->color_view, projector);
+      record_lens(cmd, t, frame->color_view);
     } else {
       transition_depth(cmd, *t.depth().image);
       begin_pass(cmd, frame->color_view, *t.depth().view, t.extent(), t.depth_output() ? 0.0F : 1.0F);
