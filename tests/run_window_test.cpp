@@ -30,11 +30,9 @@ double lit_share(const projbot::assets::Image& image) {
   return static_cast<double>(lit) / (static_cast<double>(image.width) * image.height);
 }
 
-TEST(RunWindowTest, FullscreenTwinRunLightsTheTargets) {
-  projbot::testing::X11Display x11;
-  ASSERT_TRUE(x11.ok()) << "no X display (run under xvfb-run)";
-  const std::string cmd = std::string(PROJBOT_EXE) + " run --sim --fullscreen --visits 2 --dwell 4 --seconds 20 2>&1";
-  auto run = std::async(std::launch::async, [&] {
+// A shell command run while the test takes screenshots: its exit code and output.
+std::future<std::pair<int, std::string>> run_in_background(const std::string& cmd) {
+  return std::async(std::launch::async, [cmd] {
     FILE* pipe = popen(cmd.c_str(), "r");
     std::string out;
     std::array<char, 512> buf{};
@@ -42,6 +40,13 @@ TEST(RunWindowTest, FullscreenTwinRunLightsTheTargets) {
     const int status = pipe != nullptr ? pclose(pipe) : -1;
     return std::pair{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
   });
+}
+
+TEST(RunWindowTest, FullscreenTwinRunLightsTheTargets) {
+  projbot::testing::X11Display x11;
+  ASSERT_TRUE(x11.ok()) << "no X display (run under xvfb-run)";
+  const std::string cmd = std::string(PROJBOT_EXE) + " run --sim --fullscreen --visits 2 --dwell 4 --seconds 20 2>&1";
+  auto run = run_in_background(cmd);
   // Screenshots every 100 ms while it runs: before the first stop the screen is black, then a target is lit.
   double best = 0.0;
   projbot::assets::Image best_image;
@@ -102,14 +107,7 @@ TEST(RunWindowTest, CalibrateCaptureOnAKinectAndTheProjectorWindow) {
                           " timeout 120 " + std::string(PROJBOT_EXE) + " calibrate capture --settle-ms 60 --config " +
                           (dir / "site.yaml").string() + " --out " + (dir / "cap").string() + " <" +
                           (dir / "answers.txt").string() + " 2>&1";
-  auto run = std::async(std::launch::async, [&] {
-    FILE* pipe = popen(cmd.c_str(), "r");
-    std::string out;
-    std::array<char, 512> buf{};
-    while (pipe != nullptr && fgets(buf.data(), buf.size(), pipe) != nullptr) out += buf.data();
-    const int status = pipe != nullptr ? pclose(pipe) : -1;
-    return std::pair{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-  });
+  auto run = run_in_background(cmd);
   bool stripes = false;
   std::string shares;  // what the screenshots showed, for the message
   while (run.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready)
