@@ -10,6 +10,7 @@
 #include <vector>
 #include <vulkan/vulkan_raii.hpp>
 
+#include "projbot/engine/projection.hpp"
 #include "projbot/engine/renderer.hpp"
 
 namespace projbot::engine::detail {
@@ -92,6 +93,7 @@ struct LensCanvasImages {
   Image depth;
   Image warp;                         ///< engine::lens_warp at the target's size: the canvas position per pixel
   config::ProjectorConfig projector;  ///< the projector (lens) it was made for
+  LensCanvas lens;                    ///< lens_canvas(projector): the canvas's pinhole and margins
   vk::raii::DescriptorPool pool{nullptr};
   vk::raii::DescriptorSet set{nullptr};
 };

@@ -111,8 +111,7 @@ struct Renderer::Impl {
   vk::raii::Sampler warp_sampler{nullptr};                 // nearest: the warp map is read texel for texel
   vk::raii::DescriptorSetLayout lens_set_layout{nullptr};  // the canvas and the warp map
   std::map<vk::Format, vk::raii::Pipeline> lens_pipelines;
-  std::optional<std::pair<config::ProjectorConfig, LensCanvas>> last_canvas;  // lens_canvas() of the last projector
-  detail::Image white;                                                        // bound where a material has no texture
+  detail::Image white;  // bound where a material has no texture
   std::vector<GpuModel> models;
   std::vector<DrawItem> items;
   std::uint64_t frame_index = 0;
@@ -245,20 +244,16 @@ struct Renderer::Impl {
     return lens_pipelines.emplace(format, vk::raii::Pipeline(gpu->device, nullptr, info)).first->second;
   }
 
-  const LensCanvas& canvas_for(const config::ProjectorConfig& projector) {
-    if (!last_canvas || !same_lens(last_canvas->first, projector)) last_canvas.emplace(projector, lens_canvas(projector));
-    return last_canvas->second;
-  }
-
-  // The target's canvas at the pixel density of the target, (re)made when its size or format changes.
-  detail::LensCanvasImages& ensure_canvas(detail::TargetBackend& t, const LensCanvas& lc, const config::ProjectorConfig& p) {
+  // The target's canvas at the pixel density of the target, (re)made when its size, its format or the
+  // projector's lens changes (the canvas's size and the warp map follow from those three).
+  detail::LensCanvasImages& ensure_canvas(detail::TargetBackend& t, const config::ProjectorConfig& p) {
     const vk::Extent2D e = t.extent();
+    if (t.canvas && t.canvas->warp.extent == e && t.canvas->color.format == t.color_format() && same_lens(t.canvas->projector, p))
+      return *t.canvas;
+    const LensCanvas lc = lens_canvas(p);
     const vk::Extent2D size(
         static_cast<std::uint32_t>(std::ceil(e.width * static_cast<double>(lc.pinhole.width_px) / p.width_px)),
         static_cast<std::uint32_t>(std::ceil(e.height * static_cast<double>(lc.pinhole.height_px) / p.height_px)));
-    if (t.canvas && t.canvas->color.extent == size && t.canvas->color.format == t.color_format() && t.canvas->warp.extent == e &&
-        same_lens(t.canvas->projector, p))
-      return *t.canvas;
     if (size.width > 16384 || size.height > 16384)
       throw EngineError("the projector's lens needs an undistorted canvas of " + std::to_string(size.width) + "x" +
                         std::to_string(size.height) + " pixels, more than 16384 each way");
@@ -272,6 +267,7 @@ struct Renderer::Impl {
     const std::vector<float> warp = lens_warp(p, lc, static_cast<int>(e.width), static_cast<int>(e.height));
     c.warp = upload_image(e, vk::Format::eR32G32Sfloat, warp.data(), warp.size() * sizeof(float));
     c.projector = p;
+    c.lens = lc;
     vk::DescriptorPoolSize pool_size(vk::DescriptorType::eCombinedImageSampler, 2);
     c.pool = vk::raii::DescriptorPool(
         gpu->device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, pool_size));
@@ -418,8 +414,7 @@ struct Renderer::Impl {
 
   // The lens pass's first half: the models through the canvas's pinhole, left ready to sample. One canvas
   // serves both frames in flight: the barriers order this frame's drawing after the last frame's sampling.
-  void record_canvas(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, const config::ProjectorConfig& projector) {
-    const LensCanvas& lc = canvas_for(projector);
+  void record_canvas(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t) {
     detail::LensCanvasImages& c = *t.canvas;  // made by draw_frame before the fence was reset
     detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                        vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eFragmentShader,
@@ -427,7 +422,7 @@ struct Renderer::Impl {
                        vk::AccessFlagBits2::eColorAttachmentWrite);
     transition_depth(cmd, *c.depth.image);
     begin_pass(cmd, *c.color.view, *c.depth.view, c.color.extent, 1.0F);
-    record_draws(cmd, t.color_format(), lc.pinhole, false);
+    record_draws(cmd, t.color_format(), c.lens.pinhole, false);
     cmd.endRendering();
     detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eColorAttachmentOptimal,
                        vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
@@ -467,7 +462,7 @@ struct Renderer::Impl {
                           " are uploaded");
 
     const bool lens = !t.depth_output() && config::has_distortion(projector.distortion);
-    if (lens) ensure_canvas(t, canvas_for(projector), projector);
+    if (lens) ensure_canvas(t, projector);
 
     gpu->device.resetFences(*slot.fence);
     const vk::raii::CommandBuffer& cmd = slot.cmd;
@@ -478,7 +473,7 @@ struct Renderer::Impl {
       cmd.resetQueryPool(*t.timestamps, q0, 2);
       cmd.writeTimestamp2(vk::PipelineStageFlagBits2::eTopOfPipe, *t.timestamps, q0);
     }
-    if (lens) record_canvas(cmd, t, projector);
+    if (lens) record_canvas(cmd, t);
     detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                        vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
                        vk::AccessFlagBits2::eNone, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
