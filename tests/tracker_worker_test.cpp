@@ -265,6 +265,47 @@ TEST(ViewConstraintsTest, AFaceOnBoxSlidesAlongItsFaceACornerViewHoldsEverything
   EXPECT_TRUE(unseen.weak.empty());
 }
 
+// The held step (ICP's finest stage with a colour image to follow): on a face seen face-on it moves the
+// face onto its plane and leaves the slides along it and the turn about its normal where they are; on
+// three faces of a corner it is the whole least-squares step.
+TEST(StrongStepTest, AFaceMovesOnlyAlongItsNormalACornerMovesFreely) {
+  std::vector<Eigen::Vector3d> points, normals;
+  std::vector<double> distances;
+  for (int i = 0; i < 11; ++i)
+    for (int j = 0; j < 11; ++j) {
+      points.emplace_back(0.03 * (i - 5), 0.03 * (j - 5), 1.2);
+      normals.emplace_back(0.0, 0.0, -1.0);
+      distances.push_back(-0.004);  // n . (q - p), n towards the camera: the model's plane 4 mm farther
+    }
+  const StrongStep face = strong_point_to_plane_step(points, normals, distances);
+  EXPECT_EQ(face.held, 3);
+  const Eigen::Vector3d moved = (face.T * Eigen::Vector4d(0.06, -0.09, 1.2, 1.0)).head<3>();
+  EXPECT_NEAR(moved.z(), 1.204, 1e-9);  // onto the plane: 4 mm along -n
+  EXPECT_NEAR(moved.x(), 0.06, 1e-9);   // not slid
+  EXPECT_NEAR(moved.y(), -0.09, 1e-9);
+  EXPECT_LT(Eigen::AngleAxisd(face.T.topLeftCorner<3, 3>()).angle(), 1e-9);  // not turned
+
+  // A corner: three orthogonal faces, each point 2 mm off its plane; a translation (2, 2, 2) mm fits all.
+  points.clear(), normals.clear(), distances.clear();
+  for (int a = 0; a < 3; ++a)
+    for (int i = 1; i < 8; ++i)
+      for (int j = 1; j < 8; ++j) {
+        Eigen::Vector3d p = Eigen::Vector3d::Zero(), n = Eigen::Vector3d::Zero();
+        p((a + 1) % 3) = 0.02 * i, p((a + 2) % 3) = 0.02 * j;
+        n(a) = 1.0;
+        points.push_back(p + Eigen::Vector3d(0.3, -0.2, 1.5));
+        normals.push_back(n);
+        distances.push_back(0.002);
+      }
+  const StrongStep corner = strong_point_to_plane_step(points, normals, distances);
+  EXPECT_EQ(corner.held, 0);
+  EXPECT_LT((corner.T.topRightCorner<3, 1>() - Eigen::Vector3d::Constant(0.002)).norm(), 1e-9);
+  EXPECT_LT(Eigen::AngleAxisd(corner.T.topLeftCorner<3, 3>()).angle(), 1e-9);
+  // Too few matches to say anything: no step.
+  const StrongStep few = strong_point_to_plane_step({points[0]}, {normals[0]}, {distances[0]});
+  EXPECT_TRUE(few.T.isIdentity());
+}
+
 // Searching for a target that is not there: one attempt per due frame, escalating and spaced out, the
 // model's features computed once however often the global search runs.
 TEST(TargetFollowerTest, AnAbsentTargetCostsABoundedNumberOfAttempts) {

@@ -19,9 +19,12 @@
 #include <cmath>
 #include <functional>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "file_kind.hpp"
 #include "projbot/alignment/equations.hpp"
+#include "projbot/alignment/verification.hpp"
 #include "projbot/assets/model.hpp"
 
 namespace projbot::alignment {
@@ -35,11 +38,20 @@ using Features = pcl::PointCloud<pcl::FPFHSignature33>;
 // the 6x6 normal matrix outright, and when the correspondences leave a direction unconstrained (one
 // visible plane, a handful of matches) that gives a NaN pose, and the next search asserts inside PCL.
 // Damping leaves such directions where they are instead.
+// Holding weak directions (Aligner::align's hold_weak), the step is solved only in the span of the strong
+// ones: the normal equations about the matched points' centre, rotations scaled by their radius (as
+// view_constraints), each eigen-direction with strength under kWeakStrength left out.
 class DampedPointToPlane : public pcl::registration::TransformationEstimationPointToPlaneLLS<PointN, PointN> {
  public:
+  explicit DampedPointToPlane(bool hold_weak = false) : hold_weak_(hold_weak) {}
   using pcl::registration::TransformationEstimationPointToPlaneLLS<PointN, PointN>::estimateRigidTransformation;
   void estimateRigidTransformation(const pcl::PointCloud<PointN>& source, const pcl::PointCloud<PointN>& target,
                                    const pcl::Correspondences& correspondences, Eigen::Matrix4f& T) const override {
+    if (hold_weak_) {
+      T = strong_step(source, target, correspondences);
+      return;
+    }
+    held_ = 0;
     Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> atb = Eigen::Matrix<double, 6, 1>::Zero();
     for (const auto& c : correspondences) {
@@ -64,19 +76,48 @@ class DampedPointToPlane : public pcl::registration::TransformationEstimationPoi
     }
     T = out.cast<float>();
   }
+
+  /// Weak directions the newest step left where they were.
+  int held() const { return held_; }
+
+ private:
+  Eigen::Matrix4f strong_step(const pcl::PointCloud<PointN>& source, const pcl::PointCloud<PointN>& target,
+                              const pcl::Correspondences& correspondences) const {
+    std::vector<Eigen::Vector3d> points, normals;
+    std::vector<double> distances;  // signed, to the model's plane
+    for (const auto& c : correspondences) {
+      const Eigen::Vector3d p = source[static_cast<std::size_t>(c.index_query)].getVector3fMap().cast<double>();
+      const PointN& q = target[static_cast<std::size_t>(c.index_match)];
+      const Eigen::Vector3d n = q.getNormalVector3fMap().cast<double>();
+      if (!p.allFinite() || !n.allFinite()) continue;
+      points.push_back(p);
+      normals.push_back(n);
+      distances.push_back(n.dot(q.getVector3fMap().cast<double>() - p));
+    }
+    const StrongStep step = strong_point_to_plane_step(points, normals, distances);
+    held_ = step.held;
+    return step.T.cast<float>();
+  }
+  bool hold_weak_;
+  mutable int held_ = 0;
 };
 
 // PCL keeps the iteration count protected; the result struct reports it.
 class CountingIcp : public pcl::IterativeClosestPointWithNormals<PointN, PointN> {
  public:
-  explicit CountingIcp(bool point_to_plane) {
+  explicit CountingIcp(bool point_to_plane, bool hold_weak = false) {
     min_number_correspondences_ = 10;
     if (point_to_plane)
-      setTransformationEstimation(pcl::make_shared<DampedPointToPlane>());
+      setTransformationEstimation(damped_ = pcl::make_shared<DampedPointToPlane>(hold_weak));
     else
       setTransformationEstimation(pcl::make_shared<pcl::registration::TransformationEstimationSVD<PointN, PointN>>());
   }
   int iterations() const { return nr_iterations_; }
+  /// Weak directions its newest step held (hold_weak), else 0.
+  int held() const { return damped_ ? damped_->held() : 0; }
+
+ private:
+  std::shared_ptr<DampedPointToPlane> damped_;
 };
 
 CloudN::Ptr voxel_downsample(const CloudN::ConstPtr& in, double leaf) {
@@ -238,7 +279,8 @@ struct Aligner::Impl {
   // what the target stands on drops out as the estimate tightens.
   // Out of time (a bounded attempt's deadline, checked between stages): not converged.
   Eigen::Matrix4d icp(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model_init, int& iterations, bool& converged,
-                      const std::function<bool()>& out_of_time, std::size_t first_stage = 0) const {
+                      const std::function<bool()>& out_of_time, std::size_t first_stage = 0, bool hold_weak = false,
+                      int* held = nullptr) const {
     Eigen::Matrix4f T_model_scan = rigid_inverse(T_scan_model_init).cast<float>();
     converged = true;
     for (std::size_t stage = first_stage; stage < cfg.icp_distances_m.size(); ++stage) {
@@ -262,7 +304,8 @@ struct Aligner::Impl {
         converged = false;
         break;
       }
-      CountingIcp icp(cfg.point_to_plane);
+      const bool last = stage + 1 == cfg.icp_distances_m.size();
+      CountingIcp icp(cfg.point_to_plane, hold_weak && last);
       if (cfg.max_normal_angle_deg < 180.0) {
         auto normals = pcl::make_shared<pcl::registration::CorrespondenceRejectorSurfaceNormal>();
         normals->setThreshold(std::cos(cfg.max_normal_angle_deg * M_PI / 180.0));
@@ -272,7 +315,6 @@ struct Aligner::Impl {
       icp.setInputTarget(model_icp);
       icp.setSearchMethodTarget(model_icp_tree, true);
       icp.setMaxCorrespondenceDistance(distance);
-      const bool last = stage + 1 == cfg.icp_distances_m.size();
       icp.setMaximumIterations(last ? cfg.icp_iterations : std::min(cfg.icp_iterations, cfg.coarse_iterations));
       const double step_m = last ? cfg.fine_step_m : std::max(cfg.fine_step_m, cfg.coarse_step_ratio * distance);
       icp.setTransformationEpsilon(step_m * step_m);
@@ -282,6 +324,7 @@ struct Aligner::Impl {
       iterations += icp.iterations();
       converged = converged && icp.hasConverged();
       T_model_scan = icp.getFinalTransformation();
+      if (held && last) *held = icp.held();
     }
     return rigid_inverse(T_model_scan.cast<double>());
   }
@@ -567,7 +610,7 @@ bool better_than(const AlignmentResult& r, const AlignmentResult& best) {
 }  // namespace
 
 AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage,
-                               const std::optional<Footing>& footing) const {
+                               const std::optional<Footing>& footing, bool hold_weak) const {
   const auto t0 = std::chrono::steady_clock::now();
   const Impl& m = *impl_;
   if (!T_init.allFinite()) throw AlignmentError("initial guess is not finite");
@@ -590,8 +633,10 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     AlignmentResult r;
     bool icp_converged = false;
     const std::size_t first_stage = stage == SearchStage::finish ? m.cfg.icp_distances_m.size() - 1 : 0;
-    r.T_scan_model =
-        m.icp(scan, footing ? m.stood(*footing, start) : start, best.iterations, icp_converged, out_of_time, first_stage);
+    int held = 0;
+    r.T_scan_model = m.icp(scan, footing ? m.stood(*footing, start) : start, best.iterations, icp_converged, out_of_time,
+                           first_stage, hold_weak, &held);
+    r.weak_held = held > 0;
     r.reinitialised = reinitialised;
     m.evaluate(*m.near_scan(scan, r.T_scan_model, m.gate_margin()), r.T_scan_model, r);
     const bool stands = !footing || m.stands(*footing, r);

@@ -39,7 +39,8 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
       cfg_(std::move(config)),
       filter_(cfg_.motion),
       silhouette_grow_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)),
-      model_radius_m_(guess_reach_m(model_, 0.0, 60.0)) {}  // a 60 degree turn moves the farthest point by the radius
+      model_radius_m_(guess_reach_m(model_, 0.0, 60.0)),  // a 60 degree turn moves the farthest point by the radius
+      colour_contrast_(has_colour_contrast(model_)) {}
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing) {
   set_initial_guess(T_camera_target, footing.floor);
@@ -123,7 +124,7 @@ DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matr
 }
 
 AlignmentResult TargetFollower::recropped(const DepthImage& frame, const AlignmentResult& r, const Known& known,
-                                          SearchStage stage) const {
+                                          SearchStage stage, bool hold) const {
   // The guess's crop, grown by all of its uncertainty, takes in what stands beside the target (the
   // shop's shelf beside the figure's hand), and that pulls ICP: from 10-degree guesses the figure
   // settled 11-19 mm sideways and failed the gate. Cropped again at the estimate, grown only by
@@ -131,50 +132,55 @@ AlignmentResult TargetFollower::recropped(const DepthImage& frame, const Alignme
   const PointCloud tight = depth_to_cloud(near_guess(frame, r.T_scan_model, known, cfg_.recrop_m), k_);
   if (tight.finite_count() < aligner_.config().min_points) return r;
   // From a converged estimate only ICP's finest stage: the coarse ones would find it where it is.
-  AlignmentResult again = aligner_.align(tight, r.T_scan_model, r.converged ? SearchStage::finish : stage, known.footing);
+  AlignmentResult again = aligner_.align(tight, r.T_scan_model, r.converged ? SearchStage::finish : stage, known.footing, hold);
   again.iterations += r.iterations;
   again.time_ms += r.time_ms;
   return again.converged || !r.converged ? again : r;
 }
 
 std::optional<AlignmentResult> TargetFollower::projective_first(const DepthImage& frame, const DepthImage& near,
-                                                                const Eigen::Matrix4d& guess, const Known& known) const {
+                                                                const Eigen::Matrix4d& guess, const Known& known,
+                                                                bool hold) const {
   const auto t0 = std::chrono::steady_clock::now();
   Eigen::Matrix4d T = guess;
   for (int pass = 0; pass < 2; ++pass) T = wide_tracker_.track(near, T).T_camera_target;  // accepted or not: the gate judges
   if (!T.allFinite()) return std::nullopt;
   const PointCloud tight = depth_to_cloud(near_guess(frame, T, known, cfg_.recrop_m), k_);
   if (tight.finite_count() < aligner_.config().min_points) return std::nullopt;
-  AlignmentResult r = aligner_.align(tight, T, SearchStage::finish, known.footing);
+  AlignmentResult r = aligner_.align(tight, T, SearchStage::finish, known.footing, hold);
   if (!r.converged) return std::nullopt;
-  // Where the view leaves a direction weak (a box seen face-on), the projective association settled up
-  // to a degree turned along it, which ICP's finest stage keeps: ICP coarse to fine then (a box-only
-  // shop, 5 cm / 10 degree guesses: 80 % within 3 mm and 0.5 degrees without this check, 90 % with it,
-  // 97 % always coarse to fine; a firmer threshold, 0.05, sent the figure and duck the slow way too).
-  if (!view_constraints(model_, r.T_scan_model, k_).weak.empty()) return std::nullopt;
+  // Without colour, the projective association settled up to a degree turned along a weak direction,
+  // which ICP's finest stage keeps: ICP coarse to fine then (a box-only shop, 5 cm / 10 degree guesses:
+  // 80 % within 3 mm and 0.5 degrees without this check, 90 % with it, 97 % always coarse to fine; a
+  // firmer threshold, 0.05, sent the figure and duck the slow way too).
+  if (!hold && !view_constraints(model_, r.T_scan_model, k_).weak.empty()) return std::nullopt;
   r.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
 
 AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthImage& near_depth, const PointCloud& near,
-                                           const Eigen::Matrix4d& guess, const Known& known, double grow_m,
-                                           SearchStage stage) const {
+                                           const Eigen::Matrix4d& guess, const Known& known, double grow_m, SearchStage stage,
+                                           Weak weak) const {
+  // Where the view leaves a direction weak (a box seen face-on), ICP's finest stage crept along it for
+  // all its 40 iterations (300-500 ms of the shop box's acquisition) to no better place: with colour to
+  // place it after, held.
+  const bool hold = weak != Weak::depth;
   // Too little near the guess: the aligner's error says so.
   if (!(grow_m > cfg_.recrop_m) || near.finite_count() < aligner_.config().min_points)
-    return aligner_.align(near, guess, stage, known.footing);
+    return aligner_.align(near, guess, stage, known.footing, hold);
   // The projective tracker's association reaches a 5 cm / 10 degree guess in a few passes of a few ms;
   // ICP's coarse stages took 0.5-1.5 s of the shop figure's acquisition for the same estimate.
   // Only from a guess known to within half the model's size: from a gross one it could settle on a box's
   // other face, which stands as surveyed too.
-  if (grow_m < 0.5 * model_radius_m_)
-    if (auto fast = projective_first(frame, near_depth, guess, known)) return *fast;
+  if (grow_m < 0.5 * model_radius_m_ && weak != Weak::coarse_colour)
+    if (auto fast = projective_first(frame, near_depth, guess, known, hold)) return *fast;
   // ICP from the guess and the refine on the tighter crop: the restarts and the global search of
   // `stage` only when that fails.
   // (Bounded when `stage` is: a tracking-mode search runs one attempt per frame.)
   const SearchStage first = stage == SearchStage::full ? SearchStage::icp_only : SearchStage::refine;
-  AlignmentResult r = recropped(frame, aligner_.align(near, guess, first, known.footing), known, first);
+  AlignmentResult r = recropped(frame, aligner_.align(near, guess, first, known.footing, hold), known, first, hold);
   if (r.converged || stage == SearchStage::refine || stage == SearchStage::icp_only) return r;
-  AlignmentResult wider = recropped(frame, aligner_.align(near, guess, stage, known.footing), known, first);
+  AlignmentResult wider = recropped(frame, aligner_.align(near, guess, stage, known.footing, hold), known, first, hold);
   wider.iterations += r.iterations;
   wider.time_ms += r.time_ms;
   return wider;
@@ -184,14 +190,34 @@ AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Ma
                                         double grow_m, const assets::Image* colour) const {
   const Known known{footing.floor, footing};
   const DepthImage near = near_guess(frame, guess, known, grow_m);
-  AlignmentResult r = align_near(frame, near, depth_to_cloud(near, k_), guess, known, grow_m, SearchStage::full);
+  if (!colour || !colour_contrast_) {  // colour says nothing of this model (one grey material: the figure)
+    AlignmentResult r = acquired(frame, near, guess, known, grow_m, Weak::depth);
+    if (r.converged && colour) by_colour(frame, known, *colour, r);
+    return r;
+  }
+  // Colour places what ICP held. Where it cannot (from a 5 cm guess the projective association once
+  // left the face-on box's slide 5 cm off, beyond colour's reach; or no contrast in view): ICP coarse
+  // to fine, its finest stage still held, then depth alone.
+  AlignmentResult r;
+  for (Weak weak = Weak::colour;;) {
+    r = acquired(frame, near, guess, known, grow_m, weak);
+    if (!r.converged) return r;
+    by_colour(frame, known, *colour, r);  // last: the polish is depth alone and would undo it
+    if (weak == Weak::depth || !r.weak_held || r.colour_agreement >= cfg_.min_held_colour_agreement) return r;
+    // No contrast in view: colour will not say.
+    weak = weak == Weak::colour && std::isfinite(r.colour_agreement) ? Weak::coarse_colour : Weak::depth;
+  }
+}
+
+AlignmentResult TargetFollower::acquired(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess,
+                                         const Known& known, double grow_m, Weak weak) const {
+  AlignmentResult r = align_near(frame, near, depth_to_cloud(near, k_), guess, known, grow_m, SearchStage::full, weak);
   if (!r.converged) return r;
   for (int i = 0; i < 3; ++i) {  // the polish: projective association, which a touching neighbour pulls less
     const TrackResult t = tracker_.track(frame, r.T_scan_model);
     if (!t.accepted) break;
     r.T_scan_model = t.T_camera_target;
   }
-  if (colour) by_colour(frame, known, *colour, r);  // last: the polish is depth alone and would undo it
   return r;
 }
 
@@ -224,8 +250,8 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   const DepthImage near = near_guess(frame, from, known_, grow_m);
   const PointCloud scan = depth_to_cloud(near, k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
-  last_attempt_ =
-      grow_m ? align_near(frame, near, scan, from, known_, *grow_m, stage) : aligner_.align(scan, from, stage, known_.footing);
+  last_attempt_ = grow_m ? align_near(frame, near, scan, from, known_, *grow_m, stage, Weak::depth)
+                         : aligner_.align(scan, from, stage, known_.footing);
   return last_attempt_;
 }
 
@@ -294,6 +320,8 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame, const 
     elapsed();
     return found(frame, T, quick.inlier_ratio, quick.rmse_mm);
   }
+  // Depth alone here: one bounded attempt per frame, and a held pose colour cannot place would cost a
+  // second one in the same frame (acquire() holds weak directions for colour).
   const auto a = attempt(frame, guess_, stage);
   elapsed();
   if (a && a->converged && verified(frame, T = a->T_scan_model) && coloured(frame, colour, T))

@@ -177,6 +177,66 @@ FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& 
   return c;
 }
 
+namespace {
+
+// Where points lie: their centre and RMS radius about it. The point-to-plane Jacobian of a point with
+// normal n, [n, (p - centre) x n / radius] (translation, then rotation about the centre scaled by the
+// radius), makes translations and rotations comparable.
+struct Spread {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double radius = 1e-3;
+  Eigen::Matrix<double, 6, 1> jacobian(const Eigen::Vector3d& p, const Eigen::Vector3d& n) const {
+    Eigen::Matrix<double, 6, 1> J;
+    J << n, (p - centre).cross(n) / radius;
+    return J;
+  }
+};
+
+Spread spread(const std::vector<Eigen::Vector3d>& points) {
+  Spread s;
+  for (const auto& p : points) s.centre += p;
+  s.centre /= static_cast<double>(std::max<std::size_t>(points.size(), 1));
+  double r2 = 0.0;
+  for (const auto& p : points) r2 += (p - s.centre).squaredNorm();
+  s.radius = std::max(std::sqrt(r2 / static_cast<double>(std::max<std::size_t>(points.size(), 1))), 1e-3);
+  return s;
+}
+
+}  // namespace
+
+StrongStep strong_point_to_plane_step(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
+                                      const std::vector<double>& distances) {
+  StrongStep out;
+  if (points.size() < 6 || normals.size() != points.size() || distances.size() != points.size()) return out;
+  const Spread s = spread(points);
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Matrix<double, 6, 1> J = s.jacobian(points[i], normals[i]);
+    H += J * J.transpose();
+    g += J * distances[i];
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(H);
+  const double largest = eig.eigenvalues()(5);
+  Eigen::Matrix<double, 6, 1> y = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int i = 0; i < 6; ++i) {
+    if (!(largest > 0.0 && eig.eigenvalues()(i) >= kWeakStrength * largest)) {
+      ++out.held;
+      continue;
+    }
+    y += eig.eigenvectors().col(i) * (eig.eigenvectors().col(i).dot(g) / eig.eigenvalues()(i));
+  }
+  if (!y.allFinite()) return out;
+  // p -> R (p - centre) + centre + t, R the turn by w (linearised: p + t + w x (p - centre)).
+  const Eigen::Vector3d w = y.tail<3>() / s.radius;
+  const double angle = w.norm();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  if (angle > 0.0) R = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+  out.T.topLeftCorner<3, 3>() = R;
+  out.T.topRightCorner<3, 1>() = y.head<3>() + s.centre - R * s.centre;
+  return out;
+}
+
 ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k) {
   ViewConstraints c;
   if (!T_camera_model.allFinite() || model.normals.size() != model.points.size()) return c;
@@ -190,16 +250,12 @@ ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d&
       seen.emplace_back(R * model.points[i].cast<double>() + t, (R * model.normals[i].cast<double>()).normalized());
   c.points = seen.size();
   if (seen.size() < 6) return c;
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const auto& [p, n] : seen) centre += p;
-  centre /= static_cast<double>(seen.size());
-  double r2 = 0.0;
-  for (const auto& [p, n] : seen) r2 += (p - centre).squaredNorm();
-  const double radius = std::max(std::sqrt(r2 / static_cast<double>(seen.size())), 1e-3);
+  std::vector<Eigen::Vector3d> points;
+  for (const auto& [p, n] : seen) points.push_back(p);
+  const Spread s = spread(points);
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   for (const auto& [p, n] : seen) {
-    Eigen::Matrix<double, 6, 1> J;
-    J << n, (p - centre).cross(n) / radius;
+    const Eigen::Matrix<double, 6, 1> J = s.jacobian(p, n);
     H += J * J.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(H);
@@ -222,6 +278,15 @@ struct ColourSamples {
 };
 
 double luminance(double r, double g, double b) { return 0.299 * r + 0.587 * g + 0.114 * b; }
+
+bool has_colour_contrast_impl(const ModelCloud& model) {
+  double n = 0, sum = 0, sum2 = 0;
+  for (const Eigen::Vector3f& c : model.colours) {
+    const double l = luminance(c.x(), c.y(), c.z());
+    n += 1, sum += l, sum2 += l * l;
+  }
+  return n >= static_cast<double>(kMinColourSamples) && sum2 - sum * sum / n > 1e-6 * n;  // as correlation()'s test
+}
 
 ColourSamples seen_colours(const ModelCloud& model, const Eigen::Matrix4d& T, const DepthImage& depth,
                            const assets::Image& colour, const CameraIntrinsics& k) {
@@ -373,5 +438,7 @@ ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& 
   out.agreement_after = best;
   return out;
 }
+
+bool has_colour_contrast(const ModelCloud& model) { return has_colour_contrast_impl(model); }
 
 }  // namespace projbot::alignment

@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
@@ -133,7 +134,15 @@ struct AlignmentResult {
   /// slides (mm), and the colour agreement after (NaN: colour said nothing, the pose was kept).
   double colour_shift_mm = 0.0;
   double colour_agreement = std::numeric_limits<double>::quiet_NaN();
+  /// ICP's last stage held weak directions where they started (Aligner::align's hold_weak: its last
+  /// step left at least one out; TargetFollower's acquisition with a colour image): colour places them.
+  bool weak_held = false;
 };
+
+/// A direction of motion whose point-to-plane strength (its eigenvalue over the largest, the rotations
+/// scaled by the seen surface's radius) is below this is weak: the scan hardly pins it down (a box
+/// seen face-on, along its face).
+inline constexpr double kWeakStrength = 0.02;
 
 /// Which part of the acquisition align() runs. `full` is one acquisition as `projbot align` and the
 /// localized tour do it; the tracker worker runs the others one at a time, each bounded, escalating.
@@ -158,9 +167,12 @@ class Aligner {
   /// Refines T_init (model -> scan frame) against the scan. With `footing` (in the scan's frame), only
   /// an estimate that stands as surveyed passes, and restarts go on past one that does not. Throws
   /// AlignmentError when the scan has fewer than min_points valid points (after cropping) or T_init is
-  /// not finite.
+  /// not finite. With `hold_weak`, ICP's last (finest) stage moves the estimate only along the directions
+  /// its correspondences pin down (strong_point_to_plane_step): the weak ones stay where the coarser
+  /// stages left them, for colour to place (the finest stage crept along a face-on box's face for all
+  /// its iterations, 300-500 ms, to no better place).
   AlignmentResult align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage = SearchStage::full,
-                        const std::optional<Footing>& footing = std::nullopt) const;
+                        const std::optional<Footing>& footing = std::nullopt, bool hold_weak = false) const;
 
   /// The quality-gate numbers of a given pose, without refining it (converged: the gate passes).
   AlignmentResult score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model,

@@ -75,6 +75,10 @@ struct WorkerConfig {
   /// has colour contrast at all). Correct poses in the twin: 0.95-0.99; the box fitted wrong from gross
   /// guesses: 0.0-0.5.
   double min_colour_agreement = 0.5;
+  /// ...and where ICP held the view's weak directions for colour (AlignmentResult::weak_held), a pose
+  /// colour leaves agreeing less than this is found again by depth alone, coarse to fine: from a 5 cm
+  /// guess the face-on box's slide can lie past colour's reach (it ended at 0.14 and at 0.85, 6 mm off).
+  double min_held_colour_agreement = 0.9;
   /// A pose that colour placed or confirmed (a stop's first, with a colour image) is held: tracking
   /// pulls towards it (TrackerConfig::hold_prior) instead of its start, so it does not slide along the
   /// directions depth leaves free (a face-on box, back 1.6-2.0 mm; the display's box seen from the
@@ -171,18 +175,31 @@ class TargetFollower {
     std::optional<Plane> floor;
     std::optional<Footing> footing;
   };
+  /// How an acquisition places the view's weak directions (a box seen face-on, along its face).
+  enum class Weak {
+    colour,         ///< projective_first, else ICP coarse to fine; their finest stages hold them for colour
+    coarse_colour,  ///< ICP coarse to fine (its coarse stages reach farther along them), finest held for colour
+    depth,          ///< depth alone: projective_first only for views without weak directions, else ICP
+  };
   /// From a guess: projective_first on `near_depth` (the frame's depth near `guess`: near_guess, grown
   /// by grow_m); when that fails, ICP on `near` (the same as points), refined on the depth near its
   /// estimate (recropped); when that fails the gate, the same with `stage`'s restarts and global search.
   AlignmentResult align_near(const DepthImage& frame, const DepthImage& near_depth, const PointCloud& near,
-                             const Eigen::Matrix4d& guess, const Known& known, double grow_m, SearchStage stage) const;
+                             const Eigen::Matrix4d& guess, const Known& known, double grow_m, SearchStage stage, Weak weak) const;
   /// Projective ICP from `guess` on `near` (the tracker's association at its wide reach), then ICP's
-  /// finest stage on the depth cropped tight at that estimate: the estimate when it passes the gate.
+  /// finest stage on the depth cropped tight at that estimate: the estimate when it passes the gate. A
+  /// view with weak directions (a box seen face-on): with `hold` the finest stage holds them for colour
+  /// to place; without, nothing (the projective association may have left the estimate turned along
+  /// them, and ICP coarse to fine does better).
   std::optional<AlignmentResult> projective_first(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess,
-                                                  const Known& known) const;
+                                                  const Known& known, bool hold) const;
+  /// acquire() without colour's move: align_near, then the projective polish.
+  AlignmentResult acquired(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess, const Known& known,
+                           double grow_m, Weak weak) const;
   /// r refined by ICP (`stage`: refine or icp_only) on the depth near its estimate, grown by recrop_m;
   /// r itself when only it passes the gate.
-  AlignmentResult recropped(const DepthImage& frame, const AlignmentResult& r, const Known& known, SearchStage stage) const;
+  AlignmentResult recropped(const DepthImage& frame, const AlignmentResult& r, const Known& known, SearchStage stage,
+                            bool hold) const;
   ModelCloud model_;  // for the free-space check
   Aligner aligner_;
   ProjectiveTracker tracker_;
@@ -202,6 +219,7 @@ class TargetFollower {
   MotionFilter filter_;        // fed with every pose found, reset when the target is lost or a stop begins
   double silhouette_grow_m_;   // how far the guess's configured uncertainty reaches
   double model_radius_m_;      // the model's farthest point from its origin
+  bool colour_contrast_;       // the model's colours can say where it is (has_colour_contrast)
   double last_found_s_ = 0.0;  // capture time of the newest pose found
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
   // The frame without the known floor and, with grow_m, cropped to the silhouette at `from` grown by it.

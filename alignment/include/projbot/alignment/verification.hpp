@@ -68,13 +68,25 @@ struct ViewConstraints {
   std::array<double, 6> strength{};  ///< eigenvalues over the largest, ascending
   std::vector<WeakDirection> weak;   ///< those with strength below kWeak, weakest first
   std::vector<WeakDirection> all;    ///< every direction, weakest first
-  static constexpr double kWeak = 0.02;
+  static constexpr double kWeak = kWeakStrength;
 };
 
 /// The eigen-decomposition of the point-to-plane normal equations (sum of J^T J, J = [n, (q x n) / r])
 /// over the model samples the camera sees at T_camera_model (front-facing, nearest per pixel). Depends
 /// on the model, the pose and the camera only: what any scan of this view can and cannot fix.
 ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k);
+
+/// One point-to-plane least-squares step (scan points onto planes through model points with `normals`,
+/// `distances` along them) that moves only along the directions the matches pin down: the normal
+/// equations about the points' centre, rotations scaled by their radius (as view_constraints), solved in
+/// the span of the eigen-directions with strength at least kWeakStrength; the weak ones are left where
+/// they are. Identity with fewer than 6 matches.
+struct StrongStep {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();  ///< the rigid transform to apply to the points
+  int held = 0;                                     ///< weak directions left where they were
+};
+StrongStep strong_point_to_plane_step(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
+                                      const std::vector<double>& distances);
 
 /// How well the model's colours (the projection content) agree with a colour image registered to
 /// `depth` (the same pinhole, as a Kinect v1 registers RGB to depth) at T_camera_model: the correlation
@@ -85,6 +97,9 @@ ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d&
 double colour_agreement(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
                         const assets::Image& colour, const CameraIntrinsics& k);
 inline constexpr std::size_t kMinColourSamples = 200;
+/// Whether the model's colours vary at all (colour_agreement is NaN everywhere for one that does not:
+/// one plain material).
+bool has_colour_contrast(const ModelCloud& model);
 
 /// A pose moved to where colour agrees best, in the plane of its two weakest slides.
 struct ColourRefinement {
