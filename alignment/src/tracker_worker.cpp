@@ -190,28 +190,25 @@ AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Ma
                                         double grow_m, const assets::Image* colour) const {
   const Known known{footing.floor, footing};
   const DepthImage near = near_guess(frame, guess, known, grow_m);
-  if (!colour || !colour_contrast_) {  // colour says nothing of this model (one grey material: the figure)
-    AlignmentResult r = acquired(frame, near, guess, known, grow_m, Weak::depth);
-    if (r.converged && colour) by_colour(frame, known, *colour, r);
-    return r;
-  }
-  // Colour places what ICP held. Where it cannot (from a 5 cm guess the projective association once
-  // left the face-on box's slide 5 cm off, beyond colour's reach; or no contrast in view): ICP coarse
-  // to fine, its finest stage still held, then depth alone.
-  AlignmentResult r;
-  for (Weak weak = Weak::colour;;) {
-    r = acquired(frame, near, guess, known, grow_m, weak);
+  const PointCloud near_cloud = depth_to_cloud(near, k_);
+  // Colour places what ICP held, where the model has colours to place it by (not the figure's one grey
+  // material). Where it cannot (from a 5 cm guess the projective association once left the face-on
+  // box's slide 5 cm off, beyond colour's reach): ICP coarse to fine, its finest stage still held, then
+  // depth alone.
+  Weak weak = colour && colour_contrast_ ? Weak::colour : Weak::depth;
+  for (;;) {
+    AlignmentResult r = acquired(frame, near, near_cloud, guess, known, grow_m, weak);
     if (!r.converged) return r;
-    by_colour(frame, known, *colour, r);  // last: the polish is depth alone and would undo it
+    if (colour) by_colour(frame, known, *colour, r);  // last: the polish is depth alone and would undo it
     if (weak == Weak::depth || !r.weak_held || r.colour_agreement >= cfg_.min_held_colour_agreement) return r;
-    // No contrast in view: colour will not say.
+    // A view without contrast (agreement NaN) goes straight to depth alone: colour will not say there.
     weak = weak == Weak::colour && std::isfinite(r.colour_agreement) ? Weak::coarse_colour : Weak::depth;
   }
 }
 
-AlignmentResult TargetFollower::acquired(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess,
-                                         const Known& known, double grow_m, Weak weak) const {
-  AlignmentResult r = align_near(frame, near, depth_to_cloud(near, k_), guess, known, grow_m, SearchStage::full, weak);
+AlignmentResult TargetFollower::acquired(const DepthImage& frame, const DepthImage& near, const PointCloud& near_cloud,
+                                         const Eigen::Matrix4d& guess, const Known& known, double grow_m, Weak weak) const {
+  AlignmentResult r = align_near(frame, near, near_cloud, guess, known, grow_m, SearchStage::full, weak);
   if (!r.converged) return r;
   for (int i = 0; i < 3; ++i) {  // the polish: projective association, which a touching neighbour pulls less
     const TrackResult t = tracker_.track(frame, r.T_scan_model);

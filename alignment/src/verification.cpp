@@ -192,13 +192,16 @@ struct Spread {
   }
 };
 
-Spread spread(const std::vector<Eigen::Vector3d>& points) {
+// The spread of point(e) over `items`.
+template <class Items, class Point>
+Spread spread(const Items& items, Point point) {
   Spread s;
-  for (const auto& p : points) s.centre += p;
-  s.centre /= static_cast<double>(std::max<std::size_t>(points.size(), 1));
+  for (const auto& e : items) s.centre += point(e);
+  const double n = static_cast<double>(std::max<std::size_t>(items.size(), 1));
+  s.centre /= n;
   double r2 = 0.0;
-  for (const auto& p : points) r2 += (p - s.centre).squaredNorm();
-  s.radius = std::max(std::sqrt(r2 / static_cast<double>(std::max<std::size_t>(points.size(), 1))), 1e-3);
+  for (const auto& e : items) r2 += (point(e) - s.centre).squaredNorm();
+  s.radius = std::max(std::sqrt(r2 / n), 1e-3);
   return s;
 }
 
@@ -208,7 +211,7 @@ StrongStep strong_point_to_plane_step(const std::vector<Eigen::Vector3d>& points
                                       const std::vector<double>& distances) {
   StrongStep out;
   if (points.size() < 6 || normals.size() != points.size() || distances.size() != points.size()) return out;
-  const Spread s = spread(points);
+  const Spread s = spread(points, [](const Eigen::Vector3d& p) { return p; });
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -250,9 +253,7 @@ ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d&
       seen.emplace_back(R * model.points[i].cast<double>() + t, (R * model.normals[i].cast<double>()).normalized());
   c.points = seen.size();
   if (seen.size() < 6) return c;
-  std::vector<Eigen::Vector3d> points;
-  for (const auto& [p, n] : seen) points.push_back(p);
-  const Spread s = spread(points);
+  const Spread s = spread(seen, [](const auto& point_normal) { return point_normal.first; });
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   for (const auto& [p, n] : seen) {
     const Eigen::Matrix<double, 6, 1> J = s.jacobian(p, n);
@@ -278,15 +279,6 @@ struct ColourSamples {
 };
 
 double luminance(double r, double g, double b) { return 0.299 * r + 0.587 * g + 0.114 * b; }
-
-bool has_colour_contrast_impl(const ModelCloud& model) {
-  double n = 0, sum = 0, sum2 = 0;
-  for (const Eigen::Vector3f& c : model.colours) {
-    const double l = luminance(c.x(), c.y(), c.z());
-    n += 1, sum += l, sum2 += l * l;
-  }
-  return n >= static_cast<double>(kMinColourSamples) && sum2 - sum * sum / n > 1e-6 * n;  // as correlation()'s test
-}
 
 ColourSamples seen_colours(const ModelCloud& model, const Eigen::Matrix4d& T, const DepthImage& depth,
                            const assets::Image& colour, const CameraIntrinsics& k) {
@@ -439,6 +431,13 @@ ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& 
   return out;
 }
 
-bool has_colour_contrast(const ModelCloud& model) { return has_colour_contrast_impl(model); }
+bool has_colour_contrast(const ModelCloud& model) {
+  double n = 0, sum = 0, sum2 = 0;
+  for (const Eigen::Vector3f& c : model.colours) {
+    const double l = luminance(c.x(), c.y(), c.z());
+    n += 1, sum += l, sum2 += l * l;
+  }
+  return n >= static_cast<double>(kMinColourSamples) && sum2 - sum * sum / n > 1e-6 * n;  // as correlation()'s test
+}
 
 }  // namespace projbot::alignment

@@ -194,8 +194,8 @@ class TargetFollower {
   std::optional<AlignmentResult> projective_first(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess,
                                                   const Known& known, bool hold) const;
   /// acquire() without colour's move: align_near, then the projective polish.
-  AlignmentResult acquired(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess, const Known& known,
-                           double grow_m, Weak weak) const;
+  AlignmentResult acquired(const DepthImage& frame, const DepthImage& near, const PointCloud& near_cloud,
+                           const Eigen::Matrix4d& guess, const Known& known, double grow_m, Weak weak) const;
   /// r refined by ICP (`stage`: refine or icp_only) on the depth near its estimate, grown by recrop_m;
   /// r itself when only it passes the gate.
   AlignmentResult recropped(const DepthImage& frame, const AlignmentResult& r, const Known& known, SearchStage stage,
