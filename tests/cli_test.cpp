@@ -731,26 +731,6 @@ TEST_F(CliTest, BenchMotionComparesPredictionOffAndOn) {
   EXPECT_EQ(run_projbot("bench motion --processing-ms -1").code, 2);
 }
 
-// run --sim measures each frame against the twin's truth at its display time: the box carried at
-// 0.5 m/s (visit 2 of the motion scene) stays within a few mm of where it is drawn.
-TEST_F(CliTest, RunMeasuresTheErrorAtDisplayTime) {
-  const CliRun r =
-      run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) + "/scenes/motion.yaml --visits 2 --dwell 2.5");
-  ASSERT_EQ(r.code, 0) << r.output;
-  const std::string key = "error at display (markers drawn vs true, twin): while moving mean ";
-  const auto at = r.output.find(key);
-  ASSERT_NE(at, std::string::npos) << r.output;
-  const double moving_mm = std::stod(r.output.substr(at + key.size()));
-  EXPECT_GT(moving_mm, 0.0);
-  // A live run's error while moving follows its latency, which follows the machine's load: 3-5 mm alone,
-  // 8.1 and 13.0 mm in clean-clone CIs running two suites at once (pose age p50 110 ms there). The goal
-  // itself is measured where latency is fixed (bench motion --processing-ms, BenchMotionComparesPrediction-
-  // OffAndOn); here the figures must be there and plausible: a truth taken at the wrong instant or frame
-  // puts the box tens of centimetres off.
-  EXPECT_LT(moving_mm, 25.0) << r.output;
-  EXPECT_LT(number_after(r.output, "still mean ", at), 2.0) << r.output;
-}
-
 // run lights the neighbour in view with the visited target (assets/scenes/display.yaml: the box beside
 // the duck), each from its own tracker worker.
 TEST_F(CliTest, RunLightsANeighbourInTheSameFrames) {
