@@ -213,6 +213,30 @@ TEST(SceneTest, TourSectionsAndTheirDefaults) {
   EXPECT_THROW(parse_scene(std::string(kGood) + "camera: {fx: -1}\n", "/scenes/s.yaml"), projbot::config::ConfigError);
 }
 
+// devices.laser.map: the folder `projbot slam --out-map` wrote, relative to the scene; optional (projbot devices
+// checks a laser before there is a map), but when given it must hold the map.
+TEST(SceneTest, LaserMapIsTheFolderSlamWrote) {
+  const auto dir = std::filesystem::temp_directory_path() / ("projbot_lasermap_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "site-map");
+  std::ofstream(dir / "site-map" / "map.simplemap.gz") << "x";
+  const std::string laser = std::string(kGood) + "devices:\n  laser: {class: CHokuyoURG, map: ";
+  const auto s = parse_scene(laser + "site-map}\n", dir / "s.yaml");
+  ASSERT_TRUE(s.devices.laser);
+  EXPECT_EQ(s.devices.laser->map, dir / "site-map");
+  EXPECT_EQ(s.devices.describe().at(0), "laser: mrpt CHokuyoURG, localising against " + (dir / "site-map").string());
+  EXPECT_TRUE(
+      parse_scene(std::string(kGood) + "devices:\n  laser: {class: CHokuyoURG}\n", dir / "s.yaml").devices.laser->map.empty());
+  try {
+    parse_scene(laser + "elsewhere}\n", dir / "s.yaml");
+    ADD_FAILURE() << "a map folder without the map";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("devices.laser.map: '" + (dir / "elsewhere").string() + "' holds no map.simplemap.gz"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(SceneTest, DevicesSectionNamesEachDevice) {
   EXPECT_FALSE(parse_scene(kGood, "/scenes/s.yaml").devices.any());  // none: the twin serves every role
   const auto s =

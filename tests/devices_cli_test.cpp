@@ -84,17 +84,21 @@ TEST_F(DevicesCli, ListsWhatThisMachineOffers) {
 
 // Every configured device that is not there is named with what failed, and the exit status says so.
 TEST_F(DevicesCli, NamesEachAbsentDevice) {
+  fs::create_directories(dir_ / "map");
+  std::ofstream(dir_ / "map" / "map.simplemap.gz") << "x";  // what run's laser localises against (read after opening)
   const fs::path scene = site(
       "  pan_tilt: {port: /dev/ttyUSB97}\n"
-      "  laser: {class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM97}}\n"
+      "  laser: {class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM97}, map: " +
+      (dir_ / "map").string() +
+      "}\n"
       "  base: {domain: 3}\n");
   const CliRun r = run_projbot("devices --config " + scene.string(), 60);
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_NE(r.output.find("pan_tilt: ptu-d46 on /dev/ttyUSB97 at 9600 baud: FAILED: PTU-D46 on /dev/ttyUSB97: cannot open"),
             std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("laser: mrpt CHokuyoURG: FAILED: laser (MRPT CHokuyoURG): cannot start: Error trying to open the "
-                          "serial port /dev/ttyACM97"),
+  EXPECT_NE(r.output.find("laser: mrpt CHokuyoURG, localising against " + (dir_ / "map").string() +
+                          ": FAILED: laser (MRPT CHokuyoURG): cannot start: Error trying to open the serial port /dev/ttyACM97"),
             std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("base: ros2-dds (domain 3, rt/cmd_vel out, rt/odom in): FAILED: base (ros2-dds, domain 3, rt/odom): "

@@ -9,9 +9,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <iostream>
+#include <mutex>
+#include <random>
 #include <thread>
 
 #include "dds_loopback.hpp"
+#include "projbot/robot/laser.hpp"
+#include "projbot/robot/localization.hpp"
 
 namespace {
 
@@ -75,4 +80,95 @@ TEST(Ros2Base, NoBaseDriverIsAnErrorNamingTheTopic) {
               std::string::npos)
         << e.what();
   }
+}
+
+namespace {
+
+using projbot::robot::Pose2D;
+
+// The twin's laser as a real scanner delivers it: a scan of the room from the base's true pose, at 40 Hz.
+class TwinLaser final : public projbot::robot::LaserSource {
+ public:
+  TwinLaser(const projbot::robot::Ros2BaseServer& base, std::mutex& stepping, const projbot::robot::OccupancyMap& room)
+      : base_(base), stepping_(stepping), room_(room) {}
+  projbot::robot::LaserScan next(double) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    Pose2D truth;
+    {
+      const std::lock_guard lock(stepping_);
+      truth = base_.true_pose();
+    }
+    ++scans;
+    return room_.simulate_scan(truth, {}, rng_);
+  }
+  int scans = 0;
+
+ private:
+  const projbot::robot::Ros2BaseServer& base_;
+  std::mutex& stepping_;
+  const projbot::robot::OccupancyMap& room_;
+  std::mt19937_64 rng_{7};
+};
+
+// The room's map as a survey makes it: scans at known poses every 0.5 m.
+projbot::robot::Localizer surveyed(const projbot::robot::OccupancyMap& room, const projbot::robot::RoomConfig& c) {
+  std::mt19937_64 rng(3);
+  std::vector<std::pair<Pose2D, projbot::robot::LaserScan>> keyframes;
+  for (double y = 0.5; y < c.depth_m; y += 0.5)
+    for (double x = 0.5; x < c.width_m; x += 0.5)
+      if (room.is_free(x, y) && room.is_free(x + 0.25, y))
+        keyframes.emplace_back(Pose2D{x, y, 0.0}, room.simulate_scan({x, y, 0.0}, {}, rng));
+  return projbot::robot::Localizer(keyframes);
+}
+
+double distance(const Pose2D& a, const Pose2D& b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+
+}  // namespace
+
+// A real base with a laser (devices.base and devices.laser): set down 6 cm and 2 degrees off its configured
+// start, with drifting wheels, the laser's scans against the map find it and keep it found; odometry alone
+// carries the start's error to the stop.
+TEST(Ros2Navigator, LocalisesOnTheLaserWhereOdometryAloneIsOff) {
+  const auto config = base_on_own_domain();
+  projbot::robot::RoomConfig room_config;
+  room_config.width_m = 4.0;
+  room_config.depth_m = 3.0;
+  room_config.obstacles = {{2.6, 2.2, 3.2, 3.0}, {0.0, 2.0, 0.6, 3.0}};
+  const auto room = projbot::robot::OccupancyMap::from_room(room_config);
+  auto map = surveyed(room, room_config);
+  const Pose2D start{1.0, 1.0, 0.0}, truly{1.05, 0.97, -0.035}, goal{2.0, 1.5, 0.5};
+  std::mutex stepping;
+  projbot::robot::Ros2BaseServer server(config, truly, projbot::robot::BaseErrorModel{});
+  std::jthread simulation([&](std::stop_token stop) {
+    const double dt = 0.01;
+    for (int i = 0; !stop.stop_requested(); ++i) {
+      {
+        const std::lock_guard lock(stepping);
+        server.step(i * dt, dt);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  });
+  projbot::robot::Ros2Base base(config);
+  projbot::robot::Ros2Navigator navigator(base, start, {}, 20.0, 30.0);
+  TwinLaser laser(server, stepping, room);
+  navigator.localise_on(laser, map);
+  EXPECT_LT(distance(navigator.believed_pose(), truly), 0.01);  // found at once, from 6 cm off
+  const projbot::robot::StopReport r = navigator.drive_to(goal, 0);
+  Pose2D truth;
+  {
+    const std::lock_guard lock(stepping);
+    truth = server.true_pose();
+  }
+  std::cout << "at the stop: localised " << 1000 * distance(r.estimate, truth) << " mm off, odometry alone "
+            << 1000 * distance(r.odometry, truth) << " mm; " << r.corrections << " scans matched (" << r.rejected
+            << " rejected), " << r.correct_ms_mean << " ms each; drove " << r.drive_seconds << " s\n";
+  EXPECT_TRUE(r.arrived);
+  EXPECT_LT(distance(r.estimate, truth), 0.015);
+  EXPECT_LT(std::abs(r.estimate.theta_rad - truth.theta_rad), 0.5 * M_PI / 180.0);
+  EXPECT_LT(distance(truth, goal), 0.03);
+  EXPECT_GT(distance(r.odometry, truth), 0.06);  // the start's 6 cm and 2 degrees, carried along (9 cm)
+  EXPECT_GE(r.corrections, 20);
+  EXPECT_LE(r.rejected, r.corrections / 10);
+  EXPECT_GT(r.correct_ms_mean, 0.0);
 }

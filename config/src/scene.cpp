@@ -303,6 +303,15 @@ LaserDevice read_laser_device(const YAML::Node& node, const std::string& file) {
       l.params[key] = kv.second.Scalar();
     }
   }
+  // Optional here: `projbot devices` checks a laser before there is a map; a session that drives needs it.
+  if (const std::string map = m.get<std::string>("map", ""); !map.empty()) {
+    l.map =
+        std::filesystem::path(map).is_absolute() ? std::filesystem::path(map) : std::filesystem::path(file).parent_path() / map;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(l.map / "map.simplemap.gz", ec))
+      m.fail(node["map"], "devices.laser.map",
+             "'" + l.map.string() + "' holds no map.simplemap.gz (the folder `projbot slam --out-map` wrote)");
+  }
   m.reject_unknown();
   return l;
 }
@@ -436,7 +445,9 @@ std::vector<std::string> DevicesConfig::describe() const {
                                                 : (camera->uri.empty() ? std::string(" (first device)") : " " + camera->uri)));
   if (pan_tilt)
     out.push_back("pan_tilt: " + pan_tilt->driver + " on " + pan_tilt->port + " at " + std::to_string(pan_tilt->baud) + " baud");
-  if (laser) out.push_back("laser: " + laser->driver + " " + laser->class_name);
+  if (laser)
+    out.push_back("laser: " + laser->driver + " " + laser->class_name +
+                  (laser->map.empty() ? std::string() : ", localising against " + laser->map.string()));
   if (base)
     out.push_back("base: " + base->driver + " (domain " + std::to_string(base->domain) + ", rt/" + base->cmd_vel + " out, rt/" +
                   base->odom + " in)");

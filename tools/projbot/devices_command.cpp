@@ -98,7 +98,8 @@ const Command kDevices{"devices",
                        "  devices:\n"
                        "    camera: {driver: freenect, index: 0}           # or {driver: openni2, uri: \"\"} (an .oni file too)\n"
                        "    pan_tilt: {driver: ptu-d46, port: /dev/ttyUSB0, baud: 9600}\n"
-                       "    laser: {driver: mrpt, class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM0}}\n"
+                       "    laser: {driver: mrpt, class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM0}, map: site-map}\n"
+                       "                                  # map: projbot slam's folder, which run localises against\n"
                        "    base: {driver: ros2-dds, domain: 0, cmd_vel: cmd_vel, odom: odom}\n"
                        "    projector: {monitor: 1, fullscreen: true}\n",
                        {{"config", "FILE", "a scene whose `devices:` section to check"},

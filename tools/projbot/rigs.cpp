@@ -65,11 +65,24 @@ session::Dwell TwinRig::dwell(double dwell_s, bool lockstep) {
   return d;
 }
 
-bool configured_robot(const config::DevicesConfig& d) {
-  if (d.laser)
+namespace {
+
+// A laser localises a configured base against a map: without either, the config is incomplete (said before
+// any device is opened).
+void check_laser(const config::DevicesConfig& d) {
+  if (d.laser && !d.base)
     throw DeviceError(
-        "devices.laser is configured, but no session localises on a real laser yet (the configured base closes the loop on "
-        "its odometry): leave it out of `devices:` (projbot devices still checks it)");
+        "devices.laser localises the configured base, and devices.base is not configured (the twin's robot "
+        "localises on the twin's laser): configure the base, or leave the laser out");
+  if (d.laser && d.laser->map.empty())
+    throw DeviceError(
+        "devices.laser localises the base against a map, and devices.laser.map names none: map the site "
+        "(projbot slam --out-map DIR) and name DIR there");
+}
+
+}  // namespace
+
+bool configured_robot(const config::DevicesConfig& d) {
   if (!d.base && !d.pan_tilt) return false;
   std::string missing;
   for (const auto& [name, there] : {std::pair<const char*, bool>{"base", d.base.has_value()},
@@ -86,15 +99,21 @@ bool configured_robot(const config::DevicesConfig& d) {
 Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot) {
   robot = false;
   if (!wanted.any()) return {};
+  check_laser(wanted);
   Devices devices = open_devices(wanted, checks, true);
   robot = configured_robot(wanted);  // after opening: an absent device is named before a missing one
   return devices;
 }
 
 DeviceRig::DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, Devices& devices)
-    : navigator_(*devices.base, {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()}),
+    : map_(devices.laser && scene.devices.laser
+               ? std::optional<robot::Localizer>(robot::Localizer::load(scene.devices.laser->map))
+               : std::nullopt),
+      navigator_(*devices.base, {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()}),
       camera_(*devices.camera),
-      session_(scene, targets, navigator_, *devices.pan_tilt) {}
+      session_(scene, targets, navigator_, *devices.pan_tilt) {
+  if (map_) navigator_.localise_on(*devices.laser, *map_);
+}
 
 session::Dwell DeviceRig::dwell(double dwell_s, bool lockstep) {
   session::Dwell d;

@@ -72,13 +72,15 @@ Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<De
 /// odometry, started at the scene's robot.start), the PTU-D46 and the camera. No twin, so no truth.
 class DeviceRig {
  public:
-  /// `devices` (base, pan_tilt and camera opened) outlive the rig. Throws RobotError when the base sends
-  /// no odometry.
+  /// `devices` (base, pan_tilt and camera opened; the laser when configured) outlive the rig. With a
+  /// laser, the base localises on it against the scene's devices.laser.map. Throws RobotError when the
+  /// base sends no odometry, the laser no scan or the map cannot be read.
   DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, Devices& devices);
   session::Session& session() { return session_; }
   session::Dwell dwell(double dwell_s, bool lockstep);
 
  private:
+  std::optional<robot::Localizer> map_;
   robot::Ros2Navigator navigator_;
   alignment::RgbdCamera& camera_;
   session::Session session_;

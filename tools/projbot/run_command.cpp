@@ -136,7 +136,12 @@ class RunObserver final : public session::StopObserver {
               << std::fixed << std::setprecision(1) << stop.drive.drive_seconds << " s"
               << (stop.drive.arrived ? "" : " (not arrived)") << ", believed at x " << std::setprecision(3)
               << stop.drive.estimate.x_m << " m, y " << stop.drive.estimate.y_m << " m, heading " << std::setprecision(1)
-              << stop.drive.estimate.theta_rad * 180.0 / M_PI << " deg; lit " << stop.lit.size() << " target(s)" << std::endl;
+              << stop.drive.estimate.theta_rad * 180.0 / M_PI << " deg; lit " << stop.lit.size() << " target(s)";
+    if (stop.drive.corrections > 0)  // localised on a laser: how far odometry alone had drifted from that
+      std::cout << "; " << stop.drive.corrections << " laser scans matched (" << stop.drive.rejected
+                << " rejected), odometry alone " << std::setprecision(0)
+                << 1000.0 * robot::distance_m(stop.drive.estimate, stop.drive.odometry) << " mm away";
+    std::cout << std::endl;
     std::vector<LitTarget> lit;
     for (const session::LitTarget& l : stop.lit)
       lit.push_back({l.target, l.target == stop.target ? stop.target_visit : 0,
@@ -213,8 +218,9 @@ Devices open_configured(const config::Scene& scene, bool headless) {
   Devices devices = open_session_devices(wanted, checks, robot);  // an absent device, part of a robot or a laser: refused
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
   if (robot)
-    std::cout << "the configured base, pan-tilt and camera serve the session: no twin (nothing is measured against a truth)"
-              << std::endl;
+    std::cout << "the configured base, pan-tilt and camera serve the session"
+              << (wanted.laser ? ", the base localised on the laser against " + wanted.laser->map.string() : std::string())
+              << ": no twin (nothing is measured against a truth)" << std::endl;
   else
     std::cout << "the twin serves the robot" << (scene.devices.camera ? "" : " and the camera") << std::endl;
   return devices;
@@ -264,11 +270,13 @@ const Command kRun{
     "A configured camera replaces the twin's (its frames at its own rate, its colour on arrival) and a\n"
     "configured projector sets the window's monitor and fullscreen. A configured base, pan_tilt and camera\n"
     "(together) make the whole robot: the base is driven to each stop over its ROS 2 topics on its odometry\n"
-    "(placed in the map at robot.start), the pan-tilt aims, and no twin runs (so no error is measured). Part\n"
-    "of a robot, or a laser (not localised on yet), stops the run saying so. With none configured, or with\n"
-    "--sim, the digital twin serves every device. A live camera that hands over no frame for 100 ms blanks the\n"
-    "projection until its frames come back. A device that fails while projecting blanks the projector at\n"
-    "once; what was measured until then is printed and written, and the failure is reported (exit 1).\n"
+    "(placed in the map at robot.start), the pan-tilt aims, and no twin runs (so no error is measured); a\n"
+    "configured laser localises the base against devices.laser.map (projbot slam's map) while it drives and\n"
+    "at each stop. Part of a robot, or a laser without a base or a map, stops the run saying so. With none\n"
+    "configured, or with --sim, the digital twin serves every device. A live camera that hands over no frame\n"
+    "for 100 ms blanks the projection until its frames come back. A device that fails while projecting\n"
+    "blanks the projector at once; what was measured until then is printed and written, and the failure is\n"
+    "reported (exit 1).\n"
     "With --replay DIR the session runs from a recording (projbot record): the base and pan-tilt answer\n"
     "what they answered then, each stop's frames play at their recorded pace and are tracked in lockstep,\n"
     "and every pose is compared with the recording's (the largest difference is printed); no device and\n"

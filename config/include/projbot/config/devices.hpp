@@ -2,6 +2,7 @@
 // The `devices:` section of a scene file (issue 12): which real device serves each role. Every entry is
 // optional; an absent one is simulated by the digital twin.
 
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <string>
@@ -27,12 +28,14 @@ struct PanTiltDevice {
   int baud = 9600;
 };
 
-/// A 2-D laser (`devices.laser`): `{driver: mrpt, class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM0}}`,
-/// any MRPT sensor class by name with the keys of its own configuration section.
+/// A 2-D laser (`devices.laser`): `{driver: mrpt, class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM0},
+/// map: site-map}`, any MRPT sensor class by name with the keys of its own configuration section, and the
+/// map the robot localises on with it (the folder `projbot slam --out-map` wrote, relative to the scene).
 struct LaserDevice {
   std::string driver = "mrpt";
   std::string class_name;
   std::map<std::string, std::string> params;
+  std::filesystem::path map;  ///< holds map.simplemap.gz (checked when the scene is read); empty: none given
 };
 
 /// The mobile base (`devices.base`): `{driver: ros2-dds, domain: 0, cmd_vel: cmd_vel, odom: odom}`,

@@ -33,6 +33,14 @@ struct LaserScan {
   std::vector<std::uint8_t> valid;  ///< 0 where the ray saw nothing within range
 };
 
+/// Where scans come from: a real scanner (MrptLaser) or a simulated one.
+class LaserSource {
+ public:
+  virtual ~LaserSource() = default;
+  /// The next scan (waits at most timeout_s). Throws RobotError naming the scanner when none comes.
+  virtual LaserScan next(double timeout_s) = 0;
+};
+
 /// An axis-aligned box in the world frame, metres.
 struct Box2D {
   double min_x_m, min_y_m, max_x_m, max_y_m;

@@ -11,7 +11,7 @@
 
 namespace projbot::robot {
 
-class MrptLaser {
+class MrptLaser final : public LaserSource {
  public:
   /// Creates the MRPT sensor `class_name`, loads `params` as its configuration section and starts it.
   /// Throws RobotError naming the class when MRPT has no such 2-D laser class or the device does not start
@@ -22,7 +22,7 @@ class MrptLaser {
   MrptLaser& operator=(const MrptLaser&) = delete;
 
   /// Polls the driver until a scan arrives (at most timeout_s). Throws RobotError naming the class.
-  LaserScan next(double timeout_s = 1.0);
+  LaserScan next(double timeout_s = 1.0) override;
 
  private:
   struct Impl;

@@ -14,6 +14,8 @@
 #include "projbot/config/devices.hpp"
 #include "projbot/robot/base.hpp"
 #include "projbot/robot/error.hpp"
+#include "projbot/robot/laser.hpp"
+#include "projbot/robot/localization.hpp"
 #include "projbot/robot/navigator.hpp"
 #include "projbot/robot/pose2d.hpp"
 #include "projbot/robot/sim_base.hpp"
@@ -54,7 +56,8 @@ class Ros2Base {
 /// The base over ROS 2 topics as the session's Navigator: drives to a stop under the stop controller,
 /// closing the loop on the base's odometry in real time, placed in the map where the config says the
 /// robot starts (the odometry frame's pose is fixed at the first message: a driver whose odometry starts at
-/// zero and one that publishes map poses both work). Wheel odometry only: it drifts as the paper's did.
+/// zero and one that publishes map poses both work). On wheel odometry alone it drifts as the paper's did;
+/// localise_on() adds a laser, whose scans matched against the map move the odometry frame's place in it.
 class Ros2Navigator final : public Navigator {
  public:
   /// `base` outlives the navigator. Reads the first odometry (RobotError naming the base when none comes).
@@ -62,16 +65,30 @@ class Ros2Navigator final : public Navigator {
                 double timeout_s = 120.0);
   /// Drives until the controller says arrived (or timeout_s passes: arrived false), stops the base and
   /// lets it settle. Throws RobotError naming the base when its odometry stops for a second.
+  /// The report's `odometry` is where odometry alone (from the configured start) puts the robot,
+  /// `estimate` where it believes it stands, with the laser's corrections counted and timed.
   StopReport drive_to(const Pose2D& goal, int index) override;
   Pose2D believed_pose() const override { return compose(T_map_odom_, last_.pose); }
+  /// Localises on `laser` against `map` from now on: a scan matched at every control step while driving
+  /// and three once stopped (and three now, from the configured start). Both outlive the navigator. Throws
+  /// RobotError naming the laser when it sends no scan.
+  void localise_on(LaserSource& laser, Localizer& map);
 
  private:
+  struct Corrections {
+    int count = 0, rejected = 0;
+    double ms = 0.0;
+  };
   Odometry2D fresh(double& last_change_s);
+  /// One scan matched against the map (with the newest odometry); stops the base when the laser fails.
+  void correct(double& last_change_s, Corrections& c);
   Ros2Base& base_;
   BaseController controller_;
   double rate_hz_, timeout_s_;
-  Pose2D T_map_odom_;
+  Pose2D T_map_odom_, T_map_odom_start_;
   Odometry2D last_;
+  LaserSource* laser_ = nullptr;
+  Localizer* map_ = nullptr;
 };
 
 /// The twin's side: a simulated youBot (SimulatedBase, wheel odometry) that follows the newest cmd_vel
