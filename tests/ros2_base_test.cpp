@@ -152,6 +152,8 @@ TEST(Ros2Navigator, LocalisesOnTheLaserWhereOdometryAloneIsOff) {
   projbot::robot::Ros2Base base(config);
   projbot::robot::Ros2Navigator navigator(base, start, {}, 20.0, 30.0);
   TwinLaser laser(server, stepping, room);
+  int heard = 0;  // what record writes to its rawlog: every scan matched
+  navigator.on_scan([&](const projbot::robot::LaserScan& scan, const Pose2D&) { heard += scan.ranges_m.empty() ? 0 : 1; });
   navigator.localise_on(laser, map);
   EXPECT_LT(distance(navigator.believed_pose(), truly), 0.01);  // found at once, from 6 cm off
   const projbot::robot::StopReport r = navigator.drive_to(goal, 0);
@@ -171,4 +173,5 @@ TEST(Ros2Navigator, LocalisesOnTheLaserWhereOdometryAloneIsOff) {
   EXPECT_GE(r.corrections, 20);
   EXPECT_LE(r.rejected, r.corrections / 10);
   EXPECT_GT(r.correct_ms_mean, 0.0);
+  EXPECT_EQ(heard, 3 + r.corrections);  // the start's three, then the drive's and the stop's
 }

@@ -33,6 +33,7 @@ void Ros2Navigator::correct(double& last_change_s, Corrections& c) {
     throw;
   }
   fresh(last_change_s);  // the odometry of the scan's moment (the newest, a control step at most after it)
+  if (on_scan_) on_scan_(scan, last_.pose);
   map_->reset(believed_pose());
   const LocalizationUpdate u = map_->correct(scan);
   ++c.count;

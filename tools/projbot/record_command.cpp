@@ -82,7 +82,7 @@ class RecordObserver final : public session::StopObserver {
     config::write_file_atomically(out_ / "recording.yaml", config::recording_yaml(rec_));
   }
   int frames = 0;
-  std::vector<robot::RawlogStep> scans;  // the twin robot's laser and odometry so far
+  std::vector<robot::RawlogStep> scans;  // the robot's laser and odometry so far
 
  private:
   const config::Scene& scene_;
@@ -109,15 +109,16 @@ const Command kRecord{
     "  recording.yaml  the scene, and per stop what the session asked and the devices answered: the stop\n"
     "                  driven to, where the robot then believed it stood, the pan-tilt's angles\n"
     "  poses.csv       the pose each lit target's tracker gave for every frame (the session's decisions)\n"
-    "  laser.rawlog    the twin robot's laser scans and wheel odometry while driving and settling, as an MRPT\n"
-    "                  rawlog (projbot slam and MRPT's own tools read it)\n"
+    "  laser.rawlog    the robot's laser scans and wheel odometry while driving and settling (the twin's, or\n"
+    "                  a configured laser's with the base's odometry), as an MRPT rawlog (projbot slam and\n"
+    "                  MRPT's own tools read it)\n"
     "`projbot run --replay DIR` runs the same session from them with no device and no twin, and compares\n"
     "its poses with poses.csv frame for frame. A stop's dump also replays through the real Kinect driver:\n"
     "  fakenect DIR/stop01 projbot run --config site.yaml   (camera: {driver: freenect, registered: false})\n"
     "The devices are the config's, as for run: a base, pan-tilt and camera together drive the robot with no\n"
-    "twin; a camera alone is read with the twin's robot; none, or --sim, is the twin's. Depth is kept to the Kinect's disparity "
-    "steps, for the trackers too. A configured robot's laser and odometry are not recorded yet (its\n"
-    "belief at each stop is). Ctrl-C ends the stop in progress and keeps every stop recorded.\n",
+    "twin; a camera alone is read with the twin's robot; none, or --sim, is the twin's. Depth is kept to\n"
+    "the Kinect's disparity steps, for the trackers too. Ctrl-C ends the stop in progress and keeps every\n"
+    "stop recorded.\n",
     {{"out", "DIR", "the recording's folder (new or empty)"},
      {"config", "FILE", "scene (default: assets/scenes/tour.yaml)"},
      {"sim", "", "record the twin's camera whatever `devices:` configures"},
@@ -169,17 +170,18 @@ const Command kRecord{
       catch_interrupts();  // Ctrl-C: end the stop in progress, keep every stop recorded
       Progress progress("frame", static_cast<int>(std::ceil(visits * dwell_s * 30.0)));
       RecordObserver observer(scene, rec, *out, progress);
-      if (twin_rig) {  // the twin's laser scans and wheel odometry, as an MRPT rawlog
-        twin_rig->twin().robot().on_scan([&observer, last = std::optional<robot::Pose2D>()](
-                                             const robot::LaserScan& scan, const robot::Pose2D& odometry) mutable {
-          robot::RawlogStep step;
-          step.timestamp_s = scan.timestamp_s;
-          if (last) step.odometry_increment = robot::between(*last, odometry);
-          step.scan = scan;
-          observer.scans.push_back(std::move(step));
-          last = odometry;
-        });
-      }
+      // The robot's laser scans and wheel odometry, as an MRPT rawlog: the twin's, or the configured laser's.
+      auto scans = [&observer, last = std::optional<robot::Pose2D>()](const robot::LaserScan& scan,
+                                                                      const robot::Pose2D& odometry) mutable {
+        robot::RawlogStep step;
+        step.timestamp_s = scan.timestamp_s;
+        if (last) step.odometry_increment = robot::between(*last, odometry);
+        step.scan = scan;
+        observer.scans.push_back(std::move(step));
+        last = odometry;
+      };
+      if (twin_rig) twin_rig->twin().robot().on_scan(scans);
+      if (device_rig) device_rig->navigator().on_scan(scans);
       QuantisedCamera quantised;
       dwell.camera = [&, camera = dwell.camera](const session::Stop& stop, double since_s) -> alignment::RgbdCamera& {
         quantised.inner = &camera(stop, since_s);

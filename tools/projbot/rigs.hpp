@@ -78,6 +78,7 @@ class DeviceRig {
   DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, Devices& devices);
   session::Session& session() { return session_; }
   session::Dwell dwell(double dwell_s, bool lockstep);
+  robot::Ros2Navigator& navigator() { return navigator_; }
 
  private:
   std::optional<robot::Localizer> map_;

@@ -6,6 +6,7 @@
 // Also the other side: the twin's simulated youBot served on the same topics, for tests and for
 // trying a ROS 2 tool without a robot. Cyclone DDS types stay in src/.
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -73,6 +74,8 @@ class Ros2Navigator final : public Navigator {
   /// and three once stopped (and three now, from the configured start). Both outlive the navigator. Throws
   /// RobotError naming the laser when it sends no scan.
   void localise_on(LaserSource& laser, Localizer& map);
+  /// Called with each scan matched and the wheel odometry read with it (record writes them as a rawlog).
+  void on_scan(std::function<void(const LaserScan&, const Pose2D& odometry)> listener) { on_scan_ = std::move(listener); }
 
  private:
   struct Corrections {
@@ -89,6 +92,7 @@ class Ros2Navigator final : public Navigator {
   Odometry2D last_;
   LaserSource* laser_ = nullptr;
   Localizer* map_ = nullptr;
+  std::function<void(const LaserScan&, const Pose2D&)> on_scan_;
 };
 
 /// The twin's side: a simulated youBot (SimulatedBase, wheel odometry) that follows the newest cmd_vel
