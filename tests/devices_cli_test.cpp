@@ -112,6 +112,17 @@ TEST_F(DevicesCli, NamesEachAbsentDevice) {
             std::string::npos)
       << run.output;
   EXPECT_EQ(run.output.find("device: "), std::string::npos) << "a renderer was started: " << run.output;
+  // A laser without a map: run refuses it before opening anything; record takes it (a mapping run) and
+  // so names the absent laser.
+  const fs::path mapless = site(
+      "  laser: {class: CHokuyoURG, params: {COM_port_LIN: /dev/ttyACM97}}\n"
+      "  base: {domain: 3}\n");
+  const CliRun unmapped = run_projbot("run --headless --config " + mapless.string(), 60);
+  EXPECT_EQ(unmapped.code, 1) << unmapped.output;
+  EXPECT_NE(unmapped.output.find("devices.laser.map names none"), std::string::npos) << unmapped.output;
+  const CliRun mapping = run_projbot("record --out " + (dir_ / "rec").string() + " --config " + mapless.string(), 60);
+  EXPECT_EQ(mapping.code, 1) << mapping.output;
+  EXPECT_NE(mapping.output.find("laser (MRPT CHokuyoURG): cannot start"), std::string::npos) << mapping.output;
 }
 
 // A configured projector has no monitor to check when run draws offscreen: it is left out, said so.

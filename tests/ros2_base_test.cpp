@@ -123,6 +123,28 @@ projbot::robot::Localizer surveyed(const projbot::robot::OccupancyMap& room, con
 
 double distance(const Pose2D& a, const Pose2D& b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
 
+// The twin's youBot served over DDS, stepped in real time (100 Hz) until destroyed.
+struct ServedBase {
+  ServedBase(const projbot::config::BaseDevice& config, const Pose2D& truly, const projbot::robot::BaseErrorModel& errors)
+      : server(config, truly, errors), simulation([this](const std::stop_token& stop) {
+          const double dt = 0.01;
+          for (int i = 0; !stop.stop_requested(); ++i) {
+            {
+              const std::lock_guard lock(stepping);
+              server.step(i * dt, dt);
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+          }
+        }) {}
+  Pose2D truth() {
+    const std::lock_guard lock(stepping);
+    return server.true_pose();
+  }
+  projbot::robot::Ros2BaseServer server;
+  std::mutex stepping;
+  std::jthread simulation;  // last: stopped and joined first
+};
+
 }  // namespace
 
 // A real base with a laser (devices.base and devices.laser): set down 6 cm and 2 degrees off its configured
@@ -137,31 +159,16 @@ TEST(Ros2Navigator, LocalisesOnTheLaserWhereOdometryAloneIsOff) {
   const auto room = projbot::robot::OccupancyMap::from_room(room_config);
   auto map = surveyed(room, room_config);
   const Pose2D start{1.0, 1.0, 0.0}, truly{1.05, 0.97, -0.035}, goal{2.0, 1.5, 0.5};
-  std::mutex stepping;
-  projbot::robot::Ros2BaseServer server(config, truly, projbot::robot::BaseErrorModel{});
-  std::jthread simulation([&](std::stop_token stop) {
-    const double dt = 0.01;
-    for (int i = 0; !stop.stop_requested(); ++i) {
-      {
-        const std::lock_guard lock(stepping);
-        server.step(i * dt, dt);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-  });
+  ServedBase served(config, truly, projbot::robot::BaseErrorModel{});
   projbot::robot::Ros2Base base(config);
   projbot::robot::Ros2Navigator navigator(base, start, {}, 20.0, 30.0);
-  TwinLaser laser(server, stepping, room);
+  TwinLaser laser(served.server, served.stepping, room);
   int heard = 0;  // what record writes to its rawlog: every scan matched
   navigator.on_scan([&](const projbot::robot::LaserScan& scan, const Pose2D&) { heard += scan.ranges_m.empty() ? 0 : 1; });
-  navigator.localise_on(laser, map);
+  navigator.use_laser(laser, &map);
   EXPECT_LT(distance(navigator.believed_pose(), truly), 0.01);  // found at once, from 6 cm off
   const projbot::robot::StopReport r = navigator.drive_to(goal, 0);
-  Pose2D truth;
-  {
-    const std::lock_guard lock(stepping);
-    truth = server.true_pose();
-  }
+  const Pose2D truth = served.truth();
   std::cout << "at the stop: localised " << 1000 * distance(r.estimate, truth) << " mm off, odometry alone "
             << 1000 * distance(r.odometry, truth) << " mm; " << r.corrections << " scans matched (" << r.rejected
             << " rejected), " << r.correct_ms_mean << " ms each; drove " << r.drive_seconds << " s\n";
@@ -174,4 +181,28 @@ TEST(Ros2Navigator, LocalisesOnTheLaserWhereOdometryAloneIsOff) {
   EXPECT_LE(r.rejected, r.corrections / 10);
   EXPECT_GT(r.correct_ms_mean, 0.0);
   EXPECT_EQ(heard, 3 + r.corrections);  // the start's three, then the drive's and the stop's
+}
+
+// A laser without a map (record's mapping run): its scans are handed on with the odometry read beside each,
+// and the robot's belief stays odometry's.
+TEST(Ros2Navigator, WithoutAMapTheLaserIsOnlyRecorded) {
+  const auto config = base_on_own_domain();
+  projbot::robot::RoomConfig room_config;
+  room_config.width_m = 4.0;
+  room_config.depth_m = 3.0;
+  const auto room = projbot::robot::OccupancyMap::from_room(room_config);
+  ServedBase served(config, {1.05, 0.97, 0.0}, projbot::robot::BaseErrorModel::none());
+  projbot::robot::Ros2Base base(config);
+  projbot::robot::Ros2Navigator navigator(base, {1.0, 1.0, 0.0});
+  TwinLaser laser(served.server, served.stepping, room);
+  std::vector<Pose2D> odometry;
+  navigator.on_scan([&](const projbot::robot::LaserScan& scan, const Pose2D& o) {
+    EXPECT_EQ(scan.ranges_m.size(), 1081U);
+    odometry.push_back(o);
+  });
+  navigator.use_laser(laser, nullptr);
+  ASSERT_EQ(odometry.size(), 3U);
+  EXPECT_NEAR(odometry[0].x_m, 1.05, 1e-9);               // the base's own odometry frame
+  EXPECT_NEAR(navigator.believed_pose().x_m, 1.0, 1e-9);  // not moved by the scans: no map to match
+  EXPECT_NEAR(navigator.believed_pose().y_m, 1.0, 1e-9);
 }

@@ -15,9 +15,9 @@ Ros2Navigator::Ros2Navigator(Ros2Base& base, const Pose2D& start_in_map, const C
   T_map_odom_start_ = T_map_odom_;
 }
 
-void Ros2Navigator::localise_on(LaserSource& laser, Localizer& map) {
+void Ros2Navigator::use_laser(LaserSource& laser, Localizer* map) {
   laser_ = &laser;
-  map_ = &map;
+  map_ = map;
   double last_change = steady_s();
   Corrections c;
   for (int i = 0; i < 3; ++i) correct(last_change, c);  // a robot set down a few centimetres off its start is found
@@ -34,6 +34,7 @@ void Ros2Navigator::correct(double& last_change_s, Corrections& c) {
   }
   fresh(last_change_s);  // the odometry of the scan's moment (the newest, a control step at most after it)
   if (on_scan_) on_scan_(scan, last_.pose);
+  if (!map_) return;  // a mapping run: the scans are recorded, odometry alone drives
   map_->reset(believed_pose());
   const LocalizationUpdate u = map_->correct(scan);
   ++c.count;

@@ -116,7 +116,9 @@ const Command kRecord{
     "its poses with poses.csv frame for frame. A stop's dump also replays through the real Kinect driver:\n"
     "  fakenect DIR/stop01 projbot run --config site.yaml   (camera: {driver: freenect, registered: false})\n"
     "The devices are the config's, as for run: a base, pan-tilt and camera together drive the robot with no\n"
-    "twin; a camera alone is read with the twin's robot; none, or --sim, is the twin's. Depth is kept to\n"
+    "twin, localised on a configured laser against devices.laser.map; a laser without a map is only\n"
+    "recorded (a mapping run: projbot slam --rawlog DIR/laser.rawlog makes the site's map). A\n"
+    "camera alone is read with the twin's robot; none, or --sim, is the twin's. Depth is kept to\n"
     "the Kinect's disparity steps, for the trackers too. Ctrl-C ends the stop in progress and keeps every\n"
     "stop recorded.\n",
     {{"out", "DIR", "the recording's folder (new or empty)"},
@@ -150,7 +152,7 @@ const Command kRecord{
         config::DevicesConfig wanted = scene.devices;
         wanted.projector.reset();  // nothing is projected while recording
         std::vector<DeviceCheck> checks;
-        devices = open_session_devices(wanted, checks, robot);
+        devices = open_session_devices(wanted, checks, robot, false);  // a laser without a map: a mapping run
         for (const auto& c : checks)
           if (c.role == "camera") rec.camera = c.config;
       }

@@ -67,14 +67,14 @@ session::Dwell TwinRig::dwell(double dwell_s, bool lockstep) {
 
 namespace {
 
-// A laser localises a configured base against a map: without either, the config is incomplete (said before
-// any device is opened).
-void check_laser(const config::DevicesConfig& d) {
+// A laser localises a configured base against a map (a mapping run records it without one): without
+// either, the config is incomplete (said before any device is opened).
+void check_laser(const config::DevicesConfig& d, bool laser_needs_map) {
   if (d.laser && !d.base)
     throw DeviceError(
         "devices.laser localises the configured base, and devices.base is not configured (the twin's robot "
         "localises on the twin's laser): configure the base, or leave the laser out");
-  if (d.laser && d.laser->map.empty())
+  if (laser_needs_map && d.laser && d.laser->map.empty())
     throw DeviceError(
         "devices.laser localises the base against a map, and devices.laser.map names none: map the site "
         "(projbot slam --out-map DIR) and name DIR there");
@@ -96,10 +96,11 @@ bool configured_robot(const config::DevicesConfig& d) {
   return true;
 }
 
-Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot) {
+Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot,
+                             bool laser_needs_map) {
   robot = false;
   if (!wanted.any()) return {};
-  check_laser(wanted);
+  check_laser(wanted, laser_needs_map);
   Devices devices = open_devices(wanted, checks, true);
   robot = configured_robot(wanted);  // after opening: an absent device is named before a missing one
   return devices;
@@ -112,7 +113,7 @@ DeviceRig::DeviceRig(const config::Scene& scene, const std::vector<session::Targ
       navigator_(*devices.base, {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()}),
       camera_(*devices.camera),
       session_(scene, targets, navigator_, *devices.pan_tilt) {
-  if (map_) navigator_.localise_on(*devices.laser, *map_);
+  if (devices.laser) navigator_.use_laser(*devices.laser, map_ ? &*map_ : nullptr);
 }
 
 session::Dwell DeviceRig::dwell(double dwell_s, bool lockstep) {

@@ -65,15 +65,18 @@ bool configured_robot(const config::DevicesConfig& devices);
 
 /// The config's devices for a session, each opened and read once (the first that fails a DeviceError
 /// naming it), then checked to make a whole robot or a camera alone (configured_robot): `robot` says which.
-/// None configured: no device, `robot` false.
-Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot);
+/// None configured: no device, `robot` false. A laser needs a base, and a map unless `laser_needs_map` is
+/// false (record's mapping run).
+Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot,
+                             bool laser_needs_map = true);
 
 /// The configured devices serving the whole session: the base over ROS 2 topics (closing the loop on its
 /// odometry, started at the scene's robot.start), the PTU-D46 and the camera. No twin, so no truth.
 class DeviceRig {
  public:
   /// `devices` (base, pan_tilt and camera opened; the laser when configured) outlive the rig. With a
-  /// laser, the base localises on it against the scene's devices.laser.map. Throws RobotError when the
+  /// laser, the base localises on it against the scene's devices.laser.map (without a map its scans are
+  /// only recorded: a mapping run). Throws RobotError when the
   /// base sends no odometry, the laser no scan or the map cannot be read.
   DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, Devices& devices);
   session::Session& session() { return session_; }

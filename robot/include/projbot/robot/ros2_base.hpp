@@ -58,7 +58,7 @@ class Ros2Base {
 /// closing the loop on the base's odometry in real time, placed in the map where the config says the
 /// robot starts (the odometry frame's pose is fixed at the first message: a driver whose odometry starts at
 /// zero and one that publishes map poses both work). On wheel odometry alone it drifts as the paper's did;
-/// localise_on() adds a laser, whose scans matched against the map move the odometry frame's place in it.
+/// use_laser() adds a laser, whose scans matched against the map move the odometry frame's place in it.
 class Ros2Navigator final : public Navigator {
  public:
   /// `base` outlives the navigator. Reads the first odometry (RobotError naming the base when none comes).
@@ -70,11 +70,13 @@ class Ros2Navigator final : public Navigator {
   /// `estimate` where it believes it stands, with the laser's corrections counted and timed.
   StopReport drive_to(const Pose2D& goal, int index) override;
   Pose2D believed_pose() const override { return compose(T_map_odom_, last_.pose); }
-  /// Localises on `laser` against `map` from now on: a scan matched at every control step while driving
-  /// and three once stopped (and three now, from the configured start). Both outlive the navigator. Throws
-  /// RobotError naming the laser when it sends no scan.
-  void localise_on(LaserSource& laser, Localizer& map);
-  /// Called with each scan matched and the wheel odometry read with it (record writes them as a rawlog).
+  /// Reads `laser` from now on: a scan at every control step while driving and three once stopped (and
+  /// three now). With a `map`, each is matched against it (from the configured start at first: a robot set
+  /// down a few centimetres off it is found); without, the scans are only handed to on_scan (a mapping run,
+  /// recorded for projbot slam). Both outlive the navigator. Throws RobotError naming the laser when it
+  /// sends no scan.
+  void use_laser(LaserSource& laser, Localizer* map);
+  /// Called with each scan read and the wheel odometry read with it (record writes them as a rawlog).
   void on_scan(std::function<void(const LaserScan&, const Pose2D& odometry)> listener) { on_scan_ = std::move(listener); }
 
  private:
