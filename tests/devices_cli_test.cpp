@@ -125,6 +125,21 @@ TEST_F(DevicesCli, NamesEachAbsentDevice) {
   EXPECT_NE(mapping.output.find("laser (MRPT CHokuyoURG): cannot start"), std::string::npos) << mapping.output;
 }
 
+// An OpenNI2 camera through the executable: the packaged Dummy device's depth and, said registered, its
+// colour (a device that offers registration has it switched on; one that does not, and said nothing, has
+// its colour left unread).
+TEST_F(DevicesCli, ReadsAnOpenNi2CamerasDepthAndColour) {
+  const CliRun r =
+      run_projbot("devices --config " + site("  camera: {driver: openni2, uri: Dummy, colour_registered: true}\n").string(), 60);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("camera: openni2"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("camera: openni2 Dummy: ok, 320x240 depth"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" + 320x240 colour"), std::string::npos) << r.output;
+  const CliRun unregistered = run_projbot("devices --config " + site("  camera: {driver: openni2, uri: Dummy}\n").string(), 60);
+  EXPECT_EQ(unregistered.code, 0) << unregistered.output;
+  EXPECT_NE(unregistered.output.find(", no colour"), std::string::npos) << unregistered.output;
+}
+
 // A configured projector has no monitor to check when run draws offscreen: it is left out, said so.
 TEST_F(DevicesCli, HeadlessRunLeavesTheProjectorOut) {
   const fs::path scene = site("  projector: {monitor: 3}\n");

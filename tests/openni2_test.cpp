@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <fstream>
 #include <iterator>
 
@@ -20,6 +21,7 @@ using namespace projbot::alignment;
 TEST(OpenNi2Test, DummyDeviceStreamsDepth) {
   OpenNi2Source source({"Dummy", {}, 3000});
   EXPECT_FALSE(source.intrinsics().has_value());  // the Dummy device reports no field of view
+  EXPECT_FALSE(source.has_colour());              // it has colour, but offers no registration to the depth
   EXPECT_EQ(source.recorded_frames(), -1);        // live
   double last = -1.0;
   for (int i = 0; i < 5; ++i) {
@@ -38,6 +40,41 @@ TEST(OpenNi2Test, DummyDeviceStreamsDepth) {
   }
 }
 
+// The Dummy device's colour, said to be registered (it has the depth's size): each depth frame comes with
+// one, and both are stamped on the host's steady clock, no later than they were handed over.
+TEST(OpenNi2Test, DummyDeviceDeliversColourOnTheHostClock) {
+  OpenNi2Source source({"Dummy", {}, 3000, true});
+  ASSERT_TRUE(source.has_colour());
+  double last = -1.0;
+  for (int i = 0; i < 5; ++i) {
+    const RgbdFrame f = source.next_frame();
+    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    ASSERT_EQ(f.colour.width, 320);
+    ASSERT_EQ(f.colour.height, 240);
+    ASSERT_EQ(f.colour.rgba.size(), 320U * 240U * 4U);
+    EXPECT_GT(f.colour.lit_pixels(), 0U);
+    EXPECT_LE(f.depth.capture_time_s, now);
+    EXPECT_GT(f.depth.capture_time_s, now - 0.5);
+    EXPECT_GT(f.depth.capture_time_s, last);
+    last = f.depth.capture_time_s;
+  }
+}
+
+// The device's clock mapped to the host's: the fastest frame fixes the offset, a late one is stamped at
+// its device time (earlier than its arrival), a device clock that restarts is mapped afresh.
+TEST(DeviceClockTest, FastestFrameFixesTheOffset) {
+  DeviceClock clock(0.0);
+  // Device times every 33 ms from 5 s; the host's clock is 1000 s ahead, latencies 20, 8, 30, 8 ms.
+  EXPECT_NEAR(clock.to_host(5.000, 1005.020), 1005.020, 1e-9);  // first: its arrival
+  EXPECT_NEAR(clock.to_host(5.033, 1005.041), 1005.041, 1e-9);  // faster: the offset follows it
+  EXPECT_NEAR(clock.to_host(5.066, 1005.096), 1005.074, 1e-9);  // 22 ms late: stamped 22 ms before arrival
+  EXPECT_NEAR(clock.to_host(5.099, 1005.107), 1005.107, 1e-9);
+  EXPECT_NEAR(clock.to_host(0.010, 2000.000), 2000.000, 1e-9);  // restarted (a reset, a replay from the start)
+  DeviceClock drifting(1e-4);  // the offset may grow by 0.1 ms per device second: a slow device clock
+  drifting.to_host(0.0, 100.0);
+  EXPECT_NEAR(drifting.to_host(10.0, 110.5), 110.001, 1e-9);
+}
+
 namespace {
 
 fs::path temp_oni(const std::string& tag) {
@@ -53,7 +90,8 @@ std::vector<DepthImage> record_dummy(const fs::path& oni, int frames) {
 }  // the recorder is finalised (and the cropping property added) when the source goes
 
 std::size_t playback_count_and_check(const fs::path& oni, const std::vector<DepthImage>& live) {
-  OpenNi2Source playback({oni.string(), {}, 3000});
+  OpenNi2Source playback({oni.string(), {}, 3000, true});
+  EXPECT_FALSE(playback.has_colour());  // a recording's colour is never paired with its depth
   const int n = playback.recorded_frames();
   // The recorder, attached after the stream started, may miss the first live frame.
   EXPECT_GE(n, static_cast<int>(live.size()) - 1);

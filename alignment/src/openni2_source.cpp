@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -38,12 +39,45 @@ struct OpenNi2Source::Impl {
   TemporaryFile repaired_copy;  // a copy of a recording that lacked the cropping property; outlives the device
   OpenNi2Options options;
   openni::Device device;
-  openni::VideoStream depth;
+  openni::VideoStream depth, colour;
+  bool colour_on = false;         // a colour stream registered to the depth, started
+  openni::VideoFrameRef pending;  // a colour frame read ahead of its depth frame
+  DeviceClock clock;
+  double arrival_s = 0.0;  // host steady clock: when the last depth frame was ready
   openni::Recorder recorder;
   double metres_per_unit = 0.001;
   bool playback = false;
   int frames_read = 0;
 };
+
+namespace {
+
+// The colour stream, where it is registered to the depth (the device's registration switched on, or the
+// options say so): RGB888 at the depth's resolution, created (not started); otherwise left off.
+bool make_colour(openni::Device& device, openni::VideoStream& depth, openni::VideoStream& colour, bool playback,
+                 const OpenNi2Options& options) {
+  // Not from a recording: its player restarts each stream's times and frame numbers from that stream's own
+  // first recorded frame, so depth and colour cannot be paired (one frame apart in some recordings, measured).
+  if (playback || !device.hasSensor(openni::SENSOR_COLOR)) return false;
+  const bool by_device = device.isImageRegistrationModeSupported(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR) &&
+                         device.setImageRegistrationMode(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR) == openni::STATUS_OK;
+  if (!by_device && !options.colour_registered) return false;
+  if (colour.create(device, openni::SENSOR_COLOR) != openni::STATUS_OK) fail(options.uri, "cannot create the colour stream");
+  const openni::VideoMode depth_mode = depth.getVideoMode();
+  openni::VideoMode mode = colour.getVideoMode();
+  mode.setResolution(depth_mode.getResolutionX(), depth_mode.getResolutionY());
+  mode.setPixelFormat(openni::PIXEL_FORMAT_RGB888);
+  if (colour.setVideoMode(mode) != openni::STATUS_OK) mode = colour.getVideoMode();
+  if (mode.getPixelFormat() != openni::PIXEL_FORMAT_RGB888 || mode.getResolutionX() != depth_mode.getResolutionX() ||
+      mode.getResolutionY() != depth_mode.getResolutionY()) {
+    colour.destroy();  // not the depth's pixels: colour would say nothing true about them
+    return false;
+  }
+  device.setDepthColorSyncEnabled(true);  // where the driver can; frames are paired one for one anyway
+  return true;
+}
+
+}  // namespace
 
 OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
@@ -81,7 +115,9 @@ OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_un
   else
     throw AlignmentError(describe(options.uri) + ": depth pixel format " + std::to_string(static_cast<int>(format)) +
                          " is not in mm or 100 um");
+  m.colour_on = make_colour(m.device, m.depth, m.colour, m.playback, options);
   if (m.depth.start() != openni::STATUS_OK) fail(options.uri, "cannot start the depth stream");
+  if (m.colour_on && m.colour.start() != openni::STATUS_OK) fail(options.uri, "cannot start the colour stream");
   if (!options.record_to.empty()) {
     if (m.recorder.create(options.record_to.c_str()) != openni::STATUS_OK || m.recorder.attach(m.depth) != openni::STATUS_OK ||
         m.recorder.start() != openni::STATUS_OK)
@@ -102,20 +138,25 @@ OpenNi2Source::~OpenNi2Source() {
       }
     }
   }
+  if (m.colour_on) m.colour.stop();
   m.depth.stop();
-  if (m.playback) {
-    // Debian's OpenNI2 2.2.0.33 player thread can still be inside its new-data callback, waiting for
-    // the next manual trigger, when the stream is destroyed; it then wakes on the freed stream (SIGSEGV
-    // in libOniFile, 2 in 12 test runs on a loaded machine). Closing the device first does not help:
-    // the core deletes the stream before the driver joins its thread. So a playback device and stream
-    // are stopped but never destroyed: one idle thread and a few kB per recording played, kept until
-    // the process ends (the OpenNI2 context is never shut down, so nothing tears them down at exit).
+  // Kept, never destroyed (one idle thread and a few kB, until the process ends; the OpenNI2 context is
+  // never shut down, so nothing tears them down at exit):
+  // - playback: Debian's OpenNI2 2.2.0.33 player thread can still be inside its new-data callback, waiting
+  //   for the next manual trigger, when the stream is destroyed; it then wakes on the freed stream (SIGSEGV
+  //   in libOniFile, 2 in 12 test runs on a loaded machine). Closing the device first does not help: the
+  //   core deletes the stream before the driver joins its thread.
+  // - the packaged Dummy device with colour: its frame thread runs on after its device closes (see
+  //   tests/openni2_test.cpp) and crashes on a closed device's or destroyed colour stream (SIGSEGV from
+  //   libDummyDevice into libOpenNI2, every run).
+  if (m.playback || (m.colour_on && m.options.uri == "Dummy")) {
     std::error_code ignored;
     if (!m.repaired_copy.path.empty()) std::filesystem::remove(m.repaired_copy.path, ignored);
     m.repaired_copy.path.clear();
     [[maybe_unused]] Impl* kept = impl_.release();
     return;
   }
+  if (m.colour_on) m.colour.destroy();
   m.depth.destroy();
   m.device.close();
 }
@@ -128,6 +169,7 @@ DepthImage OpenNi2Source::next() {
   int ready = -1;
   if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, m.options.timeout_ms) != openni::STATUS_OK)
     throw AlignmentError(describe(m.options.uri) + ": no depth frame within " + std::to_string(m.options.timeout_ms) + " ms");
+  m.arrival_s = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   openni::VideoFrameRef frame;
   if (m.depth.readFrame(&frame) != openni::STATUS_OK || !frame.isValid()) fail(m.options.uri, "cannot read a depth frame");
   ++m.frames_read;
@@ -144,6 +186,65 @@ DepthImage OpenNi2Source::next() {
   }
   return out;
 }
+
+namespace {
+
+// RGB888 rows into an RGBA image.
+assets::Image rgba_of(const openni::VideoFrameRef& frame) {
+  assets::Image out;
+  out.width = frame.getWidth();
+  out.height = frame.getHeight();
+  out.rgba.resize(static_cast<std::size_t>(out.width) * out.height * 4);
+  const auto* data = static_cast<const std::uint8_t*>(frame.getData());
+  for (int y = 0; y < out.height; ++y) {
+    const auto* row = data + static_cast<std::size_t>(y) * frame.getStrideInBytes();
+    for (int x = 0; x < out.width; ++x) {
+      std::uint8_t* p = out.pixel(x, y);
+      p[0] = row[3 * x], p[1] = row[3 * x + 1], p[2] = row[3 * x + 2], p[3] = 255;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+bool OpenNi2Source::paired_colour(std::uint64_t depth_us, assets::Image& out) {
+  Impl& m = *impl_;
+  constexpr std::uint64_t kHalfFrameUs = 16667;  // at 30 Hz
+  for (int tries = 0; tries < 4; ++tries) {
+    if (!m.pending.isValid()) {
+      openni::VideoStream* streams[] = {&m.colour};
+      int ready = -1;
+      if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, m.options.timeout_ms) != openni::STATUS_OK ||
+          m.colour.readFrame(&m.pending) != openni::STATUS_OK || !m.pending.isValid())
+        throw AlignmentError(describe(m.options.uri) + ": no colour frame within " + std::to_string(m.options.timeout_ms) +
+                             " ms of its depth frame");
+    }
+    if (m.pending.getTimestamp() + kHalfFrameUs < depth_us) {  // older than this depth: a frame it had no depth for
+      m.pending.release();
+      continue;
+    }
+    if (m.pending.getTimestamp() > depth_us + kHalfFrameUs) return false;  // the next depth frame's
+    out = rgba_of(m.pending);
+    m.pending.release();
+    return true;
+  }
+  return false;
+}
+
+RgbdFrame OpenNi2Source::next_frame() {
+  Impl& m = *impl_;
+  RgbdFrame out;
+  out.depth = next();
+  const auto depth_us = static_cast<std::uint64_t>(std::llround(out.depth.capture_time_s * 1e6));
+  out.depth.capture_time_s = m.clock.to_host(out.depth.capture_time_s, m.arrival_s);
+  if (m.colour_on && paired_colour(depth_us, out.colour) &&
+      (out.colour.width != out.depth.width || out.colour.height != out.depth.height))
+    out.colour = {};  // not the depth's pixels
+  return out;
+}
+
+bool OpenNi2Source::has_colour() const { return impl_->colour_on; }
 
 std::optional<CameraIntrinsics> OpenNi2Source::intrinsics() const {
   const Impl& m = *impl_;

@@ -261,6 +261,7 @@ CameraDevice read_camera_device(const YAML::Node& node, const std::string& file)
   c.driver = m.get<std::string>("driver", "", true);
   if (c.driver == "openni2") {
     c.uri = m.get<std::string>("uri", "");
+    c.colour_registered = m.get<bool>("colour_registered", c.colour_registered);
   } else if (c.driver == "freenect") {
     c.index = m.get<int>("index", 0);
     if (c.index < 0 || c.index > 15) m.fail(node["index"], "devices.camera.index", "must be 0..15 (which Kinect)");

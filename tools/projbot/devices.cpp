@@ -26,11 +26,12 @@ std::string describe_depth(const alignment::DepthImage& d) {
   return out.str();
 }
 
-// An OpenNI2 device or recording as the session's camera: depth only (OpenNi2Source reads no colour yet).
+// An OpenNI2 device or recording as the session's camera: depth, and colour where it is registered to it,
+// stamped on the host's clock.
 class OpenNi2Camera final : public alignment::RgbdCamera {
  public:
   explicit OpenNi2Camera(const alignment::OpenNi2Options& o) : source_(o) {}
-  alignment::RgbdFrame next() override { return {source_.next(), {}, 0, 0}; }
+  alignment::RgbdFrame next() override { return source_.next_frame(); }
 
  private:
   alignment::OpenNi2Source source_;
@@ -45,6 +46,7 @@ std::string open_camera(const config::CameraDevice& c, Devices& out) {
   } else {
     alignment::OpenNi2Options o;
     o.uri = c.uri;
+    o.colour_registered = c.colour_registered;
     out.camera = std::make_unique<OpenNi2Camera>(o);
   }
   const alignment::RgbdFrame f = out.camera->next();

@@ -1,6 +1,10 @@
 #pragma once
-// Depth frames from OpenNI2: a live device by URI (PrimeSense / Asus Xtion class through the PS1080
-// driver; "Dummy" for the packaged test device) or an .oni recording, optionally recorded to an .oni.
+// Depth and colour frames from OpenNI2: a live device by URI (PrimeSense / Asus Xtion class through the
+// PS1080 driver; "Dummy" for the packaged test device) or an .oni recording, optionally recorded to an
+// .oni (depth only). A live device's colour is read where it is registered to the depth: by the device
+// (registration depth-to-colour, which the PS1080 driver offers, switched on), or as the options say. A
+// recording's is not: the packaged player restarts each stream's times and frame numbers at its own first
+// recorded frame, so its depth and colour frames cannot be paired (one frame apart in some, measured).
 // One thread per source. OpenNI2 types stay in src/.
 //
 // Recordings and Debian's OpenNI2 2.2.0.33: the OniFile player hands a frame to a stream only when the
@@ -12,6 +16,7 @@
 // PlaybackControl::seek crashes the player thread of that build (recordings with or without the
 // property), so playback steps frame by frame from the start and never seeks.
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -19,6 +24,7 @@
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/rgbd_camera.hpp"
 
 namespace projbot::alignment {
 
@@ -26,6 +32,9 @@ struct OpenNi2Options {
   std::string uri;                  ///< "" for the first device, "Dummy", a device URI, or an .oni path
   std::filesystem::path record_to;  ///< record the depth stream to this .oni while reading (empty: no)
   int timeout_ms = 2000;            ///< next() gives up after this long without a frame
+  /// The live device's colour is registered to its depth already, though it offers no registration to
+  /// switch on (the Dummy device: colour and depth of the same size, one pair per tick).
+  bool colour_registered = false;
 };
 
 class OpenNi2Source {
@@ -41,6 +50,13 @@ class OpenNi2Source {
   /// and the end of the recording is an AlignmentError saying so. Throws AlignmentError when no frame
   /// arrives within timeout_ms.
   DepthImage next();
+  /// The next depth frame (as next()) with its colour, RGBA at the depth's size (empty where has_colour()
+  /// is false), paired by the device's timestamps, the capture time mapped to the host's steady clock
+  /// (DeviceClock, from when each frame arrived). Throws AlignmentError as next(), and when a live
+  /// device's colour frame does not come within timeout_ms.
+  RgbdFrame next_frame();
+  /// Whether next_frame() delivers colour.
+  bool has_colour() const;
   /// Pinhole intrinsics from the stream's resolution and fields of view (principal point at the centre);
   /// empty when the device reports no field of view (the Dummy device): then calibrate and pass them.
   std::optional<CameraIntrinsics> intrinsics() const;
@@ -50,6 +66,10 @@ class OpenNi2Source {
   int frames_read() const;
 
  private:
+  /// The colour frame taken with the depth frame stamped `depth_us` (device microseconds): older ones are
+  /// skipped (a recording whose colour began a frame before its depth), a newer one is kept for the next
+  /// depth frame. False when there is none (the end of a recording, or it belongs to a later depth).
+  bool paired_colour(std::uint64_t depth_us, assets::Image& out);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

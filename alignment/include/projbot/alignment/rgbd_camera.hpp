@@ -2,7 +2,10 @@
 // The RGB-D camera boundary (issue 12): what the robot's session reads frames from, whichever camera
 // serves it (the twin's, a Kinect v1 through libfreenect, an OpenNI2 device or recording).
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "projbot/alignment/depth.hpp"
 #include "projbot/assets/image.hpp"
@@ -16,6 +19,28 @@ struct RgbdFrame {
   std::uint32_t depth_timestamp = 0;  ///< the device's own counters (0 where it has none)
   std::uint32_t colour_timestamp = 0;
   double delivered_s = 0.0;  ///< when next() handed it over (host steady clock), stamped by the session
+};
+
+/// A device's own clock mapped to the host's steady clock, from when its frames arrive: the offset is the
+/// smallest (arrival - device time) seen, the frame that came fastest, so a frame's host time is its
+/// arrival less the latency it had beyond that one (never later than its arrival). The offset may grow
+/// by max_drift (relative) of the device time elapsed, so a device clock that runs slow is followed too;
+/// a device clock that goes back (a device reset, a recording restarted) starts the mapping afresh.
+class DeviceClock {
+ public:
+  explicit DeviceClock(double max_drift = 1e-4) : max_drift_(max_drift) {}
+  /// The host steady-clock time of a frame stamped `device_s` by the device that arrived at `arrival_s`.
+  double to_host(double device_s, double arrival_s) {
+    if (!std::isfinite(offset_s_) || device_s < last_device_s_) offset_s_ = arrival_s - device_s;
+    offset_s_ = std::min(offset_s_ + max_drift_ * (device_s - last_device_s_), arrival_s - device_s);
+    last_device_s_ = device_s;
+    return device_s + offset_s_;
+  }
+
+ private:
+  double max_drift_;
+  double offset_s_ = std::numeric_limits<double>::quiet_NaN();
+  double last_device_s_ = 0.0;
 };
 
 class RgbdCamera {

@@ -19,6 +19,10 @@ struct CameraDevice {
   /// freenect only: depth registered to colour in mm (the device's own tables; default), or raw 11-bit
   /// disparity in the depth camera's frame (`registered: false`; what a fakenect dump plays).
   bool registered = true;
+  /// openni2 only: its colour is registered to its depth already, though the device offers no registration
+  /// to switch on (`colour_registered: true`). A device that offers registration has it switched on;
+  /// otherwise, and from an .oni recording, its colour is not read.
+  bool colour_registered = false;
 };
 
 /// The pan-tilt unit (`devices.pan_tilt`): `{driver: ptu-d46, port: /dev/ttyUSB0, baud: 9600}`.
