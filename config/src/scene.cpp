@@ -133,13 +133,18 @@ Eigen::Matrix4d read_pose(MapReader& target, const std::string& path, const std:
   return T;
 }
 
+// A file or folder as the scene names it: absolute, or relative to the scene's folder `base`.
+std::filesystem::path beside_scene(const std::string& named, const std::filesystem::path& base) {
+  return std::filesystem::path(named).is_absolute() ? std::filesystem::path(named) : base / named;
+}
+
 // A glTF reference, for targets and props alike: `model` (resolved against the scene's folder), `scale`
 // and `recenter`.
 void read_model_ref(MapReader& m, const YAML::Node& node, const std::string& path, const std::filesystem::path& base,
                     std::filesystem::path& model, double& scale, bool& recenter) {
   const auto file = m.get<std::string>("model", "", true);
   if (file.empty()) m.fail(node, path + ".model", "must not be empty");
-  model = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : base / file;
+  model = beside_scene(file, base);
   scale = m.get<double>("scale", 1.0);
   if (!(scale >= 1e-4 && scale <= 1e4))
     m.fail(node["scale"], path + ".scale", "must be 0.0001..10000 (a uniform factor on the model's metres)");
@@ -306,8 +311,7 @@ LaserDevice read_laser_device(const YAML::Node& node, const std::string& file) {
   }
   // Optional here: `projbot devices` checks a laser before there is a map; a session that drives needs it.
   if (const std::string map = m.get<std::string>("map", ""); !map.empty()) {
-    l.map =
-        std::filesystem::path(map).is_absolute() ? std::filesystem::path(map) : std::filesystem::path(file).parent_path() / map;
+    l.map = beside_scene(map, std::filesystem::path(file).parent_path());
     std::error_code ec;
     if (!std::filesystem::is_regular_file(l.map / "map.simplemap.gz", ec))
       m.fail(node["map"], "devices.laser.map",
@@ -370,8 +374,7 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
   if (YAML::Node robot = root.child("robot", false);
       robot && robot.IsMap() && robot["pan_tilt"] && robot["pan_tilt"].IsMap() && robot["pan_tilt"]["projector_from_camera"])
     root.fail(node, "calibration", "robot.pan_tilt.projector_from_camera is the calibration's; leave it out of the scene");
-  const std::filesystem::path path =
-      std::filesystem::path(node.Scalar()).is_absolute() ? std::filesystem::path(node.Scalar()) : base / node.Scalar();
+  const std::filesystem::path path = beside_scene(node.Scalar(), base);
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     root.fail(node, "calibration", "cannot open '" + path.string() + "': not a file");

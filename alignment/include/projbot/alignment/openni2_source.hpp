@@ -66,9 +66,9 @@ class OpenNi2Source {
   int frames_read() const;
 
  private:
-  /// The colour frame taken with the depth frame stamped `depth_us` (device microseconds): older ones are
-  /// skipped (a recording whose colour began a frame before its depth), a newer one is kept for the next
-  /// depth frame. False when there is none (the end of a recording, or it belongs to a later depth).
+  /// The live colour frame taken with the depth frame stamped `depth_us` (device microseconds): older ones
+  /// (colour frames the depth stream dropped) are skipped, a newer one is kept for the next depth frame.
+  /// False when none pairs with it (the colour read belongs to a later depth frame, or four were older).
   bool paired_colour(std::uint64_t depth_us, assets::Image& out);
   struct Impl;
   std::unique_ptr<Impl> impl_;
