@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "projbot/engine/renderer.hpp"
@@ -19,9 +20,13 @@ std::string describe_depth(const alignment::DepthImage& d) {
       lo = std::min(lo, z);
       hi = std::max(hi, z);
     }
+  // Whole percents, but never "0%" for a frame with valid pixels (the Dummy device's test pattern: 0.4%).
+  const double percent = d.depth_m.empty() ? 0.0 : 100.0 * static_cast<double>(valid) / static_cast<double>(d.depth_m.size());
+  char share[32];
+  std::snprintf(share, sizeof share, valid > 0 && percent < 1.0 ? "%.1f" : "%.0f", std::max(percent, valid > 0 ? 0.1 : 0.0));
   std::ostringstream out;
   out.precision(3);
-  out << d.width << "x" << d.height << " depth, " << (d.depth_m.empty() ? 0 : 100 * valid / d.depth_m.size()) << "% valid";
+  out << d.width << "x" << d.height << " depth, " << share << "% valid";
   if (valid > 0) out << ", " << lo << "-" << hi << " m";
   return out.str();
 }
