@@ -662,6 +662,35 @@ TEST(TourTest, TheShopFigureIsFoundFromATenDegreeGuessBesideItsShelf) {
       << "found without the second crop: " << 1000.0 * projbot::alignment::translation_norm_m(error(r2.T_scan_model)) << " mm";
 }
 
+// An acquisition is bounded (WorkerConfig::acquire_budget_ms): from a gross guess the whole search ran
+// up to 27 s on this figure (restarts, then RANSAC over FPFH matches). Out of budget from the start, only
+// the first ICP stages run (no restart, no global search) and what they leave is not taken: blanked.
+TEST(TourTest, AnAcquisitionStopsAtItsBudgetAndBlanks) {
+  const auto scene = projbot::config::load_scene(kAssets + "/scenes/shop.yaml");
+  projbot::engine::Renderer renderer{projbot::engine::RendererOptions{}};
+  projbot::twin::Twin twin{scene, {}, renderer};
+  const std::size_t figure = twin.target_index("figure");
+  const projbot::twin::Arrival arrival = twin.arrive(figure, 0);
+  const Eigen::Matrix4d T_world_camera = arrival.truth.T_world_camera.matrix();
+  const Eigen::Matrix4d T_true = projbot::alignment::rigid_inverse(T_world_camera) * twin.targets()[figure].T_world_target_true;
+  const auto depth = twin.capture(T_world_camera, 7919);
+  Eigen::Matrix4d guess = T_true;  // 30 cm sideways and turned 40 degrees about the vertical
+  guess.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix() * T_true.topLeftCorner<3, 3>();
+  guess(0, 3) += 0.30;
+  const auto& cloud = twin.targets()[figure].cloud;
+  const auto footing =
+      projbot::alignment::footing_in_camera(cloud, arrival.T_map_target, arrival.believed.T_world_camera.matrix());
+  projbot::alignment::WorkerConfig none;
+  none.acquire_budget_ms = 0.0;
+  const auto r = projbot::alignment::TargetFollower(cloud, twin.camera(), none)
+                     .acquire(depth, guess, footing, projbot::alignment::guess_reach_m(cloud, 0.30, 40.0));
+  EXPECT_FALSE(r.converged);
+  EXPECT_FALSE(r.reinitialised);
+  // ICP's first stage from the guess, then again on the crop at its estimate: 20 iterations each at most.
+  EXPECT_LE(r.iterations, 2 * projbot::alignment::AcquisitionConfig{}.coarse_iterations) << r.iterations;
+}
+
 namespace {
 
 // The shop's twin with the robot arrived at the Duck's stop (its first visit).

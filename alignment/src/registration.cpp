@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <functional>
 #include <optional>
 #include <utility>
@@ -609,8 +610,15 @@ bool better_than(const AlignmentResult& r, const AlignmentResult& best) {
 
 }  // namespace
 
+ThreadCpuClock::time_point ThreadCpuClock::now() noexcept {
+  timespec ts{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return time_point(std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec));
+}
+
 AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage,
-                               const std::optional<Footing>& footing, bool hold_weak) const {
+                               const std::optional<Footing>& footing, bool hold_weak,
+                               std::optional<ThreadCpuClock::time_point> deadline) const {
   const auto t0 = std::chrono::steady_clock::now();
   const Impl& m = *impl_;
   if (!T_init.allFinite()) throw AlignmentError("initial guess is not finite");
@@ -619,8 +627,10 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     throw AlignmentError("scan has " + std::to_string(valid) + " valid points; at least " + std::to_string(m.cfg.min_points) +
                          " are needed");
 
-  // A bounded stage stops starting new work once attempt_budget_ms has passed; `full` runs to the end.
+  // A bounded stage stops starting new work once attempt_budget_ms has passed; `full` runs to the end;
+  // any stage at the caller's deadline.
   const auto out_of_time = [&] {
+    if (deadline && ThreadCpuClock::now() > *deadline) return true;
     return stage != SearchStage::full && stage != SearchStage::icp_only &&
            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() > m.cfg.attempt_budget_ms;
   };
@@ -668,13 +678,14 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     }
   }
   // Global re-initialisation: in `full` after the local attempts failed (as many points as the region
-  // holds on the coarse grid, up to about max_scan_points); as a stage of its own, bounded by
-  // max_global_points.
+  // holds on the coarse grid, up to about max_scan_points, unless there is a deadline); as a stage of
+  // its own, bounded by max_global_points. None once out of time: FPFH cannot stop half-way.
   const bool global = m.cfg.reinitialise && ((stage == SearchStage::full && !best.converged) ||
                                              stage == SearchStage::global_near || stage == SearchStage::global_wide);
-  if (global) {
+  if (global && !out_of_time()) {
     const double margin = stage == SearchStage::global_wide ? m.cfg.wide_crop_margin_m : m.cfg.reinit_crop_margin_m;
-    const std::size_t cap = stage == SearchStage::full ? std::numeric_limits<std::size_t>::max() : m.cfg.max_global_points;
+    const std::size_t cap =
+        stage == SearchStage::full && !deadline ? std::numeric_limits<std::size_t>::max() : m.cfg.max_global_points;
     if (const auto T = m.reinitialise(scan, T_init, margin, cap, out_of_time)) attempt(*T, true);
   }
   best.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

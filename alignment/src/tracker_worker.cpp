@@ -49,7 +49,7 @@ void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, c
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor) {
   guess_ = T_camera_target;
-  known_ = Known{floor, std::nullopt};
+  known_ = Known{floor, std::nullopt, std::nullopt};
   have_guess_ = true;
   pose_.reset();
   rejected_ = 0;
@@ -132,7 +132,8 @@ AlignmentResult TargetFollower::recropped(const DepthImage& frame, const Alignme
   const PointCloud tight = depth_to_cloud(near_guess(frame, r.T_scan_model, known, cfg_.recrop_m), k_);
   if (tight.finite_count() < aligner_.config().min_points) return r;
   // From a converged estimate only ICP's finest stage: the coarse ones would find it where it is.
-  AlignmentResult again = aligner_.align(tight, r.T_scan_model, r.converged ? SearchStage::finish : stage, known.footing, hold);
+  AlignmentResult again =
+      aligner_.align(tight, r.T_scan_model, r.converged ? SearchStage::finish : stage, known.footing, hold, known.deadline);
   again.iterations += r.iterations;
   again.time_ms += r.time_ms;
   return again.converged || !r.converged ? again : r;
@@ -147,7 +148,7 @@ std::optional<AlignmentResult> TargetFollower::projective_first(const DepthImage
   if (!T.allFinite()) return std::nullopt;
   const PointCloud tight = depth_to_cloud(near_guess(frame, T, known, cfg_.recrop_m), k_);
   if (tight.finite_count() < aligner_.config().min_points) return std::nullopt;
-  AlignmentResult r = aligner_.align(tight, T, SearchStage::finish, known.footing, hold);
+  AlignmentResult r = aligner_.align(tight, T, SearchStage::finish, known.footing, hold, known.deadline);
   if (!r.converged) return std::nullopt;
   // Without colour, the projective association settled up to a degree turned along a weak direction,
   // which ICP's finest stage keeps: ICP coarse to fine then (a box-only shop, 5 cm / 10 degree guesses:
@@ -167,7 +168,7 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthI
   const bool hold = weak != Weak::depth;
   // Too little near the guess: the aligner's error says so.
   if (!(grow_m > cfg_.recrop_m) || near.finite_count() < aligner_.config().min_points)
-    return aligner_.align(near, guess, stage, known.footing, hold);
+    return aligner_.align(near, guess, stage, known.footing, hold, known.deadline);
   // The projective tracker's association reaches a 5 cm / 10 degree guess in a few passes of a few ms;
   // ICP's coarse stages took 0.5-1.5 s of the shop figure's acquisition for the same estimate.
   // Only from a guess known to within half the model's size: from a gross one it could settle on a box's
@@ -178,9 +179,12 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthI
   // `stage` only when that fails.
   // (Bounded when `stage` is: a tracking-mode search runs one attempt per frame.)
   const SearchStage first = stage == SearchStage::full ? SearchStage::icp_only : SearchStage::refine;
-  AlignmentResult r = recropped(frame, aligner_.align(near, guess, first, known.footing, hold), known, first, hold);
+  AlignmentResult r =
+      recropped(frame, aligner_.align(near, guess, first, known.footing, hold, known.deadline), known, first, hold);
   if (r.converged || stage == SearchStage::refine || stage == SearchStage::icp_only) return r;
-  AlignmentResult wider = recropped(frame, aligner_.align(near, guess, stage, known.footing, hold), known, first, hold);
+  if (known.deadline && ThreadCpuClock::now() > *known.deadline) return r;
+  AlignmentResult wider =
+      recropped(frame, aligner_.align(near, guess, stage, known.footing, hold, known.deadline), known, first, hold);
   wider.iterations += r.iterations;
   wider.time_ms += r.time_ms;
   return wider;
@@ -188,7 +192,9 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthI
 
 AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing,
                                         double grow_m, const assets::Image* colour) const {
-  const Known known{footing.floor, footing};
+  const auto deadline =
+      ThreadCpuClock::now() + std::chrono::microseconds(static_cast<long long>(1000.0 * cfg_.acquire_budget_ms));
+  const Known known{footing.floor, footing, deadline};
   const DepthImage near = near_guess(frame, guess, known, grow_m);
   const PointCloud near_cloud = depth_to_cloud(near, k_);
   // Colour places what ICP held, where the model has colours to place it by (not the figure's one grey
@@ -201,6 +207,10 @@ AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Ma
     if (!r.converged) return r;
     if (colour) by_colour(frame, known, *colour, r);  // last: the polish is depth alone and would undo it
     if (weak == Weak::depth || !r.weak_held || r.colour_agreement >= cfg_.min_held_colour_agreement) return r;
+    if (ThreadCpuClock::now() > deadline) {  // out of time to place it another way: not confirmed
+      r.converged = false;
+      return r;
+    }
     // A view without contrast (agreement NaN) goes straight to depth alone: colour will not say there.
     weak = weak == Weak::colour && std::isfinite(r.colour_agreement) ? Weak::coarse_colour : Weak::depth;
   }

@@ -111,8 +111,9 @@ const Command kBenchAcquire{
     "scan cropped again at its estimate (3 cm); when that fails the gate, ICP coarse to fine and the same\n"
     "refine, then restarts and global re-initialisation; the quality gate, the footing (upright at the surveyed height,\n"
     "from the map, not from the guess), the pose moved along its weakest slides to where the colour image\n"
-    "agrees with the model's colours, and the free-space check. PCL's pipeline: crop around the guess,\n"
-    "normals, point-to-plane ICP, lit whenever it converges.\n"
+    "agrees with the model's colours, and the free-space check; no search step starts after 1.5 s of\n"
+    "the acquiring thread's CPU time, and what is not confirmed by then is blanked. PCL's pipeline: crop\n"
+    "around the guess, normals, point-to-plane ICP, lit whenever it converges.\n"
     "Success: lit within 3 mm and 0.5 degrees of the truth; false accept: lit more than 10 mm or 2 degrees\n"
     "off; false blank: blanked within 3 mm and 0.5 degrees.\n"
     "Without --scene, assets/scenes/shop.yaml runs. Ctrl-C prints the rows finished.\n",

@@ -4,6 +4,7 @@
 // gate fails. Not thread-safe: one Aligner per thread.
 
 #include <Eigen/Core>
+#include <chrono>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -156,6 +157,18 @@ enum class SearchStage {
   global_wide,  ///< the same within model radius + wide_crop_margin_m
 };
 
+/// The calling thread's CPU time (CLOCK_THREAD_CPUTIME_ID), as a std::chrono clock: what an
+/// acquisition's budget is counted in, so that a busy machine (a test run beside others, the renderer
+/// on the same cores) slows an acquisition down without cutting it short where an idle one finishes.
+struct ThreadCpuClock {
+  using duration = std::chrono::nanoseconds;
+  using rep = duration::rep;
+  using period = duration::period;
+  using time_point = std::chrono::time_point<ThreadCpuClock>;
+  static constexpr bool is_steady = true;
+  static time_point now() noexcept;
+};
+
 class Aligner {
  public:
   /// Prepares the model (downsampling, search structures). Throws AlignmentError for an empty model.
@@ -171,8 +184,12 @@ class Aligner {
   /// its correspondences pin down (strong_point_to_plane_step): the weak ones stay where the coarser
   /// stages left them, for colour to place (the finest stage crept along a face-on box's face for all
   /// its iterations, 300-500 ms, to no better place).
+  /// With a `deadline` (the caller's whole budget: one acquisition's, on the calling thread's CPU
+  /// clock), no ICP stage after the first, restart or RANSAC round starts after it either, whatever the
+  /// stage, and a global search keeps to max_global_points.
   AlignmentResult align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage = SearchStage::full,
-                        const std::optional<Footing>& footing = std::nullopt, bool hold_weak = false) const;
+                        const std::optional<Footing>& footing = std::nullopt, bool hold_weak = false,
+                        std::optional<ThreadCpuClock::time_point> deadline = std::nullopt) const;
 
   /// The quality-gate numbers of a given pose, without refining it (converged: the gate passes).
   AlignmentResult score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model,

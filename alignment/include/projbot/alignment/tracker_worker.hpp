@@ -86,6 +86,15 @@ struct WorkerConfig {
   /// from it; from then on tracking is depth alone until the next stop.
   double hold_release_m = 0.003;
   double hold_release_deg = 1.0;
+  /// One acquisition (acquire(): the localized mode's one per stop) starts no further ICP stage,
+  /// restart, global round or colour retry after this many ms of its thread's CPU time (a loaded machine
+  /// slows it, does not cut it short), and blanks what it has not confirmed by
+  /// then: from gross guesses (30 cm, 40 degrees) it ran to 27 s (the standing figure: ICP restarts,
+  /// then up to 20000 RANSAC iterations over FPFH matches, 16-22 s alone) and 8 s (the box: the whole
+  /// search once for each way of placing its weak slides). The ICP stage running at the deadline ends
+  /// first, so an acquisition takes up to about twice this. Tracking mode's search is not bounded by it:
+  /// its attempts are (AcquisitionConfig::attempt_budget_ms), one a frame, escalating to global ones.
+  double acquire_budget_ms = 1500.0;
 };
 
 /// What searching for a target has cost since its stop began.
@@ -164,7 +173,8 @@ class TargetFollower {
   /// pose before the polish. With `colour` (registered to the frame), the pose is last moved along its
   /// weakest slides to where the model's colours agree best (colour_refined: the shop's face-on box) as
   /// far as the depth allows (colour_max_rmse_growth), and refused when its colours disagree
-  /// (min_colour_agreement).
+  /// (min_colour_agreement). Bounded by WorkerConfig::acquire_budget_ms: what is not confirmed by then
+  /// is returned unconverged (blank).
   /// Throws AlignmentError when too little depth is left.
   AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing, double grow_m,
                           const assets::Image* colour = nullptr) const;
@@ -174,6 +184,7 @@ class TargetFollower {
   struct Known {  // what the map says at this stop (camera frame)
     std::optional<Plane> floor;
     std::optional<Footing> footing;
+    std::optional<ThreadCpuClock::time_point> deadline;  // acquire()'s: no new search step after it
   };
   /// How an acquisition places the view's weak directions (a box seen face-on, along its face).
   enum class Weak {
