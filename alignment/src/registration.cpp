@@ -630,7 +630,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   // A bounded stage stops starting new work once attempt_budget_ms has passed; `full` runs to the end;
   // any stage at the caller's deadline.
   const auto out_of_time = [&] {
-    if (deadline && ThreadCpuClock::now() > *deadline) return true;
+    if (ThreadCpuClock::past(deadline)) return true;
     return stage != SearchStage::full && stage != SearchStage::icp_only &&
            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() > m.cfg.attempt_budget_ms;
   };

@@ -182,7 +182,7 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthI
   AlignmentResult r =
       recropped(frame, aligner_.align(near, guess, first, known.footing, hold, known.deadline), known, first, hold);
   if (r.converged || stage == SearchStage::refine || stage == SearchStage::icp_only) return r;
-  if (known.deadline && ThreadCpuClock::now() > *known.deadline) return r;
+  if (ThreadCpuClock::past(known.deadline)) return r;
   AlignmentResult wider =
       recropped(frame, aligner_.align(near, guess, stage, known.footing, hold, known.deadline), known, first, hold);
   wider.iterations += r.iterations;
@@ -207,7 +207,7 @@ AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Ma
     if (!r.converged) return r;
     if (colour) by_colour(frame, known, *colour, r);  // last: the polish is depth alone and would undo it
     if (weak == Weak::depth || !r.weak_held || r.colour_agreement >= cfg_.min_held_colour_agreement) return r;
-    if (ThreadCpuClock::now() > deadline) {  // out of time to place it another way: not confirmed
+    if (ThreadCpuClock::past(known.deadline)) {  // out of time to place it another way: not confirmed
       r.converged = false;
       return r;
     }

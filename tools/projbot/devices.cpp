@@ -20,10 +20,13 @@ std::string describe_depth(const alignment::DepthImage& d) {
       lo = std::min(lo, z);
       hi = std::max(hi, z);
     }
-  // Whole percents, but never "0%" for a frame with valid pixels (the Dummy device's test pattern: 0.4%).
+  // Whole percents rounded down, as before; below 1 % one decimal rounded up, never "0%" for a frame with
+  // valid pixels (the Dummy device's test pattern: 0.5 %).
   const double percent = d.depth_m.empty() ? 0.0 : 100.0 * static_cast<double>(valid) / static_cast<double>(d.depth_m.size());
+  const bool below_one = valid > 0 && percent < 1.0;
   char share[32];
-  std::snprintf(share, sizeof share, valid > 0 && percent < 1.0 ? "%.1f" : "%.0f", std::max(percent, valid > 0 ? 0.1 : 0.0));
+  std::snprintf(share, sizeof share, "%.*f", below_one ? 1 : 0,
+                below_one ? std::ceil(10.0 * percent) / 10.0 : std::floor(percent));
   std::ostringstream out;
   out.precision(3);
   out << d.width << "x" << d.height << " depth, " << share << "% valid";

@@ -167,6 +167,8 @@ struct ThreadCpuClock {
   using time_point = std::chrono::time_point<ThreadCpuClock>;
   static constexpr bool is_steady = true;
   static time_point now() noexcept;
+  /// Whether `deadline` is set and this thread's CPU time has passed it.
+  static bool past(const std::optional<time_point>& deadline) { return deadline && now() > *deadline; }
 };
 
 class Aligner {
