@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 
 using projbot::config::ProjectorConfig;
 using projbot::engine::clip_from_projector;
@@ -75,6 +76,16 @@ TEST(PinholeTest, ProjectAndBackProjectAreInverse) {
   EXPECT_EQ(u, static_cast<int>(std::lround(x.x())));
   EXPECT_FALSE(k.contains({640.0, 10.0}));
   EXPECT_TRUE(k.contains({639.9, 479.9}));
+  // nearest_pixel rounds as lround does (half away from zero) at the image's edges, and refuses NaN.
+  const projbot::config::Pinhole unit{640, 480, 1.0, 1.0, 0.0, 0.0};  // pixel position = (x, y) / z
+  for (const double at : {-0.5, -0.49, 0.0, 2.5, 638.5, 639.49, 639.5}) {
+    const bool inside = std::lround(at) >= 0 && std::lround(at) < 640;
+    EXPECT_EQ(unit.nearest_pixel({at, 3.0, 1.0}, u, v), inside) << at;
+    if (!inside) continue;
+    EXPECT_EQ(u, std::lround(at)) << at;
+    EXPECT_EQ(v, 3);
+  }
+  EXPECT_FALSE(unit.nearest_pixel({std::nan(""), 3.0, 1.0}, u, v));
   const ProjectorConfig projector;  // 1280x800, f 1400: a Pinhole too
   EXPECT_NEAR(projector.project({0.0, 0.0, 2.0}).x(), 639.5, 1e-12);
   const projbot::config::Pinhole& as_pinhole = projector;

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "projbot/alignment/equations.hpp"
@@ -409,6 +410,27 @@ TEST_F(SyntheticDepthTest, TrackerFollowsAMovingTarget) {
   std::cout << "tracked 30 frames: worst " << worst_mm << " mm, " << worst_deg << " deg, mean " << total_ms / 30 << " ms\n";
   EXPECT_LT(worst_mm, 3.0);
   EXPECT_LT(worst_deg, 0.5);
+}
+
+// The tracker reads the frame in place (no sanitised copy): a driver's invalid pixels, NaN or infinite,
+// are missing depth exactly as zeros are.
+TEST_F(SyntheticDepthTest, TrackerTreatsNonFiniteDepthAsMissing) {
+  const projbot::alignment::ProjectiveTracker tracker(*model_, k_);
+  const Eigen::Matrix4d truth = poses()[1];
+  DepthImage zeros = apply_kinect_v1_noise(render(truth), k_, KinectNoiseConfig{}, 3U);
+  DepthImage invalid = zeros;
+  for (std::size_t i = 0; i < zeros.depth_m.size(); i += 3) {  // a third of the pixels, the target's too
+    zeros.depth_m[i] = 0.0F;
+    invalid.depth_m[i] = (i % 2 == 0) ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
+  }
+  const Eigen::Matrix4d start = projbot::config::pose_from_xyz_rpy({0.01, -0.005, 0.0}, {0, 0, 2}) * truth;
+  const auto a = tracker.track(zeros, start), b = tracker.track(invalid, start);
+  ASSERT_TRUE(a.accepted);
+  ASSERT_TRUE(b.accepted);
+  EXPECT_TRUE(b.T_camera_target.allFinite());
+  EXPECT_EQ(a.correspondences, b.correspondences);
+  EXPECT_LT((a.T_camera_target - b.T_camera_target).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT(translation_norm_m(rigid_inverse(truth) * b.T_camera_target) * 1000.0, 2.0);
 }
 
 TEST_F(SyntheticDepthTest, TrackerRejectsAFrameWithoutTheTarget) {

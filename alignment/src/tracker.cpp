@@ -56,11 +56,7 @@ std::vector<ProjectiveTracker::Level> ProjectiveTracker::pyramid(const DepthImag
                          ", the camera " + std::to_string(k_.width_px) + "x" + std::to_string(k_.height_px));
   std::vector<Level> levels(static_cast<std::size_t>(cfg_.pyramid_levels));
   levels[0].k = k_;
-  levels[0].z.resize(depth.depth_m.size());
-  for (std::size_t i = 0; i < depth.depth_m.size(); ++i) {
-    const float z = depth.depth_m[i];
-    levels[0].z[i] = (z > 0.0F && std::isfinite(z)) ? z : 0.0F;
-  }
+  levels[0].z = depth.depth_m.data();  // read in place: the pyramid, with a copy of this level, was a fifth of the tracking
   for (std::size_t l = 1; l < levels.size(); ++l) {
     const Level& fine = levels[l - 1];
     Level& coarse = levels[l];
@@ -69,7 +65,7 @@ std::vector<ProjectiveTracker::Level> ProjectiveTracker::pyramid(const DepthImag
     coarse.k.height_px = fine.k.height_px / 2;
     coarse.k.fx_px = fine.k.fx_px / 2, coarse.k.fy_px = fine.k.fy_px / 2;
     coarse.k.cx_px = (fine.k.cx_px + 0.5) / 2 - 0.5, coarse.k.cy_px = (fine.k.cy_px + 0.5) / 2 - 0.5;
-    coarse.z.assign(static_cast<std::size_t>(coarse.k.width_px) * coarse.k.height_px, 0.0F);
+    coarse.own.assign(static_cast<std::size_t>(coarse.k.width_px) * coarse.k.height_px, 0.0F);
     for (int y = 0; y < coarse.k.height_px; ++y)
       for (int x = 0; x < coarse.k.width_px; ++x) {
         // Mean of the valid 2x2 block, unless it straddles a depth edge (then no depth, not a blend).
@@ -78,12 +74,13 @@ std::vector<ProjectiveTracker::Level> ProjectiveTracker::pyramid(const DepthImag
         for (int dy = 0; dy < 2; ++dy)
           for (int dx = 0; dx < 2; ++dx) {
             const float z = fine.z[static_cast<std::size_t>(2 * y + dy) * fine.k.width_px + 2 * x + dx];
-            if (z <= 0.0F) continue;
+            if (!(z > 0.0F) || !std::isfinite(z)) continue;
             sum += z, lo = std::min(lo, z), hi = std::max(hi, z), ++n;
           }
         if (n >= 2 && hi - lo < 3.0F * static_cast<float>(sensor_sigma(lo)) + 0.01F)
-          coarse.z[static_cast<std::size_t>(y) * coarse.k.width_px + x] = sum / static_cast<float>(n);
+          coarse.own[static_cast<std::size_t>(y) * coarse.k.width_px + x] = sum / static_cast<float>(n);
       }
+    coarse.z = coarse.own.data();
   }
   return levels;
 }
@@ -141,7 +138,7 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       int u = 0, v = 0;
       if (!lv.k.nearest_pixel(x, u, v)) continue;
       const float zs = lv.z[static_cast<std::size_t>(v) * lv.k.width_px + u];
-      if (zs <= 0.0F) continue;
+      if (!(zs > 0.0F) || !std::isfinite(zs)) continue;    // no depth there
       if (zs < x.z() - cfg_.occlusion_margin_m) continue;  // something in front of the model: occluded
       ++p.candidates;
       const Eigen::Vector3d q((u - lv.k.cx_px) * zs / lv.k.fx_px, (v - lv.k.cy_px) * zs / lv.k.fy_px, zs);
@@ -180,7 +177,7 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       const Eigen::Matrix<double, 6, 1> xi = p.H.ldlt().solve(-p.g);
       if (!xi.allFinite()) break;
       T = twist_to_transform(xi) * T;
-      if (xi.head<3>().norm() < 1e-6 && xi.tail<3>().norm() < 1e-6) break;
+      if (xi.head<3>().norm() + xi.tail<3>().norm() * model_radius_m_ < cfg_.converged_step_m) break;
     }
   }
   const Pass q = run(levels[0], cfg_.model_points.back(), T);

@@ -12,12 +12,10 @@ namespace projbot::alignment {
 
 namespace {
 
-// The nearest front-facing model sample per pixel under T_camera_model: (depth, sample index), +inf
-// where none lands.
-std::vector<std::pair<float, std::size_t>> nearest_samples(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model,
-                                                           const CameraIntrinsics& k) {
-  std::vector<std::pair<float, std::size_t>> nearest(static_cast<std::size_t>(k.width_px) * k.height_px,
-                                                     {std::numeric_limits<float>::infinity(), 0});
+// Calls f(z, pixel index, sample index) for each front-facing model sample under T_camera_model that
+// lands in the image.
+template <class F>
+void for_each_front_sample(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k, F&& f) {
   const Eigen::Matrix3d R = T_camera_model.topLeftCorner<3, 3>();
   const Eigen::Vector3d t = T_camera_model.topRightCorner<3, 1>();
   for (std::size_t i = 0; i < model.points.size(); ++i) {
@@ -25,25 +23,37 @@ std::vector<std::pair<float, std::size_t>> nearest_samples(const ModelCloud& mod
     if (!(p.z() > 0.05) || (R * model.normals[i].cast<double>()).dot(p) >= 0.0) continue;  // behind the camera, or a back face
     int u = 0, v = 0;
     if (!k.nearest_pixel(p, u, v)) continue;
-    auto& best = nearest[static_cast<std::size_t>(v) * k.width_px + u];
-    if (p.z() < best.first) best = {static_cast<float>(p.z()), i};
+    f(static_cast<float>(p.z()), static_cast<std::size_t>(v) * k.width_px + u, i);
   }
+}
+
+// The nearest front-facing model sample per pixel under T_camera_model: (depth, sample index), +inf
+// where none lands.
+std::vector<std::pair<float, std::size_t>> nearest_samples(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model,
+                                                           const CameraIntrinsics& k) {
+  std::vector<std::pair<float, std::size_t>> nearest(static_cast<std::size_t>(k.width_px) * k.height_px,
+                                                     {std::numeric_limits<float>::infinity(), 0});
+  for_each_front_sample(model, T_camera_model, k, [&](float z, std::size_t pixel, std::size_t i) {
+    if (z < nearest[pixel].first) nearest[pixel] = {z, i};
+  });
   return nearest;
 }
 
 // The predicted depth image: nearest front-facing model sample per pixel, +inf where none lands; `box`
-// gets the pixel bounds of what landed (x0, y0, x1, y1, inclusive).
+// gets the pixel bounds of what landed (x0, y0, x1, y1, inclusive). Depth only: it runs on every
+// tracked frame, where the (depth, index) image of nearest_samples cost three times the memory.
 std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k,
                                    std::array<int, 4>& box) {
   box = {k.width_px, k.height_px, -1, -1};
-  const auto nearest = nearest_samples(model, T_camera_model, k);
-  std::vector<float> z_buffer(nearest.size());
-  for (std::size_t i = 0; i < nearest.size(); ++i) {
-    z_buffer[i] = nearest[i].first;
-    if (!std::isfinite(z_buffer[i])) continue;
-    const int u = static_cast<int>(i % k.width_px), v = static_cast<int>(i / k.width_px);
+  std::vector<float> z_buffer(static_cast<std::size_t>(k.width_px) * k.height_px, std::numeric_limits<float>::infinity());
+  for_each_front_sample(model, T_camera_model, k, [&](float z, std::size_t pixel, std::size_t) {
+    float& best = z_buffer[pixel];
+    if (z >= best) return;
+    best = z;
+    const int u = static_cast<int>(pixel % static_cast<std::size_t>(k.width_px)),
+              v = static_cast<int>(pixel / static_cast<std::size_t>(k.width_px));
     box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v)};
-  }
+  });
   return z_buffer;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <functional>
 #include <numeric>
+#include <utility>
 
 #include "commands.hpp"
 #include "interrupt.hpp"
@@ -21,6 +22,7 @@ namespace {
 
 struct Stats {
   std::vector<double> ms, err_mm, err_deg;
+  double iterations = 0.0;  // Gauss-Newton iterations per frame, all levels (the projective tracker's)
   void print(const char* name) const {
     double mean = 0, mean_mm = 0, max_mm = 0, max_deg = 0;
     for (std::size_t i = 0; i < ms.size(); ++i) {
@@ -29,8 +31,12 @@ struct Stats {
       max_mm = std::max(max_mm, err_mm[i]);
       max_deg = std::max(max_deg, err_deg[i]);
     }
-    std::printf("%-26s %7.1f %8.2f %8.2f %8.2f %8.2f %9.3f %9.3f %9.3f\n", name, 1000.0 / mean, mean, engine::percentile(ms, 0.5),
+    std::printf("%-26s %7.1f %8.2f %8.2f %8.2f %8.2f %9.3f %9.3f %9.3f", name, 1000.0 / mean, mean, engine::percentile(ms, 0.5),
                 engine::percentile(ms, 0.95), *std::max_element(ms.begin(), ms.end()), mean_mm, max_mm, max_deg);
+    if (iterations > 0.0)
+      std::printf(" %6.1f\n", iterations / static_cast<double>(ms.size()));
+    else
+      std::printf(" %6s\n", "-");
   }
 };
 
@@ -43,7 +49,8 @@ const Command kBenchTrack{
     "Renders N synthetic 640x480 Kinect v1 depth frames (the engine's depth camera plus the Kinect noise model)\n"
     "of the Duck (32 cm) moving up to 1 cm and 2 degrees per frame, then tracks it frame to frame with the\n"
     "projective tracker and with PCL's IterativeClosestPoint (kd-tree, point-to-point) from the same starts.\n"
-    "Times include each method's preprocessing (pyramid; cloud from depth and crop). The model is 50k points.\n",
+    "Times include each method's preprocessing (pyramid; cloud from depth and crop). The model is 50k points.\n"
+    "iters: the projective tracker's Gauss-Newton iterations per frame, all pyramid levels together.\n",
     {{"frames", "N", "frames in the sequence (default 300)"},
      {"distance", "M", "camera to target distance in metres (default 1.2)"},
      {"device", "N", "Vulkan physical device index for the depth rendering"}},
@@ -98,20 +105,24 @@ const Command kBenchTrack{
         }
         return s;
       };
-      std::printf("%-26s %7s %8s %8s %8s %8s %9s %9s %9s\n", "method", "fps", "mean_ms", "p50_ms", "p95_ms", "max_ms", "mean_mm",
-                  "max_mm", "max_deg");
+      std::printf("%-26s %7s %8s %8s %8s %8s %9s %9s %9s %6s\n", "method", "fps", "mean_ms", "p50_ms", "p95_ms", "max_ms",
+                  "mean_mm", "max_mm", "max_deg", "iters");
       const alignment::ProjectiveTracker tracker(model, k);
-      const Stats ours = measure([&](int f, const Eigen::Matrix4d& prev) {
-        return tracker.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target;
-      });
+      double iterations = 0.0;
+      const auto tracked = [&](const alignment::ProjectiveTracker& t, int f, const Eigen::Matrix4d& prev) {
+        const alignment::TrackResult r = t.track(depth[static_cast<std::size_t>(f)], prev);
+        iterations += r.iterations;
+        return r.T_camera_target;
+      };
+      Stats ours = measure([&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker, f, prev); });
+      ours.iterations = std::exchange(iterations, 0.0);
       if (interrupted()) return stopped("measuring", static_cast<int>(ours.ms.size()) + 1);
       ours.print("projective (20k of 50k)");
       alignment::TrackerConfig all_points;
       all_points.model_points = {5000, 15000, 50000};
       const alignment::ProjectiveTracker tracker_all(model, k, all_points);
-      const Stats ours_all = measure([&](int f, const Eigen::Matrix4d& prev) {
-        return tracker_all.track(depth[static_cast<std::size_t>(f)], prev).T_camera_target;
-      });
+      Stats ours_all = measure([&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker_all, f, prev); });
+      ours_all.iterations = iterations;
       if (interrupted()) return stopped("measuring", static_cast<int>(ours_all.ms.size()) + 1);
       ours_all.print("projective (all 50k)");
       const alignment::PclIcpBaseline pcl_icp(model);

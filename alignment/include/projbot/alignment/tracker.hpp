@@ -23,6 +23,10 @@ struct TrackerConfig {
   double min_inlier_ratio = 0.6;     ///< quality gate
   double max_rmse_mm = 6.0;
   std::size_t min_correspondences = 200;
+  /// A level's iterations stop once a step moves the model less than this (its origin's move plus its
+  /// turn times its RMS radius): the tracked pose's own noise (bench track: 0.13 mm mean error, the
+  /// same with or without this; 12.9 instead of 15 iterations per frame there, fewer on slow motion).
+  double converged_step_m = 1e-4;
   /// Pull towards the start pose, relative to the depth's mean information per axis: holds the
   /// directions the depth leaves free (a box seen face-on) at the start (the motion prediction).
   double start_prior = 0.01;
@@ -57,7 +61,8 @@ class ProjectiveTracker {
  private:
   struct Level {
     CameraIntrinsics k;
-    std::vector<float> z;  // metres, 0 = missing
+    const float* z = nullptr;  // metres; missing: not > 0 (0, negative, NaN) or infinite
+    std::vector<float> own;    // a coarse level's depths (the finest is the frame's own)
   };
   std::vector<Level> pyramid(const DepthImage& depth) const;
 

@@ -35,11 +35,14 @@ struct Pinhole {
   bool contains(const Eigen::Vector2d& x) const { return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < width_px && x.y() < height_px; }
   /// The pixel whose centre is nearest to where camera-frame point p (z > 0) projects; false when it
   /// falls outside the image.
+  /// (Rounds as std::lround does, half away from zero, without its library call: this runs for every
+  /// model point of every tracked frame.)
   bool nearest_pixel(const Eigen::Vector3d& p, int& u, int& v) const {
     const Eigen::Vector2d x = project(p);
-    u = static_cast<int>(std::lround(x.x()));
-    v = static_cast<int>(std::lround(x.y()));
-    return u >= 0 && v >= 0 && u < width_px && v < height_px;
+    if (!(x.x() > -0.5 && x.y() > -0.5 && x.x() < width_px - 0.5 && x.y() < height_px - 0.5)) return false;  // NaN too
+    u = static_cast<int>(x.x() + 0.5);  // non-negative here, so truncation rounds
+    v = static_cast<int>(x.y() + 0.5);
+    return true;
   }
 };
 
