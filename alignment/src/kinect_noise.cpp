@@ -43,7 +43,6 @@ DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics
   DepthImage out = clean;
   const int w = clean.width, h = clean.height;
   const float* zin = clean.depth_m.data();
-  const auto valid = [](float z) { return z > 0.0F && std::isfinite(z); };
   const float ifx = static_cast<float>(1.0 / k.fx_px), ify = static_cast<float>(1.0 / k.fy_px);
   const float cx = static_cast<float>(k.cx_px), cy = static_cast<float>(k.cy_px);
   const auto point = [&](int x, int y, float z) {
@@ -65,7 +64,7 @@ DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       float& z_out = out.depth_m[i];
       const float zf = zin[i];
-      if (!valid(zf)) {
+      if (!has_depth(zf)) {
         z_out = 0.0F;
         continue;
       }
@@ -75,7 +74,7 @@ DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics
       const float zr = x + 1 < w ? zin[i + 1] : 0.0F, zl = x > 0 ? zin[i - 1] : 0.0F;
       const float zd = y + 1 < h ? zin[i + static_cast<std::size_t>(w)] : 0.0F,
                   zu = y > 0 ? zin[i - static_cast<std::size_t>(w)] : 0.0F;
-      const bool all_valid = inside && valid(zr) && valid(zl) && valid(zd) && valid(zu);
+      const bool all_valid = inside && has_depth(zr) && has_depth(zl) && has_depth(zd) && has_depth(zu);
       if (!drop) {
         if (!all_valid) {
           drop = border_drops;

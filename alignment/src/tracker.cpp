@@ -74,7 +74,7 @@ std::vector<ProjectiveTracker::Level> ProjectiveTracker::pyramid(const DepthImag
         for (int dy = 0; dy < 2; ++dy)
           for (int dx = 0; dx < 2; ++dx) {
             const float z = fine.z[static_cast<std::size_t>(2 * y + dy) * fine.k.width_px + 2 * x + dx];
-            if (!(z > 0.0F) || !std::isfinite(z)) continue;
+            if (!has_depth(z)) continue;
             sum += z, lo = std::min(lo, z), hi = std::max(hi, z), ++n;
           }
         if (n >= 2 && hi - lo < 3.0F * static_cast<float>(sensor_sigma(lo)) + 0.01F)
@@ -138,7 +138,7 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       int u = 0, v = 0;
       if (!lv.k.nearest_pixel(x, u, v)) continue;
       const float zs = lv.z[static_cast<std::size_t>(v) * lv.k.width_px + u];
-      if (!(zs > 0.0F) || !std::isfinite(zs)) continue;    // no depth there
+      if (!has_depth(zs)) continue;
       if (zs < x.z() - cfg_.occlusion_margin_m) continue;  // something in front of the model: occluded
       ++p.candidates;
       const Eigen::Vector3d q((u - lv.k.cx_px) * zs / lv.k.fx_px, (v - lv.k.cy_px) * zs / lv.k.fy_px, zs);

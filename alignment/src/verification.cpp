@@ -12,7 +12,7 @@ namespace projbot::alignment {
 
 namespace {
 
-// Calls f(z, pixel index, sample index) for each front-facing model sample under T_camera_model that
+// Calls f(z, u, v, sample index) for each front-facing model sample under T_camera_model that
 // lands in the image.
 template <class F>
 void for_each_front_sample(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const CameraIntrinsics& k, F&& f) {
@@ -23,7 +23,7 @@ void for_each_front_sample(const ModelCloud& model, const Eigen::Matrix4d& T_cam
     if (!(p.z() > 0.05) || (R * model.normals[i].cast<double>()).dot(p) >= 0.0) continue;  // behind the camera, or a back face
     int u = 0, v = 0;
     if (!k.nearest_pixel(p, u, v)) continue;
-    f(static_cast<float>(p.z()), static_cast<std::size_t>(v) * k.width_px + u, i);
+    f(static_cast<float>(p.z()), u, v, i);
   }
 }
 
@@ -33,8 +33,9 @@ std::vector<std::pair<float, std::size_t>> nearest_samples(const ModelCloud& mod
                                                            const CameraIntrinsics& k) {
   std::vector<std::pair<float, std::size_t>> nearest(static_cast<std::size_t>(k.width_px) * k.height_px,
                                                      {std::numeric_limits<float>::infinity(), 0});
-  for_each_front_sample(model, T_camera_model, k, [&](float z, std::size_t pixel, std::size_t i) {
-    if (z < nearest[pixel].first) nearest[pixel] = {z, i};
+  for_each_front_sample(model, T_camera_model, k, [&](float z, int u, int v, std::size_t i) {
+    auto& best = nearest[static_cast<std::size_t>(v) * k.width_px + u];
+    if (z < best.first) best = {z, i};
   });
   return nearest;
 }
@@ -46,12 +47,10 @@ std::vector<float> predicted_depth(const ModelCloud& model, const Eigen::Matrix4
                                    std::array<int, 4>& box) {
   box = {k.width_px, k.height_px, -1, -1};
   std::vector<float> z_buffer(static_cast<std::size_t>(k.width_px) * k.height_px, std::numeric_limits<float>::infinity());
-  for_each_front_sample(model, T_camera_model, k, [&](float z, std::size_t pixel, std::size_t) {
-    float& best = z_buffer[pixel];
+  for_each_front_sample(model, T_camera_model, k, [&](float z, int u, int v, std::size_t) {
+    float& best = z_buffer[static_cast<std::size_t>(v) * k.width_px + u];
     if (z >= best) return;
     best = z;
-    const int u = static_cast<int>(pixel % static_cast<std::size_t>(k.width_px)),
-              v = static_cast<int>(pixel / static_cast<std::size_t>(k.width_px));
     box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u), std::max(box[3], v)};
   });
   return z_buffer;
@@ -176,7 +175,7 @@ FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& 
         interior = interior && (std::isfinite(at(x + dx, y + dy)) || std::isfinite(at(x + dx / 2, y + dy / 2)));
       if (!interior) continue;
       const float measured = depth.at(x, y);
-      if (!(measured > 0.0F) || !std::isfinite(measured)) continue;
+      if (!has_depth(measured)) continue;
       ++c.predicted;
       const float tolerance = 0.015F + 0.005F * z * z;
       if (measured > z + tolerance)

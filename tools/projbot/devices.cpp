@@ -15,7 +15,7 @@ std::string describe_depth(const alignment::DepthImage& d) {
   std::size_t valid = 0;
   float lo = 1e9F, hi = 0.0F;
   for (const float z : d.depth_m)
-    if (z > 0.0F && std::isfinite(z)) {
+    if (alignment::has_depth(z)) {
       ++valid;
       lo = std::min(lo, z);
       hi = std::max(hi, z);

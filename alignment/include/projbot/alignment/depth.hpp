@@ -31,6 +31,10 @@ struct DepthImage {
   float at(int x, int y) const { return depth_m[static_cast<std::size_t>(y) * width + x]; }
 };
 
+/// Whether a depth image's pixel holds a measurement: positive and finite (0, NaN, negative or
+/// infinite: missing).
+inline bool has_depth(float z) { return z > 0.0F && std::isfinite(z); }
+
 /// Points in the camera frame, metres. Organised when height > 1: one point per pixel, NaN where the
 /// pixel had no valid depth (like PCL's organised clouds). Unorganised: height 1, all finite.
 struct PointCloud {

@@ -61,7 +61,7 @@ class ProjectiveTracker {
  private:
   struct Level {
     CameraIntrinsics k;
-    const float* z = nullptr;  // metres; missing: not > 0 (0, negative, NaN) or infinite
+    const float* z = nullptr;  // metres; missing where !has_depth
     std::vector<float> own;    // a coarse level's depths (the finest is the frame's own)
   };
   std::vector<Level> pyramid(const DepthImage& depth) const;
