@@ -346,6 +346,10 @@ TEST(TourTest, PredictionKeepsMovingTargetsWithinTheGoal) {
   // weighs on the mean; the median frame is on the object.
   EXPECT_EQ(on.visits[3].target, "box");
   EXPECT_EQ(on.visits[3].moving_blank_frames, 0);
+  // ...and within the tracker's first pass (its coarsest level reaches 10 cm): with 4 cm there the
+  // start's frame needed the wider second pass, twice the time.
+  EXPECT_EQ(on.visits[3].second_pass_frames, 0);
+  EXPECT_EQ(off.visits[3].second_pass_frames, 0);
   EXPECT_LT(on.visits[3].moving_mean_mm, 20.0);
   std::vector<double> moving;
   for (const auto& x : on.visits[3].timeline)

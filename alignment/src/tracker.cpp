@@ -126,7 +126,7 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
     std::size_t used = 0, candidates = 0, inliers = 0;
     double inlier_sq = 0.0;
   };
-  const auto run = [&](const Level& lv, std::size_t count, const Eigen::Matrix4d& T_cur) {
+  const auto run = [&](const Level& lv, std::size_t count, const Eigen::Matrix4d& T_cur, double reach) {
     Pass p;
     const Eigen::Matrix3d R = T_cur.topLeftCorner<3, 3>();
     const Eigen::Vector3d t = T_cur.topRightCorner<3, 1>();
@@ -143,7 +143,7 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       ++p.candidates;
       const Eigen::Vector3d q((u - lv.k.cx_px) * zs / lv.k.fx_px, (v - lv.k.cy_px) * zs / lv.k.fy_px, zs);
       const Eigen::Vector3d d = x - q;
-      if (d.squaredNorm() > cfg_.max_distance_m * cfg_.max_distance_m) continue;
+      if (d.squaredNorm() > reach * reach) continue;
       const double r = nrm.dot(d);  // point-to-plane, the plane of the model's exact normal
       if (std::abs(r) <= cfg_.inlier_distance_m) {
         ++p.inliers;
@@ -165,8 +165,9 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
   for (int l = cfg_.pyramid_levels - 1; l >= 0; --l) {
     const auto li = static_cast<std::size_t>(cfg_.pyramid_levels - 1 - l);  // coarsest first in the config
     const Level& lv = levels[static_cast<std::size_t>(l)];
+    const double reach = li == 0 ? std::max(cfg_.max_distance_m, cfg_.coarse_max_distance_m) : cfg_.max_distance_m;
     for (int it = 0; it < cfg_.iterations[li]; ++it) {
-      Pass p = run(lv, cfg_.model_points[li], T);
+      Pass p = run(lv, cfg_.model_points[li], T, reach);
       ++out.iterations;
       if (p.used < 6 * 3) break;
       p.H.triangularView<Eigen::Lower>() = p.H.transpose();
@@ -180,7 +181,7 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       if (xi.head<3>().norm() + xi.tail<3>().norm() * model_radius_m_ < cfg_.converged_step_m) break;
     }
   }
-  const Pass q = run(levels[0], cfg_.model_points.back(), T);
+  const Pass q = run(levels[0], cfg_.model_points.back(), T, cfg_.max_distance_m);
   out.T_camera_target = T;
   out.correspondences = q.used;
   out.inlier_ratio = q.candidates > 0 ? static_cast<double>(q.inliers) / static_cast<double>(q.candidates) : 0.0;

@@ -56,6 +56,7 @@ void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, c
   lost_reported_ = false;
   wait_ = 0;
   stats_ = {};
+  second_passes_ = 0;
   last_attempt_.reset();
   filter_.reset();
   hold_.reset();
@@ -283,6 +284,7 @@ std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
   // (reach_m), a few milliseconds. Only when frames were dropped since the last pose (the worker was
   // busy, the target may be far from it) one ICP from there as well: on consecutive frames that ICP
   // (over a second on a full frame) kept a target that had been carried away lit all that time.
+  ++second_passes_;
   const TrackResult w = wide_tracker_.track(frame, start);
   if (w.accepted && verified(frame, w.T_camera_target)) return found(frame, w.T_camera_target, w.inlier_ratio, w.rmse_mm);
   if (frame.capture_time_s - last_found_s_ > 2.5 / cfg_.camera_hz) {

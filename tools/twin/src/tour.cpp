@@ -364,7 +364,10 @@ bool dwell(const DwellContext& c, const std::vector<alignment::TargetFollower*>&
   r.track_ms_mean = tracking && lane.tracked > 0 ? lane.track_ms / lane.tracked : 0.0;
   r.tracked_frames = lane.tracked;
   r.dropped_frames = camera.frames - lane.tracked;
-  if (tracking) r.search = followers.front()->search_stats();
+  if (tracking) {
+    r.search = followers.front()->search_stats();
+    r.second_pass_frames = followers.front()->second_passes();
+  }
   r.reconverge_s = !ever_over ? 0.0 : back_under >= 0.0 ? std::max(0.0, back_under - motion_end_s) : -1.0;
   summarise_timeline(r);
   return true;

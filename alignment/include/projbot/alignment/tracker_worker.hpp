@@ -148,6 +148,9 @@ class TargetFollower {
   /// acquire(), and the pose colour placed or confirmed is then held while the target stays still
   /// (hold_release_m).
   std::optional<PoseSample> step(const DepthImage& frame, const assets::Image* colour = nullptr);
+  /// Frames since the last guess or pose on which tracking's first pass failed and its second, wider
+  /// one (reach_m) ran: each costs about a tracking step more.
+  int second_passes() const { return second_passes_; }
   /// Whether tracking holds a pose that colour placed or confirmed.
   bool holding() const { return hold_.has_value(); }
   /// The search since the last guess or pose was set.
@@ -221,6 +224,7 @@ class TargetFollower {
   Eigen::Matrix4d guess_ = Eigen::Matrix4d::Identity();
   bool have_guess_ = false;
   int rejected_ = 0;
+  int second_passes_ = 0;
   bool lost_reported_ = false;
   int wait_ = 0;  // frames until the next search attempt
   SearchStats stats_;

@@ -115,6 +115,9 @@ struct VisitReport {
   double track_ms_mean = 0.0;  ///< tracking mode: wall time per frame
   /// Tracking mode: camera frames the worker took, and those it dropped because it was still busy.
   int tracked_frames = 0, dropped_frames = 0;
+  /// Tracking mode: frames on which tracking's first pass lost the target and its wider second pass
+  /// ran (TargetFollower::second_passes).
+  int second_pass_frames = 0;
   bool target_present = true;  ///< the target was in the world when the robot arrived
   int lit_frames = 0;          ///< projector frames that showed the target, the arrival's included
   /// Simulated seconds from arrival to the first lit frame: 0 when the acquisition lit it at once, -1
