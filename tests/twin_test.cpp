@@ -73,6 +73,24 @@ TEST_F(MarkerErrorTest, TheProjectorsLensMustBeDrawnToLandOnTheMarker) {
   EXPECT_LT(pinhole.error_mm, 30.0);
 }
 
+// The slab seen from the projector: its face-on centre and a point well inside are measurable; the
+// same face turned 85 degrees away from the projector's ray, or a point 1 mm from the slab's edge (a
+// ray 3 mm beside it passes the slab), are edge-on; turned 60 degrees it is still measurable.
+TEST_F(MarkerErrorTest, MarkersTheProjectorSeesEdgeOnAreNotMeasured) {
+  using projbot::twin::seen_edge_on;
+  EXPECT_FALSE(seen_edge_on(scene_, {0.0, 0.0, 1.0}));
+  EXPECT_FALSE(seen_edge_on(scene_, {0.1, -0.2, 1.0}));
+  EXPECT_TRUE(seen_edge_on(scene_, {0.499, 0.0, 1.0}));
+  const auto turned = [&](double deg) {  // the slab turned about its vertical axis through its centre
+    Eigen::Matrix4d T = T_true_;
+    T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    return std::vector<PlacedMesh>{{&slab_, T}};
+  };
+  EXPECT_FALSE(seen_edge_on(turned(60.0), {0.0, 0.0, 1.0}));
+  EXPECT_TRUE(seen_edge_on(turned(85.0), {0.0, 0.0, 1.0}));
+  EXPECT_TRUE(seen_edge_on({}, {0.0, 0.0, 1.0}));  // nothing there at all
+}
+
 TEST_F(MarkerErrorTest, ExactPoseLandsOnTheMarker) {
   const auto e = measure(T_true_);
   EXPECT_TRUE(e.in_image);

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -131,6 +132,22 @@ MarkerError measure_marker(const config::ProjectorConfig& k, const config::Proje
   }
   e.error_mm = 1000.0 * (truth - truth.dot(d) * d).norm();
   return e;
+}
+
+bool seen_edge_on(std::span<const PlacedMesh> scene, const Eigen::Vector3d& p) {
+  // Four rays 3 mm beside the one to p: each must land within 3 cm of p (else it went past an edge),
+  // and the surface they span must face the origin within max_incidence_deg.
+  constexpr double kStep = 0.003;
+  const Eigen::Vector3d d = p.normalized(), a = d.unitOrthogonal(), b = d.cross(a);
+  const std::array<Eigen::Vector3d, 4> offsets{kStep * a, -kStep * a, kStep * b, -kStep * b};
+  std::array<Eigen::Vector3d, 4> hits;
+  for (std::size_t i = 0; i < offsets.size(); ++i) {
+    const auto hit = cast_ray(scene, Eigen::Vector3d::Zero(), (p + offsets[i]).normalized());
+    if (!hit || (*hit - p).norm() > 10.0 * kStep) return true;
+    hits[i] = *hit;
+  }
+  const Eigen::Vector3d n = (hits[0] - hits[1]).cross(hits[2] - hits[3]);
+  return !(std::abs(n.normalized().dot(d)) >= std::cos(kEdgeOnDeg * M_PI / 180.0));
 }
 
 }  // namespace projbot::twin

@@ -49,7 +49,8 @@ struct ProjectorModels {
 };
 
 // The error at the target's markers. A marker the projector cannot light (outside its image, turned
-// away, or hidden by the target itself or something in front) has no error to measure and is left out; mean and max are
+// away, or hidden by the target itself or something in front), or lights edge-on (seen_edge_on), has no
+// error to measure and is left out; mean and max are
 // NaN when no marker is visible (such frames are left out of the visit's statistics).
 Errors marker_errors(const Twin& twin, std::size_t target, const ProjectorModels& projector,
                      const Eigen::Matrix4d& T_world_projector, const Eigen::Matrix4d& T_camera_target_estimated) {
@@ -65,6 +66,7 @@ Errors marker_errors(const Twin& twin, std::size_t target, const ProjectorModels
     if (!lit_by(projector.truth, truth)) continue;  // outside the projector's image: it cannot be lit
     const auto first = cast_ray(scene, Eigen::Vector3d::Zero(), truth.normalized());
     if (!first || (*first - truth).norm() > 0.002) continue;
+    if (seen_edge_on(scene, truth)) continue;  // a pose's error cannot be measured there
     e.markers.push_back(measure_marker(projector.believed, projector.truth, T_projector_target_estimated, T_true, m, scene));
     e.mean_mm += e.markers.back().error_mm;
     e.max_mm = std::max(e.max_mm, e.markers.back().error_mm);
