@@ -60,8 +60,9 @@ const Command kBenchMotion{
     "(or, with --processing-ms, a fixed time after its capture: figures that do not depend on the load),\n"
     "and a frame is displayed one refresh after it starts, plus the projector's input_lag_ms. Each projector\n"
     "frame's error is measured at the markers against the target's true pose at its display time. Without\n"
-    "--scene, assets/scenes/motion.yaml runs (still, 0.5 m/s with 90 deg/s, 1 m/s, an accelerating start\n"
-    "and sudden stops, a target carried away). Ctrl-C prints the visits finished so far.\n",
+    "--scene, assets/scenes/motion.yaml runs (still, 0.5 m/s with 90 deg/s, 1 m/s, accelerating starts up\n"
+    "to 1 m/s with 180 deg/s, sudden stops, a target carried away). Markers the projector lights edge-on\n"
+    "are not measured. Ctrl-C prints the visits finished so far.\n",
     {{"scene", "FILE", "scene with scripted motions (default: assets/scenes/motion.yaml)"},
      {"visits", "N", "visits, cycling through the scene's list (default: the list once)"},
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
