@@ -135,7 +135,7 @@ INSTANTIATE_TEST_SUITE_P(MotionModel, SuddenStop, ::testing::Values(1.0, 0.2));
 
 TEST(MotionModel, PredictionIsBoundedInTimeAndSpeed) {
   Trajectory traj;
-  traj.v = {5.0, 0.0, 0.0};  // faster than anyone carries a target: clamped to 2 m/s
+  traj.v = {3.0, 0.0, 0.0};  // faster than anyone carries a target: clamped to 2 m/s
   traj.w.setZero();
   MotionFilter f;
   for (int k = 0; k < 5; ++k) f.update(traj.at(k * kDt), k * kDt);
@@ -145,6 +145,30 @@ TEST(MotionModel, PredictionIsBoundedInTimeAndSpeed) {
   EXPECT_NEAR(translation_mm(f.predict(t + 1.0), traj.at(t)), 200.0, 1e-6);
   // The past is not extrapolated backwards.
   EXPECT_EQ(f.predict(t - 0.5), f.state().T);
+}
+
+// A target lifted and put down 18 cm away within one frame interval (5.4 m/s: more than twice the
+// speed anyone carries it at) jumped: drawn where it is measured, not extrapolated from the jump; a
+// steady 3 m/s (above) is a motion, clamped.
+TEST(MotionModel, AJumpStartsAgainFromTheNewPose) {
+  const Trajectory traj;
+  MotionFilter f;
+  for (int k = 0; k < 6; ++k) f.update(traj.at(k * kDt), k * kDt);
+  ASSERT_TRUE(f.state().moving());
+  Eigen::Matrix4d put_down = traj.at(6 * kDt);
+  put_down.topRightCorner<3, 1>() += Eigen::Vector3d(0.15, 0.1, 0.0);
+  for (int k = 6; k < 10; ++k) {
+    f.update(put_down, k * kDt);
+    EXPECT_FALSE(f.state().moving()) << k;
+    EXPECT_EQ(f.predict(k * kDt + 0.05), put_down) << k;
+  }
+  EXPECT_EQ(f.jumps(), 1);
+  // A turn of 30 degrees in one frame interval (900 deg/s) is a jump as well.
+  Eigen::Matrix4d turned = put_down;
+  turned.topLeftCorner<3, 3>() = rot({0.0, 30.0 * kDeg, 0.0}) * put_down.topLeftCorner<3, 3>();
+  f.update(turned, 10 * kDt);
+  EXPECT_EQ(f.jumps(), 2);
+  EXPECT_FALSE(f.state().moving());
 }
 
 TEST(MotionModel, GapsAndTimeGoingBackRestartTheFilter) {

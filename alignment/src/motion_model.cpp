@@ -61,6 +61,13 @@ void MotionFilter::restart_velocity(const Eigen::Matrix4d& T, double dt) {
   filtered_ = T;
 }
 
+bool MotionFilter::jumped(const Eigen::Matrix4d& T, double dt) const {
+  const double moved_m = (T.topRightCorner<3, 1>() - measured_.topRightCorner<3, 1>()).norm();
+  const double turned_rad = log_so3(T.topLeftCorner<3, 3>() * measured_.topLeftCorner<3, 3>().transpose()).norm();
+  return moved_m > cfg_.jump_factor * cfg_.max_speed_m_s * dt ||
+         turned_rad > cfg_.jump_factor * cfg_.max_rate_deg_s * M_PI / 180.0 * dt;
+}
+
 void MotionFilter::predict_to(double dt) {
   filtered_.topLeftCorner<3, 3>() = exp_so3(rotation_.rate * dt) * filtered_.topLeftCorner<3, 3>();
   filtered_.topRightCorner<3, 1>() += translation_.rate * dt;
@@ -71,6 +78,10 @@ void MotionFilter::predict_to(double dt) {
 void MotionFilter::update(const Eigen::Matrix4d& T, double t_s) {
   const double dt = t_s - t_;
   if (count_ > 0 && !(dt > 0.0 && dt <= cfg_.max_gap_s)) reset();
+  if (count_ > 0 && jumped(T, dt)) {
+    ++jumps_;
+    reset();
+  }
   if (count_ == 0) {
     filtered_ = T;
   } else if (count_ == 1) {
