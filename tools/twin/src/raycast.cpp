@@ -136,7 +136,7 @@ MarkerError measure_marker(const config::ProjectorConfig& k, const config::Proje
 
 bool seen_edge_on(std::span<const PlacedMesh> scene, const Eigen::Vector3d& p) {
   // Four rays 3 mm beside the one to p: each must land within 3 cm of p (else it went past an edge),
-  // and the surface they span must face the origin within max_incidence_deg.
+  // and the surface they span must face the origin within kEdgeOnDeg.
   constexpr double kStep = 0.003;
   const Eigen::Vector3d d = p.normalized(), a = d.unitOrthogonal(), b = d.cross(a);
   const std::array<Eigen::Vector3d, 4> offsets{kStep * a, -kStep * a, kStep * b, -kStep * b};

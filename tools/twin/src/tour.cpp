@@ -50,8 +50,8 @@ struct ProjectorModels {
 
 // The error at the target's markers. A marker the projector cannot light (outside its image, turned
 // away, or hidden by the target itself or something in front), or lights edge-on (seen_edge_on), has no
-// error to measure and is left out; mean and max are
-// NaN when no marker is visible (such frames are left out of the visit's statistics).
+// error to measure and is left out; mean and max are NaN when no marker is left (such frames are left
+// out of the visit's statistics).
 Errors marker_errors(const Twin& twin, std::size_t target, const ProjectorModels& projector,
                      const Eigen::Matrix4d& T_world_projector, const Eigen::Matrix4d& T_camera_target_estimated) {
   const Eigen::Matrix4d T_projector_target_estimated = projector.projector_from_target(T_camera_target_estimated);

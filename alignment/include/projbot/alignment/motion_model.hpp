@@ -66,8 +66,8 @@ class MotionFilter {
   void reset();
   /// Jumps seen (poses the filter started again from, see jump_factor), for tests and statistics.
   int jumps() const { return jumps_; }
-  /// A measured pose (the tracker's) captured at t_s. A pose not newer than the last, or after a gap
-  /// longer than max_gap_s, restarts the filter from it.
+  /// A measured pose (the tracker's) captured at t_s. A pose not newer than the last, after a gap
+  /// longer than max_gap_s, or one that jumped (jump_factor) restarts the filter from it.
   void update(const Eigen::Matrix4d& T_camera_target, double t_s);
   /// The state to extrapolate from: still (the newest measured pose, zero velocity) until two poses
   /// are in and the target has moved more than noise over the stillness window.
