@@ -180,8 +180,10 @@ TEST(MotionModel, GapsAndTimeGoingBackRestartTheFilter) {
   EXPECT_FALSE(f.state().moving());
   EXPECT_EQ(f.state().T, traj.at(1.0));
   f.update(traj.at(1.0 + kDt), 1.0 + kDt);
-  EXPECT_TRUE(f.state().moving());
-  f.update(traj.at(0.5), 0.5);  // a pose from before the newest: start again from it
+  EXPECT_FALSE(f.state().moving());  // two poses after a restart are not yet a motion (min_poses)...
+  f.update(traj.at(1.0 + 2 * kDt), 1.0 + 2 * kDt);
+  EXPECT_TRUE(f.state().moving());  // ...three are
+  f.update(traj.at(0.5), 0.5);      // a pose from before the newest: start again from it
   EXPECT_FALSE(f.state().moving());
   f.reset();
   EXPECT_EQ(f.state().T, Eigen::Matrix4d::Identity());

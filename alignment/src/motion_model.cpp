@@ -118,7 +118,7 @@ MotionState MotionFilter::state() const {
   s.T = measured_;
   s.time_s = t_;
   s.max_horizon_s = cfg_.max_horizon_s;
-  if (count_ < 2) return s;
+  if (count_ < std::max(2, cfg_.min_poses)) return s;
   // Each part of the motion is used only when it stands out of the measurement noise over the window;
   // the other part stays as measured, so a target that only turns is not also slid by noise. The
   // difference of two measured poses has sqrt(2) times their noise.

@@ -33,6 +33,11 @@ struct MotionModelConfig {
   /// a clamped velocity from the jump (a duck moved 18 cm in 40 ms was drawn up to 13 cm past where it
   /// came to rest on the next frames).
   double jump_factor = 2.0;
+  /// Poses since the filter (re)started before the target can be seen moving. The first poses after a
+  /// restart are often the search's, rough by centimetres (the duck put down 18 cm away: found again
+  /// 5 cm off, refined on the next frame), and two of them are no velocity: with 2, that refinement was
+  /// extrapolated at 1.5 m/s for one frame.
+  int min_poses = 3;
   /// Still or moving, decided on the poses of the last stillness_window_s: the target moves when the
   /// newest pose is farther from the oldest than still_sigmas times the noise of that difference (3-D;
   /// 4 sigmas: 0.1 % of still frames at the noise above) and than the minimum speed over that time. A
@@ -69,8 +74,8 @@ class MotionFilter {
   /// A measured pose (the tracker's) captured at t_s. A pose not newer than the last, after a gap
   /// longer than max_gap_s, or one that jumped (jump_factor) restarts the filter from it.
   void update(const Eigen::Matrix4d& T_camera_target, double t_s);
-  /// The state to extrapolate from: still (the newest measured pose, zero velocity) until two poses
-  /// are in and the target has moved more than noise over the stillness window.
+  /// The state to extrapolate from: still (the newest measured pose, zero velocity) until min_poses
+  /// poses are in and the target has moved more than noise over the stillness window.
   MotionState state() const;
   Eigen::Matrix4d predict(double t_s) const { return predict_pose(state(), t_s); }
   /// Velocity restarts since the last reset (starts and stops detected), for tests and statistics.
