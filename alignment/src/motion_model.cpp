@@ -62,10 +62,9 @@ void MotionFilter::restart_velocity(const Eigen::Matrix4d& T, double dt) {
 }
 
 bool MotionFilter::jumped(const Eigen::Matrix4d& T, double dt) const {
-  const double moved_m = (T.topRightCorner<3, 1>() - measured_.topRightCorner<3, 1>()).norm();
-  const double turned_rad = log_so3(T.topLeftCorner<3, 3>() * measured_.topLeftCorner<3, 3>().transpose()).norm();
-  return moved_m > cfg_.jump_factor * cfg_.max_speed_m_s * dt ||
-         turned_rad > cfg_.jump_factor * cfg_.max_rate_deg_s * M_PI / 180.0 * dt;
+  const Eigen::Matrix4d step = rigid_inverse(measured_) * T;  // its length and angle are the move's and turn's
+  return translation_norm_m(step) > cfg_.jump_factor * cfg_.max_speed_m_s * dt ||
+         rotation_angle_deg(step) > cfg_.jump_factor * cfg_.max_rate_deg_s * dt;
 }
 
 void MotionFilter::predict_to(double dt) {
