@@ -378,22 +378,23 @@ TEST(TourTest, PredictionKeepsMovingTargetsWithinTheGoal) {
   EXPECT_LT(on.visits[3].timeline.back().mean_mm, 3.0);
 }
 
+// `scene` (motion.yaml) cut to one visit of the duck, with `motion` (moved to that visit) its only one.
+projbot::config::Scene duck_alone(projbot::config::Scene scene, projbot::config::TargetMotion motion) {
+  motion.visit = 1;
+  scene.targets.at(static_cast<std::size_t>(scene.target_index("duck"))).motions = {motion};
+  scene.visits = {"duck"};
+  return scene;
+}
+
 // The duck's fourth visit in motion.yaml: turned and slid from rest at constant acceleration to 1 m/s
 // and 180 deg/s (3.3 cm and 6 degrees between camera frames at the end), then let go. Run alone (the
 // scene's tour cut to that visit): followed on every frame within the tracker's first pass, and with
 // prediction within 8 mm mean (20 ms processing; the 0.5 m/s goal is 5).
 TEST(TourTest, ATargetTurnedAt180DegreesPerSecondIsFollowed) {
-  auto scene = projbot::config::load_scene(kAssets + "/scenes/motion.yaml");
-  const int duck = scene.target_index("duck");
-  ASSERT_GE(duck, 0);
-  auto& motions = scene.targets[static_cast<std::size_t>(duck)].motions;
-  const auto fast = std::find_if(motions.begin(), motions.end(), [](const auto& m) { return m.visit == 4; });
-  ASSERT_NE(fast, motions.end());
-  auto only = *fast;
-  only.visit = 1;
-  motions = {only};
-  scene.visits = {"duck"};
-  const auto on = tracking_tour(scene, 1, 2.0, true);
+  const auto scene = projbot::config::load_scene(kAssets + "/scenes/motion.yaml");
+  const auto* fast = scene.targets.at(static_cast<std::size_t>(scene.target_index("duck"))).motion_on(4);
+  ASSERT_NE(fast, nullptr);
+  const auto on = tracking_tour(duck_alone(scene, *fast), 1, 2.0, true);
   ASSERT_EQ(on.visits.size(), 1U);
   const auto& v = on.visits[0];
   ASSERT_TRUE(v.moved);
@@ -409,19 +410,13 @@ TEST(TourTest, ATargetTurnedAt180DegreesPerSecondIsFollowed) {
 // (the wider pass, then one ICP), the motion filter starts again from where it is instead of
 // extrapolating the jump, and the error is back under 3 mm for good within half a second.
 TEST(TourTest, ATargetMovedFasterThanTrackingFollowsIsFoundAgainWithinHalfASecond) {
-  auto scene = projbot::config::load_scene(kAssets + "/scenes/motion.yaml");
-  const int duck = scene.target_index("duck");
-  ASSERT_GE(duck, 0);
   projbot::config::TargetMotion jump;
-  jump.visit = 1;
   jump.start_s = 0.5;
   jump.duration_s = 0.04;
   jump.translation_m = {0.15, 0.1, 0.0};
   jump.rpy_deg = {0.0, 0.0, 30.0};
   jump.profile = projbot::config::MotionProfile::constant;
-  scene.targets[static_cast<std::size_t>(duck)].motions = {jump};
-  scene.visits = {"duck"};
-  const auto on = tracking_tour(scene, 1, 2.0, true);
+  const auto on = tracking_tour(duck_alone(projbot::config::load_scene(kAssets + "/scenes/motion.yaml"), jump), 1, 2.0, true);
   ASSERT_EQ(on.visits.size(), 1U);
   const auto& v = on.visits[0];
   ASSERT_TRUE(v.moved);
