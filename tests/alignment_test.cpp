@@ -191,6 +191,30 @@ TEST_F(BunnyTest, Bun0OntoBun4FromPerturbedStarts) {
             << rotation_angle_deg(rigid_inverse(gt) * ours.T_scan_model) << " deg from it\n";
 }
 
+// The acquisition's own searches (a k-d tree queried without OpenMP, the outlier filter written out)
+// give PCL's answers: the same neighbours, so the same filtered points, normals, correspondences and
+// gate, pose for pose, from starts ICP settles from and from one it does not.
+TEST_F(BunnyTest, OurSearchesGiveThePclAnswers) {
+  AcquisitionConfig stock = cfg_;
+  stock.pcl_search = true;
+  const Aligner pcl(load_model_cloud(kData / "bunny" / "bun0.pcd"), stock);
+  const Eigen::Matrix4d gt = ground_truth_bun0_to_bun4();
+  std::mt19937 rng(7);
+  for (const double deg : {5.0, 10.0, 35.0}) {
+    const Eigen::Matrix4d start = perturb(gt, deg, 0.02, rng);
+    const AlignmentResult a = aligner_->align(scan_, start, SearchStage::icp_only);
+    const AlignmentResult b = pcl.align(scan_, start, SearchStage::icp_only);
+    // Element by element: the angle of a pose composed with its own inverse is not 0 when ICP's pose is
+    // single precision (its rotation is orthonormal to 1e-7, which acos makes 0.02 degrees).
+    EXPECT_LT((a.T_scan_model - b.T_scan_model).cwiseAbs().maxCoeff(), 1e-9) << deg << " degrees";
+    EXPECT_EQ(a.iterations, b.iterations) << deg << " degrees";
+    EXPECT_EQ(a.scan_points, b.scan_points) << deg << " degrees";
+    EXPECT_NEAR(a.inlier_ratio, b.inlier_ratio, 1e-9) << deg << " degrees";
+    EXPECT_EQ(a.converged, b.converged) << deg << " degrees";
+    EXPECT_GT(a.scan_points, 300u);
+  }
+}
+
 TEST_F(BunnyTest, ReinitialisationRecoversFromAWrongYaw) {
   const Eigen::Matrix4d gt = ground_truth_bun0_to_bun4();
   Eigen::Matrix4d start = gt;

@@ -27,6 +27,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/assets/model.hpp"
+#include "serial_kdtree.hpp"
 
 namespace projbot::alignment {
 namespace {
@@ -135,13 +136,64 @@ CloudN::Ptr voxel_downsample(const CloudN::ConstPtr& in, double leaf) {
   return out;
 }
 
+// PCL's statistical outlier removal (pcl::StatisticalOutlierRemoval, its arithmetic step for step): a
+// point whose mean distance to its k nearest neighbours is more than `stddev_mul` standard deviations
+// above the mean over all points is left out. Written out because PCL's filter builds its own
+// pcl::search::KdTree, whose per-query OpenMP region made it most of the filter's time (SerialKdTree).
+pcl::PointCloud<pcl::PointXYZ>::Ptr outliers_removed(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& in, int k,
+                                                     double stddev_mul) {
+  SerialKdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(in);
+  pcl::Indices nn;
+  std::vector<float> d2;
+  std::vector<float> mean_distance(in->size(), 0.0F);
+  double sum = 0.0, sq_sum = 0.0;
+  int valid = 0;
+  for (std::size_t i = 0; i < in->size(); ++i) {
+    if (tree.nearestKSearch((*in)[i], k + 1, nn, d2) == 0) continue;  // not finite
+    double dist_sum = 0.0;
+    for (std::size_t j = 1; j < d2.size(); ++j) dist_sum += std::sqrt(d2[j]);  // the first is the point itself
+    mean_distance[i] = static_cast<float>(dist_sum / k);
+    sum += mean_distance[i];
+    sq_sum += mean_distance[i] * mean_distance[i];  // in float, as PCL
+    ++valid;
+  }
+  auto kept = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  if (valid < 2) return kept;
+  const double mean = sum / valid;
+  const double stddev = std::sqrt((sq_sum - sum * sum / valid) / (valid - 1.0));
+  const double threshold = mean + stddev_mul * stddev;
+  kept->reserve(in->size());
+  for (std::size_t i = 0; i < in->size(); ++i)
+    if (mean_distance[i] <= threshold && pcl::isXYZFinite((*in)[i])) kept->push_back((*in)[i]);
+  return kept;
+}
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr pcl_outliers_removed(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& in, int k,
+                                                         double stddev_mul) {
+  auto kept = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  pcl::StatisticalOutlierRemoval<pcl::PointXYZ> sor;
+  sor.setInputCloud(in);
+  sor.setMeanK(k);
+  sor.setStddevMulThresh(stddev_mul);
+  sor.filter(*kept);
+  return kept;
+}
+
+// A k-d tree for PCL's searches: SerialKdTree, or with `pcl_search` PCL's own.
+template <typename P>
+typename pcl::search::KdTree<P>::Ptr search_tree(bool pcl_search) {
+  if (pcl_search) return pcl::make_shared<pcl::search::KdTree<P>>();
+  return pcl::make_shared<SerialKdTree<P>>();
+}
+
 // Normals from k nearest neighbours, oriented towards the sensor at the origin; points without a
 // well-defined normal are dropped.
-CloudN::Ptr with_normals(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& in, int k) {
+CloudN::Ptr with_normals(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& in, int k, bool pcl_search = false) {
   pcl::PointCloud<pcl::Normal> normals;
   pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
   ne.setInputCloud(in);
-  ne.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  ne.setSearchMethod(search_tree<pcl::PointXYZ>(pcl_search));
   ne.setKSearch(std::min<int>(k, static_cast<int>(in->size()) - 1));
   ne.setViewPoint(0.0F, 0.0F, 0.0F);
   ne.compute(normals);
@@ -158,12 +210,12 @@ CloudN::Ptr with_normals(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& in, int
   return out;
 }
 
-Features::Ptr fpfh(const CloudN::ConstPtr& cloud, double radius) {
+Features::Ptr fpfh(const CloudN::ConstPtr& cloud, double radius, bool pcl_search) {
   auto features = pcl::make_shared<Features>();
   pcl::FPFHEstimationOMP<PointN, PointN, pcl::FPFHSignature33> est;
   est.setInputCloud(cloud);
   est.setInputNormals(cloud);
-  est.setSearchMethod(pcl::make_shared<pcl::search::KdTree<PointN>>());
+  est.setSearchMethod(search_tree<PointN>(pcl_search));
   est.setRadiusSearch(radius);
   est.compute(*features);
   return features;
@@ -197,7 +249,7 @@ struct Aligner::Impl {
   CloudN::Ptr model_coarse;              // coarser: re-initialisation
   mutable Features::Ptr model_features;  // computed on the first re-initialisation, then kept
   mutable int feature_computations = 0;
-  pcl::KdTreeFLANN<PointN> model_tree;
+  pcl::search::KdTree<PointN>::Ptr model_tree;
   pcl::search::KdTree<PointN>::Ptr model_icp_tree;
   Extent extent;
 
@@ -248,13 +300,8 @@ struct Aligner::Impl {
       grid.filter(*down);
     }
     if (down->size() > static_cast<std::size_t>(cfg.outlier_neighbours) * 2) {
-      auto kept = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-      pcl::StatisticalOutlierRemoval<pcl::PointXYZ> sor;
-      sor.setInputCloud(down);
-      sor.setMeanK(cfg.outlier_neighbours);
-      sor.setStddevMulThresh(cfg.outlier_stddev);
-      sor.filter(*kept);
-      down = kept;
+      down = cfg.pcl_search ? pcl_outliers_removed(down, cfg.outlier_neighbours, cfg.outlier_stddev)
+                            : outliers_removed(down, cfg.outlier_neighbours, cfg.outlier_stddev);
     }
     if (down->size() < cfg.min_points) down->clear();
     return down;
@@ -300,7 +347,7 @@ struct Aligner::Impl {
       // Scan normals (towards the sensor) let correspondences whose surfaces disagree be rejected: the
       // side of a pedestal just below a target is near the target's underside, but faces another way,
       // and would otherwise pull the estimate down onto it.
-      const CloudN::Ptr source = with_normals(near, cfg.normal_neighbours);
+      const CloudN::Ptr source = with_normals(near, cfg.normal_neighbours, cfg.pcl_search);
       if (source->size() < cfg.min_points) {
         converged = false;
         break;
@@ -357,7 +404,7 @@ struct Aligner::Impl {
       if (!q.getVector3fMap().allFinite()) continue;
       const double tolerance = tolerance_m(p.z);
       scale_sum += tolerance / cfg.inlier_distance_m;
-      if (model_tree.nearestKSearch(q, 1, index, dist2) < 1) continue;
+      if (model_tree->nearestKSearch(q, 1, index, dist2) < 1) continue;
       if (dist2[0] > static_cast<float>(4.0 * tolerance * tolerance)) continue;
       const PointN& m = (*model)[static_cast<std::size_t>(index[0])];
       const double d = std::abs((q.getVector3fMap() - m.getVector3fMap()).dot(m.getNormalVector3fMap()));
@@ -431,12 +478,12 @@ struct Aligner::Impl {
                                               std::size_t max_points, const std::function<bool()>& out_of_time) const {
     const auto wide_points = global_points(scan, T_init, margin, max_points);
     if (wide_points->size() < cfg.min_points) return std::nullopt;
-    const CloudN::Ptr wide = with_normals(wide_points, cfg.normal_neighbours);
+    const CloudN::Ptr wide = with_normals(wide_points, cfg.normal_neighbours, cfg.pcl_search);
     if (!model_features) {
-      model_features = fpfh(model_coarse, cfg.feature_radius_m);
+      model_features = fpfh(model_coarse, cfg.feature_radius_m, cfg.pcl_search);
       ++feature_computations;
     }
-    const Features::Ptr scan_features = fpfh(wide, cfg.feature_radius_m);
+    const Features::Ptr scan_features = fpfh(wide, cfg.feature_radius_m, cfg.pcl_search);
     pcl::SampleConsensusPrerejective<PointN, PointN, pcl::FPFHSignature33> sac;
     sac.setInputSource(model_coarse);
     sac.setSourceFeatures(model_features);
@@ -563,9 +610,10 @@ Aligner::Aligner(ModelCloud model, AcquisitionConfig config) : impl_(std::make_u
     p.getNormalVector3fMap() = model.normals[i];
     impl_->model->push_back(p);
   }
-  impl_->model_tree.setInputCloud(impl_->model);
+  impl_->model_tree = search_tree<PointN>(config.pcl_search);
+  impl_->model_tree->setInputCloud(impl_->model);
   impl_->model_icp = voxel_downsample(impl_->model, config.voxel_m);
-  impl_->model_icp_tree = pcl::make_shared<pcl::search::KdTree<PointN>>();
+  impl_->model_icp_tree = search_tree<PointN>(config.pcl_search);
   impl_->model_icp_tree->setInputCloud(impl_->model_icp);
   impl_->model_coarse = voxel_downsample(impl_->model, impl_->coarse_leaf());
 }

@@ -106,6 +106,10 @@ struct AcquisitionConfig {
   /// already running finishes, so an attempt ends within about this plus one ICP (about 0.5 s here).
   double attempt_budget_ms = 500.0;
   std::size_t min_points = 30;  ///< fewer valid scan points than this is an error
+  /// Search with PCL's own k-d tree and outlier filter (pcl::search::KdTree, StatisticalOutlierRemoval)
+  /// instead of the same searches one query at a time without OpenMP (same answers; 3-7 times faster
+  /// here): for `projbot bench acquire`'s stock-PCL comparison and the test that they agree.
+  bool pcl_search = false;
   /// With a Footing, an estimate passes only if the target stands as surveyed: its lowest point within
   /// this of the surveyed height, and its up axis within footing_tilt_deg of the floor's normal. A box
   /// seen face-on slid 3.3 cm up its own face, or fitted into the front edge of its table 30 cm lower,
