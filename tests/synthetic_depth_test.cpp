@@ -255,6 +255,25 @@ TEST_F(SyntheticDepthTest, ColourTurnsABoxSeenFaceOnAboutItsFacesNormalAndReache
   }
 }
 
+TEST_F(SyntheticDepthTest, ColourSaysWhenItsSearchRanOutOfReachAndASecondSearchGoesOn) {
+  // The face-on box left 30 mm along its face, past what one search reaches (its coarse grid moves
+  // twice: about 26 mm): the search says so, and one more from where it got to (as
+  // TargetFollower::by_colour does) brings the box within 1 mm and 0.15 degrees. One that ends inside
+  // its reach says that too.
+  const FaceOnBox b = face_on_box();
+  Eigen::Matrix4d off = b.T;
+  off.topRightCorner<3, 1>() += b.T.topLeftCorner<3, 3>() * Eigen::Vector3d(0.030, 0.0, 0.0);
+  const ColourRefinement first = colour_refined(b.cloud, off, b.depth, b.colour, k_);
+  EXPECT_TRUE(first.out_of_reach);
+  EXPECT_GT(translation_norm_m(rigid_inverse(b.T) * first.T_camera_model), 0.002);
+  const ColourRefinement second = colour_refined(b.cloud, first.T_camera_model, b.depth, b.colour, k_);
+  EXPECT_FALSE(second.out_of_reach);
+  const Eigen::Matrix4d err = rigid_inverse(b.T) * second.T_camera_model;
+  EXPECT_LT(translation_norm_m(err), 0.001);
+  EXPECT_LT(rotation_angle_deg(err), 0.15);
+  EXPECT_GT(second.agreement_after, first.agreement_after + 0.05);
+}
+
 TEST_F(SyntheticDepthTest, TrackingHoldsTheBoxWhereColourPlacedIt) {
   // The face-on box of the test above. Its noisy depth is rendered 2.5 mm along its face from where
   // its colour is (as the shop's depth pulls its box 2 mm along the face): the follower's search, with

@@ -418,11 +418,12 @@ ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& 
   // colour took 80-100 ms on the shop's duck and box). Then the weakest turn, and the slide once more.
   // A best on the coarse grid's rim may lie past it (ICP left the face-on box 10 mm along its face and
   // the agreement there was 0.47): the grid moves there, up to twice.
-  for (int more = 0; more < 3; ++more) {
+  bool on_rim = true;
+  for (int more = 0; more < 3 && on_rim; ++more) {
     const Eigen::Vector3d from = best_move.shift;
     slide(reach_m, 2.0 * step_m);
     const Eigen::Vector3d moved = best_move.shift - from;
-    if (std::max(std::abs(moved.dot(axes[0])), std::abs(moved.dot(axes[1]))) < reach_m - step_m) break;
+    on_rim = std::max(std::abs(moved.dot(axes[0])), std::abs(moved.dot(axes[1]))) >= reach_m - step_m;
   }
   slide(1.5 * step_m, step_m / 2.0);
   slide(step_m / 4.0, step_m / 4.0);
@@ -437,6 +438,7 @@ ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& 
   out.shift_m = best_move.shift;
   out.turn_deg = Eigen::AngleAxisd(best_move.turn).angle() * 180.0 / M_PI;
   out.agreement_after = best;
+  out.out_of_reach = on_rim;
   return out;
 }
 

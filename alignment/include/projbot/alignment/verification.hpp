@@ -108,6 +108,9 @@ struct ColourRefinement {
   double agreement_after = 0.0;                       ///< ...and at the result
   Eigen::Vector3d shift_m = Eigen::Vector3d::Zero();  ///< the move of the seen surface's centre, camera frame
   double turn_deg = 0.0;                              ///< the turn about its weakest rotation, degrees
+  /// The coarse grid's best still lay on its rim after it had moved there twice: a better place may lie
+  /// farther along (the caller may search again from the result).
+  bool out_of_reach = false;
   bool moved() const { return shift_m.norm() > 0.0 || turn_deg > 0.0; }
 };
 /// How far colour_refined turns a pose about its weakest rotation at most (degrees).
