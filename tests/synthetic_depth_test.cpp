@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <random>
 
@@ -272,6 +273,38 @@ TEST_F(SyntheticDepthTest, ColourSaysWhenItsSearchRanOutOfReachAndASecondSearchG
   EXPECT_LT(translation_norm_m(err), 0.001);
   EXPECT_LT(rotation_angle_deg(err), 0.15);
   EXPECT_GT(second.agreement_after, first.agreement_after + 0.05);
+}
+
+TEST_F(SyntheticDepthTest, LooksAlikeTellsATexturedBoxsTurnsOntoItselfFromWrongPoses) {
+  // BoxTextured turned 90 or 180 degrees lands on its own surface (the cube's symmetry), but its faces'
+  // texture does not follow: over the whole model no such turn looks alike, nor does a 10 degree turn
+  // or a 15 mm move; the duck turned half round is not the duck either. On the face-on box's faces the
+  // camera sees, the truth looks like itself and a 15 mm move along the face does not.
+  const FaceOnBox b = face_on_box();
+  const auto turned = [](double deg, const Eigen::Vector3d& axis, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) {
+    Eigen::Matrix4d D = Eigen::Matrix4d::Identity();
+    D.topLeftCorner<3, 3>() = Eigen::AngleAxisd(deg * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+    D.topRightCorner<3, 1>() = t;
+    return D;
+  };
+  EXPECT_TRUE(looks_alike(b.cloud, Eigen::Matrix4d::Identity()));
+  for (const Eigen::Vector3d& axis : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1)}) {
+    for (const double deg : {10.0, 90.0, 180.0})
+      EXPECT_FALSE(looks_alike(b.cloud, turned(deg, axis))) << deg << ' ' << axis.transpose();
+    EXPECT_FALSE(looks_alike(b.cloud, turned(0.0, axis, 0.015 * axis))) << axis.transpose();
+  }
+  EXPECT_FALSE(looks_alike(*model_, turned(180.0, Eigen::Vector3d::UnitY())));
+  EXPECT_FALSE(looks_alike(ModelCloud{}, Eigen::Matrix4d::Identity()));
+  ModelCloud plain = b.cloud;  // one colour: content is where the shape is, and the shape alone says nothing
+  std::fill(plain.colours.begin(), plain.colours.end(), Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+  EXPECT_FALSE(looks_alike(plain, turned(180.0, Eigen::Vector3d::UnitX())));
+  const std::vector<std::size_t> seen = visible_samples(b.cloud, b.T, b.depth, k_);
+  ASSERT_EQ(seen.size(), 300u);
+  for (const std::size_t i : seen)  // facing the camera: the box's points it sees are on its near faces
+    ASSERT_LT((b.T.topLeftCorner<3, 3>() * b.cloud.normals[i].cast<double>()).z(), 0.0);
+  EXPECT_TRUE(looks_alike(b.cloud, Eigen::Matrix4d::Identity(), seen));
+  EXPECT_FALSE(looks_alike(b.cloud, turned(0.0, Eigen::Vector3d::UnitX(), Eigen::Vector3d(0.015, 0, 0)), seen));
+  EXPECT_FALSE(looks_alike(b.cloud, Eigen::Matrix4d::Identity(), {b.cloud.points.size()}));  // no such point
 }
 
 TEST_F(SyntheticDepthTest, TrackingHoldsTheBoxWhereColourPlacedIt) {

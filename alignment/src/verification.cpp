@@ -452,3 +452,66 @@ bool has_colour_contrast(const ModelCloud& model) {
 }
 
 }  // namespace projbot::alignment
+
+namespace projbot::alignment {
+namespace {
+// The model sample nearest `q` other than `skip` (brute force: a few hundred probes per call).
+std::size_t nearest_sample(const ModelCloud& model, const Eigen::Vector3f& q, std::size_t skip) {
+  std::size_t best = skip;
+  float best_d = std::numeric_limits<float>::infinity();
+  for (std::size_t j = 0; j < model.points.size(); ++j) {
+    const float d = (model.points[j] - q).squaredNorm();
+    if (j != skip && d < best_d) best_d = d, best = j;
+  }
+  return best;
+}
+}  // namespace
+
+bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, const std::vector<std::size_t>& probes) {
+  const std::size_t n = model.points.size();
+  // Without colours that vary, every slide along the model's own surface would look alike: the shop's
+  // plain figure, slid 10-20 mm by PCL's ICP, would pass. Such a model's content is where its shape is.
+  if (n < 2 || !T_model_model.allFinite() || !has_colour_contrast(model)) return false;
+  std::vector<std::size_t> spread;
+  if (probes.empty())
+    for (std::size_t i = 0; i < n; i += std::max<std::size_t>(1, n / 300)) spread.push_back(i);
+  const std::vector<std::size_t>& at = probes.empty() ? spread : probes;
+  const Eigen::Matrix3f R = T_model_model.topLeftCorner<3, 3>().cast<float>();
+  const Eigen::Vector3f t = T_model_model.topRightCorner<3, 1>().cast<float>();
+  double own_d = 0, own_c = 0, moved_d = 0, moved_c = 0;
+  for (const std::size_t i : at) {
+    if (i >= n) return false;
+    const Eigen::Vector3f& p = model.points[i];
+    const std::size_t own = nearest_sample(model, p, i);
+    const Eigen::Vector3f q = R * p + t;
+    const std::size_t moved = nearest_sample(model, q, n);
+    own_d += (model.points[own] - p).norm();
+    moved_d += (model.points[moved] - q).norm();
+    own_c += (model.colours[own] - model.colours[i]).norm();
+    moved_c += (model.colours[moved] - model.colours[i]).norm();
+  }
+  // Margins: the moved points are anywhere between samples, the probes' own neighbours are samples.
+  return moved_d <= 1.5 * own_d && moved_c <= 1.5 * own_c + 0.02 * static_cast<double>(at.size());
+}
+
+std::vector<std::size_t> visible_samples(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
+                                         const CameraIntrinsics& k, std::size_t max) {
+  std::vector<std::size_t> seen;
+  const Eigen::Matrix3d R = T_camera_model.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T_camera_model.topRightCorner<3, 1>();
+  const bool normals = model.normals.size() == model.points.size();
+  for (std::size_t i = 0; i < model.points.size(); ++i) {
+    const Eigen::Vector3d p = R * model.points[i].cast<double>() + t;
+    if (!(p.z() > 0.0) || (normals && (R * model.normals[i].cast<double>()).dot(p) >= 0.0)) continue;
+    const Eigen::Vector2d x = k.project(p);
+    if (!k.contains(x) || x.x() >= depth.width || x.y() >= depth.height) continue;
+    const float z = depth.at(static_cast<int>(x.x()), static_cast<int>(x.y()));
+    if (std::isfinite(z) && std::abs(z - p.z()) < 0.01) seen.push_back(i);
+  }
+  if (seen.size() <= max) return seen;
+  std::vector<std::size_t> spread;
+  for (std::size_t j = 0; j < max; ++j) spread.push_back(seen[j * seen.size() / max]);
+  return spread;
+}
+
+}  // namespace projbot::alignment

@@ -101,6 +101,20 @@ inline constexpr std::size_t kMinColourSamples = 200;
 /// one plain material).
 bool has_colour_contrast(const ModelCloud& model);
 
+/// Whether the model moved by `T_model_model` looks the same as unmoved at the model points `probes`
+/// (indices into model.points; empty: 300 spread over all of them): moved, they land on the model's
+/// surface (as near, on average, as a probe's nearest other sample) and carry the colour found there
+/// (as near as that sample's colour). With the probes a camera sees at the truth and T_model_model =
+/// estimate^-1 * truth, it says whether the content an estimate puts on the seen surfaces is the
+/// truth's: a textured box turned 180 degrees onto a face that shows the same texture. False for a
+/// model without colour contrast (has_colour_contrast), whose content is where its shape is.
+bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, const std::vector<std::size_t>& probes = {});
+
+/// The model points a camera sees with the model at T_camera_model: in its image, facing it, and within
+/// 1 cm of the depth measured there; at most `max` of them, spread over the model.
+std::vector<std::size_t> visible_samples(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
+                                         const CameraIntrinsics& k, std::size_t max = 300);
+
 /// A pose moved to where colour agrees best, in the plane of its two weakest slides.
 struct ColourRefinement {
   Eigen::Matrix4d T_camera_model = Eigen::Matrix4d::Identity();
