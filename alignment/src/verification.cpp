@@ -451,9 +451,6 @@ bool has_colour_contrast(const ModelCloud& model) {
   return n >= static_cast<double>(kMinColourSamples) && sum2 - sum * sum / n > 1e-6 * n;  // as correlation()'s test
 }
 
-}  // namespace projbot::alignment
-
-namespace projbot::alignment {
 namespace {
 // The model sample nearest `q` other than `skip` (brute force: a few hundred probes per call).
 std::size_t nearest_sample(const ModelCloud& model, const Eigen::Vector3f& q, std::size_t skip) {
@@ -497,17 +494,11 @@ bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, 
 std::vector<std::size_t> visible_samples(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
                                          const CameraIntrinsics& k, std::size_t max) {
   std::vector<std::size_t> seen;
-  const Eigen::Matrix3d R = T_camera_model.topLeftCorner<3, 3>();
-  const Eigen::Vector3d t = T_camera_model.topRightCorner<3, 1>();
-  const bool normals = model.normals.size() == model.points.size();
-  for (std::size_t i = 0; i < model.points.size(); ++i) {
-    const Eigen::Vector3d p = R * model.points[i].cast<double>() + t;
-    if (!(p.z() > 0.0) || (normals && (R * model.normals[i].cast<double>()).dot(p) >= 0.0)) continue;
-    const Eigen::Vector2d x = k.project(p);
-    if (!k.contains(x) || x.x() >= depth.width || x.y() >= depth.height) continue;
-    const float z = depth.at(static_cast<int>(x.x()), static_cast<int>(x.y()));
-    if (std::isfinite(z) && std::abs(z - p.z()) < 0.01) seen.push_back(i);
-  }
+  if (depth.width != k.width_px || depth.height != k.height_px || !T_camera_model.allFinite()) return seen;
+  for_each_front_sample(model, T_camera_model, k, [&](float z, int u, int v, std::size_t i) {
+    const float measured = depth.at(u, v);
+    if (std::isfinite(measured) && std::abs(measured - z) < 0.01F) seen.push_back(i);
+  });
   if (seen.size() <= max) return seen;
   std::vector<std::size_t> spread;
   for (std::size_t j = 0; j < max; ++j) spread.push_back(seen[j * seen.size() / max]);

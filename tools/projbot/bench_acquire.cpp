@@ -23,6 +23,8 @@ struct Outcome {
   bool lit = false;
   double error_mm = 0.0, error_deg = 0.0, ms = 0.0;
   bool looks_alike = false;  ///< lit far off, and the content it puts on the seen surfaces is the truth's
+  /// Lit more than 10 mm or 2 degrees off: a false accept (a cube turned onto another face too).
+  bool far_off() const { return lit && (error_mm > 10.0 || error_deg > 2.0); }
 };
 
 struct Tally {
@@ -32,9 +34,8 @@ struct Tally {
     ++trials;
     const bool close = o.error_mm <= 3.0 && o.error_deg <= 0.5;
     success += o.lit && close ? 1 : 0;
-    const bool far = o.lit && (o.error_mm > 10.0 || o.error_deg > 2.0);  // a cube turned onto another face too
-    false_accepts += far ? 1 : 0;
-    look_alikes += far && o.looks_alike ? 1 : 0;
+    false_accepts += o.far_off() ? 1 : 0;
+    look_alikes += o.far_off() && o.looks_alike ? 1 : 0;
     false_blanks += !o.lit && close ? 1 : 0;
     ms.push_back(o.ms);
   }
@@ -67,8 +68,7 @@ Outcome judged(const Truth& truth, const Eigen::Matrix4d& T_est, bool lit, doubl
   const Eigen::Matrix4d d = alignment::rigid_inverse(truth.T) * T_est;
   Outcome o{lit, 1000.0 * alignment::translation_norm_m(d), alignment::rotation_angle_deg(d), ms};
   // Where the estimate puts the content of each seen point: the model point it draws there.
-  if (lit && (o.error_mm > 10.0 || o.error_deg > 2.0))
-    o.looks_alike = alignment::looks_alike(truth.model, alignment::rigid_inverse(d), truth.seen);
+  if (o.far_off()) o.looks_alike = alignment::looks_alike(truth.model, alignment::rigid_inverse(d), truth.seen);
   return o;
 }
 
