@@ -40,7 +40,13 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
       filter_(cfg_.motion),
       silhouette_grow_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)),
       model_radius_m_(guess_reach_m(model_, 0.0, 60.0)),  // a 60 degree turn moves the farthest point by the radius
-      colour_contrast_(has_colour_contrast(model_)) {}
+      colour_contrast_(has_colour_contrast(model_)),
+      turns_(colour_contrast_ ? box_turns(model_) : std::vector<Eigen::Matrix4d>{}) {}
+
+Eigen::Matrix4d TargetFollower::nearest_guess(const DepthImage& frame, const Eigen::Matrix4d& T,
+                                              const Eigen::Matrix4d& guess) const {
+  return nearest_look_alike(model_, T, guess, turns_, frame, k_);
+}
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing) {
   set_initial_guess(T_camera_target, footing.floor);
@@ -207,7 +213,12 @@ AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Ma
     AlignmentResult r = acquired(frame, near, near_cloud, guess, known, grow_m, weak);
     if (!r.converged) return r;
     if (colour) by_colour(frame, known, *colour, r);  // last: the polish is depth alone and would undo it
-    if (weak == Weak::depth || !r.weak_held || r.colour_agreement >= cfg_.min_held_colour_agreement) return r;
+    if (weak == Weak::depth || !r.weak_held || r.colour_agreement >= cfg_.min_held_colour_agreement) {
+      // From a gross guess the search may find the textured box turned 180 degrees onto a face that
+      // shows the same texture (2 of 50 in bench acquire): the seen faces cannot tell, the guess can.
+      if (r.converged) r.T_scan_model = nearest_guess(frame, r.T_scan_model, guess);
+      return r;
+    }
     if (ThreadCpuClock::past(known.deadline)) {  // out of time to place it another way: not confirmed
       r.converged = false;
       return r;
@@ -345,8 +356,11 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame, const 
   // second one in the same frame (acquire() holds weak directions for colour).
   const auto a = attempt(frame, guess_, stage);
   elapsed();
-  if (a && a->converged && verified(frame, T = a->T_scan_model) && coloured(frame, colour, T))
+  if (a && a->converged && verified(frame, T = a->T_scan_model) && coloured(frame, colour, T)) {
+    T = nearest_guess(frame, T, guess_);  // a look-alike turn, as in acquire()
+    if (hold_) hold_ = T;
     return found(frame, T, a->inlier_ratio, a->rmse_mm);
+  }
   const auto& spacing = cfg_.search_spacing_frames;
   if (!spacing.empty()) wait_ = spacing[std::min(static_cast<std::size_t>(stats_.attempts - 1), spacing.size() - 1)];
   const double last_ms = stats_.last_attempt_ms;

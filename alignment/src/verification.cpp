@@ -8,6 +8,8 @@
 #include <limits>
 #include <vector>
 
+#include "projbot/alignment/equations.hpp"
+
 namespace projbot::alignment {
 
 namespace {
@@ -503,6 +505,50 @@ std::vector<std::size_t> visible_samples(const ModelCloud& model, const Eigen::M
   std::vector<std::size_t> spread;
   for (std::size_t j = 0; j < max; ++j) spread.push_back(seen[j * seen.size() / max]);
   return spread;
+}
+
+std::vector<Eigen::Matrix4d> box_turns(const ModelCloud& model) {
+  if (model.points.empty()) return {};
+  Eigen::Vector3f lo = model.points.front(), hi = lo;
+  for (const Eigen::Vector3f& p : model.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const Eigen::Vector3d centre = (0.5F * (lo + hi)).cast<double>();
+  // A cube's rotations are the signed permutation matrices with determinant +1.
+  std::vector<Eigen::Matrix4d> turns;
+  std::array<int, 3> axis{0, 1, 2};
+  do {
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3d R = Eigen::Matrix3d::Zero();
+      for (int r = 0; r < 3; ++r) R(r, axis[static_cast<std::size_t>(r)]) = (signs >> r) & 1 ? -1.0 : 1.0;
+      if (R.determinant() < 0.0 || R.isIdentity()) continue;
+      Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+      T.topLeftCorner<3, 3>() = R;
+      T.topRightCorner<3, 1>() = centre - R * centre;
+      turns.push_back(T);
+    }
+  } while (std::next_permutation(axis.begin(), axis.end()));
+  return turns;
+}
+
+Eigen::Matrix4d nearest_look_alike(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const Eigen::Matrix4d& prior,
+                                   const std::vector<Eigen::Matrix4d>& turns, const DepthImage& depth, const CameraIntrinsics& k,
+                                   double margin_deg) {
+  const auto off_deg = [&](const Eigen::Matrix4d& T) { return rotation_angle_deg(rigid_inverse(prior) * T); };
+  Eigen::Matrix4d best = T_camera_model;
+  double best_deg = off_deg(T_camera_model) - margin_deg;
+  std::vector<std::size_t> seen;  // looked for only when a turn would be nearer the prior
+  for (const Eigen::Matrix4d& turn : turns) {
+    const Eigen::Matrix4d candidate = T_camera_model * turn;
+    const double deg = off_deg(candidate);
+    if (!(deg < best_deg)) continue;
+    if (seen.empty()) seen = visible_samples(model, T_camera_model, depth, k, 100);
+    if (seen.empty()) break;
+    // The candidate draws model point turn * p where T draws p: the content it puts on the seen surfaces
+    // is T's where the model turned back onto itself looks alike there.
+    if (!looks_alike(model, rigid_inverse(turn), seen)) continue;
+    best = candidate;
+    best_deg = deg;
+  }
+  return best;
 }
 
 }  // namespace projbot::alignment

@@ -236,7 +236,12 @@ class TargetFollower {
   double model_radius_m_;      // the model's farthest point from its origin
   bool colour_contrast_;       // the model's colours can say where it is (has_colour_contrast)
   double last_found_s_ = 0.0;  // capture time of the newest pose found
+  // Where a textured model may look like itself turned (box_turns; none without colour contrast): a
+  // found pose is turned to the look-alike nearest the stop's guess (nearest_look_alike).
+  std::vector<Eigen::Matrix4d> turns_;
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
+  // T, or the pose nearest `guess` among those that look like T on the faces the camera sees.
+  Eigen::Matrix4d nearest_guess(const DepthImage& frame, const Eigen::Matrix4d& T, const Eigen::Matrix4d& guess) const;
   // The frame without the known floor and, with grow_m, cropped to the silhouette at `from` grown by it.
   DepthImage near_guess(const DepthImage& frame, const Eigen::Matrix4d& from, const Known& known,
                         std::optional<double> grow_m) const;

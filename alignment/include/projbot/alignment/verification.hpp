@@ -110,6 +110,22 @@ bool has_colour_contrast(const ModelCloud& model);
 /// model without colour contrast (has_colour_contrast), whose content is where its shape is.
 bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, const std::vector<std::size_t>& probes = {});
 
+/// The turns that take the model's bounding box onto itself if it were a cube: the 23 rotations of a
+/// cube (90, 180 and 270 degrees about each of its axes, 180 about the diagonals of its faces, 120 and
+/// 240 about its body's diagonals), about the box's centre, each as a T_model_model. The places a
+/// box-like model may look like itself; looks_alike says where it does.
+std::vector<Eigen::Matrix4d> box_turns(const ModelCloud& model);
+
+/// T, or T * turn for the one of `turns` nearest `prior` in rotation, where that one puts the same
+/// content on the surfaces the camera sees at T (looks_alike on visible_samples) and lies nearer the
+/// prior than T by more than margin_deg. The seen faces cannot tell such poses apart, so the prior
+/// does: a textured box found turned 180 degrees onto a face with the same texture, from a guess 40
+/// degrees off, is turned back. A pose within (90 + margin_deg) / 2 degrees of the prior is never moved
+/// (every turn is 90 degrees or more).
+Eigen::Matrix4d nearest_look_alike(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const Eigen::Matrix4d& prior,
+                                   const std::vector<Eigen::Matrix4d>& turns, const DepthImage& depth, const CameraIntrinsics& k,
+                                   double margin_deg = 20.0);
+
 /// The model points a camera sees with the model at T_camera_model: in its image, facing it, and within
 /// 1 cm of the depth measured there; at most `max` of them, spread over the model.
 std::vector<std::size_t> visible_samples(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
