@@ -509,9 +509,9 @@ std::vector<std::size_t> visible_samples(const ModelCloud& model, const Eigen::M
 
 std::vector<Eigen::Matrix4d> box_turns(const ModelCloud& model) {
   if (model.points.empty()) return {};
-  Eigen::Vector3f lo = model.points.front(), hi = lo;
-  for (const Eigen::Vector3f& p : model.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  const Eigen::Vector3d centre = (0.5F * (lo + hi)).cast<double>();
+  Eigen::AlignedBox3f box;
+  for (const Eigen::Vector3f& p : model.points) box.extend(p);
+  const Eigen::Vector3d centre = box.center().cast<double>();
   // A cube's rotations are the signed permutation matrices with determinant +1.
   std::vector<Eigen::Matrix4d> turns;
   std::array<int, 3> axis{0, 1, 2};
