@@ -3,8 +3,10 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 
@@ -23,6 +25,42 @@ Eigen::Matrix4d twist_to_transform(const Eigen::Matrix<double, 6, 1>& xi) {
 }
 
 double sensor_sigma(double z) { return std::max(kKinectV1SigmaZCoeff * z * z, 0.001); }
+
+constexpr int kSplat = 1;  // outline_grid: each model point covers the pixels this far around its own
+
+// Where, along p + s d (s in pixels, -reach..reach, d outward), the depth image steps from the
+// target's surface (at most `band` behind z_ref, the outline's depth, and not far in front of it) to
+// what lies behind, nearest s = anchor: NaN when there is no such step, or something in front of the
+// target lies between. The Kinect loses the pixel on each side of a step (and more at grazing angles
+// on the target's side), so the step is put 1.5 pixels before the first pixel behind it.
+double silhouette_step(const float* z, const CameraIntrinsics& k, const Eigen::Vector2d& p, const Eigen::Vector2d& d,
+                       double z_ref, double band, int reach, double anchor) {
+  enum Kind : signed char { none, surface, behind, in_front };
+  std::array<Kind, 2 * 32 + 1> kind{};
+  reach = std::clamp(reach, 1, 32);
+  const double front = std::max(band, 0.08);  // a limb's own curve comes nearer than band, an occluder more
+  for (int s = -reach; s <= reach; ++s) {
+    const Eigen::Vector2d x = p + s * d;
+    Kind& c = kind[static_cast<std::size_t>(s + reach)];
+    if (!(x.x() > -0.5 && x.y() > -0.5 && x.x() < k.width_px - 0.5 && x.y() < k.height_px - 0.5)) continue;
+    const float zs = z[static_cast<std::size_t>(x.y() + 0.5) * k.width_px + static_cast<std::size_t>(x.x() + 0.5)];
+    if (!has_depth(zs)) continue;
+    c = zs > z_ref + band ? behind : zs < z_ref - front ? in_front : surface;
+  }
+  double best = std::numeric_limits<double>::quiet_NaN();
+  for (int a = -reach; a < reach; ++a) {
+    if (kind[static_cast<std::size_t>(a + reach)] != surface) continue;
+    int b = a + 1;
+    while (b <= reach && b - a <= 5 && kind[static_cast<std::size_t>(b + reach)] == none) ++b;
+    if (b > reach || kind[static_cast<std::size_t>(b + reach)] != behind) continue;
+    const double step = std::max(0.5 * (a + b), b - 1.5);
+    bool hidden = false;
+    for (int s = std::min(0, a); s <= std::max(0, a); ++s)
+      hidden = hidden || kind[static_cast<std::size_t>(s + reach)] == in_front;
+    if (!hidden && !(std::abs(step - anchor) >= std::abs(best - anchor))) best = step;
+  }
+  return best;
+}
 
 }  // namespace
 
@@ -110,6 +148,65 @@ void add_start_prior(Eigen::Matrix<double, 6, 6>& H, Eigen::Matrix<double, 6, 1>
   g += Hp * xi;
 }
 
+std::vector<float> ProjectiveTracker::outline_grid(const Eigen::Matrix4d& T, std::size_t n) const {
+  const int w = k_.width_px, h = k_.height_px;
+  std::vector<float> grid(static_cast<std::size_t>(w) * h, std::numeric_limits<float>::infinity());
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T.topRightCorner<3, 1>();
+  for (std::size_t i = 0; i < std::min(n, model_.points.size()); ++i) {
+    const Eigen::Vector3d x = R * model_.points[i].cast<double>() + t;
+    int u = 0, v = 0;
+    if (x.z() <= 0.05 || (R * model_.normals[i].cast<double>()).dot(x) >= 0.0 || !k_.nearest_pixel(x, u, v)) continue;
+    for (int y = std::max(v - kSplat, 0); y <= std::min(v + kSplat, h - 1); ++y)
+      for (int c = std::max(u - kSplat, 0); c <= std::min(u + kSplat, w - 1); ++c) {
+        float& near = grid[static_cast<std::size_t>(y) * w + c];
+        near = std::min(near, static_cast<float>(x.z()));
+      }
+  }
+  return grid;
+}
+
+bool ProjectiveTracker::add_edge(const Level& lv, const std::vector<float>& outline, const Eigen::Vector3d& x,
+                                 const Eigen::Vector3d& x0, const Eigen::Vector3d& nrm, Eigen::Matrix<double, 6, 6>& H,
+                                 Eigen::Matrix<double, 6, 1>& g) const {
+  const CameraIntrinsics& k = lv.k;
+  const double iz = 1.0 / x.z();
+  Eigen::Matrix<double, 2, 3> P;  // pixels per metre of the point's motion
+  P << k.fx_px * iz, 0.0, -k.fx_px * x.x() * iz * iz, 0.0, k.fy_px * iz, -k.fy_px * x.y() * iz * iz;
+  const Eigen::Vector2d dn = P * nrm;
+  if (!(dn.norm() > 1e-9)) return false;
+  const Eigen::Vector2d d = dn.normalized();  // the outline's outward normal in the image
+  if (std::abs(d.x()) < cfg_.edge_min_across) return false;
+  const Eigen::Vector2d p = k.project(x);
+  // Where the model's own outline lies along d from x (x may lie inside it: a box's side seen at a
+  // grazing angle), and where the image's silhouette does.
+  const double band = 3.0 * sensor_sigma(x.z()) + 0.01;
+  double predicted = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Vector2d p0 = k.project(x0);  // the outline was drawn at the start pose: it moves with the model
+  for (int s = 1; s <= cfg_.edge_search_px; ++s) {
+    const Eigen::Vector2d b = p0 + s * d;  // rounded to its pixel as silhouette_step rounds
+    if (!(b.x() > -0.5 && b.y() > -0.5 && b.x() < k.width_px - 0.5 && b.y() < k.height_px - 0.5)) break;
+    if (outline[static_cast<std::size_t>(b.y() + 0.5) * k.width_px + static_cast<std::size_t>(b.x() + 0.5)] > x.z() + band) {
+      predicted = s - 1.0 - kSplat;
+      break;
+    }
+  }
+  if (!std::isfinite(predicted) || predicted > 0.5 * cfg_.edge_search_px) return false;
+  const double step = silhouette_step(lv.z, k, p, d, x.z(), band, cfg_.edge_search_px, predicted) - predicted;
+  if (!std::isfinite(step)) return false;
+  const double scale = x.z() / (0.5 * (k.fx_px + k.fy_px));  // metres per pixel at this depth
+  const double r = -step * scale;                            // the outline is to move `step` pixels along d
+  const Eigen::Vector3d j = scale * (P.transpose() * d);
+  Eigen::Matrix<double, 6, 1> J;
+  J.head<3>() = j;
+  J.tail<3>() = x.cross(j);
+  const double delta = 1.5 * scale;  // Huber at 1.5 pixels
+  const double w = cfg_.edge_weight * (std::abs(r) <= delta ? 1.0 : delta / std::abs(r));
+  H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
+  g += w * r * J;
+  return true;
+}
+
 TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matrix4d& T_prev,
                                      const Eigen::Matrix4d* T_hold) const {
   const auto t0 = std::chrono::steady_clock::now();
@@ -123,18 +220,27 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
   struct Pass {
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    std::size_t used = 0, candidates = 0, inliers = 0;
+    std::size_t used = 0, candidates = 0, inliers = 0, edges = 0;
     double inlier_sq = 0.0;
   };
+  // The outline under the start pose (a frame's steps are millimetres), for the finest level's edges.
+  const bool edges = cfg_.edge_weight > 0.0;
+  const std::vector<float> outline = edges ? outline_grid(T_prev, cfg_.model_points.back()) : std::vector<float>{};
+  const Eigen::Matrix3d R0 = T_prev.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t_0 = T_prev.topRightCorner<3, 1>();
   const auto run = [&](const Level& lv, std::size_t count, const Eigen::Matrix4d& T_cur, double reach) {
     Pass p;
     const Eigen::Matrix3d R = T_cur.topLeftCorner<3, 3>();
     const Eigen::Vector3d t = T_cur.topRightCorner<3, 1>();
     const std::size_t n = std::min(count, model_.points.size());
+    const bool finest = edges && lv.z == levels[0].z;
     for (std::size_t i = 0; i < n; ++i) {
       const Eigen::Vector3d x = R * model_.points[i].cast<double>() + t;
       const Eigen::Vector3d nrm = R * model_.normals[i].cast<double>();
       if (x.z() <= 0.05 || nrm.dot(x) >= 0.0) continue;  // behind the camera, or facing away
+      if (finest && -nrm.dot(x) < cfg_.edge_max_cos * x.norm() &&
+          add_edge(lv, outline, x, R0 * model_.points[i].cast<double>() + t_0, nrm, p.H, p.g))
+        ++p.edges;
       int u = 0, v = 0;
       if (!lv.k.nearest_pixel(x, u, v)) continue;
       const float zs = lv.z[static_cast<std::size_t>(v) * lv.k.width_px + u];
@@ -184,6 +290,7 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
   const Pass q = run(levels[0], cfg_.model_points.back(), T, cfg_.max_distance_m);
   out.T_camera_target = T;
   out.correspondences = q.used;
+  out.edge_points = q.edges;
   out.inlier_ratio = q.candidates > 0 ? static_cast<double>(q.inliers) / static_cast<double>(q.candidates) : 0.0;
   out.rmse_mm =
       q.inliers > 0 ? 1000.0 * std::sqrt(q.inlier_sq / static_cast<double>(q.inliers)) : std::numeric_limits<double>::infinity();

@@ -17,6 +17,12 @@ TrackerConfig wide(const WorkerConfig& c) {
   return t;
 }
 
+TrackerConfig polish(const WorkerConfig& c) {
+  TrackerConfig t = c.tracking;
+  t.edge_weight = c.polish_edge_weight;
+  return t;
+}
+
 // A sample at rest: the motion to draw it with is the pose itself.
 PoseSample still_sample(const Eigen::Matrix4d& T, double capture_time_s, bool lost, double inlier_ratio, double rmse_mm) {
   PoseSample s;
@@ -34,7 +40,8 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
     : model_(model),
       aligner_(model, config.acquisition),
       tracker_(model, intrinsics, config.tracking),
-      wide_tracker_(std::move(model), intrinsics, wide(config)),
+      wide_tracker_(model, intrinsics, wide(config)),
+      polish_tracker_(std::move(model), intrinsics, polish(config)),
       k_(intrinsics),
       cfg_(std::move(config)),
       filter_(cfg_.motion),
@@ -233,7 +240,7 @@ AlignmentResult TargetFollower::acquired(const DepthImage& frame, const DepthIma
   AlignmentResult r = align_near(frame, near, near_cloud, guess, known, grow_m, SearchStage::full, weak);
   if (!r.converged) return r;
   for (int i = 0; i < 3; ++i) {  // the polish: projective association, which a touching neighbour pulls less
-    const TrackResult t = tracker_.track(frame, r.T_scan_model);
+    const TrackResult t = polish_tracker_.track(frame, r.T_scan_model);
     if (!t.accepted) break;
     r.T_scan_model = t.T_camera_target;
   }

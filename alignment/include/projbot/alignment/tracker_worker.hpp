@@ -23,6 +23,12 @@ namespace projbot::alignment {
 struct WorkerConfig {
   AcquisitionConfig acquisition;
   TrackerConfig tracking;
+  /// The silhouette's edges in the projective polish that ends an acquisition (TrackerConfig::edge_weight).
+  /// Depth alone leaves the shop's figure, standing face-on, nearly free to turn in the image plane: the
+  /// polish ended 1.9 mm (median) and up to 3.2 mm off at its feet (bench acquire, seed 2), noise-free
+  /// still 1.4 mm; its outline holds it (1.0 and 1.3 mm). Not while tracking: there the face-on box's
+  /// outline shows one side only, and it pulled the held box 4-5 mm along its face (shop tour).
+  double polish_edge_weight = 1.0;
   /// Consecutive frames in which neither tracking nor a second, wider tracking pass (on the same frame,
   /// correspondences up to reach_m; and one ICP when frames were dropped since the last pose) found the
   /// target, after which it is reported lost and blanked: 2 frames at 30 Hz blank within 100 ms of the
@@ -217,7 +223,8 @@ class TargetFollower {
   ModelCloud model_;  // for the free-space check
   Aligner aligner_;
   ProjectiveTracker tracker_;
-  ProjectiveTracker wide_tracker_;  // the same frame again, with a wider reach, when tracking failed
+  ProjectiveTracker wide_tracker_;    // the same frame again, with a wider reach, when tracking failed
+  ProjectiveTracker polish_tracker_;  // acquisition's last step, with the silhouette's edges
   CameraIntrinsics k_;
   WorkerConfig cfg_;
   std::optional<Eigen::Matrix4d> pose_;  // tracked pose; empty while acquiring
