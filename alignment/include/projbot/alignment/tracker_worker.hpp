@@ -23,10 +23,11 @@ namespace projbot::alignment {
 struct WorkerConfig {
   AcquisitionConfig acquisition;
   TrackerConfig tracking;
-  /// The silhouette's edges in the projective polish that ends an acquisition (TrackerConfig::edge_weight).
+  /// The silhouette's edges in the projective polish that ends an acquisition (TrackerConfig::edge_weight),
+  /// for models without colour contrast (a textured one is placed along its free directions by colour).
   /// Depth alone leaves the shop's figure, standing face-on, nearly free to turn in the image plane: the
-  /// polish ended 1.9 mm (median) and up to 3.2 mm off at its feet (bench acquire, seed 2), noise-free
-  /// still 1.4 mm; its outline holds it (1.0 and 1.3 mm). Not while tracking: there the face-on box's
+  /// polish ended 1.9 mm (median) and up to 3.2 mm off at its feet (bench acquire, seed 2); its outline's
+  /// sides hold it (0.49 and 0.88 mm). Not while tracking: there the face-on box's
   /// outline shows one side only, and it pulled the held box 4-5 mm along its face (shop tour).
   double polish_edge_weight = 1.0;
   /// Consecutive frames in which neither tracking nor a second, wider tracking pass (on the same frame,
@@ -224,7 +225,7 @@ class TargetFollower {
   Aligner aligner_;
   ProjectiveTracker tracker_;
   ProjectiveTracker wide_tracker_;    // the same frame again, with a wider reach, when tracking failed
-  ProjectiveTracker polish_tracker_;  // acquisition's last step, with the silhouette's edges
+  ProjectiveTracker polish_tracker_;  // acquisition's last step, with the silhouette's edges (no colour contrast)
   CameraIntrinsics k_;
   WorkerConfig cfg_;
   std::optional<Eigen::Matrix4d> pose_;  // tracked pose; empty while acquiring
