@@ -313,7 +313,7 @@ TEST_F(SyntheticDepthTest, LooksAlikeTellsATexturedBoxsTurnsOntoItselfFromWrongP
 TEST_F(SyntheticDepthTest, ALookAlikeTurnOfTheBoxIsTurnedBackToTheGuess) {
   // The face-on box's seen faces look the same under some of a cube's turns (bench acquire lit it
   // turned 180 degrees from gross guesses). Found turned so, the pose nearest a guess 40 degrees off the
-  // truth is the truth; a pose near its guess is never moved, nor is the untextured duck.
+  // truth is the truth; a pose near its guess is never moved.
   // Seen within 5 degrees of face-on, three of a cube's turns show the same picture (from 10 degrees
   // off, none: the top and a side come into view).
   const FaceOnBox b = face_on_box(projbot::config::pose_from_xyz_rpy({0.02, 0.05, 1.6}, {-5, 5, 0}));
@@ -529,6 +529,10 @@ TEST_F(SyntheticDepthTest, TheOutlineHoldsAFigureSeenFaceOnThatDepthLetsTurn) {
   EXPECT_GT(depth_only_mm, 0.25);
   EXPECT_LT(outline_mm, 0.5 * depth_only_mm);
   EXPECT_GT(edges, 200U);
+  TrackerConfig too_far;  // the step search's reach is bounded
+  too_far.edge_weight = 1.0;
+  too_far.edge_search_px = 33;
+  EXPECT_THROW(ProjectiveTracker(cloud, k_, too_far), AlignmentError);
 }
 
 TEST_F(SyntheticDepthTest, TrackerFollowsAMovingTarget) {

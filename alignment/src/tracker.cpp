@@ -9,6 +9,7 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <string>
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
@@ -26,7 +27,8 @@ Eigen::Matrix4d twist_to_transform(const Eigen::Matrix<double, 6, 1>& xi) {
 
 double sensor_sigma(double z) { return std::max(kKinectV1SigmaZCoeff * z * z, 0.001); }
 
-constexpr int kSplat = 1;  // outline_grid: each model point covers the pixels this far around its own
+constexpr int kSplat = 1;           // outline_grid: each model point covers the pixels this far around its own
+constexpr int kMaxEdgeSearch = 32;  // TrackerConfig::edge_search_px at most
 
 // Where, along p + s d (s in pixels, -reach..reach, d outward), the depth image steps from the
 // target's surface (at most `band` behind z_ref, the outline's depth, and not far in front of it) to
@@ -36,8 +38,7 @@ constexpr int kSplat = 1;  // outline_grid: each model point covers the pixels t
 double silhouette_step(const float* z, const CameraIntrinsics& k, const Eigen::Vector2d& p, const Eigen::Vector2d& d,
                        double z_ref, double band, int reach, double anchor) {
   enum Kind : signed char { none, surface, behind, in_front };
-  std::array<Kind, 2 * 32 + 1> kind{};
-  reach = std::clamp(reach, 1, 32);
+  std::array<Kind, 2 * kMaxEdgeSearch + 1> kind{};
   const double front = std::max(band, 0.08);  // a limb's own curve comes nearer than band, an occluder more
   for (int s = -reach; s <= reach; ++s) {
     const Eigen::Vector2d x = p + s * d;
@@ -73,6 +74,9 @@ ProjectiveTracker::ProjectiveTracker(ModelCloud model, CameraIntrinsics intrinsi
   if (cfg_.pyramid_levels < 1 || cfg_.iterations.size() != static_cast<std::size_t>(cfg_.pyramid_levels) ||
       cfg_.model_points.size() != static_cast<std::size_t>(cfg_.pyramid_levels))
     throw AlignmentError("tracker: iterations and model_points need one entry per pyramid level");
+  if (cfg_.edge_weight > 0.0 && !(cfg_.edge_search_px >= 1 && cfg_.edge_search_px <= kMaxEdgeSearch))
+    throw AlignmentError("tracker: edge_search_px must be 1.." + std::to_string(kMaxEdgeSearch) + ", not " +
+                         std::to_string(cfg_.edge_search_px));
   // A fixed shuffle: the first n points are a uniform subsample for every n.
   std::vector<std::size_t> order(model_.points.size());
   std::iota(order.begin(), order.end(), 0);

@@ -17,9 +17,12 @@ TrackerConfig wide(const WorkerConfig& c) {
   return t;
 }
 
-TrackerConfig polish(const WorkerConfig& c) {
+// The polish's settings: the silhouette's edges only where colour will not place the model next (the
+// edges' pull along the face-on box's one visible side cost it: 2 of 50 from 5 cm guesses ended 3 mm
+// or 0.5 degrees off, one from a gross guess lit 10 mm off; bench acquire).
+TrackerConfig polish(const WorkerConfig& c, bool colour_contrast) {
   TrackerConfig t = c.tracking;
-  t.edge_weight = c.polish_edge_weight;
+  t.edge_weight = colour_contrast ? 0.0 : c.polish_edge_weight;
   return t;
 }
 
@@ -38,16 +41,16 @@ PoseSample still_sample(const Eigen::Matrix4d& T, double capture_time_s, bool lo
 
 TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config)
     : model_(model),
+      colour_contrast_(has_colour_contrast(model_)),
       aligner_(model, config.acquisition),
       tracker_(model, intrinsics, config.tracking),
       wide_tracker_(model, intrinsics, wide(config)),
-      polish_tracker_(std::move(model), intrinsics, polish(config)),
+      polish_tracker_(std::move(model), intrinsics, polish(config, colour_contrast_)),
       k_(intrinsics),
       cfg_(std::move(config)),
       filter_(cfg_.motion),
       silhouette_grow_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)),
       model_radius_m_(guess_reach_m(model_, 0.0, 60.0)),  // a 60 degree turn moves the farthest point by the radius
-      colour_contrast_(has_colour_contrast(model_)),
       turns_(colour_contrast_ ? box_turns(model_) : std::vector<Eigen::Matrix4d>{}) {}
 
 Eigen::Matrix4d TargetFollower::nearest_guess(const DepthImage& frame, const Eigen::Matrix4d& T,
@@ -239,12 +242,10 @@ AlignmentResult TargetFollower::acquired(const DepthImage& frame, const DepthIma
                                          const Eigen::Matrix4d& guess, const Known& known, double grow_m, Weak weak) const {
   AlignmentResult r = align_near(frame, near, near_cloud, guess, known, grow_m, SearchStage::full, weak);
   if (!r.converged) return r;
-  // The polish: projective association, which a touching neighbour pulls less. With the silhouette's
-  // sides where the model has no colours to place it by (the figure); a textured one is placed by colour
-  // next, and the edges' pull along the face-on box's one visible side cost it: 2 of 50 from 5 cm
-  // guesses ended 3 mm or 0.5 degrees off, one from a gross guess lit 10 mm off (bench acquire).
+  // The polish: projective association, which a touching neighbour pulls less; held sideways by the
+  // silhouette's edges where the model has no colours to place it by (the figure).
   for (int i = 0; i < 3; ++i) {
-    const TrackResult t = (colour_contrast_ ? tracker_ : polish_tracker_).track(frame, r.T_scan_model);
+    const TrackResult t = polish_tracker_.track(frame, r.T_scan_model);
     if (!t.accepted) break;
     r.T_scan_model = t.T_camera_target;
   }

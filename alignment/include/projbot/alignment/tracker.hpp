@@ -38,7 +38,7 @@ struct TrackerConfig {
   /// (bench acquire, seed 2: 0.97 mm mean, noise-free 0.9 mm; the duck's were even), a bias not traced.
   /// Sideways is the direction that depth left free.
   double edge_min_across = 0.7;
-  int edge_search_px = 8;         ///< how far along the outline's normal the step is looked for, each way
+  int edge_search_px = 8;         ///< how far along the outline's normal the step is looked for, each way (1..32)
   double min_inlier_ratio = 0.6;  ///< quality gate
   double max_rmse_mm = 6.0;
   std::size_t min_correspondences = 200;

@@ -221,11 +221,14 @@ class TargetFollower {
   /// r itself when only it passes the gate.
   AlignmentResult recropped(const DepthImage& frame, const AlignmentResult& r, const Known& known, SearchStage stage,
                             bool hold) const;
-  ModelCloud model_;  // for the free-space check
+  ModelCloud model_;      // for the free-space check
+  bool colour_contrast_;  // the model's colours can say where it is (has_colour_contrast)
   Aligner aligner_;
   ProjectiveTracker tracker_;
-  ProjectiveTracker wide_tracker_;    // the same frame again, with a wider reach, when tracking failed
-  ProjectiveTracker polish_tracker_;  // acquisition's last step, with the silhouette's edges (no colour contrast)
+  ProjectiveTracker wide_tracker_;  // the same frame again, with a wider reach, when tracking failed
+  // Acquisition's last step: tracking's settings, with the silhouette's edges where the model has no
+  // colour contrast.
+  ProjectiveTracker polish_tracker_;
   CameraIntrinsics k_;
   WorkerConfig cfg_;
   std::optional<Eigen::Matrix4d> pose_;  // tracked pose; empty while acquiring
@@ -242,7 +245,6 @@ class TargetFollower {
   MotionFilter filter_;        // fed with every pose found, reset when the target is lost or a stop begins
   double silhouette_grow_m_;   // how far the guess's configured uncertainty reaches
   double model_radius_m_;      // the model's farthest point from its origin
-  bool colour_contrast_;       // the model's colours can say where it is (has_colour_contrast)
   double last_found_s_ = 0.0;  // capture time of the newest pose found
   // Where a textured model may look like itself turned (box_turns; none without colour contrast): a
   // found pose is turned to the look-alike nearest the stop's guess (nearest_look_alike).
