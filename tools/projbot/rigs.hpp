@@ -29,7 +29,7 @@ namespace projbot::tools {
 struct SceneTrackers {
   std::vector<std::unique_ptr<alignment::ModelCloud>> clouds;    ///< by scene index; null: not tracked
   std::vector<std::unique_ptr<alignment::TrackerWorker>> owned;  ///< by scene index
-  std::vector<alignment::TrackerWorker*> workers;                ///< by scene index, for Session::visit
+  std::vector<alignment::PoseTracker*> workers;                  ///< by scene index, for Session::visit
   std::vector<session::Target> targets;                          ///< for the session
 };
 /// The trackers' configuration: prediction on or off. In lockstep (record, replay) a search is bounded by

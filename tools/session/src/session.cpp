@@ -105,11 +105,11 @@ Stop Session::arrive(int visit) {
   return stop;
 }
 
-Stop Session::visit(int visit, const std::vector<alignment::TrackerWorker*>& workers, const Dwell& dwell, StopObserver& observer,
+Stop Session::visit(int visit, const std::vector<alignment::PoseTracker*>& workers, const Dwell& dwell, StopObserver& observer,
                     const std::stop_token& stop) {
   observer.driving(visit);
   Stop at = arrive(visit);
-  std::vector<alignment::TrackerWorker*> lit;
+  std::vector<alignment::PoseTracker*> lit;
   for (const LitTarget& l : at.lit) {
     const auto t = static_cast<std::size_t>(l.target);
     if (t >= workers.size() || workers[t] == nullptr)
@@ -136,7 +136,7 @@ Stop Session::visit(int visit, const std::vector<alignment::TrackerWorker*>& wor
   for (int k = 0;; ++k) {
     const std::shared_ptr<const alignment::DepthImage> depth(frame, &frame->depth);  // shared, never copied
     samples.clear();
-    for (alignment::TrackerWorker* w : lit)
+    for (alignment::PoseTracker* w : lit)
       if (dwell.lockstep)
         samples.push_back(w->track(depth));
       else

@@ -1,10 +1,13 @@
 #include "projbot/twin/tour.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <memory>
 #include <optional>
+#include <stop_token>
 #include <tuple>
 #include <utility>
 
@@ -79,12 +82,22 @@ Errors marker_errors(const Twin& twin, std::size_t target, const ProjectorModels
   return e;
 }
 
+// What a stop's acquisition gave for one target: the estimate, its check against free space, whether it
+// is lit, and its wall time.
+struct Acquired {
+  alignment::AlignmentResult icp;
+  alignment::FreeSpaceCheck free_space;
+  bool projected = false;
+  double align_ms = 0.0;
+};
+
 // One acquisition at arrival. Odometry and localized modes: the whole acquisition once (the paper's
 // one alignment per stop; odometry projects whatever it gives). Tracking mode: the follower's first
 // step, the bounded start of its search, as the live engine's worker does it.
-void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const alignment::DepthImage& depth,
-             const Eigen::Matrix4d& T_init, const alignment::Footing& footing, const assets::Image* colour, VisitReport& r) {
+Acquired acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const alignment::DepthImage& depth,
+                 const Eigen::Matrix4d& T_init, const alignment::Footing& footing, const assets::Image* colour) {
   const auto t0 = Clock::now();
+  Acquired r;
   r.icp.T_scan_model = T_init;  // too little in view: nothing to align
   r.icp.converged = false;
   if (mode == TourMode::tracking) {
@@ -117,11 +130,7 @@ void acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twi
     r.projected = mode == TourMode::odometry || r.icp.converged;
   }
   r.align_ms = ms_since(t0);
-  if (r.projected) {
-    r.first_light_s = 0.0;
-    r.first_light_wall_ms = r.align_ms;
-    r.lit_frames = 1;
-  }
+  return r;
 }
 
 // A neighbour lit with the visited target (issue 11, item 5): what the projector draws for it, and the
@@ -153,13 +162,20 @@ std::pair<double, double> guess_error(const robot::HeadPoses& truth, const TwinT
   return {100.0 * alignment::translation_norm_m(error), alignment::rotation_angle_deg(error)};
 }
 
+// A neighbour's report after the stop: the mean over its lit frames added.
+NeighbourReport finished(const NeighbourLight& l) {
+  NeighbourReport r = l.report;
+  r.lit_mean_mm = l.measured > 0 ? l.sum_mm / l.measured : std::nan("");
+  return r;
+}
+
+// What a dwell's projector frames are measured against (measure_frame, measure_neighbour).
 struct DwellContext {
   Twin& twin;
   std::size_t target;
   const ProjectorModels& models;
   const robot::HeadPoses& truth;
   const TourOptions& options;
-  std::uint32_t noise_seed;
   std::vector<NeighbourLight>& neighbours;
 };
 
@@ -169,74 +185,159 @@ struct InFlight {
   double ready_s = 0.0;
 };
 
-// One target's tracker worker on the simulated clock (`projbot run` runs one per target).
-struct Lane {
-  alignment::TargetFollower* follower = nullptr;
-  std::deque<InFlight> in_flight;
-  double free_s = 0.0;  // when its current step ends
-  double track_ms = 0.0;
-  int tracked = 0;  // frames it took
+// The tour's simulated clock as its camera and its lanes share it: how long the camera's last frame took
+// to render (wall time; a lane starts on a frame that long after its exposure, the twin's rendering
+// standing in for the camera's readout), unless options.processing_ms fixes each frame's whole
+// processing time.
+struct SimClock {
+  double capture_ms = 0.0;
+  std::optional<double> processing_ms;
 };
 
-// The camera side of the dwell, on the simulated clock: frames captured at 30 Hz and handed to the
-// tracker workers (the visited target's first, then its neighbours'), as in `projbot run`. A frame
-// reaches a worker after its capture time (the twin's rendering, standing in for the camera's
-// readout); a worker takes it when it is free before the next frame arrives, else the frame is dropped
-// for it (a worker always takes the newest). Its result is ready when the worker's step ends: measured
-// wall time, or options.processing_ms for both together.
-class CameraSide {
+// One target's tracker worker on the tour's simulated clock: what Session::visit hands a lit target's
+// frames to in the tour, as `projbot run` hands them to alignment::TrackerWorker. The stop's first frame
+// is its acquisition (the mode's, acquire()). Later frames (tracking mode) are tracked by the follower,
+// the policy the engine's worker runs: a frame that comes while the lane is still busy with an earlier
+// one is dropped (a worker always takes the newest), and a result is ready on the simulated clock when
+// its step ends: after the frame's capture, its measured wall time, or processing_ms for both together.
+class Lane final : public alignment::PoseTracker {
  public:
-  CameraSide(const DwellContext& c, const std::vector<alignment::TargetFollower*>& followers, VisitReport& r) : c_(c), r_(r) {
-    for (auto* f : followers) lanes_.push_back(Lane{f, {}, 0.0, 0.0, 0});
-  }
-  // Captures and tracks every frame taken up to t_s; returns, per lane, the results ready by then,
-  // oldest first.
-  std::vector<std::vector<alignment::PoseSample>> ready_by(double t_s);
-  const Lane& visited() const { return lanes_.front(); }
-  int frames = 0;        // captured
-  double gone_s = -1.0;  // capture time of the first frame without the target (motion.removed)
+  Lane(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const SimClock& clock)
+      : mode_(mode), follower_(follower), twin_(twin), clock_(clock) {}
+  void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const alignment::Footing& footing,
+                         std::shared_ptr<const assets::Image> colour) override;
+  std::optional<alignment::PoseSample> track(std::shared_ptr<const alignment::DepthImage> frame) override;
+  void submit(std::shared_ptr<const alignment::DepthImage> frame) override { track(std::move(frame)); }
+  // Whether it takes a frame that arrives at t_s (simulated clock).
+  bool free_at(double t_s) const { return free_s_ <= t_s; }
+  // The results ready by t_s, oldest first.
+  std::vector<alignment::PoseSample> ready_by(double t_s);
+  const Acquired& acquired() const { return acquired_; }  // the stop's acquisition
+  alignment::TargetFollower& follower() { return follower_; }
+  double track_ms() const { return track_ms_; }  // at this stop, after the acquisition
+  int tracked() const { return tracked_; }       // frames it took there
 
  private:
-  const DwellContext& c_;
-  VisitReport& r_;
-  std::vector<Lane> lanes_;
+  struct Start {
+    Eigen::Matrix4d T_camera_target;
+    alignment::Footing footing;
+    std::shared_ptr<const assets::Image> colour;
+  };
+  TourMode mode_;
+  alignment::TargetFollower& follower_;
+  const Twin& twin_;
+  const SimClock& clock_;
+  std::optional<Start> start_;  // set: the next frame acquires
+  Acquired acquired_;
+  std::deque<InFlight> in_flight_;
+  double free_s_ = 0.0;  // when its current step ends
+  double track_ms_ = 0.0;
+  int tracked_ = 0;
 };
 
-std::vector<std::vector<alignment::PoseSample>> CameraSide::ready_by(double t_s) {
-  TwinTarget& target = c_.twin.targets()[c_.target];
-  for (double t_k = (frames + 1) / kCameraHz; t_k <= t_s + 1e-9; t_k = (frames + 1) / kCameraHz) {
-    ++frames;
-    target.T_world_target_true = c_.twin.scripted_pose(c_.target, r_.target_visit, t_k);
-    target.in_world = c_.twin.scripted_presence(c_.target, r_.target_visit, t_k);
-    if (!target.in_world && r_.target_present && gone_s < 0.0) gone_s = t_k;
-    const double next_s = t_k + 1.0 / kCameraHz;
-    if (std::none_of(lanes_.begin(), lanes_.end(), [&](const Lane& l) { return l.free_s <= next_s; })) continue;
-    const auto t0 = Clock::now();
-    alignment::DepthImage frame =
-        c_.twin.capture(c_.truth.T_world_camera.matrix(), c_.noise_seed + static_cast<std::uint32_t>(frames));
-    frame.capture_time_s = t_k;  // the exposure, on the simulated clock
-    const double capture_ms = ms_since(t0);
-    for (Lane& l : lanes_) {
-      if (l.free_s > next_s) continue;  // still busy when the next frame comes: dropped
-      const auto tt = Clock::now();
-      InFlight f{l.follower->step(frame), 0.0};
-      const double step_ms = ms_since(tt);
-      l.track_ms += step_ms;
-      ++l.tracked;
-      const double start_s = std::max(l.free_s, t_k + (c_.options.processing_ms ? 0.0 : 1e-3 * capture_ms));
-      f.ready_s = l.free_s = start_s + 1e-3 * c_.options.processing_ms.value_or(step_ms);
-      l.in_flight.push_back(std::move(f));
-    }
+void Lane::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const alignment::Footing& footing,
+                             std::shared_ptr<const assets::Image> colour) {
+  start_ = Start{T_camera_target, footing, std::move(colour)};
+  acquired_ = Acquired{};
+  in_flight_.clear();
+  free_s_ = track_ms_ = 0.0;
+  tracked_ = 0;
+}
+
+std::optional<alignment::PoseSample> Lane::track(std::shared_ptr<const alignment::DepthImage> frame) {
+  if (start_) {
+    acquired_ = acquire(mode_, follower_, twin_, *frame, start_->T_camera_target, start_->footing, start_->colour.get());
+    start_.reset();
+    alignment::PoseSample s;
+    s.T_camera_target = s.motion.T = acquired_.icp.T_scan_model;
+    s.lost = !acquired_.projected;
+    return s;
   }
-  std::vector<std::vector<alignment::PoseSample>> out(lanes_.size());
-  for (std::size_t k = 0; k < lanes_.size(); ++k) {
-    auto& q = lanes_[k].in_flight;
-    while (!q.empty() && q.front().ready_s <= t_s + 1e-9) {
-      if (q.front().sample) out[k].push_back(*q.front().sample);
-      q.pop_front();
-    }
+  const double t_k = frame->capture_time_s;
+  // Not rendered (nothing is tracked in this mode, or every lane was busy), or this one is still busy
+  // when the next frame comes: dropped.
+  if (frame->width == 0 || free_s_ > t_k + 1.0 / kCameraHz) return std::nullopt;
+  const auto t0 = Clock::now();
+  InFlight f{follower_.step(*frame), 0.0};
+  const double step_ms = ms_since(t0);
+  track_ms_ += step_ms;
+  ++tracked_;
+  const double start_s = std::max(free_s_, t_k + (clock_.processing_ms ? 0.0 : 1e-3 * clock_.capture_ms));
+  f.ready_s = free_s_ = start_s + 1e-3 * clock_.processing_ms.value_or(step_ms);
+  in_flight_.push_back(f);
+  return f.sample;
+}
+
+std::vector<alignment::PoseSample> Lane::ready_by(double t_s) {
+  std::vector<alignment::PoseSample> out;
+  while (!in_flight_.empty() && in_flight_.front().ready_s <= t_s + 1e-9) {
+    if (in_flight_.front().sample) out.push_back(*in_flight_.front().sample);
+    in_flight_.pop_front();
   }
   return out;
+}
+
+// The twin's RGB-D camera on the tour's simulated clock, as Session::visit reads one. A stop's first
+// frame is the arrival's capture: depth, and the colour registered to it unless the mode is odometry
+// (the paper's set-up has none). Then, in tracking mode, a frame every 1/30 s, the visited target moved
+// by its motion script to the frame's instant first; it is rendered only when a lit target's lane will
+// take it (one is free before the next frame comes), else its depth is empty. In the other modes nothing
+// is tracked while the robot dwells, and nothing is rendered.
+class TourCamera final : public alignment::RgbdCamera {
+ public:
+  struct Stop {
+    std::size_t target = 0;  // index into Twin::targets()
+    int target_visit = 0;
+    Eigen::Matrix4d T_world_camera = Eigen::Matrix4d::Identity();  // true
+    std::uint32_t noise_seed = 0;                                  // the arrival's; frame k's is noise_seed + k
+    bool colour = true, tracking = true;
+    bool present = true;                 // the target was there at arrival
+    std::function<bool(double)> wanted;  // whether a lit target's lane takes a frame arriving at t_s
+  };
+  TourCamera(Twin& twin, SimClock& clock) : twin_(twin), clock_(clock) {}
+  void at_stop(Stop stop) {
+    stop_ = std::move(stop);
+    frames_ = 0;
+    arrival_ = true;
+    gone_s_ = -1.0;
+  }
+  alignment::RgbdFrame next() override;
+  int frames() const { return frames_; }             // after the arrival's
+  double gone_s() const { return gone_s_; }          // capture time of the first frame without the target, -1: none
+  double arrival_ms() const { return arrival_ms_; }  // wall time of the arrival's depth
+
+ private:
+  Twin& twin_;
+  SimClock& clock_;
+  Stop stop_;
+  int frames_ = 0;
+  bool arrival_ = true;
+  double gone_s_ = -1.0, arrival_ms_ = 0.0;
+};
+
+alignment::RgbdFrame TourCamera::next() {
+  alignment::RgbdFrame f;
+  if (arrival_) {
+    arrival_ = false;
+    const auto t0 = Clock::now();
+    f.depth = twin_.capture(stop_.T_world_camera, stop_.noise_seed);
+    arrival_ms_ = ms_since(t0);
+    if (stop_.colour) f.colour = twin_.capture_colour(stop_.T_world_camera, stop_.noise_seed);
+    return f;
+  }
+  if (!stop_.tracking) return f;  // nothing is tracked while the robot dwells: no frame is taken
+  const double t_k = ++frames_ / kCameraHz;
+  f.depth.capture_time_s = t_k;
+  TwinTarget& target = twin_.targets()[stop_.target];
+  target.T_world_target_true = twin_.scripted_pose(stop_.target, stop_.target_visit, t_k);
+  target.in_world = twin_.scripted_presence(stop_.target, stop_.target_visit, t_k);
+  if (!target.in_world && stop_.present && gone_s_ < 0.0) gone_s_ = t_k;
+  if (!stop_.wanted(t_k + 1.0 / kCameraHz)) return f;
+  const auto t0 = Clock::now();
+  f.depth = twin_.capture(stop_.T_world_camera, stop_.noise_seed + static_cast<std::uint32_t>(frames_));
+  f.depth.capture_time_s = t_k;  // the exposure, on the simulated clock
+  clock_.capture_ms = ms_since(t0);
+  return f;
 }
 
 // The error of one projector frame, against the target's true pose at the frame's display time.
@@ -304,113 +405,329 @@ void summarise_timeline(VisitReport& r) {
   r.age_p95_ms = engine::percentile(ages, 0.95);
 }
 
-// Projection while the robot dwells at the stop, on a simulated clock: the camera at 30 Hz, its frames
-// tracked (tracking mode), and the projector at its refresh rate drawing the newest result ready when
-// its frame starts, predicted to the frame's display time (one refresh later, plus the projector's
-// input lag). Each projector frame's error is measured against the target's true pose at its display
-// time. Returns false when the tour was asked to stop in the middle.
-bool dwell(const DwellContext& c, const std::vector<alignment::TargetFollower*>& followers, VisitReport& r) {
-  const TwinTarget& target = c.twin.targets()[c.target];
-  const bool tracking = c.options.mode == TourMode::tracking;
-  const double period_s = 1.0 / c.models.truth.refresh_hz;
-  const double display_delay_s = period_s + 1e-3 * c.models.truth.input_lag_ms;
-  alignment::PoseSample drawn;  // the newest result: at first the arrival's estimate
-  drawn.T_camera_target = drawn.motion.T = r.icp.T_scan_model;
-  bool shown = r.projected;
-  CameraSide camera(c, followers, r);
-  double wall_to_light_ms = r.align_ms;
-  const config::TargetMotion* motion = target.config.motion_on(r.target_visit);
-  const double motion_end_s = motion ? motion->end_s() : 0.0;
-  double back_under = -1.0;  // when the error went back under the goal for good, -1 while it is not
-  bool ever_over = false;
-  const int frames = static_cast<int>(std::lround(c.options.dwell_s * c.models.truth.refresh_hz));
-  for (int j = 1; j <= frames; ++j) {
-    if (c.options.stop_requested && c.options.stop_requested()) return false;
-    const double start_s = j * period_s;
-    if (tracking) {
-      const double before_ms = camera.visited().track_ms;
-      const auto ready = camera.ready_by(start_s);
-      for (const auto& sample : ready.front()) {
-        shown = !sample.lost;
-        if (shown) drawn = sample;
-      }
-      for (std::size_t k = 0; k < c.neighbours.size(); ++k)
-        for (const auto& sample : ready[k + 1]) {
-          c.neighbours[k].shown = !sample.lost;
-          if (!sample.lost) c.neighbours[k].drawn = sample;
-        }
-      if (r.first_light_s < 0.0) wall_to_light_ms += camera.visited().track_ms - before_ms;
-    }
-    const TimelineSample s = measure_frame(c, r, start_s + display_delay_s, shown, drawn, c.options.predict);
-    for (NeighbourLight& n : c.neighbours) measure_neighbour(c, n, start_s + display_delay_s);
-    r.timeline.push_back(s);
-    r.lit_frames += shown ? 1 : 0;
-    if (shown && r.first_light_s < 0.0) {
-      r.first_light_s = s.t_s;
-      r.first_light_wall_ms = wall_to_light_ms;
-    }
-    if (!shown && camera.gone_s >= 0.0 && r.blank_after_removal_s < 0.0) r.blank_after_removal_s = s.t_s - camera.gone_s;
-    if (s.moving) r.max_mm_moving = std::max(r.max_mm_moving, s.mean_mm);
-    if (std::isnan(s.mean_mm) && shown) continue;  // no marker in the projector's light: nothing measured
-    const bool good = shown && s.mean_mm <= kConvergedMm;
-    if (!good && c.twin.targets()[c.target].in_world) {
-      ever_over = true;
-      back_under = -1.0;
-    } else if (good && back_under < 0.0 && s.t_s >= motion_end_s) {
-      back_under = s.t_s;
-    }
-  }
-  r.shown_at_end = shown;
-  r.T_camera_target_at_end = drawn.T_camera_target;
-  const Lane& lane = camera.visited();
-  r.track_ms_mean = tracking && lane.tracked > 0 ? lane.track_ms / lane.tracked : 0.0;
-  r.tracked_frames = lane.tracked;
-  r.dropped_frames = camera.frames - lane.tracked;
-  if (tracking) {
-    r.search = followers.front()->search_stats();
-    r.second_pass_frames = followers.front()->second_passes();
-  }
-  r.reconverge_s = !ever_over ? 0.0 : back_under >= 0.0 ? std::max(0.0, back_under - motion_end_s) : -1.0;
-  summarise_timeline(r);
-  return true;
+// Where --frames writes one of a visit's pictures: DIR/visitNN_TARGET<suffix>.png.
+std::filesystem::path frame_path(const TourOptions& options, const VisitReport& r, const char* suffix) {
+  char file[96];
+  std::snprintf(file, sizeof file, "visit%02d_%s%s.png", r.visit, r.target.c_str(), suffix);
+  return options.frames_dir / file;
 }
 
 // A neighbour at arrival: acquired from the stop's capture (and colour) from its own Eq. 1 guess, as
-// the visited target is, and its error at the markers measured.
-NeighbourLight acquire_neighbour(TourMode mode, const Twin& twin, alignment::TargetFollower& follower, std::size_t target,
-                                 const session::LitTarget& n, const robot::HeadPoses& truth, const alignment::DepthImage& depth,
-                                 const std::optional<assets::Image>& colour, const ProjectorModels& models) {
+// the visited target is (its lane's acquisition), and its error at the markers measured.
+NeighbourLight neighbour_light(const Twin& twin, const Acquired& a, std::size_t target, const session::LitTarget& n,
+                               const robot::HeadPoses& truth, const ProjectorModels& models) {
   const TwinTarget& t = twin.targets()[target];
-  VisitReport scratch;
-  acquire(mode, follower, twin, depth, n.T_camera_target_guess, n.footing, colour ? &*colour : nullptr, scratch);
   NeighbourLight l;
   l.target = target;
-  l.shown = scratch.projected;
-  l.drawn.T_camera_target = l.drawn.motion.T = scratch.icp.T_scan_model;
+  l.shown = a.projected;
+  l.drawn.T_camera_target = l.drawn.motion.T = a.icp.T_scan_model;
   NeighbourReport& r = l.report;
   r.target = t.config.name;
-  r.projected = scratch.projected;
-  r.align_ms = scratch.align_ms;
+  r.projected = a.projected;
+  r.align_ms = a.align_ms;
   std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth, t, n.T_camera_target_guess);
-  const Errors e = marker_errors(twin, target, models, truth.T_world_projector.matrix(), scratch.icp.T_scan_model);
+  const Errors e = marker_errors(twin, target, models, truth.T_world_projector.matrix(), a.icp.T_scan_model);
   r.mean_mm = e.mean_mm;
   r.max_mm = e.max_mm;
   count_frame(l, e.mean_mm);  // the arrival's frame
   return l;
 }
 
-// A neighbour's report after the stop: the mean over its lit frames added.
-NeighbourReport finished(const NeighbourLight& l) {
-  NeighbourReport r = l.report;
-  r.lit_mean_mm = l.measured > 0 ? l.sum_mm / l.measured : std::nan("");
-  return r;
+// The projector as the twin's light follows it and as the session believes it (options.calibration).
+ProjectorModels projector_models(const config::Scene& scene, const TourOptions& options) {
+  ProjectorModels models{scene.projector, scene.projector, scene.pan_tilt.T_projector_camera};
+  if (options.calibration) {
+    static_cast<config::Pinhole&>(models.believed) = options.calibration->projector;
+    models.believed.distortion = options.calibration->distortion;
+    models.T_projector_camera = options.calibration->T_projector_camera;
+  }
+  return models;
 }
 
-// Where --frames writes one of a visit's pictures: DIR/visitNN_TARGET<suffix>.png.
-std::filesystem::path frame_path(const TourOptions& options, const VisitReport& r, const char* suffix) {
-  char file[96];
-  std::snprintf(file, sizeof file, "visit%02d_%s%s.png", r.visit, r.target.c_str(), suffix);
-  return options.frames_dir / file;
+// The trackers' policy for the tour's mode. The paper aligned once per stop with plain ICP from the
+// initial guess; ours is point-to-plane, coarse to fine, rejects correspondences whose normals disagree,
+// and adds local restarts, FPFH re-initialisation and the quality gate.
+alignment::WorkerConfig follower_config(const TourOptions& options) {
+  alignment::WorkerConfig follow;
+  follow.predict = options.predict;
+  follow.motion = options.motion;
+  if (options.mode == TourMode::odometry) {
+    alignment::AcquisitionConfig& acquisition = follow.acquisition;
+    acquisition.restart_angle_deg = 0.0;
+    acquisition.reinitialise = false;
+    // Plain ICP as the paper ran it: point-to-point (PCL's SVD estimation), one pass with a fixed
+    // correspondence distance and iteration budget, on the scan near the expected target.
+    acquisition.point_to_plane = false;
+    acquisition.icp_distances_m = {0.05};
+    acquisition.icp_iterations = 30;
+    acquisition.max_normal_angle_deg = 180.0;
+  }
+  return follow;
+}
+
+// What every stop of a tour shares: the twin, its camera on the simulated clock, and a follower and its
+// lane per target (the follower's aligner acquires at each stop, its policy tracks while projecting: the
+// same one the live engine's TrackerWorker runs).
+struct Tour {
+  Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Twin& t);
+  const config::Scene& scene;
+  const TourOptions& options;
+  engine::Renderer& renderer;
+  Twin& twin;
+  ProjectorModels models;
+  SimClock clock;
+  TourCamera camera{twin, clock};
+  std::vector<alignment::TargetFollower> followers;       // by index into Twin::targets()
+  std::vector<Lane> lanes;                                // likewise
+  std::vector<alignment::PoseTracker*> by_scene;          // the lanes by scene index, for Session::visit
+  std::unique_ptr<engine::RenderTarget> projector_frame;  // with --frames
+  std::unique_ptr<SpectatorView> spectator;
+};
+
+Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Twin& t)
+    : scene(s), options(o), renderer(r), twin(t), models(projector_models(s, o)) {
+  clock.processing_ms = options.processing_ms;
+  const alignment::WorkerConfig follow = follower_config(options);
+  followers.reserve(twin.targets().size());
+  for (const auto& target : twin.targets()) followers.emplace_back(target.cloud, twin.camera(), follow);
+  lanes.reserve(followers.size());
+  for (auto& f : followers) lanes.emplace_back(options.mode, f, twin, clock);
+  by_scene.assign(scene.targets.size(), nullptr);
+  for (const session::Target& target : twin.session_targets())
+    by_scene[static_cast<std::size_t>(target.scene_index)] =
+        &lanes[twin.target_index(scene.targets[static_cast<std::size_t>(target.scene_index)].name)];
+  if (!options.frames_dir.empty()) {
+    std::filesystem::create_directories(options.frames_dir);
+    projector_frame = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+    spectator = std::make_unique<SpectatorView>(renderer, scene.projector);
+  }
+}
+
+// One visit of the tour as the session runs it (session::Session::visit, in lockstep). On the stop's
+// first frame: the acquisitions' errors (the visited target's and each neighbour's) and, with --frames,
+// the pictures. Then, while the robot dwells (tracking mode, or a target that moves), projection on the
+// simulated clock: the projector at its refresh rate drawing the newest result ready when its frame
+// starts, predicted to the frame's display time (one refresh later, plus the projector's input lag), each
+// frame's error measured against the target's true pose at its display time.
+class TourStop final : public session::StopObserver {
+ public:
+  TourStop(Tour& tour, int visit) : t_(tour), visit_(visit) {}
+  // Dwell::camera: the robot has arrived and aimed; the camera is set for the stop.
+  alignment::RgbdCamera& arrived(const session::Stop& at);
+  void frame(const session::Stop& at, int k, const alignment::RgbdFrame& f,
+             const std::vector<std::optional<alignment::PoseSample>>& samples) override;
+  // Dwell::over: asked to stop, or the dwell's projector frames are all measured.
+  bool over() const { return interrupted || !dwelling_ || next_ > frames_; }
+  // After the session's visit: the neighbours' reports, and a moved target's last picture.
+  void finish();
+  std::size_t target() const { return i_; }  // index into Twin::targets()
+  VisitReport r;
+  bool interrupted = false;  // the tour was asked to stop in the middle of the dwell
+
+ private:
+  void at_arrival(const session::Stop& at, const alignment::RgbdFrame& f);
+  assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target);
+  assets::Image spectator_picture(const assets::Image& projector);
+  void write_pictures(const assets::Image& colour);
+  void project(double start_s);
+  void end_dwell();
+
+  Tour& t_;
+  int visit_;
+  std::size_t i_ = 0;             // the visited target, in Twin::targets()
+  std::vector<std::size_t> lit_;  // the stop's lit targets, likewise: the visited one first
+  robot::HeadPoses truth_;
+  std::uint32_t noise_seed_ = 0;
+  std::vector<NeighbourLight> lights_;
+  std::optional<DwellContext> c_;
+  // The dwell.
+  bool dwelling_ = false;
+  int frames_ = 0, next_ = 1;  // projector frames: in all, and the next to measure (1-based)
+  double period_s_ = 0.0, display_delay_s_ = 0.0;
+  alignment::PoseSample drawn_;  // the newest result: at first the arrival's estimate
+  bool shown_ = false;
+  double wall_to_light_ms_ = 0.0, seen_track_ms_ = 0.0;
+  double motion_end_s_ = 0.0;
+  double back_under_ = -1.0;  // when the error went back under the goal for good, -1 while it is not
+  bool ever_over_ = false;
+};
+
+alignment::RgbdCamera& TourStop::arrived(const session::Stop& at) {
+  const std::string& name = t_.scene.targets[static_cast<std::size_t>(at.target)].name;
+  i_ = t_.twin.target_index(name);
+  r.visit = visit_ + 1;
+  r.target_visit = at.target_visit;
+  r.target = name;
+  r.drive_s = at.drive.drive_seconds;
+  r.base_error_cm = 100.0 * at.drive.error_m;
+  r.base_error_deg = at.drive.error_rad * 180.0 / M_PI;
+  r.odometry_error_cm = 100.0 * at.drive.odometry_error_m;
+  truth_ = t_.twin.true_head();
+  TwinTarget& target = t_.twin.targets()[i_];
+  target.in_world = t_.twin.scripted_presence(i_, r.target_visit, 0.0);
+  r.target_present = target.in_world;
+  r.moved = target.config.motion_on(r.target_visit) != nullptr;
+  const bool tracking = t_.options.mode == TourMode::tracking;
+  dwelling_ = tracking || r.moved;
+  for (const session::LitTarget& l : at.lit)
+    lit_.push_back(t_.twin.target_index(t_.scene.targets[static_cast<std::size_t>(l.target)].name));
+  noise_seed_ = static_cast<std::uint32_t>(t_.options.seed * 100003 + static_cast<std::uint64_t>(visit_) * 1009);
+  const auto wanted = [this](double t_s) {
+    return std::any_of(lit_.begin(), lit_.end(), [&](std::size_t j) { return t_.lanes[j].free_at(t_s); });
+  };
+  t_.camera.at_stop({i_, r.target_visit, truth_.T_world_camera.matrix(), noise_seed_, t_.options.mode != TourMode::odometry,
+                     tracking, r.target_present, wanted});
+  return t_.camera;
+}
+
+void TourStop::frame(const session::Stop& at, int k, const alignment::RgbdFrame& f,
+                     const std::vector<std::optional<alignment::PoseSample>>& /*samples: ready later, see Lane*/) {
+  if (k == 0) at_arrival(at, f);
+  if (!dwelling_) return;
+  // The projector frames that start before the next camera frame is taken.
+  const double next_frame_s = (k + 1) / kCameraHz;
+  for (; next_ <= frames_ && next_frame_s > next_ * period_s_ + 1e-9; ++next_) {
+    if (t_.options.stop_requested && t_.options.stop_requested()) {
+      interrupted = true;
+      return;
+    }
+    project(next_ * period_s_);
+  }
+  if (next_ > frames_) end_dwell();
+}
+
+// Capture, Eq. 1, acquisition (the lanes', from the session), Eq. 2, and the errors at the markers.
+void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f) {
+  const TwinTarget& target = t_.twin.targets()[i_];
+  r.capture_ms = t_.camera.arrival_ms();
+  std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth_, target, at.lit.front().T_camera_target_guess);
+  const Acquired& a = t_.lanes[i_].acquired();
+  r.icp = a.icp;
+  r.free_space = a.free_space;
+  r.projected = a.projected;
+  r.align_ms = a.align_ms;
+  if (r.projected) {
+    r.first_light_s = 0.0;
+    r.first_light_wall_ms = r.align_ms;
+    r.lit_frames = 1;
+  }
+  const Eigen::Matrix4d T_world_projector = truth_.T_world_projector.matrix();
+  r.view = alignment::view_constraints(target.cloud, r.icp.T_scan_model, t_.twin.camera());
+  r.T_projector_target_estimated = t_.models.projector_from_target(r.icp.T_scan_model);
+  r.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;
+  const Errors e = marker_errors(t_.twin, i_, t_.models, T_world_projector, r.icp.T_scan_model);
+  r.markers = e.markers;
+  r.mean_mm = e.mean_mm;
+  r.max_mm = e.max_mm;
+  for (std::size_t k = 1; k < at.lit.size(); ++k)
+    lights_.push_back(neighbour_light(t_.twin, t_.lanes[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, t_.models));
+  if (t_.projector_frame) write_pictures(f.colour);
+
+  c_.emplace(DwellContext{t_.twin, i_, t_.models, truth_, t_.options, lights_});
+  period_s_ = 1.0 / t_.models.truth.refresh_hz;
+  display_delay_s_ = period_s_ + 1e-3 * t_.models.truth.input_lag_ms;
+  drawn_.T_camera_target = drawn_.motion.T = r.icp.T_scan_model;
+  shown_ = r.projected;
+  wall_to_light_ms_ = r.align_ms;
+  const config::TargetMotion* motion = target.config.motion_on(r.target_visit);
+  motion_end_s_ = motion ? motion->end_s() : 0.0;
+  frames_ = static_cast<int>(std::lround(t_.options.dwell_s * t_.models.truth.refresh_hz));
+}
+
+// The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else
+// all black.
+assets::Image TourStop::projector_image(bool lit, const Eigen::Matrix4d& T_projector_target) {
+  std::vector<engine::DrawItem> items;
+  if (lit) items.push_back({t_.twin.target_model_ids()[i_], T_projector_target});
+  for (const NeighbourLight& n : lights_)
+    if (n.shown)
+      items.push_back({t_.twin.target_model_ids()[n.target], t_.models.projector_from_target(n.drawn.T_camera_target)});
+  t_.renderer.draw_frame(*t_.projector_frame, t_.models.believed, items);
+  return t_.projector_frame->read_back();
+}
+
+// What a visitor beside the robot sees of the projector's frame, looking at the target where it truly
+// stands now.
+assets::Image TourStop::spectator_picture(const assets::Image& projector) {
+  const TwinTarget& target = t_.twin.targets()[i_];
+  const Eigen::Matrix4d T_world_spectator =
+      spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
+  return t_.spectator->draw(t_.twin, T_world_spectator, truth_.T_world_projector.matrix(), projector);
+}
+
+// --frames at arrival: the projector's frame, the RGB-D camera's colour (registered to the depth that
+// was used) and the visitor's view.
+void TourStop::write_pictures(const assets::Image& colour) {
+  const auto t0 = Clock::now();
+  const auto image = projector_image(r.projected, r.T_projector_target_estimated);
+  r.frame_ms = ms_since(t0);
+  assets::write_png(frame_path(t_.options, r, ""), image);
+  assets::write_png(frame_path(t_.options, r, "_camera"),
+                    !colour.rgba.empty() ? colour : t_.twin.capture_colour(truth_.T_world_camera.matrix(), noise_seed_));
+  assets::write_png(frame_path(t_.options, r, "_spectator"), spectator_picture(image));
+}
+
+// One projector frame of the dwell, starting at start_s: the newest results ready by then drawn
+// (tracking mode), and the frame's error measured at its display time.
+void TourStop::project(double start_s) {
+  const DwellContext& c = *c_;
+  if (t_.options.mode == TourMode::tracking) {
+    for (std::size_t k = 0; k < lit_.size(); ++k)
+      for (const auto& sample : t_.lanes[lit_[k]].ready_by(start_s)) {
+        bool& shown = k == 0 ? shown_ : lights_[k - 1].shown;
+        shown = !sample.lost;
+        if (shown) (k == 0 ? drawn_ : lights_[k - 1].drawn) = sample;
+      }
+    const double track_ms = t_.lanes[i_].track_ms();  // the visited target's frames tracked since the last
+    if (r.first_light_s < 0.0) wall_to_light_ms_ += track_ms - seen_track_ms_;
+    seen_track_ms_ = track_ms;
+  }
+  const TimelineSample s = measure_frame(c, r, start_s + display_delay_s_, shown_, drawn_, t_.options.predict);
+  for (NeighbourLight& n : lights_) measure_neighbour(c, n, start_s + display_delay_s_);
+  r.timeline.push_back(s);
+  r.lit_frames += shown_ ? 1 : 0;
+  if (shown_ && r.first_light_s < 0.0) {
+    r.first_light_s = s.t_s;
+    r.first_light_wall_ms = wall_to_light_ms_;
+  }
+  const double gone_s = t_.camera.gone_s();
+  if (!shown_ && gone_s >= 0.0 && r.blank_after_removal_s < 0.0) r.blank_after_removal_s = s.t_s - gone_s;
+  if (s.moving) r.max_mm_moving = std::max(r.max_mm_moving, s.mean_mm);
+  if (std::isnan(s.mean_mm) && shown_) return;  // no marker in the projector's light: nothing measured
+  const bool good = shown_ && s.mean_mm <= kConvergedMm;
+  if (!good && t_.twin.targets()[i_].in_world) {
+    ever_over_ = true;
+    back_under_ = -1.0;
+  } else if (good && back_under_ < 0.0 && s.t_s >= motion_end_s_) {
+    back_under_ = s.t_s;
+  }
+}
+
+// The dwell's figures once its last projector frame is measured.
+void TourStop::end_dwell() {
+  const bool tracking = t_.options.mode == TourMode::tracking;
+  Lane& lane = t_.lanes[i_];
+  r.shown_at_end = shown_;
+  r.T_camera_target_at_end = drawn_.T_camera_target;
+  r.track_ms_mean = tracking && lane.tracked() > 0 ? lane.track_ms() / lane.tracked() : 0.0;
+  r.tracked_frames = lane.tracked();
+  r.dropped_frames = t_.camera.frames() - lane.tracked();
+  if (tracking) {
+    r.search = lane.follower().search_stats();
+    r.second_pass_frames = lane.follower().second_passes();
+  }
+  r.reconverge_s = !ever_over_ ? 0.0 : back_under_ >= 0.0 ? std::max(0.0, back_under_ - motion_end_s_) : -1.0;
+  summarise_timeline(r);
+}
+
+void TourStop::finish() {
+  for (const NeighbourLight& l : lights_) r.neighbours.push_back(finished(l));
+  if (t_.spectator && r.moved && !interrupted) {
+    // A moved target: what the visitor sees at the end of the dwell, where the target went and where
+    // the light went (followed, or left where the target was).
+    const auto image = projector_image(r.shown_at_end, t_.models.projector_from_target(r.T_camera_target_at_end));
+    assets::write_png(frame_path(t_.options, r, "_spectator_end"), spectator_picture(image));
+  }
 }
 
 }  // namespace
@@ -435,46 +752,11 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   twin_options.seed = options.seed;
   twin_options.depth_noise = options.depth_noise;
   Twin twin(scene, twin_options, renderer);
-  auto& targets = twin.targets();
-  ProjectorModels models{scene.projector, scene.projector, scene.pan_tilt.T_projector_camera};
-  if (options.calibration) {
-    static_cast<config::Pinhole&>(models.believed) = options.calibration->projector;
-    models.believed.distortion = options.calibration->distortion;
-    models.T_projector_camera = options.calibration->T_projector_camera;
-  }
-
-  // The paper aligned once per stop with plain ICP from the initial guess; ours is point-to-plane, coarse
-  // to fine, rejects correspondences whose normals disagree, and adds local restarts, FPFH
-  // re-initialisation and the quality gate.
-  alignment::AcquisitionConfig acquisition;
-  if (options.mode == TourMode::odometry) {
-    acquisition.restart_angle_deg = 0.0;
-    acquisition.reinitialise = false;
-    // Plain ICP as the paper ran it: point-to-point (PCL's SVD estimation), one pass with a fixed
-    // correspondence distance and iteration budget, on the scan near the expected target.
-    acquisition.point_to_plane = false;
-    acquisition.icp_distances_m = {0.05};
-    acquisition.icp_iterations = 30;
-    acquisition.max_normal_angle_deg = 180.0;
-  }
-  // One follower per target: its aligner acquires at each stop, its policy tracks while projecting
-  // (the same one the live engine's TrackerWorker runs).
-  alignment::WorkerConfig follow;
-  follow.acquisition = acquisition;
-  follow.predict = options.predict;
-  follow.motion = options.motion;
-  std::vector<alignment::TargetFollower> followers;
-  for (const auto& t : targets) followers.emplace_back(t.cloud, twin.camera(), follow);
-  // The stop sequence (drive, aim, Eq. 1 for the visited target and its neighbours) is the session's;
-  // the twin serves its base and pan-tilt.
+  Tour tour(scene, options, renderer, twin);
+  // The stop sequence (drive, aim, Eq. 1 for the visited target and its neighbours, capture, acquire,
+  // track) is the session's, as in `projbot run`; the twin serves its base, pan-tilt and camera, and
+  // the tour's lanes track on the simulated clock.
   session::Session session(scene, twin.session_targets(), twin.robot(), twin.pan_tilt());
-  std::unique_ptr<engine::RenderTarget> projector_frame;
-  std::unique_ptr<SpectatorView> spectator;
-  if (!options.frames_dir.empty()) {
-    std::filesystem::create_directories(options.frames_dir);
-    projector_frame = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
-    spectator = std::make_unique<SpectatorView>(renderer, scene.projector);
-  }
 
   TourReport report;
   report.mode = options.mode;
@@ -482,100 +764,20 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   report.predict = options.predict;
   report.projector = scene.projector;
   const int visits = options.visits > 0 ? options.visits : static_cast<int>(scene.visits.size());
-  const auto stop = [&] { return options.stop_requested && options.stop_requested(); };
-  for (int v = 0; v < visits && !(report.interrupted = stop()); ++v) {
-    // Drive to the stop, closing the loop on localisation (or odometry, the paper's set-up), and aim at
-    // where the map says the target is, from where the robot believes it is.
-    const session::Stop arrival = session.arrive(v);
-    const std::string& name = scene.targets[static_cast<std::size_t>(arrival.target)].name;
-    const std::size_t i = twin.target_index(name);
-    TwinTarget& target = targets[i];
-    VisitReport r;
-    r.visit = v + 1;
-    r.target_visit = arrival.target_visit;
-    r.target = name;
-    r.drive_s = arrival.drive.drive_seconds;
-    r.base_error_cm = 100.0 * arrival.drive.error_m;
-    r.base_error_deg = arrival.drive.error_rad * 180.0 / M_PI;
-    r.odometry_error_cm = 100.0 * arrival.drive.odometry_error_m;
-    const robot::HeadPoses truth = twin.true_head();
-    // A visitor beside the robot, looking at the target where it truly stands now.
-    // The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else all black.
-    std::vector<NeighbourLight> lights;
-    const auto projector_image = [&](bool lit, const Eigen::Matrix4d& T_projector_target) {
-      std::vector<engine::DrawItem> items;
-      if (lit) items.push_back({twin.target_model_ids()[i], T_projector_target});
-      for (const NeighbourLight& n : lights)
-        if (n.shown) items.push_back({twin.target_model_ids()[n.target], models.projector_from_target(n.drawn.T_camera_target)});
-      renderer.draw_frame(*projector_frame, models.believed, items);
-      return projector_frame->read_back();
-    };
-    const auto spectator_at = [&](const TwinTarget& t) {
-      return spectator_pose(truth.T_world_camera.translation(), model_middle(t, t.T_world_target_true));
-    };
-    target.in_world = twin.scripted_presence(i, r.target_visit, 0.0);
-    r.target_present = target.in_world;
-
-    // Capture, Eq. 1, acquisition, Eq. 2.
-    auto t0 = Clock::now();
-    const std::uint32_t noise_seed = static_cast<std::uint32_t>(options.seed * 100003 + static_cast<std::uint64_t>(v) * 1009);
-    const alignment::DepthImage depth = twin.capture(truth.T_world_camera.matrix(), noise_seed);
-    r.capture_ms = ms_since(t0);
-    const session::LitTarget& visited = arrival.lit.front();
-    const Eigen::Matrix4d& T_init = visited.T_camera_target_guess;
-    std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth, target, T_init);
-    // Localized and tracking: the colour the RGB-D camera registers to the depth, taken with it (before
-    // any light).
-    std::optional<assets::Image> colour;
-    if (options.mode != TourMode::odometry) colour = twin.capture_colour(truth.T_world_camera.matrix(), noise_seed);
-    acquire(options.mode, followers[i], twin, depth, T_init, visited.footing, colour ? &*colour : nullptr, r);
-    const Eigen::Matrix4d T_world_projector = truth.T_world_projector.matrix();
-    r.view = alignment::view_constraints(target.cloud, r.icp.T_scan_model, twin.camera());
-    r.T_projector_target_estimated = models.projector_from_target(r.icp.T_scan_model);
-    r.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;
-    Errors e = marker_errors(twin, i, models, T_world_projector, r.icp.T_scan_model);
-    r.markers = e.markers;
-    r.mean_mm = e.mean_mm;
-    r.max_mm = e.max_mm;
-    for (std::size_t k = 1; k < arrival.lit.size(); ++k) {
-      const session::LitTarget& n = arrival.lit[k];
-      const std::size_t j = twin.target_index(scene.targets[static_cast<std::size_t>(n.target)].name);
-      lights.push_back(acquire_neighbour(options.mode, twin, followers[j], j, n, truth, depth, colour, models));
-    }
-
-    if (projector_frame) {
-      t0 = Clock::now();
-      const auto image = projector_image(r.projected, r.T_projector_target_estimated);
-      r.frame_ms = ms_since(t0);
-      assets::write_png(frame_path(options, r, ""), image);
-      // What the RGB-D camera saw at the capture: its colour, registered to the depth that was used.
-      assets::write_png(frame_path(options, r, "_camera"),
-                        colour ? *colour : twin.capture_colour(truth.T_world_camera.matrix(), noise_seed));
-      // What a visitor beside the robot sees: the frame's light on the true surfaces.
-      assets::write_png(frame_path(options, r, "_spectator"),
-                        spectator->draw(twin, spectator_at(target), T_world_projector, image));
-    }
-
-    // Projecting: the target may be moved or taken away; the tracker (tracking mode) follows it at
-    // camera rate, and a lost or missing target is searched for within the follower's budget.
-    r.moved = target.config.motion_on(r.target_visit) != nullptr;
-    if (options.mode == TourMode::tracking || r.moved) {
-      std::vector<alignment::TargetFollower*> lanes{&followers[i]};
-      for (const NeighbourLight& n : lights) lanes.push_back(&followers[n.target]);
-      report.interrupted = !dwell(DwellContext{twin, i, models, truth, options, noise_seed, lights}, lanes, r);
-    }
-    for (const NeighbourLight& l : lights) r.neighbours.push_back(finished(l));
-    if (spectator && r.moved && !report.interrupted) {
-      // A moved target: what the visitor sees at the end of the dwell, where the target went and where
-      // the light went (followed, or left where the target was).
-      const auto image = projector_image(r.shown_at_end, models.projector_from_target(r.T_camera_target_at_end));
-      assets::write_png(frame_path(options, r, "_spectator_end"),
-                        spectator->draw(twin, spectator_at(target), T_world_projector, image));
-    }
-    twin.end_visit(i, r.target_visit);  // back home, or left where it was moved
-    if (report.interrupted) break;      // this visit did not finish: keep the finished ones only
-    if (options.on_visit) options.on_visit(r);
-    report.visits.push_back(std::move(r));
+  const auto stop_requested = [&] { return options.stop_requested && options.stop_requested(); };
+  const std::stop_source never;  // the tour asks options.stop_requested between projector frames
+  for (int v = 0; v < visits && !(report.interrupted = stop_requested()); ++v) {
+    TourStop stop(tour, v);
+    session::Dwell dwell;
+    dwell.camera = [&](const session::Stop& at, double) -> alignment::RgbdCamera& { return stop.arrived(at); };
+    dwell.over = [&](const session::Stop&, int, double) { return stop.over(); };
+    dwell.lockstep = true;
+    session.visit(v, tour.by_scene, dwell, stop, never.get_token());
+    stop.finish();
+    twin.end_visit(stop.target(), stop.r.target_visit);  // back home, or left where it was moved
+    if ((report.interrupted = stop.interrupted)) break;  // this visit did not finish: keep the finished ones only
+    if (options.on_visit) options.on_visit(stop.r);
+    report.visits.push_back(std::move(stop.r));
   }
   report.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   return report;

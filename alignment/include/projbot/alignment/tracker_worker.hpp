@@ -269,7 +269,23 @@ class TargetFollower {
   std::optional<AlignmentResult> attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage);
 };
 
-class TrackerWorker {
+/// What a projection session hands a lit target's frames to (session::Session::visit): the stop's initial
+/// guess, then the camera's frames, each tracked in order (lockstep) or the newest taken when free (live).
+/// TrackerWorker is the engine's; the twin's tour has one on its simulated clock.
+class PoseTracker {
+ public:
+  virtual ~PoseTracker() = default;
+  /// The stop's initial guess (Eq. 1), the target's surveyed footing and the colour taken on arrival
+  /// (null: none): the next frame acquires from them.
+  virtual void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing,
+                                 std::shared_ptr<const assets::Image> colour) = 0;
+  /// Tracks `frame` before returning: the sample published for it, if any.
+  virtual std::optional<PoseSample> track(std::shared_ptr<const DepthImage> frame) = 0;
+  /// Hands `frame` over without waiting; a frame not yet taken is replaced.
+  virtual void submit(std::shared_ptr<const DepthImage> frame) = 0;
+};
+
+class TrackerWorker final : public PoseTracker {
  public:
   /// Starts the worker thread. Throws AlignmentError for a bad model or intrinsics.
   TrackerWorker(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config = {});
@@ -279,11 +295,11 @@ class TrackerWorker {
   TrackerWorker& operator=(const TrackerWorker&) = delete;
 
   /// A new depth frame (from the sensor thread). Replaces any frame not yet taken.
-  void submit(std::shared_ptr<const DepthImage> frame);
+  void submit(std::shared_ptr<const DepthImage> frame) override;
   /// Submits `frame` and waits until the worker has tracked it, so that every frame is tracked, in order,
   /// and the same frames give the same poses (record and replay). Returns the sample published for it
   /// (none when the step published none). Rethrows what the worker died of.
-  std::optional<PoseSample> track(std::shared_ptr<const DepthImage> frame);
+  std::optional<PoseSample> track(std::shared_ptr<const DepthImage> frame) override;
   /// The stop's initial guess (Eq. 1): the next frame acquires from it.
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target);
   /// ...with what the robot knows at the stop, as the tour uses it: the target's surveyed footing (its
@@ -291,7 +307,7 @@ class TrackerWorker {
   /// before the projector lit anything, registered to the depth (null: none). The next frame's search
   /// is moved and checked by that colour (TargetFollower::step), later ones are depth alone.
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing,
-                         std::shared_ptr<const assets::Image> colour);
+                         std::shared_ptr<const assets::Image> colour) override;
   /// The newest published sample (reader thread only); false before the first.
   bool latest(PoseSample& out) { return poses_.read(out); }
   /// Frames taken and processed so far (for tests and statistics).

@@ -4,10 +4,11 @@
 // at the middle of the target where the map says it stands, from where the robot believes it is
 // (robot::PanTilt), reads the angles back, and takes Eq. 1's initial guess and the surveyed footing of
 // the visited target and of each neighbour the robot expects in the projector's view. Acquiring,
-// Session::visit then hands the camera's frames (alignment::RgbdCamera) to the lit targets' tracker
-// workers while the robot dwells, live (`projbot run`) or in lockstep (`record`, `run --replay`); the
-// tour runs the same arrival on a simulated clock. Nothing here knows which implementation of a device it
-// drives (twin, hardware or recording).
+// Session::visit then hands the camera's frames (alignment::RgbdCamera) to the lit targets' trackers
+// (alignment::PoseTracker) while the robot dwells, live (`projbot run`: TrackerWorker threads) or in
+// lockstep (`record` and `run --replay`: the same; the twin's `tour`: trackers on its simulated clock).
+// Nothing here knows which implementation of a device or tracker it drives (twin, hardware or
+// recording).
 
 #include <Eigen/Core>
 #include <functional>
@@ -104,11 +105,11 @@ class Session {
   int target_of(int visit) const;
   /// Drives to the `visit`-th stop, aims, and plans what to light there.
   Stop arrive(int visit);
-  /// The whole `visit`-th stop: arrive, give each lit target's worker (`workers`, by scene index) its
+  /// The whole `visit`-th stop: arrive, give each lit target's tracker (`workers`, by scene index) its
   /// guess, footing and the colour of the stop's first frame, then hand the camera's frames to them until
   /// the dwell is over or `stop` is requested. Throws SessionError for a lit target without a worker, and
   /// what a device throws.
-  Stop visit(int visit, const std::vector<alignment::TrackerWorker*>& workers, const Dwell& dwell, StopObserver& observer,
+  Stop visit(int visit, const std::vector<alignment::PoseTracker*>& workers, const Dwell& dwell, StopObserver& observer,
              const std::stop_token& stop);
   /// The targets besides the visited one that a robot with this believed head expects to share the
   /// view: each one's surveyed middle 0.3-5 m in front of the camera, inside the depth camera's image
