@@ -59,8 +59,10 @@ MrptLaser::MrptLaser(const std::string& class_name, const std::map<std::string, 
   impl_->sensor = mrpt::hwdrivers::CGenericSensor::createSensorPtr(class_name);
   if (!impl_->sensor)
     throw RobotError(impl_->name + ": MRPT has no sensor class of that name (CHokuyoURG, CSickLaserSerial, ...)");
-  if (dynamic_cast<mrpt::hwdrivers::C2DRangeFinderAbstract*>(impl_->sensor.get()) == nullptr)
-    throw RobotError(impl_->name + ": is an MRPT sensor but not a 2-D laser");
+  auto* laser = dynamic_cast<mrpt::hwdrivers::C2DRangeFinderAbstract*>(impl_->sensor.get());
+  if (laser == nullptr) throw RobotError(impl_->name + ": is an MRPT sensor but not a 2-D laser");
+  // The drivers' own chatter (a Hokuyo's product and version tables, at INFO) stays out of our output.
+  laser->setMinLoggingLevel(mrpt::system::LVL_WARN);
   mrpt::config::CConfigFileMemory config;
   for (const auto& [key, value] : params) config.write("LASER", key, value);
   CaptureStderr said;

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "projbot/robot/ptu_d46.hpp"
+#include "pseudo_terminal.hpp"
 
 namespace projbot::robot {
 namespace {
@@ -31,9 +32,7 @@ bool parse_long(const std::string& s, long& out) {
 }  // namespace
 
 struct PtuD46Emulator::Impl {
-  int master = -1;
-  int slave = -1;  // held open so the master never sees EOF between driver sessions
-  std::string slave_path;
+  detail::PseudoTerminal pty{"PTU emulator"};
   mutable std::mutex mutex;
   long pan = 0, tilt = 0;
   long pan_speed = 1000, tilt_speed = 1000;
@@ -99,10 +98,10 @@ struct PtuD46Emulator::Impl {
   void run(const std::stop_token& stop) {
     std::string pending;
     while (!stop.stop_requested()) {
-      pollfd p{master, POLLIN, 0};
+      pollfd p{pty.master, POLLIN, 0};
       if (::poll(&p, 1, 20) <= 0 || !(p.revents & POLLIN)) continue;
       char buf[256];
-      const ssize_t n = ::read(master, buf, sizeof buf);
+      const ssize_t n = ::read(pty.master, buf, sizeof buf);
       if (n <= 0) continue;
       for (ssize_t i = 0; i < n; ++i) {
         const char c = buf[i];
@@ -111,7 +110,7 @@ struct PtuD46Emulator::Impl {
           const std::string reply = answer(pending);
           pending.clear();
           if (!silent.load() && !reply.empty()) {
-            [[maybe_unused]] const ssize_t w = ::write(master, reply.data(), reply.size());
+            [[maybe_unused]] const ssize_t w = ::write(pty.master, reply.data(), reply.size());
           }
         } else if (pending.size() < 64) {
           pending.push_back(c);
@@ -122,29 +121,15 @@ struct PtuD46Emulator::Impl {
 };
 
 PtuD46Emulator::PtuD46Emulator() : impl_(std::make_unique<Impl>()) {
-  impl_->master = ::posix_openpt(O_RDWR | O_NOCTTY);
-  if (impl_->master < 0 || ::grantpt(impl_->master) != 0 || ::unlockpt(impl_->master) != 0)
-    throw RobotError(std::string("PTU emulator: cannot create a pseudo-terminal: ") + std::strerror(errno));
-  char name[128];
-  if (::ptsname_r(impl_->master, name, sizeof name) != 0) throw RobotError("PTU emulator: ptsname failed");
-  impl_->slave_path = name;
-  impl_->slave = ::open(name, O_RDWR | O_NOCTTY);
-  if (impl_->slave < 0) throw RobotError("PTU emulator: cannot open " + impl_->slave_path);
-  termios t{};
-  ::tcgetattr(impl_->slave, &t);
-  ::cfmakeraw(&t);  // a serial line: no echo, no line editing on the pty itself
-  ::tcsetattr(impl_->slave, TCSANOW, &t);
   impl_->thread = std::jthread([impl = impl_.get()](const std::stop_token& stop) { impl->run(stop); });
 }
 
 PtuD46Emulator::~PtuD46Emulator() {
   impl_->thread.request_stop();
   if (impl_->thread.joinable()) impl_->thread.join();
-  if (impl_->slave >= 0) ::close(impl_->slave);
-  if (impl_->master >= 0) ::close(impl_->master);
 }
 
-std::string PtuD46Emulator::port() const { return impl_->slave_path; }
+std::string PtuD46Emulator::port() const { return impl_->pty.slave_path; }
 long PtuD46Emulator::pan_steps() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->pan;

@@ -1,0 +1,68 @@
+// The configured-laser path (MrptLaser, MRPT's CHokuyoURG driver) end to end against a Hokuyo UTM-30LX
+// emulated on a pty, speaking SCIP 2.0.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <thread>
+
+#include "projbot/robot/mrpt_laser.hpp"
+#include "projbot/robot/urg_emulator.hpp"
+
+namespace {
+
+using namespace projbot::robot;
+
+// A room seen from inside: 1-10 m, with a gap (no echo) over 40 steps.
+std::vector<std::uint32_t> ramp(std::uint32_t offset_mm) {
+  std::vector<std::uint32_t> r(UrgEmulator::kSteps);
+  for (int i = 0; i < UrgEmulator::kSteps; ++i)
+    r[static_cast<std::size_t>(i)] = 1000 + offset_mm + 8 * static_cast<std::uint32_t>(i);
+  std::fill(r.begin() + 500, r.begin() + 540, 0U);
+  return r;
+}
+
+TEST(UrgLaser, MrptsHokuyoDriverReadsTheScansTheUnitSends) {
+  const auto served = ramp(0);
+  UrgEmulator unit(served);
+  MrptLaser laser("CHokuyoURG", {{"COM_port_LIN", unit.port()}});
+  const LaserScan scan = laser.next(2.0);
+  // The UTM-30LX's steps 0..1080 as PP reported them: 1081 rays, 1440 to the turn (270.25 degrees), 60 m.
+  ASSERT_EQ(scan.ranges_m.size(), 1081U);
+  EXPECT_NEAR(scan.aperture_rad, 1081 * 2 * std::numbers::pi / 1440, 1e-6);
+  EXPECT_NEAR(scan.max_range_m, 60.0, 1e-6);
+  for (std::size_t i = 0; i < served.size(); ++i) {
+    SCOPED_TRACE(i);
+    if (served[i] == 0) {
+      EXPECT_EQ(scan.valid[i], 0);  // no echo
+    } else {
+      ASSERT_EQ(scan.valid[i], 1);
+      ASSERT_NEAR(scan.ranges_m[i], 0.001 * served[i], 1e-4);  // ray i is step i: right to left, as the unit counts
+    }
+  }
+  // MRPT's start-up over SCIP 2.0: the laser on, the parameters read, then continuous scans of every step.
+  const auto cmds = unit.received();
+  for (const char* c : {"SCIP2.0", "BM", "PP", "MD0000108001000"})
+    EXPECT_NE(std::find(cmds.begin(), cmds.end(), c), cmds.end()) << c;
+}
+
+TEST(UrgLaser, FollowsWhatTheUnitSeesNow) {
+  UrgEmulator unit(ramp(0));
+  MrptLaser laser("CHokuyoURG", {{"COM_port_LIN", unit.port()}});
+  laser.next(2.0);
+  unit.set_ranges(ramp(500));
+  // Scans already on the line come first; within a second the new ranges arrive.
+  bool moved = false;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (!moved && std::chrono::steady_clock::now() < give_up) moved = std::abs(laser.next(1.0).ranges_m[0] - 1.5f) < 1e-4f;
+  EXPECT_TRUE(moved);
+  EXPECT_GT(unit.scans_sent(), 1);
+}
+
+TEST(UrgLaser, AnEmulatorRefusesAScanOfTheWrongSize) {
+  EXPECT_THROW(UrgEmulator(std::vector<std::uint32_t>(100, 1000)), RobotError);
+}
+
+}  // namespace
