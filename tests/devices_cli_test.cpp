@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +20,7 @@
 #include "projbot/alignment/freenect_source.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/pan_tilt.hpp"
+#include "projbot/robot/pose2d.hpp"
 #include "projbot/robot/ptu_d46.hpp"
 #include "projbot/twin/world.hpp"
 
@@ -208,6 +210,33 @@ TEST_F(DevicesCli, FindsTheTwinsBaseServedInASecondProcess) {
       << served;
   EXPECT_NE(served.find("served 300 odometry messages, 0 commands received"), std::string::npos) << served;
 }
+
+namespace {
+
+// What a Kinect at the demo tour's first stop (the Duck) sees once a drift-free base has reached it and
+// aimed at the Duck, as a fakenect dump in `folder` that lasts 60 s at 30 Hz (the drive, then the dwell).
+// Returns the stop (x, y, heading) and the aim.
+std::pair<Eigen::Vector3d, projbot::robot::AimResult> duck_stop_dump(const projbot::config::Scene& scene,
+                                                                     const fs::path& folder) {
+  projbot::engine::Renderer renderer{projbot::engine::RendererOptions{}};
+  projbot::twin::Twin twin{scene, {}, renderer};
+  const std::size_t duck = twin.target_index("duck");
+  const Eigen::Vector3d stop = *scene.targets[static_cast<std::size_t>(scene.target_index("duck"))].stop;
+  const projbot::robot::Pose2D goal{stop.x(), stop.y(), stop.z()};
+  const auto aim = projbot::robot::aim_at(goal, twin.surveyed_middle(duck), scene.pan_tilt);
+  const Eigen::Matrix4d T_world_camera = projbot::robot::head_poses(goal, aim.angles, scene.pan_tilt).T_world_camera.matrix();
+  projbot::alignment::write_fakenect_dump(folder, twin_frames(twin, T_world_camera, 10, 100, 0.0).frames());
+  std::string once;
+  {
+    std::ifstream in(folder / "INDEX.txt");
+    once.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  std::ofstream out(folder / "INDEX.txt");
+  for (int i = 0; i < 180; ++i) out << once;
+  return {stop, aim};
+}
+
+}  // namespace
 
 // run with a real camera driver and the twin's robot: the twin's frames at the demo tour's first stop
 // (the Duck), written as a fakenect dump, reach the tracker through libfreenect; the Duck is found and
@@ -401,24 +430,7 @@ TEST_F(DevicesCli, RunReplaysARecordingFrameForFrame) {
 TEST_F(DevicesCli, RunDrivesAConfiguredRobotWithNoTwin) {
   const int domain = 150 + static_cast<int>(::getpid() % 50);
   const auto scene = projbot::config::load_scene(std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml");
-  projbot::engine::Renderer renderer{projbot::engine::RendererOptions{}};
-  projbot::twin::Twin twin{scene, {}, renderer};
-  // Where the camera stands once a drift-free base has reached the Duck's stop and aimed at it.
-  const std::size_t duck = twin.target_index("duck");
-  const Eigen::Vector3d& stop = *scene.targets[static_cast<std::size_t>(scene.target_index("duck"))].stop;
-  const projbot::robot::Pose2D goal{stop.x(), stop.y(), stop.z()};
-  const auto aim = projbot::robot::aim_at(goal, twin.surveyed_middle(duck), scene.pan_tilt);
-  const Eigen::Matrix4d T_world_camera = projbot::robot::head_poses(goal, aim.angles, scene.pan_tilt).T_world_camera.matrix();
-  projbot::alignment::write_fakenect_dump(dir_ / "dump", twin_frames(twin, T_world_camera, 10, 100, 0.0).frames());
-  std::string once;
-  {
-    std::ifstream in(dir_ / "dump" / "INDEX.txt");
-    once.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  {
-    std::ofstream out(dir_ / "dump" / "INDEX.txt");  // 60 s at 30 Hz: the drive, then the dwell
-    for (int i = 0; i < 180; ++i) out << once;
-  }
+  const auto [stop, aim] = duck_stop_dump(scene, dir_ / "dump");
   const projbot::robot::PtuD46Emulator ptu;
   const fs::path site_yaml = site("  camera: {driver: freenect, registered: false}\n  pan_tilt: {port: " + ptu.port() +
                                   "}\n  base: {domain: " + std::to_string(domain) + "}\n");
@@ -443,4 +455,79 @@ TEST_F(DevicesCli, RunDrivesAConfiguredRobotWithNoTwin) {
   EXPECT_NEAR(static_cast<double>(ptu.pan_steps()) * scene.pan_tilt.step_rad, aim.angles.pan_rad, 0.01);
   EXPECT_GT(number_after(r.output, "pose age at display (depth capture to expected display), "), 60.0) << r.output;
   EXPECT_NE(r.output.find("error at display: not measured (the configured robot"), std::string::npos) << r.output;
+}
+
+// Issue 12's laser through `projbot run`: a robot set down 15 cm and 4 degrees off its configured start,
+// its base served over DDS and its laser (a Hokuyo UTM-30LX on a pty, speaking SCIP 2.0 to MRPT's
+// CHokuyoURG driver) by `projbot sim-base` in a second process, is localised against the map `projbot
+// slam` made of a twin recording, and truly reaches the Duck's stop; odometry alone would leave it where
+// it was set down, 15 cm off.
+TEST_F(DevicesCli, RunLocalisesAConfiguredRobotByItsLaser) {
+  // The map: the twin robot's laser on its way to the first stop, mapped by ICP-SLAM.
+  // record says how to map its rawlog in the scene's frame: from robot.start, where the run began.
+  const fs::path rec = dir_ / "rec";
+  const CliRun recorded = run_projbot("record --out " + rec.string() + " --visits 1 --dwell 1", 120);
+  ASSERT_EQ(recorded.code, 0) << recorded.output;
+  const std::string start_option = " --start \"1 1 0\"";  // tour.yaml's robot.start
+  ASSERT_NE(recorded.output.find("map: projbot slam --rawlog " + (rec / "laser.rawlog").string() + start_option),
+            std::string::npos)
+      << recorded.output;
+  const CliRun slam = run_projbot("slam --rawlog " + (rec / "laser.rawlog").string() + start_option + " --out-map " +
+                                      (dir_ / "map").string() + " --out-trajectory " + (dir_ / "slam.txt").string(),
+                                  120);
+  ASSERT_EQ(slam.code, 0) << slam.output;
+  const int domain = 200 + static_cast<int>(::getpid() % 30);
+  const auto scene = projbot::config::load_scene(std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml");
+  const auto [stop, aim] = duck_stop_dump(scene, dir_ / "dump");
+  const projbot::robot::PtuD46Emulator ptu;
+  const fs::path urg = dir_ / "urg";
+  const fs::path site_yaml = site("  camera: {driver: freenect, registered: false}\n  pan_tilt: {port: " + ptu.port() +
+                                  "}\n  base: {domain: " + std::to_string(domain) +
+                                  "}\n  laser: {class: CHokuyoURG, params: {COM_port_LIN: " + urg.string() +
+                                  ", pose_x: 0.25}, map: " + (dir_ / "map").string() + "}\n");
+  const Eigen::Vector3d& start = scene.robot_start;
+  const double set_down_x = start.x() + 0.12, set_down_y = start.y() - 0.09, set_down_rad = start.z() + 4.0 * M_PI / 180.0;
+  const fs::path log = dir_ / "sim-base.txt", pid = dir_ / "sim-base.pid";
+  // Its own --seconds bounds it (not `timeout`, which would pass the stop signal on twice: the second quits at once).
+  ASSERT_EQ(std::system(("sh -c 'echo $$ > " + pid.string() + "; exec " + std::string(PROJBOT_EXE) +
+                         " sim-base --seconds 150 --config " + site_yaml.string() + " --laser " + urg.string() +
+                         " --true-start " + std::to_string(set_down_x) + "," + std::to_string(set_down_y) + "," +
+                         std::to_string(set_down_rad) + "' > " + log.string() + " 2>&1 &")
+                            .c_str()),
+            0);
+  for (int i = 0; i < 200 && !fs::is_symlink(urg); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(fs::is_symlink(urg));
+  ::setenv("LD_LIBRARY_PATH", PROJBOT_FAKENECT_DIR, 1);
+  ::setenv("FAKENECT_PATH", (dir_ / "dump").c_str(), 1);
+  const CliRun r = run_projbot("run --headless --visits 1 --dwell 1 --config " + site_yaml.string(), 120);
+  ::unsetenv("LD_LIBRARY_PATH");
+  // sim-base stops on SIGTERM (as on Ctrl-C) and says where the base truly is.
+  int sim_pid = 0;
+  std::ifstream(pid) >> sim_pid;
+  ASSERT_GT(sim_pid, 0);
+  ::kill(sim_pid, SIGTERM);
+  std::string served;
+  for (int i = 0; i < 200 && served.find("truly at") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::ifstream in(log);
+    served.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("laser: mrpt CHokuyoURG"), std::string::npos) << r.output;
+  const std::string visit = r.output.substr(r.output.find("visit 1: duck"));
+  EXPECT_GT(number_after(visit, " target(s); "), 10.0) << r.output;  // laser scans matched on the way
+  // Odometry alone still counts from robot.start: at the stop it is as far from where the laser puts the
+  // robot as the set-down offset moves that point (8 cm here: 15 cm, turned 4 degrees about the start).
+  using projbot::robot::Pose2D;
+  const Pose2D T_room_odometry = projbot::robot::compose(Pose2D{set_down_x, set_down_y, set_down_rad},
+                                                         projbot::robot::inverse(Pose2D{start.x(), start.y(), start.z()}));
+  const Pose2D at_stop{stop.x(), stop.y(), stop.z()};
+  const double odometry_off_mm =
+      1000.0 * projbot::robot::distance_m(at_stop, projbot::robot::compose(projbot::robot::inverse(T_room_odometry), at_stop));
+  EXPECT_NEAR(number_after(visit, "odometry alone "), odometry_off_mm, 15.0) << r.output;
+  ASSERT_NE(served.find("truly at x "), std::string::npos) << served;
+  const std::string truly = served.substr(served.find("truly at x "));
+  EXPECT_NEAR(number_after(truly, "truly at x "), stop.x(), 0.03) << served << r.output;
+  EXPECT_NEAR(number_after(truly, " m, y "), stop.y(), 0.03) << served << r.output;
+  EXPECT_NEAR(static_cast<double>(ptu.pan_steps()) * scene.pan_tilt.step_rad, aim.angles.pan_rad, 0.05);
 }

@@ -15,7 +15,6 @@
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3DPDF.h>
 #include <mrpt/poses/CPosePDF.h>
-#include <mrpt/poses/CPosePDFGaussian.h>
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/serialization/CSerializable.h>
 #include <mrpt/slam/CICP.h>
@@ -279,7 +278,8 @@ std::vector<TrajectoryPoint> read_trajectory(const std::filesystem::path& path) 
 }
 
 SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,
-                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested, bool verbose) {
+                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested, bool verbose,
+                     const Pose2D& start) {
   const auto t0 = Clock::now();
   mrpt::slam::CMetricMapBuilderICP builder;
   // MRPT logs to stdout, where our results go: its lines go to stderr, and only with --verbose.
@@ -305,6 +305,8 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
   } catch (const std::exception& e) {
     throw RobotError((ini ? ini->string() : std::string("default icp-slam config")) + ": " + first_line(e));
   }
+  // The first pose at the origin, the map moved to `start` afterwards: given an initial pose instead,
+  // MRPT 2.5.x's builder stopped following the rawlog's odometry (one keyframe for the whole run).
   builder.initialize();
 
   SlamResult result;
@@ -316,10 +318,18 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
     mrpt::obs::CSensoryFrame frame;
     frame.insert(detail::to_mrpt(step.scan));
     builder.processActionObservation(*odometry_action(step.odometry_increment.value_or(Pose2D{}), step.timestamp_s), frame);
-    result.trajectory.push_back({step.timestamp_s, detail::from_mrpt(builder.getCurrentPoseEstimation()->getMeanVal())});
+    const Pose2D mapped = detail::from_mrpt(builder.getCurrentPoseEstimation()->getMeanVal());
+    result.trajectory.push_back({step.timestamp_s, compose(start, mapped)});
   }
   mrpt::maps::CSimpleMap keyframes;
   builder.getCurrentlyBuiltMap(keyframes);
+  const mrpt::poses::CPose3D T_map_first(detail::to_mrpt(start));  // the map moved to the frame of `start`
+  for (std::size_t i = 0; i < keyframes.size(); ++i) {
+    mrpt::poses::CPose3DPDF::Ptr pose;
+    mrpt::obs::CSensoryFrame::Ptr frame;
+    keyframes.get(i, pose, frame);
+    pose->changeCoordinatesReference(T_map_first);
+  }
   result.keyframes = keyframes.size();
 
   // The map is written whole into a folder beside out_dir, then swapped in: an old map stays usable

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "projbot/robot/pose2d.hpp"
 
 namespace projbot::tools {
 
@@ -35,5 +36,9 @@ extern const Command kRecord;
 extern const Command kCalibrateSimulate;
 extern const Command kCalibrateSolve;
 extern const Command kCalibrateCapture;
+
+/// A planar pose from "x y phi" (metres, metres, radians; commas also separate). Throws a UsageError-like
+/// config error naming `what` (the option) when it is not three finite numbers.
+robot::Pose2D parse_pose(const std::string& text, const std::string& what);
 
 }  // namespace projbot::tools

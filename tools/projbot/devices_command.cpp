@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <random>
+#include <sstream>
 #include <thread>
 
 #include "commands.hpp"
@@ -13,6 +15,10 @@
 #include "interrupt.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
+#include "projbot/robot/laser.hpp"
+#include "projbot/robot/pose2d.hpp"
+#include "projbot/robot/ros2_base.hpp"
+#include "projbot/robot/urg_emulator.hpp"
 
 namespace projbot::tools {
 namespace {
@@ -83,6 +89,105 @@ void list_found(std::ostream& out, int dds_domain) {
   out << "\n";
 }
 
+// sim-base's laser: a Hokuyo UTM-30LX on a pseudo-terminal linked at `link`, its scans ray-traced in the
+// scene's room from where the base truly stands (T_room_odometry composed with the server's pose, which
+// starts at robot.start). The link is removed when it is done.
+class SimBaseLaser {
+ public:
+  SimBaseLaser(const config::Scene& scene, std::filesystem::path link, const robot::Pose2D& T_room_odometry)
+      : map_(robot::OccupancyMap::from_room(room(scene))),
+        unit_(std::vector<std::uint32_t>(robot::UrgEmulator::kSteps, 0)),
+        link_(std::move(link)),
+        T_room_odometry_(T_room_odometry) {
+    std::error_code ec;
+    if (std::filesystem::is_symlink(link_, ec)) std::filesystem::remove(link_, ec);
+    std::filesystem::create_symlink(unit_.port(), link_, ec);
+    if (ec)
+      throw cli::UsageError("--laser " + link_.string() + ": cannot link the laser's pseudo-terminal there: " + ec.message());
+    laser_.rays = robot::UrgEmulator::kSteps;  // the UTM-30LX: 270 degrees in 0.25 degree steps
+  }
+  ~SimBaseLaser() {
+    std::error_code ec;
+    std::filesystem::remove(link_, ec);
+  }
+  SimBaseLaser(const SimBaseLaser&) = delete;
+  SimBaseLaser& operator=(const SimBaseLaser&) = delete;
+
+  // The scans from now on: from the base at `pose` (the server's frame).
+  void stand_at(const robot::Pose2D& pose) {
+    const robot::LaserScan scan = map_.simulate_scan(robot::compose(T_room_odometry_, pose), laser_, rng_);
+    std::vector<std::uint32_t> mm(scan.ranges_m.size(), 0);
+    for (std::size_t i = 0; i < mm.size(); ++i)
+      if (scan.valid[i]) mm[i] = static_cast<std::uint32_t>(std::lround(1000.0 * scan.ranges_m[i]));
+    unit_.set_ranges(std::move(mm));
+  }
+  int scans_sent() const { return unit_.scans_sent(); }
+
+ private:
+  static robot::RoomConfig room(const config::Scene& scene) {
+    robot::RoomConfig r;
+    r.width_m = scene.room.width_m;
+    r.depth_m = scene.room.depth_m;
+    for (const auto& o : scene.room.obstacles) r.obstacles.push_back({o[0], o[1], o[2], o[3]});
+    for (const auto& p : scene.props)
+      if (p.is_box()) r.obstacles.push_back({p.box_min_m.x(), p.box_min_m.y(), p.box_max_m.x(), p.box_max_m.y()});
+    return r;
+  }
+  robot::OccupancyMap map_;
+  robot::UrgEmulator unit_;
+  std::filesystem::path link_;
+  robot::Pose2D T_room_odometry_;
+  robot::LaserConfig laser_;
+  std::mt19937_64 rng_{7};
+};
+
+int serve_sim_base(const cli::Args& args) {
+  catch_interrupts();
+  config::BaseDevice base;
+  robot::Pose2D start{1.0, 1.0, 0.0};
+  std::optional<config::Scene> scene;
+  if (const auto path = args.get("config")) {
+    scene = config::load_scene(*path);
+    if (scene->devices.base) base = *scene->devices.base;
+    start = {scene->robot_start.x(), scene->robot_start.y(), scene->robot_start.z()};
+  }
+  base.domain = args.get_int("domain", base.domain, 0, 232);
+  const double seconds = args.get_double("seconds", 0.0);
+  if (!(seconds >= 0.0 && seconds <= 1e6)) throw cli::UsageError("--seconds must be 0 (until Ctrl-C) to 1e6");
+  const int rate = args.get_int("rate", 50, 1, 1000);
+  const robot::Pose2D true_start = args.get("true-start") ? parse_pose(*args.get("true-start"), "--true-start") : start;
+  const robot::Pose2D T_room_odometry = robot::compose(true_start, robot::inverse(start));  // where the base was set down
+  std::unique_ptr<SimBaseLaser> laser;
+  if (const auto link = args.get("laser")) {
+    if (!scene) throw cli::UsageError("--laser needs --config: the laser's scans are ray-traced in its room");
+    laser = std::make_unique<SimBaseLaser>(*scene, *link, T_room_odometry);
+  }
+  robot::Ros2BaseServer server(base, start);
+  std::cout << "serving the twin's youBot on DDS domain " << base.domain << ": rt/" << base.cmd_vel << " in, rt/" << base.odom
+            << " out at " << rate << " Hz";
+  if (laser) std::cout << "; its laser (Hokuyo UTM-30LX, SCIP 2.0) on " << *args.get("laser");
+  std::cout << " (Ctrl-C stops)" << std::endl;
+  const auto t0 = std::chrono::steady_clock::now();
+  const double dt = 1.0 / rate;
+  int steps = 0;
+  for (; !interrupted(); ++steps) {
+    const double t = steps * dt;
+    if (seconds > 0.0 && t >= seconds) break;
+    std::this_thread::sleep_until(
+        t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(t)));
+    server.step(t, dt);
+    if (laser) laser->stand_at(server.true_pose());
+  }
+  const auto& p = server.odometry_pose();
+  const robot::Pose2D truth = robot::compose(T_room_odometry, server.true_pose());
+  std::cout << "served " << steps << " odometry messages, " << server.commands_received() << " commands received; odometry at x "
+            << p.x_m << " m, y " << p.y_m << " m, heading " << p.theta_rad * 180.0 / M_PI << " deg; truly at x " << truth.x_m
+            << " m, y " << truth.y_m << " m, heading " << truth.theta_rad * 180.0 / M_PI << " deg";
+  if (laser) std::cout << "; " << laser->scans_sent() << " laser scans sent";
+  std::cout << "\n";
+  return interrupted() ? interrupt_exit_code() : 0;
+}
+
 }  // namespace
 
 const Command kDevices{"devices",
@@ -129,49 +234,26 @@ const Command kDevices{"devices",
 
 const Command kSimBase{"sim-base",
                        "serve the twin's youBot base on ROS 2 DDS topics (cmd_vel in, odom out), for trying a base driver",
-                       "projbot sim-base [--config site.yaml] [--domain N] [--seconds S] [--rate HZ]\n\n"
+                       "projbot sim-base [--config site.yaml] [--domain N] [--seconds S] [--rate HZ] [--laser LINK]\n"
+                       "                 [--true-start \"x y phi\"]\n\n"
                        "Runs the digital twin's youBot (wheel kinematics, encoders, wheel odometry; no drift) as a ROS 2 base\n"
                        "driver would: it follows the newest geometry_msgs/msg/Twist on rt/cmd_vel (stopping when none came\n"
                        "for 0.5 s) and publishes nav_msgs/msg/Odometry on rt/odom at --rate, over Cyclone DDS with ROS 2's\n"
                        "names on the wire, so `ros2 topic echo /odom` on another machine shows it and `projbot devices` or a\n"
                        "real session can drive it. The domain and topic names come from the config's `devices.base` (default\n"
-                       "domain 0, cmd_vel, odom), the start pose from its `robot.start`. Runs until Ctrl-C or --seconds.\n",
-                       {{"config", "FILE", "scene whose devices.base and robot.start to use"},
+                       "domain 0, cmd_vel, odom), the start pose from its `robot.start`. Runs until Ctrl-C or --seconds.\n\n"
+                       "With --laser it also serves the robot's laser: a Hokuyo UTM-30LX speaking SCIP 2.0 on a pseudo-terminal\n"
+                       "linked at LINK (what `devices.laser` names as COM_port_LIN, class CHokuyoURG), its scans ray-traced\n"
+                       "in the config's room (walls, obstacles and box props; not the targets) from where the base truly\n"
+                       "stands, the scanner 0.25 m ahead of the base (pose_x: 0.25). With --true-start the base truly starts\n"
+                       "there (metres, metres, radians) while its odometry starts at robot.start: a robot set down off its\n"
+                       "place, which only the laser can tell.\n",
+                       {{"config", "FILE", "scene whose devices.base, robot.start and room to use"},
                         {"domain", "N", "DDS domain id 0..232 (overrides devices.base.domain)"},
                         {"seconds", "S", "stop after S seconds (default 0: until Ctrl-C)"},
-                        {"rate", "HZ", "odometry messages per second (default 50)"}},
-                       [](const cli::Args& args) {
-                         catch_interrupts();
-                         config::BaseDevice base;
-                         robot::Pose2D start{1.0, 1.0, 0.0};
-                         if (const auto path = args.get("config")) {
-                           const config::Scene scene = config::load_scene(*path);
-                           if (scene.devices.base) base = *scene.devices.base;
-                           start = {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()};
-                         }
-                         base.domain = args.get_int("domain", base.domain, 0, 232);
-                         const double seconds = args.get_double("seconds", 0.0);
-                         if (!(seconds >= 0.0 && seconds <= 1e6))
-                           throw cli::UsageError("--seconds must be 0 (until Ctrl-C) to 1e6");
-                         const int rate = args.get_int("rate", 50, 1, 1000);
-                         robot::Ros2BaseServer server(base, start);
-                         std::cout << "serving the twin's youBot on DDS domain " << base.domain << ": rt/" << base.cmd_vel
-                                   << " in, rt/" << base.odom << " out at " << rate << " Hz (Ctrl-C stops)" << std::endl;
-                         const auto t0 = std::chrono::steady_clock::now();
-                         const double dt = 1.0 / rate;
-                         int steps = 0;
-                         for (; !interrupted(); ++steps) {
-                           const double t = steps * dt;
-                           if (seconds > 0.0 && t >= seconds) break;
-                           std::this_thread::sleep_until(t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                                  std::chrono::duration<double>(t)));
-                           server.step(t, dt);
-                         }
-                         const auto& p = server.odometry_pose();
-                         std::cout << "served " << steps << " odometry messages, " << server.commands_received()
-                                   << " commands received; odometry at x " << p.x_m << " m, y " << p.y_m << " m, heading "
-                                   << p.theta_rad * 180.0 / M_PI << " deg\n";
-                         return interrupted() ? interrupt_exit_code() : 0;
-                       }};
+                        {"rate", "HZ", "odometry messages per second (default 50)"},
+                        {"laser", "LINK", "serve the laser on a pseudo-terminal linked at LINK (needs --config)"},
+                        {"true-start", "\"x y phi\"", "where the base truly starts (default: robot.start)"}},
+                       serve_sim_base};
 
 }  // namespace projbot::tools

@@ -117,7 +117,8 @@ const Command kRecord{
     "  fakenect DIR/stop01 projbot run --config site.yaml   (camera: {driver: freenect, registered: false})\n"
     "The devices are the config's, as for run: a base, pan-tilt and camera together drive the robot with no\n"
     "twin, localised on a configured laser against devices.laser.map; a laser without a map is only\n"
-    "recorded (a mapping run: projbot slam --rawlog DIR/laser.rawlog makes the site's map). A\n"
+    "recorded (a mapping run: projbot slam --rawlog DIR/laser.rawlog --start \"robot.start\" makes the site's\n"
+    "map, in the scene's frame; record prints the command). A\n"
     "camera alone is read with the twin's robot; none, or --sim, is the twin's. Depth is kept to\n"
     "the Kinect's disparity steps, for the trackers too. Ctrl-C ends the stop in progress and keeps every\n"
     "stop recorded.\n",
@@ -198,6 +199,10 @@ const Command kRecord{
       observer.save();
       std::cout << "recorded " << rec.stops.size() << " stop(s), " << observer.frames << " frames from " << rec.camera << " to "
                 << *out << "\nreplay: projbot run --replay " << *out << "\n";
+      if (!rec.laser.empty())  // the rawlog's odometry starts at robot.start: the map goes in the scene's frame
+        std::cout << "map: projbot slam --rawlog " << (fs::path(*out) / rec.laser).string() << " --start \""
+                  << scene.robot_start.x() << " " << scene.robot_start.y() << " " << scene.robot_start.z()
+                  << "\" --out-map MAP --out-trajectory MAP.txt\n";
       return interrupt_exit_code();
     }};
 

@@ -63,6 +63,10 @@ void print_errors(const std::string& what, const ErrorStats& s) {
             << " deg, max " << s.max_m * 100 << " cm / " << s.max_deg << " deg over " << s.n << " poses\n";
 }
 
+const fs::path kDefaultGtRawlog = fs::path(PROJBOT_SHARED_DATA) / "mrpt" / "range_030_bearing_015.rawlog";
+
+}  // namespace
+
 Pose2D parse_pose(const std::string& text, const std::string& what) {
   std::string commas = text;
   for (char& c : commas)
@@ -71,25 +75,27 @@ Pose2D parse_pose(const std::string& text, const std::string& what) {
   return {v[0], v[1], v[2]};
 }
 
-const fs::path kDefaultGtRawlog = fs::path(PROJBOT_SHARED_DATA) / "mrpt" / "range_030_bearing_015.rawlog";
-
-}  // namespace
-
 const Command kSlam{
     "slam",
     "build the environment map from a laser rawlog (MRPT ICP-SLAM)",
-    "projbot slam --rawlog R [--config icp-slam.ini] --out-map DIR --out-trajectory T.txt [--ground-truth GT.txt]\n\n"
+    "projbot slam --rawlog R [--config icp-slam.ini] --out-map DIR --out-trajectory T.txt [--ground-truth GT.txt]\n"
+    "            [--start \"x y phi\"]\n\n"
     "Runs mrpt::slam::CMetricMapBuilderICP over an MRPT rawlog of 2-D laser scans and odometry. DIR receives\n"
     "map.simplemap.gz (keyframes, what `projbot localize` reads), grid.png and grid.yaml (occupancy grid,\n"
     "ROS map_server form). T.txt gets one line per step: timestamp x y phi (s, m, m, rad). Without --config the\n"
     "settings of MRPT's icp-slam_demo_classic.ini apply. With --ground-truth (same line format) it prints the\n"
-    "trajectory error; without, the gap between the first and last pose for SLAM and for odometry alone.\n",
+    "trajectory error; without, the gap between the first and last pose for SLAM and for odometry alone.\n"
+    "The map's frame is the one the rawlog's first pose is given in by --start (metres, metres, radians;\n"
+    "default 0 0 0, the first pose is the origin). For a mapping run of `projbot record` (a laser configured\n"
+    "without a map), pass the scene's robot.start, as record says: the map is then in the scene's frame, where\n"
+    "its targets, stops and robot.start are, and `projbot run` localises in it.\n",
     {{"rawlog", "FILE", "MRPT rawlog (.rawlog, plain or gzip)"},
      {"config", "FILE", "icp-slam .ini with [MappingApplication] and [ICP] sections"},
      {"out-map", "DIR", "directory for the map (created)"},
      {"out-trajectory", "FILE", "where to write the corrected trajectory"},
      {"ground-truth", "FILE", "true trajectory to compare with (timestamp x y phi lines)"},
-     {"verbose", "", "let MRPT's own log lines (its map builder's) through to stderr"}},
+     {"verbose", "", "let MRPT's own log lines (its map builder's) through to stderr"},
+     {"start", "\"x y phi\"", "where the rawlog's first pose lies in the map (default 0 0 0)"}},
     [](const cli::Args& args) {
       for (const char* required : {"rawlog", "out-map", "out-trajectory"})
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
@@ -101,6 +107,7 @@ const Command kSlam{
         for (const auto& warning : robot::check_icp_slam_config(*ini)) std::cerr << "projbot slam: warning: " << warning << '\n';
       std::optional<std::vector<robot::TrajectoryPoint>> truth;  // read before the work: a bad file costs nothing
       if (const auto gt = args.get("ground-truth")) truth = robot::read_trajectory(*gt);
+      const Pose2D start = parse_pose(args.get_or("start", "0 0 0"), "--start");
       catch_interrupts();  // Ctrl-C: map and write the scans done so far, then exit 130
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
       std::cout << "mapping " << steps.size() << " scans (Ctrl-C stops and keeps the map of the scans done)..." << std::endl;
@@ -112,7 +119,7 @@ const Command kSlam{
             if (++asked > 1) progress.step(asked - 1);
             return interrupted();
           },
-          args.flag("verbose"));
+          args.flag("verbose"), start);
       robot::write_trajectory(*args.get("out-trajectory"), r.trajectory);
       if (r.interrupted) {
         std::cout << "ICP-SLAM interrupted after " << r.trajectory.size() << " of " << steps.size()

@@ -56,9 +56,12 @@ std::vector<std::string> check_icp_slam_config(const std::filesystem::path& ini)
 /// `stop_requested`, asked before each step, ends the run there (Ctrl-C): the steps done are mapped and
 /// written as for a whole run.
 /// `verbose` lets MRPT's own log lines (its map builder's, at info level) through to stderr.
+/// `start` is where the rawlog's first pose lies in the map (its odometry holds increments only): the
+/// map and the trajectory are in that frame, so a mapping run begun at the scene's robot.start gives a
+/// map in the scene's world frame.
 SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,
-                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested = {},
-                     bool verbose = false);
+                     const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested = {}, bool verbose = false,
+                     const Pose2D& start = {});
 
 /// Localiser settings.
 struct LocalizerConfig {
