@@ -1,6 +1,9 @@
 // The configured-laser path (MrptLaser, MRPT's CHokuyoURG driver) end to end against a Hokuyo UTM-30LX
 // emulated on a pty, speaking SCIP 2.0.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <poll.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -59,6 +62,34 @@ TEST(UrgLaser, FollowsWhatTheUnitSeesNow) {
   while (!moved && std::chrono::steady_clock::now() < give_up) moved = std::abs(laser.next(1.0).ranges_m[0] - 1.5f) < 1e-4f;
   EXPECT_TRUE(moved);
   EXPECT_GT(unit.scans_sent(), 1);
+}
+
+// What a unit answers a command it does not know, or a scan request it cannot read: status 0E, and it
+// stays ready for the next command.
+TEST(UrgLaser, AMalformedCommandIsRefusedAndTheUnitAnswersOn) {
+  UrgEmulator unit(ramp(0));
+  const int fd = ::open(unit.port().c_str(), O_RDWR | O_NOCTTY);
+  ASSERT_GE(fd, 0);
+  const auto ask = [&](const std::string& cmd) {
+    const std::string line = cmd + "\n";
+    EXPECT_EQ(::write(fd, line.data(), line.size()), static_cast<ssize_t>(line.size()));
+    std::string reply;
+    char buf[512];
+    for (int i = 0; i < 100 && (reply.size() < 2 || reply.substr(reply.size() - 2) != "\n\n"); ++i) {
+      pollfd p{fd, POLLIN, 0};
+      if (::poll(&p, 1, 20) > 0) {
+        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (n > 0) reply.append(buf, static_cast<std::size_t>(n));
+      }
+    }
+    return reply;
+  };
+  EXPECT_EQ(ask("MD0000108001x00"),
+            "MD0000108001x00\n0E" + std::string(1, static_cast<char>((('0' + 'E') & 0x3F) + 0x30)) + "\n\n");
+  EXPECT_EQ(ask("XX"), "XX\n0E" + std::string(1, static_cast<char>((('0' + 'E') & 0x3F) + 0x30)) + "\n\n");
+  EXPECT_NE(ask("VV").find("PROT:SCIP 2.0;"), std::string::npos);
+  EXPECT_EQ(unit.scans_sent(), 0);
+  ::close(fd);
 }
 
 TEST(UrgLaser, AnEmulatorRefusesAScanOfTheWrongSize) {

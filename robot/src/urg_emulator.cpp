@@ -5,6 +5,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <mutex>
 #include <thread>
@@ -77,7 +78,8 @@ struct UrgEmulator::Impl {
     if (cmd == "II")
       return ok + info({"MODL:UTM-30LX", "LASR:ON", "SCSP:2400", "MESM:Measuring", "SBPS:Unknown", "TIME:" + encode(ms(), 4)}) +
              "\n";
-    if ((cmd.rfind("MD", 0) == 0 || cmd.rfind("ME", 0) == 0) && cmd.size() == 15) {
+    const auto digits = [&] { return std::all_of(cmd.begin() + 2, cmd.end(), [](char c) { return c >= '0' && c <= '9'; }); };
+    if ((cmd.rfind("MD", 0) == 0 || cmd.rfind("ME", 0) == 0) && cmd.size() == 15 && digits()) {
       streaming = cmd;
       next_scan = Clock::now();
       return ok + "\n";
