@@ -207,6 +207,7 @@ class Lane final : public alignment::PoseTracker {
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const alignment::Footing& footing,
                          std::shared_ptr<const assets::Image> colour) override;
   std::optional<alignment::PoseSample> track(std::shared_ptr<const alignment::DepthImage> frame) override;
+  // The tour runs in lockstep: a frame handed over is tracked at once, its result kept for its ready time.
   void submit(std::shared_ptr<const alignment::DepthImage> frame) override { track(std::move(frame)); }
   // Whether it takes a frame that arrives at t_s (simulated clock).
   bool free_at(double t_s) const { return free_s_ <= t_s; }
