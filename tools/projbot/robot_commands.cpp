@@ -87,8 +87,9 @@ const Command kSlam{
     "trajectory error; without, the gap between the first and last pose for SLAM and for odometry alone.\n"
     "The map's frame is the one the rawlog's first pose is given in by --start (metres, metres, radians;\n"
     "default 0 0 0, the first pose is the origin). For a mapping run of `projbot record` (a laser configured\n"
-    "without a map), pass the scene's robot.start, as record says: the map is then in the scene's frame, where\n"
-    "its targets, stops and robot.start are, and `projbot run` localises in it.\n",
+    "without a map), pass where it began as record prints it (the scene's robot.start, its heading in\n"
+    "radians): the map is then in the scene's frame, where its targets, stops and robot.start are, and\n"
+    "`projbot run` localises in it.\n",
     {{"rawlog", "FILE", "MRPT rawlog (.rawlog, plain or gzip)"},
      {"config", "FILE", "icp-slam .ini with [MappingApplication] and [ICP] sections"},
      {"out-map", "DIR", "directory for the map (created)"},
