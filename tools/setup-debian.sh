@@ -3,13 +3,17 @@
 # Safe to run again: it asks apt only for what dpkg does not already have.
 set -euo pipefail
 
+# Every package is named: the script installs without recommends, so nothing may come in as one (clang's
+# sanitizer and libFuzzer runtimes are libclang-rt-14-dev, not clang). After changing this list, run
+# tools/fresh-check.sh (the quick start on a fresh Debian 12 root).
 packages=(
-  build-essential cmake ninja-build ccache pkg-config git clang clang-format
+  build-essential cmake ninja-build ccache pkg-config git ca-certificates
+  clang libclang-rt-14-dev clang-format
   libvulkan-dev vulkan-validationlayers mesa-vulkan-drivers glslang-tools vulkan-tools
   libglm-dev libeigen3-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
   libglfw3-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
   libpcl-dev libopenni2-dev libfreenect-dev libfreenect-bin cyclonedds-dev cyclonedds-tools libtiff-dev libboost-dev libmrpt-dev
-  libopencv-dev libopencv-contrib-dev
+  libopencv-dev libopencv-contrib-dev libassimp-dev
   libx11-dev libxrandr-dev xvfb x11-apps xauth bc valgrind
 )
 
