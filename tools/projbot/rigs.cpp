@@ -28,7 +28,7 @@ SceneTrackers make_trackers(const config::Scene& scene, const alignment::WorkerC
   for (std::size_t i = 0; i < n; ++i) {
     const config::TargetConfig& c = scene.targets[i];
     if (!c.T_world_target && !c.T_map_target) continue;
-    auto model = assets::load_gltf(c.model);
+    auto model = assets::load_model(c.model);
     assets::scale_and_recenter(model, c.scale, c.recenter);
     t.clouds[i] = std::make_unique<alignment::ModelCloud>(alignment::model_cloud_from(model, 50000));
     t.owned[i] = std::make_unique<alignment::TrackerWorker>(*t.clouds[i], k, config);

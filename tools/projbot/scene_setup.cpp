@@ -92,7 +92,7 @@ config::Scene scene_from_args(const cli::Args& args) {
   }
   if (frame_model) {
     // Framing needs the model's size: load it once here (upload_scene loads it again, cheaply).
-    auto model = assets::load_gltf(scene.targets[0].model);
+    auto model = assets::load_model(scene.targets[0].model);
     assets::scale_and_recenter(model, 1.0, true);
     const double radius = 0.5 * model.bounds().diagonal().norm();
     if (!(radius > 0.0) || !std::isfinite(radius))
@@ -111,7 +111,7 @@ config::Scene scene_from_args(const cli::Args& args) {
 std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene) {
   std::vector<engine::DrawItem> items;
   for (const auto& target : scene.targets) {
-    auto model = assets::load_gltf(target.model);
+    auto model = assets::load_model(target.model);
     assets::scale_and_recenter(model, target.scale, target.recenter);
     items.push_back({renderer.add_model(model), target.T_projector_target});
   }

@@ -86,7 +86,7 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
       footprints.push_back({p.box_min_m.x(), p.box_min_m.y(), p.box_max_m.x(), p.box_max_m.y()});
       continue;
     }
-    assets::Model model = assets::load_gltf(p.model);
+    assets::Model model = assets::load_model(p.model);
     assets::scale_and_recenter(model, p.scale, p.recenter);
     footprints.push_back(footprint(world_bounds(model, p.T_world_prop)));
     props_.push_back({std::make_unique<MeshRaycaster>(model), renderer_.add_model(model), p.T_world_prop});
@@ -98,7 +98,7 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
       throw TwinError(where + ": target '" + t.name + "' has no markers to measure the projection error at");
     TwinTarget tt;
     tt.config = t;
-    tt.model = assets::load_gltf(t.model);
+    tt.model = assets::load_model(t.model);
     assets::scale_and_recenter(tt.model, t.scale, t.recenter);
     tt.raycaster = std::make_unique<MeshRaycaster>(tt.model);
     for (std::size_t k = 0; k < t.markers_m.size(); ++k) {

@@ -67,6 +67,16 @@ struct Model {
 /// Throws AssetError naming the file and the problem; never returns a partly loaded model.
 Model load_gltf(const std::filesystem::path& path);
 
+/// Loads a PLY (binary or ASCII), OBJ (with its .mtl) or STL mesh through Assimp, in a child process (the
+/// importers are not safe on hostile files). Faces are triangulated; normals come from the faces where the
+/// file has none; UVs are flipped to glTF's top-left origin. A material's texture that is missing or
+/// unreadable is a warning on stderr and the material keeps its base colour. Units as stored (scale with
+/// scale_and_recenter). Throws AssetError naming the file; a file without faces is an error.
+Model load_mesh(const std::filesystem::path& path);
+
+/// load_gltf for .gltf / .glb, load_mesh for .ply / .obj / .stl; any other extension is an AssetError.
+Model load_model(const std::filesystem::path& path);
+
 /// Scales the model frame uniformly, then (if recenter) moves the origin to the surface centroid.
 void scale_and_recenter(Model& model, double scale, bool recenter);
 
