@@ -1,8 +1,11 @@
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
+#include "projbot/config/rigid.hpp"
 #include "projbot/config/scene.hpp"
 
 namespace projbot::config {
@@ -19,15 +22,31 @@ Eigen::Matrix4d pose_from_xyz_rpy(const Eigen::Vector3d& translation_m, const Ei
   return T;
 }
 
-void validate_rigid(const Eigen::Matrix4d& T, std::string_view where) {
+namespace {
+
+void check_rigid(const Eigen::Matrix4d& T, std::string_view where, double tolerance) {
   const auto fail = [&](const std::string& why) { throw ConfigError(std::string(where) + ": " + why); };
   if (!T.allFinite()) fail("pose has a non-finite entry");
   if ((T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > 1e-9) fail("pose's last row must be 0 0 0 1");
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   const double orth = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  if (orth > 1e-6 || R.determinant() < 0.0)
-    fail("pose's rotation is not a proper rotation (orthonormality error " + std::to_string(orth) + ", det " +
-         std::to_string(R.determinant()) + "); scale the model with 'scale' instead");
+  if (orth > tolerance || R.determinant() < 0.0) {
+    char numbers[96];
+    std::snprintf(numbers, sizeof numbers, "orthonormality error %.3g, allowed %.1g, det %.6g", orth, tolerance, R.determinant());
+    fail("pose's rotation is not a proper rotation (" + std::string(numbers) + "); scale the model with 'scale' instead");
+  }
+}
+
+}  // namespace
+
+void validate_rigid(const Eigen::Matrix4d& T, std::string_view where) { check_rigid(T, where, 1e-6); }
+
+Eigen::Matrix4d orthonormalised_rigid(const Eigen::Matrix4d& T, std::string_view where, double tolerance) {
+  check_rigid(T, where, tolerance);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(T.topLeftCorner<3, 3>(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix4d out = T;
+  out.topLeftCorner<3, 3>() = svd.matrixU() * svd.matrixV().transpose();  // det +1: checked above, near I
+  return out;
 }
 
 std::vector<double> parse_number_list(std::string_view text, std::size_t count, std::string_view what) {

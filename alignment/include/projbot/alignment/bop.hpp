@@ -1,0 +1,74 @@
+#pragma once
+// BOP datasets (the Benchmark for 6D Object Pose Estimation's format, which LM, LM-O, YCB-V, T-LESS, HB
+// ... ship in): models in millimetres with models_info.json, and per scene depth/ rgb/ mask_visib/
+// images with scene_camera.json, scene_gt.json and scene_gt_info.json. Read and checked once; every
+// problem is an AlignmentError naming the file and what is wrong. Poses come out in metres.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "projbot/alignment/depth.hpp"
+
+namespace projbot::alignment {
+
+/// One object of the dataset (models_info.json).
+struct BopObject {
+  int id = 0;
+  std::filesystem::path model;  ///< models/obj_IIIIII.ply, millimetres
+  double diameter_m = 0.0;
+  /// Scored with ADD-S: models_info.json gives symmetries, or (none given anywhere) a YCB-V dataset's
+  /// known symmetric shapes.
+  bool symmetric = false;
+};
+
+/// One annotated instance in one image (scene_gt.json with scene_gt_info.json).
+struct BopInstance {
+  int gt_index = 0;  ///< position in that image's scene_gt.json list (mask_visib/IMAGE_GTINDEX.png)
+  int obj_id = 0;
+  Eigen::Matrix4d T_camera_model = Eigen::Matrix4d::Identity();  ///< metres, rotation re-orthonormalised
+  int visible_px = -1;                                           ///< px_count_visib; -1 where not given
+};
+
+/// One image of a scene.
+struct BopImage {
+  int id = 0;
+  CameraIntrinsics k;                        ///< cam_K, with the depth image's size
+  double depth_units_per_m = 1000.0;         ///< 1000 / depth_scale (depth_scale: mm per stored unit)
+  std::filesystem::path depth;               ///< depth/IIIIII.png
+  std::optional<std::filesystem::path> rgb;  ///< rgb/IIIIII.png or .jpg, where the dataset has it
+  std::vector<BopInstance> instances;
+};
+
+struct BopScene {
+  std::string name;  ///< the scene folder's name, e.g. "000001"
+  std::filesystem::path folder;
+  std::vector<BopImage> images;  ///< in image id order
+};
+
+struct BopDataset {
+  std::filesystem::path root;
+  std::vector<BopObject> objects;  ///< by id
+  std::vector<BopScene> scenes;    ///< by name
+  const BopObject* object(int id) const;
+};
+
+/// The ids YCB-V's own evaluation scores as symmetric (cans, bowl, wood block, marker, clamps, foam brick).
+inline const std::vector<int> kYcbvSymmetricIds{1, 4, 6, 13, 16, 18, 19, 20, 21};
+
+/// Reads the dataset at `root` (holding models/ and `split`/), only the scenes named in `scenes` when it
+/// is not empty. Checks every JSON file, that each image's depth image exists, that scene_gt_info.json
+/// lists as many instances as scene_gt.json, that every obj_id has a model, and that poses are rigid.
+/// Images are not decoded here: read_bop_depth does that.
+BopDataset read_bop_dataset(const std::filesystem::path& root, const std::vector<std::string>& scenes = {},
+                            const std::string& split = "test");
+
+/// The image's depth in metres; an image whose size disagrees with the first image's camera is an error.
+DepthImage read_bop_depth(const BopImage& image);
+
+/// mask_visib/IMAGE_GTINDEX.png of one instance as a per-pixel flag (row-major, the depth image's size).
+std::vector<std::uint8_t> read_bop_mask(const BopScene& scene, const BopImage& image, const BopInstance& instance);
+
+}  // namespace projbot::alignment

@@ -1,0 +1,255 @@
+// BOP dataset reader: models_info.json and each scene's scene_camera / scene_gt / scene_gt_info JSON, checked
+// once. nlohmann::json parses; every value read from it is checked for kind and range here.
+
+#include "projbot/alignment/bop.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "projbot/assets/image.hpp"
+#include "projbot/config/rigid.hpp"
+
+namespace projbot::alignment {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr std::uintmax_t kMaxJsonBytes = 256ULL << 20;
+
+[[noreturn]] void fail(const fs::path& file, const std::string& why) { throw AlignmentError(file.string() + ": " + why); }
+
+json read_json(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) fail(file, "missing (a BOP dataset needs it)");
+  if (!fs::is_regular_file(file, ec)) fail(file, "not a regular file");
+  if (fs::file_size(file, ec) > kMaxJsonBytes) fail(file, "larger than 256 MB, not a BOP annotation file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) fail(file, "cannot be opened");
+  try {
+    json j = json::parse(in);
+    if (!j.is_object()) fail(file, "must hold a JSON object");
+    return j;
+  } catch (const json::exception& e) {
+    fail(file, std::string("malformed JSON (") + e.what() + ")");
+  }
+}
+
+int parse_id(const fs::path& file, const std::string& key) {
+  int id = -1;
+  std::istringstream in(key);
+  in >> id;
+  if (!in || !in.eof() || id < 0) fail(file, "key '" + key + "' is not an id (a whole number >= 0)");
+  return id;
+}
+
+std::vector<double> numbers(const fs::path& file, const json& value, std::size_t count, const std::string& what) {
+  if (!value.is_array() || value.size() != count) fail(file, what + " must be a list of " + std::to_string(count) + " numbers");
+  std::vector<double> out;
+  for (const json& v : value) {
+    if (!v.is_number() || !std::isfinite(v.get<double>())) fail(file, what + " holds a value that is not a finite number");
+    out.push_back(v.get<double>());
+  }
+  return out;
+}
+
+const json& member(const fs::path& file, const json& object, const char* key, const std::string& where) {
+  if (!object.is_object() || !object.contains(key)) fail(file, where + " has no '" + key + "'");
+  return object.at(key);
+}
+
+std::string image_name(int id, const char* ext) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d%s", id, ext);
+  return name;
+}
+
+bool has_symmetries(const json& info) { return info.contains("symmetries_discrete") || info.contains("symmetries_continuous"); }
+
+std::vector<BopObject> read_objects(const fs::path& root) {
+  const fs::path file = root / "models" / "models_info.json";
+  const json info = read_json(file);
+  bool any_symmetry = false;
+  for (const auto& [key, value] : info.items()) any_symmetry = any_symmetry || has_symmetries(value);
+  // BOP's YCB-V ships symmetries; a dataset that names none anywhere (converted elsewhere) but is YCB-V
+  // gets YCB-V's list, so its cans and clamps are not scored as if their turn could be seen.
+  const bool ycbv = root.filename().string().find("ycbv") != std::string::npos ||
+                    root.parent_path().filename().string().find("ycbv") != std::string::npos;
+  std::vector<BopObject> objects;
+  for (const auto& [key, value] : info.items()) {
+    BopObject o;
+    o.id = parse_id(file, key);
+    const json& d = member(file, value, "diameter", "object " + key);
+    if (!d.is_number() || !(d.get<double>() > 0.0) || !std::isfinite(d.get<double>()))
+      fail(file, "object " + key + ": diameter must be a finite number > 0 (mm)");
+    o.diameter_m = d.get<double>() / 1000.0;
+    o.model = root / "models" / ("obj_" + image_name(o.id, ".ply"));
+    o.symmetric =
+        any_symmetry ? has_symmetries(value) : ycbv && std::count(kYcbvSymmetricIds.begin(), kYcbvSymmetricIds.end(), o.id) > 0;
+    objects.push_back(o);
+  }
+  if (objects.empty()) fail(file, "lists no objects");
+  std::sort(objects.begin(), objects.end(), [](const BopObject& a, const BopObject& b) { return a.id < b.id; });
+  return objects;
+}
+
+BopImage read_camera(const fs::path& file, const fs::path& folder, int id, const json& cam) {
+  const std::string where = "image " + std::to_string(id);
+  BopImage image;
+  image.id = id;
+  const auto K = numbers(file, member(file, cam, "cam_K", where), 9, where + ": cam_K");
+  if (!(K[0] > 0.0) || !(K[4] > 0.0)) fail(file, where + ": cam_K's focal lengths must be > 0");
+  image.k.fx_px = K[0], image.k.fy_px = K[4], image.k.cx_px = K[2], image.k.cy_px = K[5];
+  const json& scale = member(file, cam, "depth_scale", where);
+  if (!scale.is_number() || !(scale.get<double>() > 0.0) || !std::isfinite(scale.get<double>()))
+    fail(file, where + ": depth_scale must be a finite number > 0 (mm per stored unit)");
+  image.depth_units_per_m = 1000.0 / scale.get<double>();
+  image.depth = folder / "depth" / image_name(id, ".png");
+  std::error_code ec;
+  if (!fs::is_regular_file(image.depth, ec))
+    fail(image.depth, "missing: " + file.string() + " lists image " + std::to_string(id));
+  for (const char* ext : {".png", ".jpg"})
+    if (fs::is_regular_file(folder / "rgb" / image_name(id, ext), ec)) image.rgb = folder / "rgb" / image_name(id, ext);
+  return image;
+}
+
+BopInstance read_instance(const fs::path& file, const json& gt, const std::string& where) {
+  BopInstance inst;
+  const json& obj = member(file, gt, "obj_id", where);
+  if (!obj.is_number_integer() || obj.get<long long>() < 0 || obj.get<long long>() > 1000000)
+    fail(file, where + ": obj_id must be a whole number >= 0");
+  inst.obj_id = obj.get<int>();
+  const auto R = numbers(file, member(file, gt, "cam_R_m2c", where), 9, where + ": cam_R_m2c");
+  const auto t = numbers(file, member(file, gt, "cam_t_m2c", where), 3, where + ": cam_t_m2c");
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  for (int i = 0; i < 9; ++i) T(i / 3, i % 3) = R[static_cast<std::size_t>(i)];
+  for (int i = 0; i < 3; ++i) T(i, 3) = t[static_cast<std::size_t>(i)] / 1000.0;
+  try {
+    inst.T_camera_model = config::orthonormalised_rigid(T, file.string() + ": " + where);
+  } catch (const std::exception& e) {
+    throw AlignmentError(e.what());
+  }
+  return inst;
+}
+
+void read_instances(const fs::path& folder, std::map<int, BopImage>& images) {
+  const fs::path gt_file = folder / "scene_gt.json", info_file = folder / "scene_gt_info.json";
+  const json gt = read_json(gt_file);
+  std::error_code ec;
+  const std::optional<json> info = fs::exists(info_file, ec) ? std::optional<json>(read_json(info_file)) : std::nullopt;
+  for (const auto& [key, list] : gt.items()) {
+    const int id = parse_id(gt_file, key);
+    const auto image = images.find(id);
+    if (image == images.end()) fail(gt_file, "image " + key + " is not in scene_camera.json");
+    if (!list.is_array()) fail(gt_file, "image " + key + " must hold a list of instances");
+    const json* visib = nullptr;
+    if (info) {
+      if (!info->contains(key)) fail(info_file, "image " + key + " is missing (scene_gt.json lists it)");
+      visib = &info->at(key);
+      if (!visib->is_array() || visib->size() != list.size())
+        fail(info_file, "image " + key + " lists " + std::to_string(visib->is_array() ? visib->size() : 0) +
+                            " instances, scene_gt.json " + std::to_string(list.size()));
+    }
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string where = "image " + key + ", instance " + std::to_string(i);
+      BopInstance inst = read_instance(gt_file, list[i], where);
+      inst.gt_index = static_cast<int>(i);
+      if (visib) {
+        const json& px = member(info_file, (*visib)[i], "px_count_visib", where);
+        if (!px.is_number_integer() || px.get<long long>() < 0 || px.get<long long>() > 100000000)
+          fail(info_file, where + ": px_count_visib must be a whole number >= 0");
+        inst.visible_px = px.get<int>();
+      }
+      image->second.instances.push_back(inst);
+    }
+  }
+}
+
+BopScene read_scene(const fs::path& folder) {
+  BopScene scene;
+  scene.name = folder.filename().string();
+  scene.folder = folder;
+  const fs::path cam_file = folder / "scene_camera.json";
+  const json cams = read_json(cam_file);
+  std::map<int, BopImage> images;
+  for (const auto& [key, cam] : cams.items()) {
+    const int id = parse_id(cam_file, key);
+    images.emplace(id, read_camera(cam_file, folder, id, cam));
+  }
+  if (images.empty()) fail(cam_file, "lists no images");
+  read_instances(folder, images);
+  for (auto& [id, image] : images) scene.images.push_back(std::move(image));
+  return scene;
+}
+
+}  // namespace
+
+const BopObject* BopDataset::object(int id) const {
+  for (const BopObject& o : objects)
+    if (o.id == id) return &o;
+  return nullptr;
+}
+
+BopDataset read_bop_dataset(const fs::path& root, const std::vector<std::string>& scenes, const std::string& split) {
+  std::error_code ec;
+  if (!fs::is_directory(root, ec)) fail(root, "no such folder (a BOP dataset: models/ and " + split + "/)");
+  BopDataset out;
+  out.root = root;
+  out.objects = read_objects(root);
+  const fs::path split_dir = root / split;
+  if (!fs::is_directory(split_dir, ec)) fail(split_dir, "no such folder (the dataset's " + split + " split)");
+  std::vector<fs::path> folders;
+  for (const auto& entry : fs::directory_iterator(split_dir, ec))
+    if (entry.is_directory() && (scenes.empty() || std::count(scenes.begin(), scenes.end(), entry.path().filename().string())))
+      folders.push_back(entry.path());
+  for (const std::string& s : scenes)
+    if (!fs::is_directory(split_dir / s, ec)) fail(split_dir / s, "no such scene");
+  if (folders.empty()) fail(split_dir, "holds no scene folders");
+  std::sort(folders.begin(), folders.end());
+  for (const fs::path& f : folders) out.scenes.push_back(read_scene(f));
+  std::set<int> missing;
+  for (const BopScene& s : out.scenes)
+    for (const BopImage& im : s.images)
+      for (const BopInstance& inst : im.instances)
+        if (!out.object(inst.obj_id))
+          fail(s.folder / "scene_gt.json", "obj_id " + std::to_string(inst.obj_id) + " is not in models_info.json");
+  for (const BopObject& o : out.objects)
+    if (!fs::is_regular_file(o.model, ec)) missing.insert(o.id);
+  for (const BopScene& s : out.scenes)
+    for (const BopImage& im : s.images)
+      for (const BopInstance& inst : im.instances)
+        if (missing.count(inst.obj_id))
+          fail(out.object(inst.obj_id)->model, "missing (object " + std::to_string(inst.obj_id) + " has instances)");
+  return out;
+}
+
+DepthImage read_bop_depth(const BopImage& image) {
+  DepthImage d = read_depth_png(image.depth, image.depth_units_per_m);
+  if (!(image.k.cx_px > 0.0 && image.k.cx_px < d.width && image.k.cy_px > 0.0 && image.k.cy_px < d.height))
+    fail(image.depth,
+         "cam_K's principal point lies outside the " + std::to_string(d.width) + "x" + std::to_string(d.height) + " image");
+  return d;
+}
+
+std::vector<std::uint8_t> read_bop_mask(const BopScene& scene, const BopImage& image, const BopInstance& instance) {
+  char name[48];
+  std::snprintf(name, sizeof name, "%06d_%06d.png", image.id, instance.gt_index);
+  const fs::path file = scene.folder / "mask_visib" / name;
+  assets::Image mask;
+  try {
+    mask = assets::read_image(file);
+  } catch (const assets::AssetError& e) {
+    throw AlignmentError(e.what());
+  }
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(mask.width) * mask.height);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = mask.rgba[4 * i] > 127 ? 1 : 0;
+  return out;
+}
+
+}  // namespace projbot::alignment

@@ -1,0 +1,212 @@
+// The BOP dataset reader on the shared YCB-V frames and on broken copies, the pose-error measures, and
+// rigid transforms read from outside.
+
+#include "projbot/alignment/bop.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "projbot/alignment/pose_error.hpp"
+#include "projbot/config/rigid.hpp"
+#include "projbot/config/scene.hpp"
+
+namespace fs = std::filesystem;
+using projbot::alignment::AlignmentError;
+using projbot::alignment::read_bop_dataset;
+
+namespace {
+
+const fs::path kYcbv = fs::path(PROJBOT_SHARED_DATA) / "ycbv-bop";
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void spill(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p) << text;
+}
+
+// A copy of the dataset's models_info and scene 000000's annotations and depth images, to break.
+class BopCopy : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("projbot_bop_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "models");
+    fs::copy_file(kYcbv / "models" / "models_info.json", dir_ / "models" / "models_info.json");
+    for (int id : {8, 14, 21}) {
+      char name[32];
+      std::snprintf(name, sizeof name, "obj_%06d.ply", id);
+      fs::copy_file(kYcbv / "models" / name, dir_ / "models" / name);
+    }
+    fs::create_directories(scene());
+    fs::copy(kYcbv / "test" / "000000", scene(), fs::copy_options::recursive);
+    // ../shared comes without write bits (CI): the copy must be ours to break.
+    for (const auto& e : fs::recursive_directory_iterator(dir_))
+      fs::permissions(e.path(), fs::perms::owner_read | fs::perms::owner_write | fs::perms::owner_exec, fs::perm_options::add);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path scene() const { return dir_ / "test" / "000000"; }
+  // The reader's message on the copy as it is now.
+  std::string error() const {
+    try {
+      read_bop_dataset(dir_);
+    } catch (const AlignmentError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
+  fs::path dir_;
+};
+
+}  // namespace
+
+TEST(BopDataset, ReadsTheSharedYcbvFrames) {
+  const auto data = read_bop_dataset(kYcbv);
+  ASSERT_EQ(data.scenes.size(), 3U);
+  std::size_t instances = 0, images = 0;
+  for (const auto& s : data.scenes) {
+    images += s.images.size();
+    for (const auto& im : s.images) instances += im.instances.size();
+  }
+  EXPECT_EQ(images, 60U);
+  EXPECT_EQ(instances, 260U);  // the shared data's README
+  const auto& first = data.scenes[0].images[0];
+  EXPECT_EQ(data.scenes[0].name, "000000");
+  EXPECT_EQ(first.id, 1);
+  EXPECT_NEAR(first.k.fx_px, 1066.778, 1e-9);
+  EXPECT_NEAR(first.k.cy_px, 241.3109, 1e-9);
+  EXPECT_NEAR(first.depth_units_per_m, 10000.0, 1e-6);  // depth_scale 0.1 mm per unit
+  ASSERT_TRUE(first.rgb.has_value());
+  ASSERT_EQ(first.instances.size(), 3U);
+  const auto& gelatin = first.instances[0];
+  EXPECT_EQ(gelatin.obj_id, 8);
+  EXPECT_EQ(gelatin.gt_index, 0);
+  EXPECT_EQ(gelatin.visible_px, 18265);
+  EXPECT_NEAR(gelatin.T_camera_model(0, 3), -0.030632, 1e-6);  // cam_t_m2c in mm, now metres
+  EXPECT_NEAR(gelatin.T_camera_model(2, 3), 0.592641, 1e-6);
+  const Eigen::Matrix3d R = gelatin.T_camera_model.topLeftCorner<3, 3>();
+  EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  // YCB-V without symmetry entries: its own list (mug 14 is not in it; foam brick 21 and wood block 16 are).
+  EXPECT_TRUE(data.object(21)->symmetric);
+  EXPECT_TRUE(data.object(1)->symmetric);
+  EXPECT_FALSE(data.object(14)->symmetric);
+  EXPECT_NEAR(data.object(14)->diameter_m, 0.1247, 1e-4);
+  // The depth at the gelatin box's projected origin lies in front of the origin by less than its radius.
+  const auto depth = projbot::alignment::read_bop_depth(first);
+  ASSERT_EQ(depth.width, 640);
+  const Eigen::Vector3d t = gelatin.T_camera_model.topRightCorner<3, 1>();
+  const int u = static_cast<int>(first.k.fx_px * t.x() / t.z() + first.k.cx_px);
+  const int v = static_cast<int>(first.k.fy_px * t.y() / t.z() + first.k.cy_px);
+  EXPECT_LT(depth.at(u, v), t.z() + 0.005);
+  EXPECT_GT(depth.at(u, v), t.z() - 0.06);
+  const auto mask = projbot::alignment::read_bop_mask(data.scenes[0], first, gelatin);
+  std::size_t on = 0;
+  for (auto m : mask) on += m;
+  EXPECT_EQ(on, 18265U);
+}
+
+TEST(BopDataset, PicksScenesByName) {
+  const auto data = read_bop_dataset(kYcbv, {"000002"});
+  ASSERT_EQ(data.scenes.size(), 1U);
+  EXPECT_EQ(data.scenes[0].name, "000002");
+  EXPECT_THROW(read_bop_dataset(kYcbv, {"000009"}), AlignmentError);
+}
+
+TEST_F(BopCopy, ReadsTheCopy) { EXPECT_EQ(error(), "(no error)"); }
+
+TEST_F(BopCopy, MalformedJsonNamesTheFile) {
+  spill(scene() / "scene_gt.json", slurp(scene() / "scene_gt.json").substr(0, 500));
+  const std::string e = error();
+  EXPECT_NE(e.find("scene_gt.json: malformed JSON"), std::string::npos) << e;
+}
+
+TEST_F(BopCopy, AMissingDepthImageIsNamed) {
+  fs::remove(scene() / "depth" / "000007.png");
+  const std::string e = error();
+  EXPECT_NE(e.find("depth/000007.png: missing"), std::string::npos) << e;
+}
+
+TEST_F(BopCopy, AnInstanceCountThatDisagreesIsRefused) {
+  // Image 3 loses its last instance in scene_gt_info.json only.
+  auto info = nlohmann::json::parse(slurp(scene() / "scene_gt_info.json"));
+  info.at("3").erase(2);
+  spill(scene() / "scene_gt_info.json", info.dump());
+  const std::string e = error();
+  EXPECT_NE(e.find("scene_gt_info.json: image 3 lists 2 instances, scene_gt.json 3"), std::string::npos) << e;
+}
+
+TEST_F(BopCopy, AnObjectWithoutAModelIsRefused) {
+  fs::remove(dir_ / "models" / "obj_000014.ply");
+  const std::string e = error();
+  EXPECT_NE(e.find("obj_000014.ply: missing (object 14 has instances)"), std::string::npos) << e;
+}
+
+TEST_F(BopCopy, ARotationThatIsNoneIsRefused) {
+  // The first instance's rotation scaled by 2 (a model in other units, not a pose).
+  const std::string gt = slurp(scene() / "scene_gt.json");
+  const std::string scaled =
+      std::regex_replace(gt, std::regex(R"("cam_R_m2c": \[[^\]]*\])"), R"("cam_R_m2c": [2.0, 0, 0, 0, 2.0, 0, 0, 0, 2.0])",
+                         std::regex_constants::format_first_only);
+  ASSERT_NE(scaled, gt);
+  spill(scene() / "scene_gt.json", scaled);
+  const std::string e = error();
+  EXPECT_NE(e.find("scene_gt.json: image 1, instance 0: pose's rotation is not a proper rotation"), std::string::npos) << e;
+}
+
+TEST_F(BopCopy, AFolderWithoutTheSplitIsNamed) {
+  fs::remove_all(dir_ / "test");
+  const std::string e = error();
+  EXPECT_NE(e.find("test: no such folder"), std::string::npos) << e;
+}
+
+TEST(PoseError, AddIsTheMeanVertexDistanceAndAddsForgivesASymmetry) {
+  // Points on a ring about z: turning it about z by any angle is a symmetry.
+  std::vector<Eigen::Vector3f> ring;
+  for (int i = 0; i < 360; ++i) {
+    const double a = i * M_PI / 180.0;
+    ring.emplace_back(static_cast<float>(0.05 * std::cos(a)), static_cast<float>(0.05 * std::sin(a)), 0.0F);
+  }
+  const Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d shifted = I;
+  shifted(1, 3) = 0.01;
+  EXPECT_NEAR(projbot::alignment::add_error_m(ring, shifted, I), 0.01, 1e-9);
+  EXPECT_NEAR(projbot::alignment::adds_error_m(ring, I, I), 0.0, 1e-12);
+  Eigen::Matrix4d turned = I;
+  turned.topLeftCorner<3, 3>() = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_NEAR(projbot::alignment::add_error_m(ring, turned, I), 2 * 0.05 * std::sin(0.35), 1e-6);
+  EXPECT_LT(projbot::alignment::adds_error_m(ring, turned, I), 0.0005);  // within half the 0.87 mm spacing
+  // Far off: every point is a metre away, ADD-S says so too.
+  Eigen::Matrix4d far = I;
+  far(2, 3) = 1.0;
+  EXPECT_NEAR(projbot::alignment::adds_error_m(ring, far, I), 1.0, 1e-9);
+}
+
+TEST(RigidInput, AFloat32RotationIsTakenAndMadeOrthonormal) {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  T.topLeftCorner<3, 3>() = T.topLeftCorner<3, 3>().cast<float>().cast<double>();  // float32, as a dataset stores it
+  T(0, 0) += 2e-6;
+  EXPECT_THROW(projbot::config::validate_rigid(T, "x"), projbot::config::ConfigError);
+  const Eigen::Matrix4d fixed = projbot::config::orthonormalised_rigid(T, "--init-matrix");
+  const Eigen::Matrix3d R = fixed.topLeftCorner<3, 3>();
+  EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((fixed - T).cwiseAbs().maxCoeff(), 3e-6);
+  T(0, 0) += 1e-3;
+  try {
+    projbot::config::orthonormalised_rigid(T, "--init-matrix");
+    FAIL() << "a rotation off by 1e-3 was taken";
+  } catch (const projbot::config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("--init-matrix: pose's rotation is not a proper rotation (orthonormality error 0.001"),
+              std::string::npos)
+        << e.what();
+  }
+}
