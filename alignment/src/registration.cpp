@@ -18,8 +18,10 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <fstream>
 #include <functional>
 #include <optional>
+#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -370,7 +372,9 @@ struct Aligner::Impl {
       CloudN aligned;
       icp.align(aligned, T_model_scan);
       iterations += icp.iterations();
-      converged = converged && icp.hasConverged();
+      // PCL's flag says only whether its iterations stopped by a step or a count; the gate judges the
+      // result (a right pose started at the truth ends with 0 iterations and 'not converged').
+      converged = converged && (!cfg.icp_flag_decides || icp.hasConverged());
       T_model_scan = icp.getFinalTransformation();
       if (held && last) *held = icp.held();
     }
@@ -435,6 +439,11 @@ struct Aligner::Impl {
   // along the floor's normal to the surveyed height. What remains for ICP is where on the floor and
   // which way round: a gross guess tilted 40 degrees loses most of its error here.
   Eigen::Matrix4d stood(const Footing& footing, const Eigen::Matrix4d& T) const {
+    if (!footing.upright_known) {  // only the height is known: moved onto the support, not turned
+      Eigen::Matrix4d out = T;
+      out.topRightCorner<3, 1>() += footing.floor.normal * (footing.height_m - lowest(footing, out));
+      return out;
+    }
     const Eigen::Vector3d up = (T.topLeftCorner<3, 3>() * footing.up_model).normalized();
     const Eigen::Vector3d c = extent.centre_in(T);
     Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
@@ -457,7 +466,8 @@ struct Aligner::Impl {
     const double cosine = std::clamp(up.normalized().dot(footing.floor.normal), -1.0, 1.0);
     r.footing_height_error_mm = 1000.0 * (h - footing.height_m);
     r.footing_tilt_deg = std::acos(cosine) * 180.0 / M_PI;
-    r.stands = std::abs(h - footing.height_m) <= cfg.footing_height_m && r.footing_tilt_deg <= cfg.footing_tilt_deg;
+    r.stands = std::abs(h - footing.height_m) <= cfg.footing_height_m &&
+               (!footing.upright_known || r.footing_tilt_deg <= cfg.footing_tilt_deg);
     return r.stands;
   }
 
@@ -568,17 +578,23 @@ ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
   return {s.points, s.normals, s.colours};
 }
 
-ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t samples) {
-  const std::string ext = detail::lower_extension(path);
-  ModelCloud m;
-  if (ext == ".gltf" || ext == ".glb") {
-    try {
-      return model_cloud_from(assets::load_gltf(path), samples);
-    } catch (const assets::AssetError& e) {
-      throw AlignmentError(e.what());
-    }
-    return m;
+namespace {
+
+// Whether a PLY file's header declares faces: a mesh (sampled over its surface) rather than a cloud.
+bool ply_has_faces(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int i = 0; i < 200 && std::getline(in, line); ++i) {
+    if (line.rfind("end_header", 0) == 0) break;
+    std::istringstream words(line);
+    std::string element, name;
+    long long count = 0;
+    if (words >> element >> name >> count && element == "element" && name == "face" && count > 0) return true;
   }
+  return false;
+}
+
+ModelCloud cloud_model(const std::filesystem::path& path) {
   const PointCloud cloud = finite_points(read_cloud(path));
   if (cloud.points.size() < 10)
     throw AlignmentError(path.string() + ": model cloud has " + std::to_string(cloud.points.size()) + " valid points");
@@ -586,10 +602,34 @@ ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t sampl
   for (const auto& p : cloud.points) xyz->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
   // Keep the cloud alive for the loop: a range-for over `*with_normals(...)` would read a freed cloud.
   const CloudN::Ptr with = with_normals(xyz, 16);
+  ModelCloud m;
   for (const auto& p : *with) {
     m.points.push_back(p.getVector3fMap());
     m.normals.push_back(p.getNormalVector3fMap());
   }
+  return m;
+}
+
+}  // namespace
+
+ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t samples, double scale) {
+  if (!(scale > 0.0) || !std::isfinite(scale) || scale < 1e-6 || scale > 1e6)
+    throw AlignmentError(path.string() + ": model scale must be a finite number in [1e-6, 1e6], not " + std::to_string(scale));
+  const std::string ext = detail::lower_extension(path);
+  const bool mesh = ext == ".gltf" || ext == ".glb" || ext == ".obj" || ext == ".stl" || (ext == ".ply" && ply_has_faces(path));
+  if (mesh) {
+    try {
+      assets::Model model = assets::load_model(path);
+      assets::scale_and_recenter(model, scale, false);
+      ModelCloud m = model_cloud_from(model, samples);
+      if (m.points.size() < 10) throw AlignmentError(path.string() + ": the model's surface has no area to sample");
+      return m;
+    } catch (const assets::AssetError& e) {
+      throw AlignmentError(e.what());
+    }
+  }
+  ModelCloud m = cloud_model(path);
+  for (auto& p : m.points) p *= static_cast<float>(scale);
   return m;
 }
 
@@ -713,7 +753,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     const double step = m.cfg.restart_angle_deg * M_PI / 180.0;
     for (int i = 0; i < 3; ++i)
       for (const double sign : {1.0, -1.0})
-        if (!footing)
+        if (!footing || !footing->upright_known)
           turns.emplace_back(sign * step, Eigen::Vector3d::Unit(i));
         else if (i < 2)
           turns.emplace_back(sign * step * (i + 1), footing->floor.normal);

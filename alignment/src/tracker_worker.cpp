@@ -66,6 +66,7 @@ void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, c
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor) {
   guess_ = T_camera_target;
   known_ = Known{floor, std::nullopt, std::nullopt};
+  find_support_ = !floor;  // no map: the first search looks for what the target rests on in the frame
   have_guess_ = true;
   pose_.reset();
   rejected_ = 0;
@@ -131,9 +132,8 @@ DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matr
   // the crop is left out by clustering (crop_to_silhouette), for a guess known to within half the
   // model's size.
   // Both are cuts below one horizontal plane: one pass, at the higher of the two.
-  double cut_m = cfg_.floor_margin_m;
-  if (known.footing && known.footing->height_m > cfg_.floor_margin_m)
-    cut_m = std::max(cut_m, known.footing->height_m + cfg_.support_margin_m);
+  double cut_m = known.footing && !known.footing->upright_known ? cfg_.frame_support_margin_m : cfg_.floor_margin_m;
+  if (known.footing && known.footing->height_m > cut_m) cut_m = std::max(cut_m, known.footing->height_m + cfg_.support_margin_m);
   DepthImage left = known.floor ? without_plane(frame, k_, *known.floor, cut_m) : frame;
   if (grow_m)
     left = crop_to_silhouette(left, k_, model_, from, *grow_m, cfg_.cluster_neighbours && *grow_m < 0.5 * model_radius_m_);
@@ -211,7 +211,20 @@ AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Ma
                                         double grow_m, const assets::Image* colour) const {
   const auto deadline =
       ThreadCpuClock::now() + std::chrono::microseconds(static_cast<long long>(1000.0 * cfg_.acquire_budget_ms));
-  const Known known{footing.floor, footing, deadline};
+  return acquire_known(frame, guess, Known{footing.floor, footing, deadline}, grow_m, colour);
+}
+
+AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, double grow_m,
+                                        const assets::Image* colour) const {
+  const auto deadline =
+      ThreadCpuClock::now() + std::chrono::microseconds(static_cast<long long>(1000.0 * cfg_.acquire_budget_ms));
+  const std::optional<Footing> support = support_in_frame(model_, frame, k_, guess, grow_m);
+  return acquire_known(frame, guess, Known{support ? std::optional<Plane>(support->floor) : std::nullopt, support, deadline},
+                       grow_m, colour);
+}
+
+AlignmentResult TargetFollower::acquire_known(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known,
+                                              double grow_m, const assets::Image* colour) const {
   const DepthImage near = near_guess(frame, guess, known, grow_m);
   const PointCloud near_cloud = depth_to_cloud(near, k_);
   // Colour places what ICP held, where the model has colours to place it by (not the figure's one grey
@@ -290,6 +303,11 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   // uncertainty (a wall behind, a neighbour beside drop out). Global stages search wider on purpose, and
   // a refine after dropped frames starts from a pose the target may have left by more than that.
   const auto grow_m = stage == SearchStage::local ? std::optional<double>(silhouette_grow_m_) : std::nullopt;
+  if (find_support_ && grow_m) {  // as acquire() without a map does
+    find_support_ = false;
+    if (const auto support = support_in_frame(model_, frame, k_, from, *grow_m))
+      known_.floor = support->floor, known_.footing = support;
+  }
   const DepthImage near = near_guess(frame, from, known_, grow_m);
   const PointCloud scan = depth_to_cloud(near, k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;

@@ -1,6 +1,7 @@
 // projbot align: one acquisition (ICP with quality gate and re-initialisation) of a model against a scan.
 
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -10,6 +11,7 @@
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/config/rigid.hpp"
 #include "projbot/config/scene.hpp"
 
 namespace projbot::tools {
@@ -81,8 +83,7 @@ Eigen::Matrix4d initial_guess(const cli::Args& args) {
     const auto v = config::parse_number_list(*matrix, 16, "--init-matrix");
     Eigen::Matrix4d T;
     for (int i = 0; i < 16; ++i) T(i / 4, i % 4) = v[static_cast<std::size_t>(i)];
-    config::validate_rigid(T, "--init-matrix");
-    return T;
+    return config::orthonormalised_rigid(T, "--init-matrix");  // a dataset's float32 rotation is good to ~1e-7
   }
   if (xyz_rpy) {
     std::string text = *xyz_rpy;
@@ -97,6 +98,18 @@ Eigen::Matrix4d initial_guess(const cli::Args& args) {
   return Eigen::Matrix4d::Identity();
 }
 
+// How far the guess may be off (--guess-error MM,DEG): the depth image is cropped to the guess's
+// silhouette grown by how far that can move a model point.
+double guess_reach(const cli::Args& args, const alignment::ModelCloud& model) {
+  const std::string text = args.get_or("guess-error", "50,15");
+  double mm = 0.0, deg = 0.0;
+  char extra = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf%c", &mm, &deg, &extra) != 2 || !(mm >= 0.0 && mm <= 500.0) ||
+      !(deg >= 0.0 && deg <= 180.0))
+    throw cli::UsageError("--guess-error must be MM,DEG with 0..500 mm and 0..180 degrees, not '" + text + "'");
+  return alignment::guess_reach_m(model, mm / 1000.0, deg);
+}
+
 }  // namespace
 
 const Command kAlign{
@@ -106,19 +119,24 @@ const Command kAlign{
     "Refines the initial guess (default: identity) of T_scan_model, the transform mapping model points into\n"
     "the scan's frame, by point-to-plane ICP; when the result fails the quality gate it restarts ICP from the\n"
     "guess turned +-25 degrees about each axis, then re-initialises globally (FPFH features,\n"
-    "SampleConsensusPrerejective) and tries again. M is a glTF model or a PCD / PLY\n"
-    "cloud; S is a PCD / PLY cloud or a 16-bit PNG / TIFF depth image (then --intrinsics and --depth-scale).\n"
+    "SampleConsensusPrerejective) and tries again. M is a mesh (glTF, OBJ, STL, PLY with faces) or a\n"
+    "PCD / PLY cloud; S is a PCD / PLY cloud or a 16-bit PNG / TIFF depth image (then --intrinsics and\n"
+    "--depth-scale). On a depth image the acquisition is the tour's and bench dataset's: the surface the\n"
+    "target rests on (a table) is found under the guess and left out, the depth is cropped to the guess's\n"
+    "silhouette grown by --guess-error, and projective ICP goes first.\n"
     "A depth image is also checked for free space: the depth the model would give at the estimate against\n"
     "the depth measured inside its silhouette; where the camera sees through the model (more than 20 % of\n"
     "the silhouette), the pose is rejected however well it fits.\n"
     "Exit status: 0 when the pose passed the quality gate, 3 when it did not, 1 or 2 on bad input.\n",
-    {{"model", "FILE", "target model: .gltf / .glb (surface-sampled) or .pcd / .ply"},
+    {{"model", "FILE", "target model: .gltf / .glb / .obj / .stl / .ply mesh (surface-sampled), or .pcd / .ply cloud"},
      {"scan", "FILE", "scan: .pcd / .ply cloud, or .png / .tiff 16-bit depth image"},
      {"intrinsics", "fx,fy,cx,cy", "depth camera intrinsics in pixels (default: Kinect v1)"},
      {"depth-scale", "K", "depth units per metre: 1000 for millimetres (default), 5000 for TUM"},
      {"init-matrix", "m00,...,m33", "initial T_scan_model, 16 numbers, row-major, metres"},
      {"init", "\"x y z r p y\"", "initial pose: metres and degrees, R = Rz(yaw) Ry(pitch) Rx(roll)"},
-     {"no-crop", "", "use the whole scan, not only the region around the initial guess"},
+     {"no-crop", "", "use the whole scan, not only the region around the initial guess (clouds)"},
+     {"guess-error", "MM,DEG", "how far the initial guess may be off (depth images; default 50,15)"},
+     {"model-scale", "S", "model units to metres (default 1; 0.001 for a model in millimetres, as BOP's)"},
      {"voxel", "M", "downsampling voxel size in metres (default 0.004)"},
      {"json", "", "print one JSON object instead of text"}},
     [](const cli::Args& args) {
@@ -129,21 +147,38 @@ const Command kAlign{
       cfg.crop = !args.flag("no-crop");
       cfg.voxel_m = args.get_double("voxel", cfg.voxel_m);
       if (!(cfg.voxel_m > 0.0) || cfg.voxel_m > 0.1) throw cli::UsageError("--voxel must be in (0, 0.1] metres");
-      const alignment::ModelCloud model = alignment::load_model_cloud(*args.get("model"));
+      const double model_scale = args.get_double("model-scale", 1.0);
+      if (!(model_scale >= 1e-6 && model_scale <= 1e6)) throw cli::UsageError("--model-scale must be in [1e-6, 1e6]");
+      const alignment::ModelCloud model = alignment::load_model_cloud(*args.get("model"), 50000, model_scale);
+      const double grow_m = guess_reach(args, model);
       const Scan loaded = load_scan(args);
-      // A cloud's frame is unknown: its z is no range, and the depth camera's noise at a range says nothing.
-      if (!loaded.depth) cfg.depth_sigma_coeff = 0.0;
-      const alignment::Aligner aligner(model, cfg);
       const alignment::PointCloud& scan = loaded.cloud;
       if (const std::size_t valid = scan.finite_count(); valid < cfg.min_points)
         throw alignment::AlignmentError(*args.get("scan") + ": " + std::to_string(valid) + " valid points; at least " +
                                         std::to_string(cfg.min_points) + " are needed");
-      const alignment::AlignmentResult r = aligner.align(scan, T_init);
-      // A depth image can say more than the fit: where the camera looks through the model at the
-      // estimate, it is in the wrong place, however well it fits.
+      alignment::AlignmentResult r;
       std::optional<alignment::FreeSpaceCheck> free_space;
       const double limit = alignment::WorkerConfig{}.max_behind_ratio;
-      if (loaded.depth) free_space = alignment::check_free_space(model, r.T_scan_model, *loaded.depth, loaded.k);
+      if (loaded.depth) {
+        // A depth image: the acquisition the tour, the tracker and bench dataset run (the support under the
+        // guess found in the frame and left out, the depth cropped to the guess's silhouette grown by how
+        // far its error reaches, ICP, the gate), then the free-space check: where the camera looks through
+        // the model at the estimate, it is in the wrong place, however well it fits.
+        alignment::WorkerConfig worker;
+        worker.acquisition = cfg;
+        const alignment::TargetFollower follower(model, loaded.k, worker);
+        try {
+          r = follower.acquire(*loaded.depth, T_init, grow_m);
+        } catch (const alignment::AlignmentError& e) {  // too little depth near the guess: nothing to align, refused
+          std::cerr << "projbot align: " << e.what() << "\n";
+          r.T_scan_model = T_init;
+        }
+        free_space = follower.verify(*loaded.depth, r.T_scan_model);
+      } else {
+        // A cloud's frame is unknown: its z is no range, and the depth camera's noise at a range says nothing.
+        cfg.depth_sigma_coeff = 0.0;
+        r = alignment::Aligner(model, cfg).align(scan, T_init);
+      }
       const bool accepted = r.converged && (!free_space || free_space->passes(limit));
       if (args.flag("json")) {
         nlohmann::json T = nlohmann::json::array();

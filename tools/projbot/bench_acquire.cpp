@@ -108,6 +108,7 @@ alignment::AcquisitionConfig pcl_config(bool stock) {
   c.pcl_search = stock;
   c.restart_angle_deg = 0.0;
   c.reinitialise = false;
+  c.icp_flag_decides = true;
   c.min_inlier_ratio = 0.0;  // no gate: PCL reports convergence, not whether the pose is right
   c.max_rmse_mm = 1e9;
   return c;

@@ -37,12 +37,18 @@ Args::Args(const std::vector<OptionSpec>& specs, int argc, char** argv, int firs
       if (i + 1 >= argc) throw UsageError("--" + name + " needs a value (" + spec->value + ")");
       values_[name] = argv[++i];
     }
+    if (!spec->value.empty()) all_[name].push_back(values_[name]);
   }
 }
 
 std::optional<std::string> Args::get(const std::string& name) const {
   if (auto it = values_.find(name); it != values_.end()) return it->second;
   return std::nullopt;
+}
+
+std::vector<std::string> Args::get_all(const std::string& name) const {
+  if (auto it = all_.find(name); it != all_.end()) return it->second;
+  return {};
 }
 
 std::string Args::get_or(const std::string& name, const std::string& fallback) const { return get(name).value_or(fallback); }

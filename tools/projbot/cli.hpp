@@ -29,6 +29,8 @@ class Args {
 
   bool flag(const std::string& name) const { return values_.contains(name); }
   std::optional<std::string> get(const std::string& name) const;
+  /// Every value of a repeatable option, in the order given (get() returns the last).
+  std::vector<std::string> get_all(const std::string& name) const;
   std::string get_or(const std::string& name, const std::string& fallback) const;
   int get_int(const std::string& name, int fallback, int min_value, int max_value) const;
   double get_double(const std::string& name, double fallback) const;
@@ -41,6 +43,7 @@ class Args {
 
  private:
   std::map<std::string, std::string> values_;
+  std::map<std::string, std::vector<std::string>> all_;
   std::vector<std::string> positional_;
 };
 

@@ -25,8 +25,10 @@ struct ModelCloud {
   std::vector<Eigen::Vector3f> colours;
 };
 
-/// Model points from a glTF (area-uniform surface samples) or a PCD / PLY file (normals estimated).
-ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t samples = 50000);
+/// Model points: area-uniform surface samples of a mesh (glTF, OBJ, STL, a PLY with faces), or the points
+/// of a cloud (PCD, a PLY without faces; normals estimated). `scale` multiplies the file's units into
+/// metres (0.001 for a model in millimetres, as BOP's); the origin stays the file's.
+ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t samples = 50000, double scale = 1.0);
 
 /// Model points from a loaded (scaled, recentred) model: area-uniform surface samples, reproducible.
 ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples = 50000);
@@ -39,11 +41,23 @@ struct Footing {
   Plane floor;
   Eigen::Vector3d up_model = Eigen::Vector3d::UnitZ();
   double height_m = 0.0;
+  /// Whether up_model is known (a survey). A support found in the frame itself (support_in_frame) says
+  /// only that the target rests on it: its lowest point at height_m, any way up.
+  bool upright_known = true;
 };
 
 /// The footing of `model` surveyed at T_world_target, seen by a camera at T_world_camera (the floor is
 /// z = 0 in the world). Throws AlignmentError for an empty model or a non-finite pose.
 Footing footing_in_camera(const ModelCloud& model, const Eigen::Matrix4d& T_world_target, const Eigen::Matrix4d& T_world_camera);
+
+/// Where there is no map: the surface the target rests on, found in the depth around the guess (a table
+/// under objects, the floor under a figure), as a Footing whose height is 0 and whose upright is unknown.
+/// PCL's RANSAC plane fit (SACSegmentation) on the frame's points within `reach_m` of the model's sphere at
+/// the guess; a plane is taken only if the model's centre at the guess lies on its camera side and the
+/// model's lowest point at the guess is within reach_m of it (the target rests on it: not one of its own
+/// faces, nor a wall behind it), and it holds at least 300 points. Nothing when no such plane is found.
+std::optional<Footing> support_in_frame(const ModelCloud& model, const DepthImage& depth, const CameraIntrinsics& k,
+                                        const Eigen::Matrix4d& T_camera_guess, double reach_m);
 
 /// Defaults suit a Kinect-class camera 0.5-3 m from a 10-50 cm object.
 struct AcquisitionConfig {
@@ -63,6 +77,10 @@ struct AcquisitionConfig {
   /// keeps the error distribution whole; a 6 mm cut left a 0.69 degree bias at 2 m, 20 mm 0.27 degrees.
   std::vector<double> icp_distances_m{0.08, 0.03, 0.02};
   int icp_iterations = 40;  ///< per stage
+  /// Whether PCL's own convergence flag (its iterations ended by a small step, not by their count) must
+  /// also hold. False: the result alone decides, through the quality gate (a right pose started at the
+  /// truth ended with 0 iterations, refused). True: a plain PCL user's pipeline (bench baselines).
+  bool icp_flag_decides = false;
   /// A coarse stage only has to bring the estimate within the next one's reach: it stops once an
   /// iteration moves the model less than this share of its correspondence distance (0.4 mm at 8 cm).
   /// The last stage runs until a step is under fine_step_m. (With every stage run to 0.01 mm, the first

@@ -62,6 +62,10 @@ struct WorkerConfig {
   /// face-on box's bottom edge, which pins it vertically) and drops most of the table top. With +0.5 cm,
   /// one gross guess of the shop's box was lit wrong in 10 (bench acquire); with -0.5 cm none.
   double support_margin_m = -0.005;
+  /// Without a map (acquire() with no footing): the support found in the frame (support_in_frame) is left
+  /// out up to this far above it: its RANSAC plane is good to a few mm, and a 3 cm box lying on a table
+  /// would lose most of its sides to the map's 2 cm.
+  double frame_support_margin_m = 0.008;
   /// Acquisition from a guess known to within half the model's size leaves out each surface that runs
   /// on past the crop and lies mostly outside the silhouette (crop_to_silhouette's clustering): the
   /// shelf beside the shop figure's hand, the vase beside the duck.
@@ -140,7 +144,8 @@ class TargetFollower {
   /// Throws AlignmentError for a bad model or intrinsics.
   TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, WorkerConfig config = {});
   /// A new stop: the next frame acquires from this guess (Eq. 1). With `floor` (from the map and the
-  /// camera's pose), acquisition leaves out what lies on it (floor_margin_m).
+  /// camera's pose), acquisition leaves out what lies on it (floor_margin_m); without, the first local
+  /// search finds what the target rests on in the frame (support_in_frame), as acquire() without a map.
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor = std::nullopt);
   /// ...and with the target's surveyed footing (its floor left out as above), acquisition accepts only
   /// poses that stand as surveyed (AcquisitionConfig::footing_height_m, footing_tilt_deg). Tracking is
@@ -188,6 +193,12 @@ class TargetFollower {
   /// Throws AlignmentError when too little depth is left.
   AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing, double grow_m,
                           const assets::Image* colour = nullptr) const;
+  /// The same without a map (a real frame of objects on a table, `projbot align` on a depth image, a BOP
+  /// dataset): the support under the guess is found in the frame (support_in_frame, within grow_m) and
+  /// stands in for the footing (the target rests on it, any way up); where none is found, nothing is
+  /// left out and no footing is asked for.
+  AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, double grow_m,
+                          const assets::Image* colour = nullptr) const;
   double silhouette_grow_m() const { return silhouette_grow_m_; }
 
  private:
@@ -214,6 +225,9 @@ class TargetFollower {
   /// them, and ICP coarse to fine does better).
   std::optional<AlignmentResult> projective_first(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess,
                                                   const Known& known, bool hold) const;
+  /// acquire()'s body, with what is known at this stop.
+  AlignmentResult acquire_known(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
+                                const assets::Image* colour) const;
   /// acquire() without colour's move: align_near, then the projective polish.
   AlignmentResult acquired(const DepthImage& frame, const DepthImage& near, const PointCloud& near_cloud,
                            const Eigen::Matrix4d& guess, const Known& known, double grow_m, Weak weak) const;
@@ -221,8 +235,9 @@ class TargetFollower {
   /// r itself when only it passes the gate.
   AlignmentResult recropped(const DepthImage& frame, const AlignmentResult& r, const Known& known, SearchStage stage,
                             bool hold) const;
-  ModelCloud model_;      // for the free-space check
-  bool colour_contrast_;  // the model's colours can say where it is (has_colour_contrast)
+  ModelCloud model_;           // for the free-space check
+  bool find_support_ = false;  // a guess without a map: the next local search finds the support in the frame
+  bool colour_contrast_;       // the model's colours can say where it is (has_colour_contrast)
   Aligner aligner_;
   ProjectiveTracker tracker_;
   ProjectiveTracker wide_tracker_;  // the same frame again, with a wider reach, when tracking failed

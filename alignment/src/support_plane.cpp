@@ -1,0 +1,91 @@
+// The support a target rests on, found in the frame (no map): PCL's RANSAC plane segmentation. Its own
+// translation unit, the only one with pcl/segmentation.
+
+#include <pcl/ModelCoefficients.h>
+#include <pcl/filters/extract_indices.h>
+#include <pcl/point_types.h>
+#include <pcl/segmentation/sac_segmentation.h>
+
+#include <limits>
+
+#include "projbot/alignment/registration.hpp"
+
+namespace projbot::alignment {
+namespace {
+
+constexpr double kPlaneDistanceM = 0.008;  // RANSAC inlier band: a Kinect's table at 1 m is +-3 mm (2 sigma)
+constexpr std::size_t kMinPlanePoints = 300;
+constexpr int kMaxPlanes = 4;  // rejected planes (the target's own faces, a wall) are removed and the search goes on
+constexpr double kMinCentreAboveM = 0.005;
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+// The frame's points within `radius` of `centre`, every other pixel (enough for a plane; half the time).
+Cloud::Ptr points_near(const DepthImage& depth, const CameraIntrinsics& k, const Eigen::Vector3d& centre, double radius) {
+  auto cloud = pcl::make_shared<Cloud>();
+  const PointCloud all = depth_to_cloud(depth, k);
+  const Eigen::Vector3f c = centre.cast<float>();
+  const auto r2 = static_cast<float>(radius * radius);
+  for (int y = 0; y < all.height; y += 2)
+    for (int x = 0; x < all.width; x += 2) {
+      const Eigen::Vector3f& p = all.points[static_cast<std::size_t>(y) * all.width + x];
+      if (p.allFinite() && (p - c).squaredNorm() <= r2) cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    }
+  return cloud;
+}
+
+}  // namespace
+
+std::optional<Footing> support_in_frame(const ModelCloud& model, const DepthImage& depth, const CameraIntrinsics& k,
+                                        const Eigen::Matrix4d& T_camera_guess, double reach_m) {
+  if (model.points.empty()) throw AlignmentError("support_in_frame: empty model");
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  for (const auto& p : model.points) centroid += p;
+  centroid /= static_cast<float>(model.points.size());
+  double radius = 0.0;
+  for (const auto& p : model.points) radius = std::max(radius, static_cast<double>((p - centroid).norm()));
+  const Eigen::Vector3d centre = (T_camera_guess * centroid.cast<double>().homogeneous()).head<3>();
+  Cloud::Ptr cloud = points_near(depth, k, centre, radius + reach_m);
+  pcl::SACSegmentation<pcl::PointXYZ> seg;
+  seg.setOptimizeCoefficients(true);
+  seg.setModelType(pcl::SACMODEL_PLANE);
+  seg.setMethodType(pcl::SAC_RANSAC);
+  seg.setDistanceThreshold(kPlaneDistanceM);
+  seg.setMaxIterations(300);
+  for (int attempt = 0; attempt < kMaxPlanes && cloud->size() >= kMinPlanePoints; ++attempt) {
+    pcl::ModelCoefficients coefficients;
+    pcl::PointIndices::Ptr inliers = pcl::make_shared<pcl::PointIndices>();
+    seg.setInputCloud(cloud);
+    seg.segment(*inliers, coefficients);
+    if (inliers->indices.size() < kMinPlanePoints || coefficients.values.size() != 4) break;
+    Plane plane;
+    plane.normal = Eigen::Vector3d(coefficients.values[0], coefficients.values[1], coefficients.values[2]);
+    plane.d = coefficients.values[3];
+    const double norm = plane.normal.norm();
+    if (!(norm > 0.0) || !std::isfinite(plane.d)) break;
+    plane.normal /= norm, plane.d /= norm;
+    if (plane.d < 0.0) plane.normal = -plane.normal, plane.d = -plane.d;  // the camera (origin) on its upper side
+    // Under the target and touching it at the guess (within the guess's reach): not a wall behind it.
+    const double centre_above = plane.height_of(centre);
+    double lowest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < model.points.size(); i += 7)
+      lowest = std::min(lowest, plane.height_of((T_camera_guess * model.points[i].cast<double>().homogeneous()).head<3>()));
+    if (centre_above >= kMinCentreAboveM && std::abs(lowest) <= reach_m + kPlaneDistanceM) {
+      Footing f;
+      f.floor = plane;
+      f.height_m = 0.0;
+      f.upright_known = false;
+      return f;
+    }
+    pcl::ExtractIndices<pcl::PointXYZ> extract;  // not under the target: take it away and look again
+    extract.setInputCloud(cloud);
+    extract.setIndices(inliers);
+    extract.setNegative(true);
+    auto rest = pcl::make_shared<Cloud>();
+    extract.filter(*rest);
+    cloud = rest;
+  }
+  return std::nullopt;
+}
+
+}  // namespace projbot::alignment
