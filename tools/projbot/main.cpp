@@ -55,6 +55,7 @@ void print_help() {
          "  projbot render --model duck.glb --out duck.png    one model, framed in view\n"
          "  projbot show --scene my.yaml --fullscreen --monitor 1\n"
          "  projbot align --model bun0.pcd --scan bun4.pcd --init \"0 0 0 0 -30 0\" --json\n"
+         "  projbot bench dataset ../shared/data/ycbv-bop     pose estimation on real frames (BOP)\n"
          "  projbot slam --rawlog run.rawlog --out-map map --out-trajectory slam.txt\n"
          "  projbot localize --map map --rawlog run2.rawlog --out-trajectory loc.txt\n"
          "  projbot tour                                      the demo tour in the digital twin (Table 1)\n"
