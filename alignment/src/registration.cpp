@@ -573,6 +573,17 @@ Eigen::Matrix4d PclIcpBaseline::track(const PointCloud& scan, const Eigen::Matri
   return rigid_inverse(icp.getFinalTransformation().cast<double>());
 }
 
+AcquisitionConfig pcl_pipeline_config(bool pcl_search) {
+  AcquisitionConfig c;
+  c.pcl_search = pcl_search;
+  c.restart_angle_deg = 0.0;
+  c.reinitialise = false;
+  c.icp_flag_decides = true;
+  c.min_inlier_ratio = 0.0;  // no gate: PCL reports convergence, not whether the pose is right
+  c.max_rmse_mm = 1e9;
+  return c;
+}
+
 ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
   const auto s = assets::sample_surface(model, samples, 1);
   return {s.points, s.normals, s.colours};

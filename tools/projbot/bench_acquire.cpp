@@ -102,18 +102,6 @@ Outcome pcl_pipeline(const alignment::Aligner& aligner, const twin::Twin& twin, 
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
 }
 
-// `stock`: PCL's own k-d tree and outlier filter; else the serial searches ours uses (same answers).
-alignment::AcquisitionConfig pcl_config(bool stock) {
-  alignment::AcquisitionConfig c;
-  c.pcl_search = stock;
-  c.restart_angle_deg = 0.0;
-  c.reinitialise = false;
-  c.icp_flag_decides = true;
-  c.min_inlier_ratio = 0.0;  // no gate: PCL reports convergence, not whether the pose is right
-  c.max_rmse_mm = 1e9;
-  return c;
-}
-
 const char* const kMethods[3] = {"ours", "PCL", "PCL, serial search"};
 
 }  // namespace
@@ -183,8 +171,8 @@ const Command kBenchAcquire{
         // The crop grows by how far each kind of guess's error (known here) can reach.
         const double grow_m[2] = {alignment::guess_reach_m(target.cloud, cm / 100.0, deg),
                                   alignment::guess_reach_m(target.cloud, 0.30, 40.0)};
-        const alignment::Aligner pcl[2] = {alignment::Aligner(target.cloud, pcl_config(true)),
-                                           alignment::Aligner(target.cloud, pcl_config(false))};
+        const alignment::Aligner pcl[2] = {alignment::Aligner(target.cloud, alignment::pcl_pipeline_config(true)),
+                                           alignment::Aligner(target.cloud, alignment::pcl_pipeline_config(false))};
         Tally tallies[6];  // ours, PCL, PCL with our searches: small guesses; the same for gross guesses
         int k = 0;
         for (; k < trials && !interrupted(); ++k) {

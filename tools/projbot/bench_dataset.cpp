@@ -117,18 +117,6 @@ double error_mm(const ObjectModel& m, const Eigen::Matrix4d& T_est, const Eigen:
                                      : alignment::add_error_m(m.vertices, T_est, T_true));
 }
 
-// PCL's pipeline as a PCL user runs it: crop around the guess, normals, ICP; lit when it converges.
-alignment::AcquisitionConfig pcl_user_config() {
-  alignment::AcquisitionConfig c;
-  c.pcl_search = true;
-  c.restart_angle_deg = 0.0;
-  c.reinitialise = false;
-  c.icp_flag_decides = true;
-  c.min_inlier_ratio = 0.0;  // no gate: PCL reports convergence, not whether the pose is right
-  c.max_rmse_mm = 1e9;
-  return c;
-}
-
 bool same_camera(const alignment::CameraIntrinsics& a, const alignment::CameraIntrinsics& b) {
   return a.fx_px == b.fx_px && a.fy_px == b.fy_px && a.cx_px == b.cx_px && a.cy_px == b.cy_px && a.width_px == b.width_px &&
          a.height_px == b.height_px;
@@ -260,8 +248,9 @@ class Bench {
     if (it != estimators_.end() && !same_camera(it->second.first, k)) estimators_.erase(it), it = estimators_.end();
     if (it == estimators_.end())
       it = estimators_
-               .emplace(m.info->id, std::make_pair(k, Estimators{alignment::TargetFollower(m.cloud, k),
-                                                                 alignment::Aligner(m.cloud, pcl_user_config())}))
+               .emplace(m.info->id,
+                        std::make_pair(k, Estimators{alignment::TargetFollower(m.cloud, k),
+                                                     alignment::Aligner(m.cloud, alignment::pcl_pipeline_config(true))}))
                .first;
     return it->second.second;
   }

@@ -137,6 +137,12 @@ struct AcquisitionConfig {
   double footing_tilt_deg = 5.0;
 };
 
+/// The benchmarks' baseline, PCL's pipeline as a PCL user runs it with Aligner::align(SearchStage::icp_only):
+/// crop, voxel grid, outlier filter, normals, point-to-plane ICP, no restarts, no global search, and no
+/// gate: `converged` is PCL's own flag. `pcl_search`: PCL's k-d tree and outlier filter (what a PCL user
+/// gets); false: the serial searches ours uses (the same answers).
+AcquisitionConfig pcl_pipeline_config(bool pcl_search);
+
 /// One estimate with the numbers the quality gate judged it by.
 struct AlignmentResult {
   Eigen::Matrix4d T_scan_model = Eigen::Matrix4d::Identity();  ///< maps model points into the scan frame
