@@ -54,7 +54,7 @@ trap 'exit 143' TERM
 
 # Whatever an earlier run left mounted inside (a killed run) goes first.
 if [[ -d $root ]]; then
-  grep -o " $root/[^ ]*" /proc/mounts | sort -r | while read -r m; do umount -l "$m" || true; done
+  { grep -o " $root/[^ ]*" /proc/mounts || true; } | sort -r | while read -r m; do umount -l "$m" || true; done
   rm -rf --one-file-system "$root"
 fi
 echo "fresh-check: debootstrap bookworm (minbase) into $root"
