@@ -213,19 +213,17 @@ BopDataset read_bop_dataset(const fs::path& root, const std::vector<std::string>
   if (folders.empty()) fail(split_dir, "holds no scene folders");
   std::sort(folders.begin(), folders.end());
   for (const fs::path& f : folders) out.scenes.push_back(read_scene(f));
-  std::set<int> missing;
+  // Every object an instance names is in models_info.json and has its model file (each looked up once).
+  std::set<int> checked;
   for (const BopScene& s : out.scenes)
     for (const BopImage& im : s.images)
-      for (const BopInstance& inst : im.instances)
-        if (!out.object(inst.obj_id))
-          fail(s.folder / "scene_gt.json", "obj_id " + std::to_string(inst.obj_id) + " is not in models_info.json");
-  for (const BopObject& o : out.objects)
-    if (!fs::is_regular_file(o.model, ec)) missing.insert(o.id);
-  for (const BopScene& s : out.scenes)
-    for (const BopImage& im : s.images)
-      for (const BopInstance& inst : im.instances)
-        if (missing.count(inst.obj_id))
-          fail(out.object(inst.obj_id)->model, "missing (object " + std::to_string(inst.obj_id) + " has instances)");
+      for (const BopInstance& inst : im.instances) {
+        if (!checked.insert(inst.obj_id).second) continue;
+        const BopObject* o = out.object(inst.obj_id);
+        if (!o) fail(s.folder / "scene_gt.json", "obj_id " + std::to_string(inst.obj_id) + " is not in models_info.json");
+        if (!fs::is_regular_file(o->model, ec))
+          fail(o->model, "missing (object " + std::to_string(inst.obj_id) + " has instances)");
+      }
   return out;
 }
 

@@ -207,17 +207,18 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthI
   return wider;
 }
 
+ThreadCpuClock::time_point TargetFollower::acquire_deadline() const {
+  return ThreadCpuClock::now() + std::chrono::microseconds(static_cast<long long>(1000.0 * cfg_.acquire_budget_ms));
+}
+
 AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing,
                                         double grow_m, const assets::Image* colour) const {
-  const auto deadline =
-      ThreadCpuClock::now() + std::chrono::microseconds(static_cast<long long>(1000.0 * cfg_.acquire_budget_ms));
-  return acquire_known(frame, guess, Known{footing.floor, footing, deadline}, grow_m, colour);
+  return acquire_known(frame, guess, Known{footing.floor, footing, acquire_deadline()}, grow_m, colour);
 }
 
 AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, double grow_m,
                                         const assets::Image* colour) const {
-  const auto deadline =
-      ThreadCpuClock::now() + std::chrono::microseconds(static_cast<long long>(1000.0 * cfg_.acquire_budget_ms));
+  const auto deadline = acquire_deadline();  // the support's search counts against the budget too
   const std::optional<Footing> support = support_in_frame(model_, frame, k_, guess, grow_m);
   return acquire_known(frame, guess, Known{support ? std::optional<Plane>(support->floor) : std::nullopt, support, deadline},
                        grow_m, colour);

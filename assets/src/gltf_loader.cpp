@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 
+#include "default_material.hpp"
 #include "projbot/assets/model.hpp"
 
 namespace projbot::assets {
@@ -33,14 +34,7 @@ class Loader {
       visit_node(root, Eigen::Matrix4d::Identity(), path, out);
     }
     if (out.primitives.empty()) fail("no triangle meshes in the scene");
-    bool need_default = false;
-    for (auto& p : out.primitives) {
-      if (p.material < 0) {
-        p.material = static_cast<int>(out.materials.size());
-        need_default = true;
-      }
-    }
-    if (need_default) out.materials.emplace_back();
+    detail::give_default_material(out);
     return out;
   }
 

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "default_material.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/isolated_read.hpp"
 
@@ -52,11 +53,7 @@ void put_mesh(const aiMesh& mesh, config::Bytes& out) {
   for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
     const aiFace& face = mesh.mFaces[f];
     if (face.mNumIndices != 3) continue;  // points and lines: SortByPType put them in meshes of their own
-    for (unsigned k = 0; k < 3; ++k) {
-      if (face.mIndices[k] >= mesh.mNumVertices)
-        throw AssetError("a face names vertex " + std::to_string(face.mIndices[k]) + " of " + std::to_string(mesh.mNumVertices));
-      indices.push_back(face.mIndices[k]);
-    }
+    for (unsigned k = 0; k < 3; ++k) indices.push_back(face.mIndices[k]);  // checked where they arrive
   }
   out.put<std::int32_t>(static_cast<std::int32_t>(mesh.mMaterialIndex));
   out.put_vector(vertices);
@@ -105,12 +102,12 @@ bool finite_vertex(const Vertex& v) {
   return true;
 }
 
-Primitive read_primitive(config::BytesReader& in, const std::string& file, std::uint32_t materials) {
+// One primitive as the child sent it, checked: the child's bytes are not trusted.
+Primitive read_primitive(config::BytesReader& in, const std::string& file) {
   Primitive p;
   p.material = in.get<std::int32_t>();
   p.vertices = in.get_vector<Vertex>();
   p.indices = in.get_vector<std::uint32_t>();
-  if (p.material < 0 || static_cast<std::uint32_t>(p.material) >= materials) p.material = -1;
   for (const Vertex& v : p.vertices)
     if (!finite_vertex(v)) throw AssetError(file + ": a vertex position or normal is not a finite number");
   for (std::uint32_t i : p.indices)
@@ -145,7 +142,7 @@ Model model_from_bytes(const std::string& bytes, const std::filesystem::path& pa
   out.source = file;
   const auto meshes = in.get<std::uint32_t>();
   std::vector<Primitive> primitives;
-  for (std::uint32_t m = 0; m < meshes; ++m) primitives.push_back(read_primitive(in, file, UINT32_MAX));
+  for (std::uint32_t m = 0; m < meshes; ++m) primitives.push_back(read_primitive(in, file));
   const auto materials = in.get<std::uint32_t>();
   for (std::uint32_t m = 0; m < materials; ++m) {
     const auto values = in.get<MaterialValues>();
@@ -165,13 +162,7 @@ Model model_from_bytes(const std::string& bytes, const std::filesystem::path& pa
     out.primitives.push_back(std::move(p));
   }
   if (out.primitives.empty()) throw AssetError(file + ": no triangles (a mesh file without faces is a point cloud, not a model)");
-  bool need_default = false;
-  for (Primitive& p : out.primitives)
-    if (p.material < 0) {
-      p.material = static_cast<int>(out.materials.size());
-      need_default = true;
-    }
-  if (need_default) out.materials.emplace_back();
+  detail::give_default_material(out);
   return out;
 }
 

@@ -101,12 +101,7 @@ Eigen::Matrix4d initial_guess(const cli::Args& args) {
 // How far the guess may be off (--guess-error MM,DEG): the depth image is cropped to the guess's
 // silhouette grown by how far that can move a model point.
 double guess_reach(const cli::Args& args, const alignment::ModelCloud& model) {
-  const std::string text = args.get_or("guess-error", "50,15");
-  double mm = 0.0, deg = 0.0;
-  char extra = 0;
-  if (std::sscanf(text.c_str(), "%lf,%lf%c", &mm, &deg, &extra) != 2 || !(mm >= 0.0 && mm <= 500.0) ||
-      !(deg >= 0.0 && deg <= 180.0))
-    throw cli::UsageError("--guess-error must be MM,DEG with 0..500 mm and 0..180 degrees, not '" + text + "'");
+  const auto [mm, deg] = cli::parse_distance_angle(args.get_or("guess-error", "50,15"), "guess-error", "mm", 500);
   return alignment::guess_reach_m(model, mm / 1000.0, deg);
 }
 
@@ -125,7 +120,7 @@ const Command kAlign{
     "target rests on (a table) is found under the guess and left out, the depth is cropped to the guess's\n"
     "silhouette grown by --guess-error, and projective ICP goes first.\n"
     "A depth image is also checked for free space: the depth the model would give at the estimate against\n"
-    "the depth measured inside its silhouette; where the camera sees through the model (more than 20 % of\n"
+    "the depth measured inside its silhouette; where the camera sees through the model (more than 10 % of\n"
     "the silhouette), the pose is rejected however well it fits.\n"
     "Exit status: 0 when the pose passed the quality gate, 3 when it did not, 1 or 2 on bad input.\n",
     {{"model", "FILE", "target model: .gltf / .glb / .obj / .stl / .ply mesh (surface-sampled), or .pcd / .ply cloud"},

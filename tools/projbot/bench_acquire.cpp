@@ -137,12 +137,7 @@ const Command kBenchAcquire{
      {"seed", "K", "seed of the guesses and the depth noise (default 1)"}},
     [](const cli::Args& args) {
       const int trials = args.get_int("trials", 20, 1, 10000);
-      double cm = 5.0, deg = 10.0;
-      const std::string ge = args.get_or("guess-error", "5,10");
-      char extra = 0;
-      if (std::sscanf(ge.c_str(), "%lf,%lf%c", &cm, &deg, &extra) != 2 || !(cm >= 0.0 && cm <= 100.0) ||
-          !(deg >= 0.0 && deg <= 180.0))
-        throw cli::UsageError("--guess-error must be CM,DEG with 0..100 cm and 0..180 degrees, not '" + ge + "'");
+      const auto [cm, deg] = cli::parse_distance_angle(args.get_or("guess-error", "5,10"), "guess-error", "cm", 100);
       const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
       catch_interrupts();

@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "commands.hpp"
@@ -59,12 +60,8 @@ Row row_for(const std::string& scene, const char* mode, int image, int gt_index,
 std::vector<Perturbation> parse_perturbations(const std::vector<std::string>& texts) {
   std::vector<Perturbation> out;
   for (const std::string& t : texts) {
-    Perturbation p;
-    char extra = 0;
-    if (std::sscanf(t.c_str(), "%lf,%lf%c", &p.mm, &p.deg, &extra) != 2 || !(p.mm >= 0.0 && p.mm <= 500.0) ||
-        !(p.deg >= 0.0 && p.deg <= 180.0))
-      throw cli::UsageError("--perturb must be MM,DEG with 0..500 mm and 0..180 degrees, not '" + t + "'");
-    out.push_back(p);
+    const auto [mm, deg] = cli::parse_distance_angle(t, "perturb", "mm", 500);
+    out.push_back({mm, deg});
   }
   if (out.empty()) out.push_back(Perturbation{});
   return out;
@@ -287,12 +284,12 @@ void print_tables(const std::vector<Row>& rows, const std::vector<Perturbation>&
   std::printf(
       "| object | start | method | estimates | lit within 5 mm | lit within 10 mm | false accepts (> 20 mm) | false rejects "
       "(<= 10 mm) | time median / p95 / max ms |\n|---|---|---|---|---|---|---|---|---|\n");
-  std::map<int, bool> ids;
-  for (const Row& r : rows) ids[r.obj_id] = true;
+  std::set<int> ids;
+  for (const Row& r : rows) ids.insert(r.obj_id);
   for (const Perturbation& p : perturbations)
     for (const std::string& method : methods) {
       Tally all;
-      for (const auto& [id, _] : ids) {
+      for (const int id : ids) {
         Tally t;
         for (const Row& r : rows)
           if (r.obj_id == id && r.method == method && r.perturbation.mm == p.mm && r.perturbation.deg == p.deg)
@@ -394,7 +391,8 @@ int run_bench_dataset(const cli::Args& args) {
 const Command kBenchDataset{
     "bench dataset",
     "pose estimation on a BOP dataset's real frames, ours beside PCL's pipeline",
-    "projbot bench dataset DIR [--perturb MM,DEG]... [--seed K] [--min-visible PX] [--scenes A,B] [--report FILE.json]\n\n"
+    "projbot bench dataset DIR [--perturb MM,DEG]... [--seed K] [--min-visible PX] [--scenes A,B] [--max-instances N]\n"
+    "                          [--model-scale S] [--track] [--report FILE.json]\n\n"
     "DIR is a BOP dataset (models/ with models_info.json, test/SCENE/ with depth/, mask_visib/, scene_camera.json,\n"
     "scene_gt.json, scene_gt_info.json). Each object instance with at least PX visible pixels is estimated from its\n"
     "ground truth moved MM in a random direction and turned DEG about a random axis through the model's centre\n"

@@ -2,8 +2,10 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
 
@@ -44,6 +46,20 @@ Args::Args(const std::vector<OptionSpec>& specs, int argc, char** argv, int firs
 std::optional<std::string> Args::get(const std::string& name) const {
   if (auto it = values_.find(name); it != values_.end()) return it->second;
   return std::nullopt;
+}
+
+std::pair<double, double> parse_distance_angle(const std::string& text, const std::string& option, const std::string& unit,
+                                               int max_distance) {
+  double distance = 0.0, deg = 0.0;
+  char extra = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf%c", &distance, &deg, &extra) != 2 || !(distance >= 0.0 && distance <= max_distance) ||
+      !(deg >= 0.0 && deg <= 180.0)) {
+    std::string upper = unit;
+    for (auto& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    throw UsageError("--" + option + " must be " + upper + ",DEG with 0.." + std::to_string(max_distance) + " " + unit +
+                     " and 0..180 degrees, not '" + text + "'");
+  }
+  return {distance, deg};
 }
 
 std::vector<std::string> Args::get_all(const std::string& name) const {

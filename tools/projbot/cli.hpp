@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace projbot::cli {
@@ -46,6 +47,11 @@ class Args {
   std::map<std::string, std::vector<std::string>> all_;
   std::vector<std::string> positional_;
 };
+
+/// A distance and an angle given as "D,DEG" (a guess's or a start's error), the distance in `unit` ("mm",
+/// "cm") within 0..max_distance and the angle within 0..180 degrees. Throws UsageError naming `option`.
+std::pair<double, double> parse_distance_angle(const std::string& text, const std::string& option, const std::string& unit,
+                                               int max_distance);
 
 /// "  --scene FILE     help" lines for a subcommand's help text.
 std::string format_options(const std::vector<OptionSpec>& specs);

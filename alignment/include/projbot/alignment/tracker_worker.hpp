@@ -227,6 +227,8 @@ class TargetFollower {
   /// them, and ICP coarse to fine does better).
   std::optional<AlignmentResult> projective_first(const DepthImage& frame, const DepthImage& near, const Eigen::Matrix4d& guess,
                                                   const Known& known, bool hold) const;
+  /// When an acquisition starting now must stop starting new steps (acquire_budget_ms of CPU time).
+  ThreadCpuClock::time_point acquire_deadline() const;
   /// acquire()'s body, with what is known at this stop.
   AlignmentResult acquire_known(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
                                 const assets::Image* colour) const;
