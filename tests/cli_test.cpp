@@ -234,6 +234,11 @@ TEST_F(CliTest, OverridesAndProfile) {
   ASSERT_EQ(behind.code, 3) << behind.output;
   const auto img = projbot::assets::read_image(out);
   for (std::size_t i = 0; i < img.rgba.size(); i += 4) ASSERT_EQ(img.rgba[i], 0);
+  // A scene without targets is an empty frame too (it once exited 0).
+  const fs::path none = write("none.yaml", "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets: []\n");
+  const CliRun nothing = run_projbot("render --scene " + none.string() + " --out " + out.string());
+  EXPECT_EQ(nothing.code, 3) << nothing.output;
+  EXPECT_NE(nothing.output.find("the frame is empty: the scene has no targets"), std::string::npos) << nothing.output;
 }
 
 TEST_F(CliTest, SlamThenLocalize) {
@@ -475,7 +480,35 @@ TEST_F(CliTest, RecordInterruptedKeepsTheStopsAndReplays) {
   EXPECT_EQ(yaml.str().find("frames: \"stop04\""), std::string::npos) << yaml.str();
   const CliRun replay = run_projbot("run --headless --replay " + rec.string(), 120);
   EXPECT_EQ(replay.code, 0) << replay.output;
-  EXPECT_NE(replay.output.find(" deg; 0 found or lost in one and not the other"), std::string::npos) << replay.output;
+  EXPECT_NE(replay.output.find(" deg; 0 found or lost in one and not the other; 0 recorded rows for frames the replay did not "
+                               "reach"),
+            std::string::npos)
+      << replay.output;
+  // The poses read as strictly as any input (issue 47: these replayed as "largest difference 0.0000 mm").
+  std::ifstream csv_in(rec / "poses.csv");
+  std::stringstream csv;
+  csv << csv_in.rdbuf();
+  const std::string good = csv.str();
+  const std::string first_row = good.substr(good.find('\n') + 1, good.find('\n', good.find('\n') + 1) - good.find('\n'));
+  const auto replay_with = [&](const std::string& text) {
+    std::ofstream(rec / "poses.csv", std::ios::trunc) << text;
+    return run_projbot("run --headless --replay " + rec.string(), 120);
+  };
+  const std::string nan = good.substr(0, good.rfind(',')) + ",nan\n";  // the last row's last number NaN
+  const CliRun with_nan = replay_with(nan);
+  EXPECT_EQ(with_nan.code, 1) << with_nan.output;
+  EXPECT_NE(with_nan.output.find("poses.csv:"), std::string::npos) << with_nan.output;
+  EXPECT_NE(with_nan.output.find("a value is not a finite number"), std::string::npos) << with_nan.output;
+  const CliRun twice = replay_with(good + first_row);
+  EXPECT_EQ(twice.code, 1) << twice.output;
+  EXPECT_NE(twice.output.find("a second row for visit"), std::string::npos) << twice.output;
+  std::string beyond = first_row;  // the first row moved to a frame that does not exist
+  const auto c1 = beyond.find(','), c2 = beyond.find(',', c1 + 1);
+  beyond.replace(c1 + 1, c2 - c1 - 1, "99999");
+  const CliRun unreached = replay_with(good + beyond);
+  EXPECT_EQ(unreached.code, 0) << unreached.output;
+  EXPECT_NE(unreached.output.find("; 1 recorded rows for frames the replay did not reach"), std::string::npos)
+      << unreached.output;
 }
 
 // Ctrl-C in ICP-SLAM: the scans done so far are mapped and their trajectory written; exit 130.
@@ -493,6 +526,37 @@ TEST_F(CliTest, SlamInterruptedKeepsTheScansDone) {
   EXPECT_NE(slam.output().find("ICP-SLAM interrupted after"), std::string::npos) << slam.output();
   EXPECT_TRUE(fs::exists(dir_ / "map" / "map.simplemap.gz"));
   EXPECT_LT(trajectory_lines(trajectory), 1460);
+}
+
+// Ctrl-C while slam still reads its rawlog: nothing is written, an earlier map and trajectory stay as they
+// were (they were once replaced by an empty map, "0 of 1460 scans").
+TEST_F(CliTest, SlamInterruptedWhileReadingWritesNothing) {
+  const fs::path rawlog = dir_ / "long.rawlog";  // the dataset five times over: a read long enough to interrupt
+  {
+    std::ifstream in(std::string(PROJBOT_SHARED_DATA) + "/mrpt/range_030_bearing_015.rawlog", std::ios::binary);
+    std::stringstream bytes;
+    bytes << in.rdbuf();
+    std::ofstream out(rawlog, std::ios::binary);
+    for (int i = 0; i < 5; ++i) out << bytes.str();
+  }
+  const CliRun first =
+      run_projbot("slam --rawlog " + std::string(PROJBOT_SHARED_DATA) + "/mrpt/localization_demo.rawlog --out-map " +
+                  (dir_ / "map").string() + " --out-trajectory " + (dir_ / "t.txt").string());
+  ASSERT_EQ(first.code, 0) << first.output;
+  const auto map_size = fs::file_size(dir_ / "map" / "map.simplemap.gz");
+  const auto lines = trajectory_lines(dir_ / "t.txt");
+  Background slam(
+      {"slam", "--rawlog", rawlog.string(), "--out-map", (dir_ / "map").string(), "--out-trajectory", (dir_ / "t.txt").string()},
+      dir_ / "slam.log");
+  ASSERT_GT(slam.pid, 0);
+  ASSERT_TRUE(slam.wait_for_output("reading ", std::chrono::seconds(60))) << slam.output();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  if (slam.output().find("mapping") != std::string::npos) GTEST_SKIP() << "read before the signal: " << slam.output();
+  const auto [code, seconds] = slam.signal_and_wait(SIGINT, std::chrono::seconds(60));
+  EXPECT_EQ(code, 130) << slam.output();
+  EXPECT_NE(slam.output().find("nothing written"), std::string::npos) << slam.output();
+  EXPECT_EQ(fs::file_size(dir_ / "map" / "map.simplemap.gz"), map_size);
+  EXPECT_EQ(trajectory_lines(dir_ / "t.txt"), lines);
 }
 
 // Ctrl-C in localize: the trajectory of the scans done is written, exit 130.

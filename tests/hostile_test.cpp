@@ -4,8 +4,11 @@
 // leave its scratch folder exactly as it was (no output created, no previous output changed).
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -20,7 +23,7 @@ namespace {
 
 // Files written into the scratch folder before a case runs; a plain string is the scene `bad.yaml`.
 // A content "@head:N:PATH" is the first N bytes of PATH, "@random:N" N random bytes; {dir}, {data} and
-// {src} are replaced in paths and contents.
+// {src} are replaced in paths and contents. "@fifo" makes a FIFO, "@link:TARGET" a symbolic link.
 struct Files {
   std::vector<std::pair<std::string, std::string>> list;
   Files() = default;
@@ -105,7 +108,12 @@ TEST_P(HostileTest, ExitsCleanlyNamingTheProblemAndWritesNothing) {
   const Hostile& h = GetParam();
   for (const auto& [name, spec] : h.files.list) {
     fs::create_directories((dir_ / name).parent_path());
-    std::ofstream(dir_ / name, std::ios::binary) << content(expand(spec, dir_));
+    if (spec == "@fifo")
+      ASSERT_EQ(::mkfifo((dir_ / name).c_str(), 0644), 0);
+    else if (spec.rfind("@link:", 0) == 0)
+      fs::create_symlink(spec.substr(6), dir_ / name);
+    else
+      std::ofstream(dir_ / name, std::ios::binary) << content(expand(spec, dir_));
   }
   const auto before = snapshot(dir_);
   const CliRun r = run_projbot(expand(h.args, dir_), 120);
@@ -124,6 +132,174 @@ TEST_P(HostileTest, ExitsCleanlyNamingTheProblemAndWritesNothing) {
     }
   }
   for (const auto& [path, bytes] : before) EXPECT_TRUE(after.count(path) == 1) << path << " was removed";
+}
+
+// A PNG whose header claims `w` x `h` pixels (an IHDR, no data: the size is refused before any decoding).
+std::string png_claiming(std::uint32_t w, std::uint32_t h) {
+  std::string s("\x89PNG\r\n\x1a\n", 8);
+  const auto be32 = [&](std::uint32_t v) {
+    for (int k = 3; k >= 0; --k) s.push_back(static_cast<char>((v >> (8 * k)) & 0xff));
+  };
+  be32(13);
+  s += "IHDR";
+  be32(w);
+  be32(h);
+  s += std::string("\x08\x06\x00\x00\x00", 5);
+  be32(0);  // stb does not check the CRC
+  be32(0);
+  s += "IEND";
+  be32(0xae426082u);
+  return s;
+}
+
+// A pose folder of 14 capture images, each a real PNG cut before its IEND chunk.
+Files truncated_captures() {
+  Files f;
+  for (int i = 0; i < 14; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "cap/p0/%02d.png", i);
+    f.list.emplace_back(name, "@head:78:{src}/tests/fuzz/corpus/depth_png/gray16_4x3.png");
+  }
+  return f;
+}
+
+// Outputs that would destroy an input (issue 47): refused before any work, exit 2, naming both; inputs that
+// are not regular files refused by kind, exit 1, before anything opens them (a FIFO would block).
+std::vector<Hostile> clash_cases() {
+  const std::string whole_rawlog = "@head:4000000:{rawlog}";
+  std::string chain = R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [)";
+  for (int i = 0; i < 20000; ++i) chain += R"({"children": [)" + std::to_string(i + 1) + "]},";
+  chain += "{}]}";
+  std::string doubling = R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [)";  // 2^40 placements
+  for (int i = 0; i < 40; ++i) doubling += R"({"children": [)" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]},";
+  doubling += "{}]}";
+  return {
+      Hostile{"ply_more_vertices_than_declared",
+              "align --model {duck} --scan {dir}/c.ply",
+              Files{{"c.ply",
+                     "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+                     "end_header\n0 0 1\n0 1 1\n1 0 1\n1 1 1\n"}},
+              1,
+              {"c.ply: the header declares 2 elements (2 vertices), the body holds 4 lines"}},
+      Hostile{"gltf_texture_20000_pixels_a_side",
+              "align --model {dir}/big.gltf --scan {data}/bunny/bun4.pcd",
+              Files{{"big.gltf", R"({"asset": {"version": "2.0"}, "images": [{"uri": "big.png"}]})"},
+                    {"big.png", png_claiming(20000, 20000)}},
+              1,
+              {"big.gltf: image 0: 20000x20000 pixels, larger than the 16384 pixels a side a texture may have"}},
+      Hostile{"gltf_shared_children_doubling_40_levels",
+              "align --model {dir}/dag.gltf --scan {data}/bunny/bun4.pcd",
+              Files{{"dag.gltf", doubling}},
+              1,
+              {"dag.gltf: the node hierarchy places more than 100000 nodes"}},
+      Hostile{"slam_ini_threshold_without_end",
+              "slam --rawlog {rawlog} --config {dir}/huge.ini --out-map {dir}/m --out-trajectory {dir}/t.txt",
+              Files{{"huge.ini", "[MappingApplication]\npointsMap_count=1\n[ICP]\nthresholdDist = 1e308\n"}},
+              1,
+              {"huge.ini:4: [ICP] thresholdDist = '1e308' must be 0.001..100"}},
+      Hostile{"slam_ini_points_maps_that_crashed_mrpt",
+              "slam --rawlog {rawlog} --config {dir}/maps.ini --out-map {dir}/m --out-trajectory {dir}/t.txt",
+              Files{{"maps.ini", "[MappingApplication]\npointsMap_count = 100000\n[ICP]\nmaxIterations = 80\n"}},
+              1,
+              {"maps.ini:2: [MappingApplication] pointsMap_count = '100000' must be 1..4"}},
+      Hostile{"slam_ground_truth_backwards",
+              "slam --rawlog {rawlog} --ground-truth {dir}/gt.txt --out-map {dir}/m --out-trajectory {dir}/t.txt",
+              Files{{"gt.txt", "2 0 0 0\n1 0 0 0\n"}},
+              1,
+              {"gt.txt:2: timestamp 1.000000 does not come after"}},
+      Hostile{"localize_ground_truth_1e308",
+              "localize --map {dir}/goodmap --rawlog {rawlog} --ground-truth {dir}/gt.txt --out-trajectory {dir}/t.txt",
+              Files{{"gt.txt", "1 1e308 0 0\n"}},
+              1,
+              {"gt.txt:1: x and y must lie within 1000 km"}},
+      Hostile{"scene_key_given_twice",
+              "render --scene {dir}/bad.yaml --out {dir}/x.png",
+              "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets: []\nprojector: {width: 8}\n",
+              1,
+              {"bad.yaml:3: 'projector' is given twice in one mapping"}},
+      Hostile{"scene_near_tiny",
+              "render --scene {dir}/bad.yaml --out {dir}/x.png",
+              "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24, near: 1e-300, far: 10}\ntargets: []\n",
+              1,
+              {"bad.yaml", "0.0001 m <= near"}},
+      Hostile{"scene_slip_scale_1e308",
+              "tour --scene {dir}/bad.yaml",
+              "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets: []\n"
+              "robot: {drift: {slip_scale: 1e308}}\n",
+              1,
+              {"robot.drift.slip_scale: must be 0..0.5"}},
+      Hostile{"gltf_node_chain_20000_deep",
+              "align --model {dir}/chain.gltf --scan {data}/bunny/bun4.pcd",
+              Files{{"chain.gltf", chain}},
+              1,
+              {"chain.gltf: node 256: the node hierarchy is deeper than 256 levels"}},
+      Hostile{"slam_out_map_holds_the_rawlog",
+              "slam --rawlog {dir}/rec/laser.rawlog --out-map {dir}/rec --out-trajectory {dir}/t.txt",
+              Files{{"rec/laser.rawlog", whole_rawlog}},
+              2,
+              {"--out-map {dir}/rec holds the input --rawlog {dir}/rec/laser.rawlog"}},
+      Hostile{"slam_out_map_holds_other_files",
+              "slam --rawlog {rawlog} --out-map {dir}/mine --out-trajectory {dir}/t.txt",
+              Files{{"mine/notes.txt", "the user's\n"}},
+              2,
+              {"--out-map {dir}/mine: holds 'notes.txt', which this command did not write"}},
+      Hostile{"slam_trajectory_over_the_rawlog",
+              "slam --rawlog {dir}/r.rawlog --out-map {dir}/m --out-trajectory {dir}/r.rawlog",
+              Files{{"r.rawlog", whole_rawlog}},
+              2,
+              {"--out-trajectory {dir}/r.rawlog is also the input --rawlog"}},
+      Hostile{"localize_trajectory_over_the_map",
+              "localize --map {dir}/goodmap --rawlog {rawlog} --out-trajectory {dir}/goodmap/map.simplemap.gz",
+              "",
+              2,
+              {"is inside the input folder --map {dir}/goodmap"}},
+      Hostile{"tour_report_over_the_scene",
+              "tour --scene {dir}/bad.yaml --report {dir}/bad.yaml",
+              "a: 1\n",
+              2,
+              {"--report {dir}/bad.yaml is also the input --scene {dir}/bad.yaml"}},
+      Hostile{"tour_report_over_the_scene_through_a_link",
+              "tour --scene {dir}/link.yaml --report {dir}/bad.yaml",
+              Files{{"bad.yaml", "a: 1\n"}, {"link.yaml", "@link:bad.yaml"}},
+              2,
+              {"is also the input --scene {dir}/link.yaml"}},
+      Hostile{"render_profile_over_the_scene",
+              "render --scene {dir}/bad.yaml --out {dir}/x.png --profile {dir}/bad.yaml",
+              "a: 1\n",
+              2,
+              {"--profile {dir}/bad.yaml is also the input --scene"}},
+      Hostile{"render_out_and_profile_one_file", "render --out {dir}/x.png --profile {dir}/x.png", "", 2, {"are the same path"}},
+      Hostile{"calibrate_solve_out_over_its_manifest",
+              "calibrate solve {dir}/cap --out {dir}/cap/capture.yaml",
+              Files{{"cap/capture.yaml", "projector: [8, 8]\n"}},
+              2,
+              {"--out {dir}/cap/capture.yaml is inside the input folder the folder {dir}/cap"}},
+      Hostile{"run_replay_profile_over_its_poses",
+              "run --headless --replay {dir}/rec --profile {dir}/rec/poses.csv",
+              Files{{"rec/poses.csv", "frame\n"}, {"rec/recording.yaml", "a: 1\n"}},
+              2,
+              {"--profile {dir}/rec/poses.csv is inside the input folder --replay {dir}/rec"}},
+      Hostile{"tour_scene_is_a_fifo",
+              "tour --scene {dir}/f.yaml",
+              Files{{"f.yaml", "@fifo"}},
+              1,
+              {"--scene {dir}/f.yaml: is a FIFO, not a regular file"}},
+      Hostile{"align_scan_is_a_fifo",
+              "align --model {duck} --scan {dir}/f.pcd",
+              Files{{"f.pcd", "@fifo"}},
+              1,
+              {"--scan {dir}/f.pcd: is a FIFO, not a regular file"}},
+      Hostile{"render_scene_is_dev_zero",
+              "render --scene /dev/zero --out {dir}/x.png",
+              "",
+              1,
+              {"--scene /dev/zero: is a character device, not a regular file"}},
+      Hostile{"slam_rawlog_is_dev_zero",
+              "slam --rawlog /dev/zero --out-map {dir}/m --out-trajectory {dir}/t.txt",
+              "",
+              1,
+              {"--rawlog /dev/zero: is a character device"}},
+  };
 }
 
 const std::string kProj = "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\n";
@@ -175,7 +351,7 @@ std::vector<Hostile> cloud_cases() {
       {"empty.ply", "", "ply"},
       {"header_only.ply", kPly, "ply"},
       {"random.ply", "@random:2000", "ply"},
-      {"assert.ply", "@head:100000:{src}/tests/hostile/pcl_ply_assert.ply", "PCL's reader crashed on it"},
+      {"assert.ply", "@head:100000:{src}/tests/hostile/pcl_ply_assert.ply", "assert.ply:7: PLY header: 'eleme3z face 1'"},
       {"short.ply", kPly + "0 0 1\n1 0 1\n", "ply"},
       {"binary_short.ply", replace_all(kPly, "ascii", "binary_little_endian") + std::string(10, '\x01'), "ply"}};
   std::vector<Hostile> cases;
@@ -698,7 +874,8 @@ std::vector<Hostile> all_cases() {
               "",
               2,
               {"single target", "2"}},
-      Hostile{"missing_scene", "render --out {dir}/a.png --scene {dir}/none.yaml", "", 1, {"none.yaml", "cannot open"}},
+      Hostile{
+          "missing_scene", "render --out {dir}/a.png --scene {dir}/none.yaml", "", 1, {"none.yaml", "none.yaml: does not exist"}},
       Hostile{"scene_unknown_key",
               "render --out {dir}/a.png --scene {dir}/bad.yaml",
               kProj + "targets: []\nextra: 1\n",
@@ -842,7 +1019,7 @@ std::vector<Hostile> all_cases() {
               {"--initial"}},
       Hostile{"bench_localize_bad_stops", "bench localize --stops 3,x", "", 2, {"--stops"}},
       Hostile{"tour_bad_mode", "tour --mode paper", "", 2, {"--mode must be odometry, localized or tracking"}},
-      Hostile{"tour_missing_scene", "tour --scene {dir}/nope.yaml", "", 1, {"nope.yaml: cannot open scene file"}},
+      Hostile{"tour_missing_scene", "tour --scene {dir}/nope.yaml", "", 1, {"nope.yaml: does not exist"}},
       Hostile{"tour_without_tour_section", "tour --scene {dir}/bad.yaml", kProj + "targets: []\n", 1, {"needs a 'tour"}},
       Hostile{"tour_bad_visits", "tour --visits 0", "", 2, {"--visits"}},
       Hostile{"run_without_tour_section",
@@ -874,11 +1051,21 @@ std::vector<Hostile> all_cases() {
               Files{{"cap/p0/00.png", "@head:40:{src}/assets/scenes/../../README.md"}},
               1,
               {"cap/p0': 1 images, expected 14"}},
+      Hostile{"calibrate_solve_png_cut_before_iend",
+              "calibrate solve {dir}/cap --out {dir}/c.yaml --projector 8x8 --board checkerboard:9x6:0.05",
+              truncated_captures(),
+              1,
+              {"cap/p0/00.png: corrupt PNG: the file ends after 78 bytes without its IEND chunk"}},
       Hostile{"calibrate_solve_bad_board",
               "calibrate solve {dir}/goodmap --out {dir}/c.yaml --board chess:9x6:0.05",
               "",
-              1,
-              {"unknown kind 'chess'"}},
+              2,
+              {"--board 'chess:9x6:0.05': unknown kind 'chess'"}},
+      Hostile{"calibrate_simulate_bad_board",
+              "calibrate simulate --out {dir}/cap --board charuco:10x7",
+              "",
+              2,
+              {"--board 'charuco:10x7': too few fields"}},
       Hostile{"calibrate_solve_bad_projector",
               "calibrate solve {dir}/goodmap --out {dir}/c.yaml --projector 0x800",
               "",
@@ -895,9 +1082,11 @@ std::vector<Hostile> all_cases() {
       Hostile{"calibrate_simulate_too_few_markers",
               "calibrate simulate --out {dir}/cap --board charuco:30x20:0.1:0.08",
               "",
-              1,
-              {"300 markers, DICT_4X4_50 has 50"}},
-      Hostile{"tour_missing_calibration", "tour --calibration {dir}/none.yaml", "", 1, {"none.yaml: not a file"}}};
+              2,
+              {"--board 'charuco:30x20:0.1:0.08': 300 markers, DICT_4X4_50 has 50"}},
+      Hostile{"tour_missing_calibration", "tour --calibration {dir}/none.yaml", "", 1, {"none.yaml: does not exist"}}};
+  const auto clashes = clash_cases();
+  cases.insert(cases.end(), clashes.begin(), clashes.end());
   const auto clouds = cloud_cases();
   cases.insert(cases.end(), clouds.begin(), clouds.end());
   cases.insert(cases.end(), kFileCases.begin(), kFileCases.end());

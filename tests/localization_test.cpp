@@ -114,6 +114,19 @@ TEST(Trajectory, RoundTripAndBadLines) {
   } catch (const RobotError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.txt:2"), std::string::npos) << e.what();
   }
+  const std::vector<std::pair<std::string, std::string>> nonsense{
+      {"1 0 0 0\n0.5 1 0 0\n", "bad.txt:2: timestamp 0.500000 does not come after"},
+      {"1 0 0 0\n1 1 0 0\n", "timestamps must increase"},
+      {"1 1e308 0 0\n", "bad.txt:1: x and y must lie within 1000 km"}};
+  for (const auto& [text, message] : nonsense) {
+    std::ofstream(dir / "bad.txt") << text;
+    try {
+      read_trajectory(dir / "bad.txt");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const RobotError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
   fs::remove_all(dir);
 }
 
@@ -231,7 +244,13 @@ TEST(IcpSlam, ConfigValuesAreParsedStrictly) {
       {"matchAgainstTheGrid = 0", "matchAgainstTheGrid = maybe", "[MappingApplication] matchAgainstTheGrid = 'maybe'"},
       {"insertionLinDistance\t= 1.2", "insertionLinDistance = ", "insertionLinDistance = '' is not a finite number"},
       {"ALFA             = 0.8", "ALFA 0.8", "expected 'key = value' or '[section]', not 'ALFA 0.8'"},
-      {"\n[ICP]\n", "\n[ICP\n", "a section is '[name]'"}};
+      {"\n[ICP]\n", "\n[ICP\n", "a section is '[name]'"},
+      // Typed but out of what MRPT runs in bounded time (issue 47: these never ended, or crashed MRPT).
+      {"thresholdDist    = 0.3", "thresholdDist = 1e308", "thresholdDist = '1e308' must be 0.001..100"},
+      {"smallestThresholdDist=0.05", "smallestThresholdDist = 0", "smallestThresholdDist = '0' must be 0.0001..100"},
+      {"pointsMap_count=1", "pointsMap_count=-1", "pointsMap_count = '-1' must be 1..4"},
+      {"pointsMap_count=1", "pointsMap_count=100000", "pointsMap_count = '100000' must be 1..4"},
+      {"pointsMap_count=1", "pointsMap_count=1\nlandmarksMap_count=9", "landmarksMap_count = '9' must be 0..4"}};
   for (const auto& [from, to, message] : cases) {
     std::string text = good;
     const auto at = text.find(from);
@@ -252,6 +271,31 @@ TEST(IcpSlam, ConfigValuesAreParsedStrictly) {
   const auto warnings = check_icp_slam_config(dir / "typo.ini");
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("typo.ini:13: [ICP] maxIteratons: not a setting of MRPT's ICP"), std::string::npos) << warnings[0];
+  fs::remove_all(dir);
+}
+
+// The map's folder is replaced only when it holds nothing but an earlier map; a run stopped before its
+// first scan writes nothing (issue 47: a Ctrl-C while loading once replaced a good map with an empty one).
+TEST(IcpSlam, TheMapFolderIsNeverAUsersFolder) {
+  const auto steps = read_rawlog(kData / "localization_demo.rawlog");
+  const fs::path dir = temp_dir("slamfolder");
+  fs::create_directories(dir / "mine");
+  std::ofstream(dir / "mine" / "notes.txt") << "the user's";
+  try {
+    build_map(steps, std::nullopt, dir / "mine");
+    ADD_FAILURE() << "a folder with the user's notes was replaced";
+  } catch (const RobotError& e) {
+    EXPECT_NE(std::string(e.what()).find("holds 'notes.txt'"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::exists(dir / "mine" / "notes.txt"));
+  const SlamResult none = build_map(steps, std::nullopt, dir / "never", [] { return true; });
+  EXPECT_TRUE(none.interrupted);
+  EXPECT_FALSE(fs::exists(dir / "never"));
+  build_map(steps, std::nullopt, dir / "map");
+  const auto first = fs::file_size(dir / "map" / "map.simplemap.gz");
+  EXPECT_GT(first, 1000u);
+  build_map(steps, std::nullopt, dir / "map", [] { return true; });  // stopped at once: the old map stays
+  EXPECT_EQ(fs::file_size(dir / "map" / "map.simplemap.gz"), first);
   fs::remove_all(dir);
 }
 
@@ -303,6 +347,24 @@ TEST(SimulatedLaser, RangesMatchTheRoomGeometry) {
   EXPECT_NEAR(back[1].odometry_increment->theta_rad, 0.1, 1e-9);
   EXPECT_NEAR(back[1].scan.ranges_m[540], s.ranges_m[540], 1e-6);
   fs::remove_all(dir);
+}
+
+// Building the simulated robot hears a stop request within a survey scan (issue 47: a 200 x 200 m room
+// kept `tour` surveying for 520 s, deaf to SIGTERM), and a large room's survey is bounded.
+TEST(SimulatedTour, SetUpStopsOnRequestAndLargeRoomsStayBounded) {
+  SimTourConfig c = default_sim_tour();
+  int asked = 0;
+  c.stop_requested = [&] { return ++asked > 3; };
+  EXPECT_THROW(SimRobot robot(c), SetupInterrupted);
+  EXPECT_EQ(asked, 4);
+  c.room.width_m = 200.0;
+  c.room.depth_m = 200.0;
+  c.room.obstacles.clear();
+  c.start = {100.0, 100.0, 0.0};
+  asked = 0;
+  c.stop_requested = [&] { return ++asked > 100000; };
+  const SimRobot big(c);
+  EXPECT_LE(asked, 1100);  // about 1000 survey scans, not the 40000 of a 1 m grid
 }
 
 TEST(SimulatedTour, LocalisationHoldsAtEveryStopWhileOdometryDrifts) {

@@ -179,6 +179,7 @@ TEST(OpenNi2Test, MalformedRecordingsAreNamed) {
     ADD_FAILURE() << "no error";
   } catch (const AlignmentError& e) {
     EXPECT_NE(std::string(e.what()).find(cut.string()), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("projbot_playback_"), std::string::npos) << "names our temporary copy: " << e.what();
   }
   fs::remove(not_oni);
   fs::remove(cut);

@@ -4,12 +4,14 @@
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 
 #include <csignal>
 #include <fstream>
 #include <sstream>
 
 #include "projbot/assets/image.hpp"
+#include "projbot/config/paths.hpp"
 
 namespace fs = std::filesystem;
 using projbot::assets::AssetError;
@@ -104,3 +106,73 @@ TEST_F(AtomicFile, PngRoundTripAndFailedPngWrite) {
   EXPECT_EQ(back.pixel(2, 1)[0], 200);
   expect_error([&] { projbot::assets::write_png("/dev/full", img); }, "/dev/full");
 }
+
+// A command's inputs against its outputs (issue 47): what would destroy an input is found, through links
+// and "..", and what is harmless is not.
+namespace {
+
+using projbot::config::find_path_clash;
+using projbot::config::NamedPath;
+
+TEST_F(AtomicFile, AnOutputOnAnInputIsAClashThroughLinksAndDots) {
+  std::ofstream(dir_ / "scene.yaml") << "a: 1\n";
+  fs::create_symlink(dir_ / "scene.yaml", dir_ / "link.yaml");
+  const std::vector<NamedPath> in{{"--scene", dir_ / "link.yaml", false}};
+  const auto clash = find_path_clash(in, {{"--report", dir_ / "sub" / ".." / "scene.yaml", false}});
+  ASSERT_TRUE(clash.has_value());
+  EXPECT_NE(clash->find("--report"), std::string::npos) << *clash;
+  EXPECT_NE(clash->find("is also the input --scene"), std::string::npos) << *clash;
+  EXPECT_FALSE(find_path_clash(in, {{"--report", dir_ / "report.json", false}}).has_value());
+}
+
+TEST_F(AtomicFile, AnOutputFolderHoldingAnInputIsAClash) {
+  fs::create_directories(dir_ / "rec");
+  std::ofstream(dir_ / "rec" / "laser.rawlog") << "x";
+  const std::vector<NamedPath> in{{"--rawlog", dir_ / "rec" / "laser.rawlog", false}};
+  EXPECT_TRUE(find_path_clash(in, {{"--out-map", dir_ / "rec/", true}}).has_value());
+  EXPECT_TRUE(find_path_clash(in, {{"--out-map", dir_, true}}).has_value());
+  EXPECT_FALSE(find_path_clash(in, {{"--out-map", dir_ / "rec2", true}}).has_value());  // a name that starts alike
+}
+
+TEST_F(AtomicFile, AnExistingFileInsideAnInputFolderIsAClashANewOneIsNot) {
+  fs::create_directories(dir_ / "cap");
+  std::ofstream(dir_ / "cap" / "capture.yaml") << "x";
+  const std::vector<NamedPath> in{{"DIR", dir_ / "cap", true}};
+  EXPECT_TRUE(find_path_clash(in, {{"--out", dir_ / "cap" / "capture.yaml", false}}).has_value());
+  EXPECT_FALSE(find_path_clash(in, {{"--out", dir_ / "cap" / "calibration.yaml", false}}).has_value());
+}
+
+TEST_F(AtomicFile, TwoOutputsOnOnePathAreAClash) {
+  const auto clash = find_path_clash({}, {{"--out", dir_ / "x.png", false}, {"--profile", dir_ / "./x.png", false}});
+  ASSERT_TRUE(clash.has_value());
+  EXPECT_NE(clash->find("are the same path"), std::string::npos) << *clash;
+}
+
+TEST_F(AtomicFile, OnlyAFolderOfOurOwnFilesMayBeReplaced) {
+  const std::set<std::string> ours{"map.simplemap.gz", "grid.png"};
+  EXPECT_NO_THROW(projbot::config::check_replaceable_folder(dir_ / "new", ours));
+  fs::create_directories(dir_ / "old");
+  EXPECT_NO_THROW(projbot::config::check_replaceable_folder(dir_ / "old", ours));  // empty
+  std::ofstream(dir_ / "old" / "grid.png") << "x";
+  EXPECT_NO_THROW(projbot::config::check_replaceable_folder(dir_ / "old", ours));
+  std::ofstream(dir_ / "old" / "notes.txt") << "mine";
+  try {
+    projbot::config::check_replaceable_folder(dir_ / "old", ours);
+    ADD_FAILURE() << "a folder with the user's notes was accepted";
+  } catch (const OutputError& e) {
+    EXPECT_NE(std::string(e.what()).find("holds 'notes.txt'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(projbot::config::check_replaceable_folder(dir_ / "old" / "notes.txt", ours), OutputError);
+}
+
+TEST_F(AtomicFile, InputsAreNamedByKind) {
+  ASSERT_EQ(::mkfifo((dir_ / "f").c_str(), 0644), 0);
+  EXPECT_EQ(projbot::config::input_file_problem(dir_ / "f"), "is a FIFO, not a regular file");
+  EXPECT_EQ(projbot::config::input_file_problem("/dev/zero"), "is a character device, not a regular file");
+  EXPECT_EQ(projbot::config::input_file_problem(dir_), "is a folder, not a file");
+  EXPECT_EQ(projbot::config::input_file_problem(dir_ / "none"), "does not exist");
+  std::ofstream(dir_ / "ok") << "x";
+  EXPECT_EQ(projbot::config::input_file_problem(dir_ / "ok"), "");
+}
+
+}  // namespace

@@ -8,7 +8,9 @@
 #include <fstream>
 #include <random>
 
+#include "../alignment/src/ply_body.hpp"
 #include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/registration.hpp"
 
 namespace fs = std::filesystem;
 using namespace projbot::alignment;
@@ -117,5 +119,71 @@ TEST_F(PcdReader, HugeClaimIsRefusedQuicklyInLittleMemory) {
     std::string other = body;
     other.replace(other.find("binary\n"), 7, std::string(mode) + "\n");
     expect_refused(other, "2000000000 points");
+  }
+}
+
+// A PLY cloud's body must end where its header's counts say (issue 47: a binary PLY holding more
+// vertices than it declared was half read and its pose accepted).
+namespace {
+
+std::string ply_cloud(const std::string& format, int declared, int stored) {
+  std::string s = "ply\nformat " + format + " 1.0\nelement vertex " + std::to_string(declared) +
+                  "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  for (int i = 0; i < stored; ++i) {
+    const float v[3] = {0.01f * static_cast<float>(i), 0.02f * static_cast<float>(i % 7), 1.0f};
+    if (format == "ascii")
+      s += std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) + "\n";
+    else
+      s.append(reinterpret_cast<const char*>(v), sizeof v);
+  }
+  return s;
+}
+
+TEST_F(PcdReader, PlyBodiesMustMatchTheirHeaders) {
+  const fs::path p = dir_ / "cloud.ply";
+  const auto refused = [&](const std::string& bytes, const std::string& needle) {
+    std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
+    try {
+      read_cloud(p);
+      ADD_FAILURE() << "accepted: " << needle;
+    } catch (const AlignmentError& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  for (const std::string format : {"binary_little_endian", "ascii"}) {
+    std::ofstream(p, std::ios::binary | std::ios::trunc) << ply_cloud(format, 40, 40);
+    EXPECT_EQ(read_cloud(p).points.size(), 40u) << format;
+  }
+  refused(ply_cloud("binary_little_endian", 30, 40), "120 bytes follow them");
+  refused(ply_cloud("binary_little_endian", 40, 30), "more than the file holds");
+  refused(ply_cloud("ascii", 30, 40), "the body holds 40 lines");
+  refused(ply_cloud("binary_little_endian", 40, 40).replace(4, 27, "format binary_middle_endian"), "binary_middle_endian");
+}
+
+// The shared real models (binary, with normals and face lists) pass the same walk.
+TEST_F(PcdReader, RealPlyMeshesPassTheBodyCheck) {
+  int checked = 0;
+  for (const auto& e : fs::directory_iterator(kData / "ycbv-bop" / "models"))
+    if (e.path().extension() == ".ply") {
+      EXPECT_NO_THROW(detail::check_ply_body(e.path())) << e.path();
+      ++checked;
+    }
+  EXPECT_GE(checked, 10);
+}
+
+}  // namespace
+
+// A model with too few points is named by its file (issue 47: "model needs at least 10 points ... (got 0)").
+TEST(ModelCloudMessages, NameTheFile) {
+  ModelCloud m;
+  m.points = {Eigen::Vector3f(0, 0, 1)};
+  m.normals = {Eigen::Vector3f(0, 0, 1)};
+  m.source = "/models/tiny.ply";
+  try {
+    Aligner aligner(m, AcquisitionConfig{});
+    ADD_FAILURE() << "a one-point model was accepted";
+  } catch (const AlignmentError& e) {
+    EXPECT_NE(std::string(e.what()).find("/models/tiny.ply: the model needs at least 10 points"), std::string::npos) << e.what();
   }
 }

@@ -1,8 +1,11 @@
 // The PTU-D46 driver (MRPT's CPtuDPerception) end to end against the protocol emulator on a pty.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 
 #include "projbot/robot/ptu_d46.hpp"
@@ -84,6 +87,22 @@ TEST(PtuD46, BadPortsAreNamed) {
   PtuD46Emulator unit;
   unit.set_silent(true);
   EXPECT_THROW(PtuD46 ptu(unit.port()), RobotError);
+  // Not a serial port at all: said so, not "the unit did not answer" (issue 47).
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / ("projbot_ptu_" + std::to_string(::getpid()));
+  std::ofstream(file) << "x";
+  const std::vector<std::pair<std::string, std::string>> not_ports{
+      {file.string(), "is a regular file, not a serial port"},
+      {std::filesystem::temp_directory_path().string(), "is a folder, not a serial port"},
+      {"/dev/null", "not a terminal"}};
+  for (const auto& [port, message] : not_ports) {
+    try {
+      PtuD46 ptu(port);
+      ADD_FAILURE() << "opened " << port;
+    } catch (const RobotError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove(file);
 }
 
 }  // namespace

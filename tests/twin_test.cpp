@@ -190,7 +190,7 @@ TEST(TwinSceneTest, BadToursAreNamed) {
             std::string::npos);
   EXPECT_NE(config_error("motion: {visit: 2,", "motion: {visit: 0,").find("targets[1].motion.visit: must be >= 1"),
             std::string::npos);
-  EXPECT_NE(config_error("slip_scale: 0.01", "slip_scale: -0.01").find("robot.drift.slip_scale: must be >= 0"),
+  EXPECT_NE(config_error("slip_scale: 0.01", "slip_scale: -0.01").find("robot.drift.slip_scale: must be 0..0.5"),
             std::string::npos);
   EXPECT_NE(
       config_error("stays: true}", "stays: true, removed: true}").find("targets[1].motion: a removed target cannot also stay"),

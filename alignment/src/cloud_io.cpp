@@ -10,6 +10,7 @@
 
 #include "file_kind.hpp"
 #include "pcd_header.hpp"
+#include "ply_body.hpp"
 #include "projbot/alignment/depth.hpp"
 #include "projbot/config/isolated_read.hpp"
 
@@ -81,8 +82,12 @@ PointCloud read_cloud(const std::filesystem::path& path) {
         throw AlignmentError(path.string() + ": read " + std::to_string(cloud.size()) + " points, the header claims " +
                              std::to_string(header.points) + " (malformed data section?)");
     } else if (ext == ".ply") {
+      const std::uint64_t vertices = detail::check_ply_body(path);  // PCL reads the declared counts, ignores the rest
       rc = load_isolated(
           path, "PLY file", [&](Cloud& c) { return pcl::io::loadPLYFile(path.string(), c); }, cloud);
+      if (rc >= 0 && cloud.size() != vertices)
+        throw AlignmentError(path.string() + ": read " + std::to_string(cloud.size()) + " points, the header declares " +
+                             std::to_string(vertices) + " vertices");
     } else {
       throw AlignmentError(path.string() + ": unknown point cloud format (use .pcd or .ply)");
     }

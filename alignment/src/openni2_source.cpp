@@ -94,7 +94,15 @@ OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_un
     m.repaired_copy.path = std::filesystem::temp_directory_path() /
                            ("projbot_playback_" + std::to_string(::getpid()) + "_" + std::to_string(copies++) + ".oni");
     std::filesystem::copy_file(options.uri, m.repaired_copy.path, std::filesystem::copy_options::overwrite_existing);
-    add_oni_cropping_property(m.repaired_copy.path);
+    try {
+      add_oni_cropping_property(m.repaired_copy.path);
+    } catch (const AlignmentError& e) {  // named as the user named it, not as our temporary copy
+      std::string why = e.what();
+      const std::string copy = m.repaired_copy.path.string();
+      for (auto at = why.find(copy); at != std::string::npos; at = why.find(copy, at + options.uri.size()))
+        why.replace(at, copy.size(), options.uri);
+      throw AlignmentError(why);
+    }
     open_uri = m.repaired_copy.path.string();
   }
   if (m.device.open(open_uri.empty() ? openni::ANY_DEVICE : open_uri.c_str()) != openni::STATUS_OK)

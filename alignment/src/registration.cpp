@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "file_kind.hpp"
+#include "ply_body.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/assets/model.hpp"
@@ -586,7 +587,7 @@ AcquisitionConfig pcl_pipeline_config(bool pcl_search) {
 
 ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
   const auto s = assets::sample_surface(model, samples, 1);
-  return {s.points, s.normals, s.colours};
+  return {s.points, s.normals, s.colours, {}};
 }
 
 namespace {
@@ -628,12 +629,14 @@ ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t sampl
     throw AlignmentError(path.string() + ": model scale must be a finite number in [1e-6, 1e6], not " + std::to_string(scale));
   const std::string ext = detail::lower_extension(path);
   const bool mesh = ext == ".gltf" || ext == ".glb" || ext == ".obj" || ext == ".stl" || (ext == ".ply" && ply_has_faces(path));
+  if (ext == ".ply") detail::check_ply_body(path);  // a mesh's counts too: Assimp ignores what follows them
   if (mesh) {
     try {
       assets::Model model = assets::load_model(path);
       assets::scale_and_recenter(model, scale, false);
       ModelCloud m = model_cloud_from(model, samples);
       if (m.points.size() < 10) throw AlignmentError(path.string() + ": the model's surface has no area to sample");
+      m.source = path.string();
       return m;
     } catch (const assets::AssetError& e) {
       throw AlignmentError(e.what());
@@ -641,6 +644,7 @@ ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t sampl
   }
   ModelCloud m = cloud_model(path);
   for (auto& p : m.points) p *= static_cast<float>(scale);
+  m.source = path.string();
   return m;
 }
 
@@ -650,12 +654,14 @@ Aligner::Aligner(ModelCloud model, AcquisitionConfig config) : impl_(std::make_u
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   impl_->cfg = config;
   impl_->extent = Extent(model.points);
+  const std::string named = model.source.empty() ? std::string("model") : model.source + ": the model";
   if (model.points.size() < 10 || model.normals.size() != model.points.size())
-    throw AlignmentError("model needs at least 10 points, each with a normal (got " + std::to_string(model.points.size()) + ")");
+    throw AlignmentError(named + " needs at least 10 points, each with a normal (got " + std::to_string(model.points.size()) +
+                         ")");
   impl_->model = pcl::make_shared<CloudN>();
   for (std::size_t i = 0; i < model.points.size(); ++i) {
     if (!model.points[i].allFinite() || !model.normals[i].allFinite())
-      throw AlignmentError("model point " + std::to_string(i) + " is not finite");
+      throw AlignmentError(named + "'s point " + std::to_string(i) + " is not finite");
     PointN p;
     p.getVector3fMap() = model.points[i];
     p.getNormalVector3fMap() = model.normals[i];

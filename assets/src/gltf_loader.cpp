@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "default_material.hpp"
+#include "image_info.hpp"
 #include "projbot/assets/model.hpp"
 
 namespace projbot::assets {
@@ -39,6 +40,10 @@ class Loader {
   }
 
  private:
+  static constexpr std::size_t kMaxNodeDepth = 256;
+  static constexpr std::size_t kMaxNodeVisits = 100000;
+  std::size_t visits_ = 0;
+
   template <typename T>
   void check_index(int index, const std::vector<T>& items, const std::string& what) const {
     if (index < 0 || static_cast<std::size_t>(index) >= items.size())
@@ -87,6 +92,12 @@ class Loader {
   void visit_node(int index, const Eigen::Matrix4d& parent, std::set<int>& path, Model& out) {
     check_index(index, g_.nodes, "node");
     if (!path.insert(index).second) fail("node " + std::to_string(index) + " is its own ancestor (cycle in node hierarchy)");
+    // Bounded: a 20000-deep chain overflowed the stack, and nodes shared as children multiply the visits.
+    if (path.size() > kMaxNodeDepth)
+      fail("node " + std::to_string(index) + ": the node hierarchy is deeper than " + std::to_string(kMaxNodeDepth) + " levels");
+    if (++visits_ > kMaxNodeVisits)
+      fail("the node hierarchy places more than " + std::to_string(kMaxNodeVisits) +
+           " nodes (children shared between parents, many levels deep)");
     const auto& node = g_.nodes[static_cast<std::size_t>(index)];
     const Eigen::Matrix4d world = parent * local_transform(node, index);
     if (node.mesh >= 0) {
@@ -434,6 +445,24 @@ bool is_glb(const std::filesystem::path& path) {
 
 }  // namespace
 
+namespace {
+
+// tinygltf's own image loader, after a look at the size the header claims: a 20000 x 20000 texture was
+// decoded into 1.6 GB and then refused as "Unknown image format".
+bool load_checked_image(tinygltf::Image* image, const int index, std::string* err, std::string* warn, int width, int height,
+                        const unsigned char* bytes, int size, void* user) {
+  int w = 0, h = 0;
+  if (detail::claimed_image_size(bytes, size, w, h) && (w > detail::kMaxTextureSide || h > detail::kMaxTextureSide)) {
+    if (err != nullptr)
+      *err += "image " + std::to_string(index) + ": " + std::to_string(w) + "x" + std::to_string(h) +
+              " pixels, larger than the " + std::to_string(detail::kMaxTextureSide) + " pixels a side a texture may have";
+    return false;
+  }
+  return tinygltf::LoadImageData(image, index, err, warn, width, height, bytes, size, user);
+}
+
+}  // namespace
+
 Model load_gltf(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::error_code ec;
@@ -444,6 +473,7 @@ Model load_gltf(const std::filesystem::path& path) {
   if (ext == ".glb" && !is_glb(path))
     throw AssetError(file + ": not a binary glTF: a .glb file starts with the bytes 'glTF' (wrong extension, or not a model?)");
   tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(load_checked_image, nullptr);
   tinygltf::Model gltf;
   std::string err;
   std::string warn;

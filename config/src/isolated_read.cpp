@@ -15,6 +15,7 @@
 #include <fstream>
 #include <new>
 
+#include "projbot/config/paths.hpp"
 #include "write_all.hpp"
 
 // A fuzzer's or sanitizer's report-and-exit hook, present only in such builds.
@@ -135,6 +136,8 @@ std::string how_it_died(int status) {
 std::string read_isolated(const std::filesystem::path& file, const IsolatedReader& what,
                           const std::function<std::string(ReadProgress&)>& read) {
   const std::string name = file.string();
+  // Not opened unless a regular file: a FIFO blocks open(), /dev/zero reads to the memory cap.
+  if (const std::string problem = input_file_problem(file); !problem.empty()) throw IsolatedReadError(name + ": " + problem);
   void* shared = ::mmap(nullptr, sizeof(ReadProgress), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
   if (shared == MAP_FAILED) throw IsolatedReadError(name + ": cannot set up the isolated reader (mmap)");
   auto* progress = new (shared) ReadProgress{};

@@ -3,6 +3,7 @@
 #include <iomanip>
 
 #include "map_reader.hpp"
+#include "projbot/config/yaml_keys.hpp"
 
 namespace projbot::config {
 namespace {
@@ -75,6 +76,7 @@ Recording load_recording(const std::filesystem::path& folder) {
   } catch (const YAML::Exception& e) {
     throw ConfigError(file + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) : std::string()) + ": " + e.msg);
   }
+  if (const std::string twice = duplicate_key_message(root, file); !twice.empty()) throw ConfigError(twice);
   MapReader r(root, "", file);
   Recording rec;
   rec.source = file;

@@ -12,6 +12,8 @@
 #include <sstream>
 
 #include "map_reader.hpp"
+#include "projbot/config/paths.hpp"
+#include "projbot/config/yaml_keys.hpp"
 
 namespace projbot::config {
 namespace {
@@ -211,16 +213,18 @@ PanTiltConfig read_robot(MapReader& root, Scene& scene) {
   if (YAML::Node dn = r.child("drift", false)) {
     MapReader d(dn, "robot.drift", root.file());
     DriftSpec& s = scene.drift;
-    const auto non_negative = [&](const char* key, double& value) {
+    // Fractions of the distance or turn travelled: beyond 0.5 no base drives (slip_scale 1e308 once gave an
+    // infinite base error and a report of 0.0 mm over 0 lit frames).
+    const auto bounded = [&](const char* key, double& value, double lo) {
       value = d.get<double>(key, value);
-      if (value < 0.0) d.fail(dn[key], d.key_path(key), "must be >= 0");
+      if (!(value >= lo && value <= 0.5)) d.fail(dn[key], d.key_path(key), lo < 0.0 ? "must be -0.5..0.5" : "must be 0..0.5");
     };
-    non_negative("wheel_scale_sigma", s.wheel_scale_sigma);
-    non_negative("slip_scale", s.slip_scale);
-    s.heading_bias_rad_per_m = d.get<double>("heading_bias_rad_per_m", s.heading_bias_rad_per_m);
-    s.heading_bias_rad_per_rad = d.get<double>("heading_bias_rad_per_rad", s.heading_bias_rad_per_rad);
-    non_negative("random_translation_sigma", s.random_translation_sigma);
-    non_negative("random_rotation_sigma", s.random_rotation_sigma);
+    bounded("wheel_scale_sigma", s.wheel_scale_sigma, 0.0);
+    bounded("slip_scale", s.slip_scale, 0.0);
+    bounded("heading_bias_rad_per_m", s.heading_bias_rad_per_m, -0.5);
+    bounded("heading_bias_rad_per_rad", s.heading_bias_rad_per_rad, -0.5);
+    bounded("random_translation_sigma", s.random_translation_sigma, 0.0);
+    bounded("random_rotation_sigma", s.random_rotation_sigma, 0.0);
     d.reject_unknown();
   }
   YAML::Node pt = r.child("pan_tilt", false);
@@ -391,8 +395,8 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
 }  // namespace
 
 ProjectorCalibration load_calibration(const std::filesystem::path& path) {
+  if (const std::string problem = input_file_problem(path); !problem.empty()) throw ConfigError(path.string() + ": " + problem);
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw ConfigError(path.string() + ": not a file");
   if (std::filesystem::file_size(path, ec) > (1U << 20))
     throw ConfigError(path.string() + ": larger than 1 MB: not a calibration file");
   std::ifstream in(path, std::ios::binary);
@@ -407,6 +411,7 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
     throw ConfigError(file + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
   }
   if (!c || c.IsNull()) throw ConfigError(file + ": the calibration file is empty");
+  if (const std::string twice = duplicate_key_message(c, file); !twice.empty()) throw ConfigError(twice);
   MapReader r(c, "", file);
   MapReader p(r.child("projector", true), "projector", file);
   ProjectorCalibration out;
@@ -499,8 +504,12 @@ void validate_projector(const ProjectorConfig& p, std::string_view where) {
   if (!(p.fx_px > 0.0) || !(p.fy_px > 0.0) || !std::isfinite(p.fx_px) || !std::isfinite(p.fy_px))
     fail("fx and fy must be finite and > 0");
   if (!std::isfinite(p.cx_px) || !std::isfinite(p.cy_px)) fail("cx and cy must be finite");
-  if (!(p.near_m > 0.0) || !std::isfinite(p.far_m) || !(p.near_m < p.far_m))
-    fail("need 0 < near < far (near " + std::to_string(p.near_m) + ", far " + std::to_string(p.far_m) + ")");
+  // Bounded below and above, not only positive: near 1e-300 passed "> 0" and tore the depth buffer.
+  if (!(p.near_m >= 1e-4) || !(p.far_m <= 1e4) || !(p.near_m < p.far_m) || !(p.far_m <= p.near_m * 1e7)) {
+    std::ostringstream v;
+    v << "need 0.0001 m <= near < far <= 10000 m with far / near <= 1e7 (near " << p.near_m << ", far " << p.far_m << ")";
+    fail(v.str());
+  }
   validate_lens(p, fail);
 }
 
@@ -628,6 +637,8 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
     m.reject_unknown();
   }
   r.reject_unknown();
+  // Last, so that a value the reader refuses is named first: a key given twice reads as its first.
+  if (const std::string twice = duplicate_key_message(root, file); !twice.empty()) throw ConfigError(twice);
   return scene;
 }
 
@@ -640,8 +651,12 @@ int Scene::target_index(std::string_view name) const {
 }
 
 Scene load_scene(const std::filesystem::path& path) {
+  // Checked by kind before it is opened: a FIFO would block open(), /dev/zero never end.
+  if (const std::string problem = input_file_problem(path); !problem.empty())
+    throw ConfigError(path.string() + ": " + problem + (problem == "is a folder, not a file" ? " (a scene file, .yaml)" : ""));
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw ConfigError(path.string() + ": is a folder, not a scene file (.yaml)");
+  if (std::filesystem::file_size(path, ec) > (16U << 20))
+    throw ConfigError(path.string() + ": larger than 16 MB: not a scene file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path.string() + ": cannot open scene file");
   std::ostringstream text;

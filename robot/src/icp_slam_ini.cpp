@@ -175,11 +175,60 @@ std::string value_problem(const KeyKind& k, const std::string& v) {
   return "";
 }
 
+// What MRPT runs in bounded time and memory, per "section/key": typed values outside these never ended
+// (thresholdDist = 1e308, smallestThresholdDist = 0, pointsMap_count = -1) or crashed inside MRPT
+// (pointsMap_count = 100000).
+struct Range {
+  double lo, hi;
+};
+const std::map<std::string, Range>& value_ranges() {
+  static const std::map<std::string, Range> ranges{
+      {"icp/maxiterations", {1, 1000}},
+      {"icp/thresholddist", {1e-3, 100}},
+      {"icp/thresholdang", {0, 1.6}},
+      {"icp/thresholdang_deg", {0, 90}},
+      {"icp/alfa", {0.01, 0.99}},
+      {"icp/smallestthresholddist", {1e-4, 100}},
+      {"icp/minabsstep_trans", {1e-12, 1}},
+      {"icp/minabsstep_rot", {1e-12, 1}},
+      {"icp/corresponding_points_decimation", {1, 1000}},
+      {"icp/ransac_minsetsize", {0, 1000}},
+      {"icp/ransac_maxsetsize", {0, 10000}},
+      {"icp/ransac_nsimulations", {0, 10000}},
+      {"mappingapplication/localizationlindistance", {0, 100}},
+      {"mappingapplication/localizationangdistance", {0, 360}},
+      {"mappingapplication/insertionlindistance", {0, 100}},
+      {"mappingapplication/insertionangdistance", {0, 360}},
+      {"mappingapplication/minicpgoodnesstoaccept", {0, 1}},
+      {"mappingapplication/occupancygrid_count", {0, 4}},
+      {"mappingapplication/gasgrid_count", {0, 4}},
+      {"mappingapplication/beaconmap_count", {0, 4}},
+      {"mappingapplication/landmarksmap_count", {0, 4}},
+      {"mappingapplication/pointsmap_count", {1, 4}},
+      {"mappingapplication_pointsmap_00_insertopts/mindistbetweenlaserpoints", {0, 10}},
+  };
+  return ranges;
+}
+
+// "must be LO..HI" when a number lies outside what MRPT runs in bounded time, or "".
+std::string range_problem(const std::string& key, const std::string& v) {
+  const auto r = value_ranges().find(key);
+  if (r == value_ranges().end()) return "";
+  if (!parses_as_real(v)) return is_flag(v) ? "" : "is not a finite number";
+  const double d = std::strtod(v.c_str(), nullptr);
+  if (d >= r->second.lo && d <= r->second.hi) return "";
+  std::ostringstream out;
+  out << "must be " << r->second.lo << ".." << r->second.hi << " (outside, MRPT's ICP-SLAM does not end or runs out of memory)";
+  return out.str();
+}
+
 }  // namespace
 
 std::vector<std::string> check_icp_slam_config(const std::filesystem::path& ini) {
+  std::error_code ec;  // the kind first: opening a FIFO would block
+  if (!std::filesystem::is_regular_file(ini, ec)) throw RobotError(ini.string() + ": no such icp-slam config");
   std::ifstream in(ini);
-  if (!std::filesystem::is_regular_file(ini) || !in) throw RobotError(ini.string() + ": no such icp-slam config");
+  if (!in) throw RobotError(ini.string() + ": cannot open the icp-slam config");
   std::stringstream text;
   text << in.rdbuf();
   const auto entries = parse_ini(text.str(), ini.string());
@@ -191,12 +240,12 @@ std::vector<std::string> check_icp_slam_config(const std::filesystem::path& ini)
     has_icp |= lower(e.section) == "icp";
     const auto k = keys.find(lower(e.section) + "/" + lower(e.key));
     const std::string where = ini.string() + ":" + std::to_string(e.line) + ": [" + e.section + "] " + e.key;
-    if (k == keys.end()) {
-      if (lower(e.section) == "icp") warnings.push_back(where + ": not a setting of MRPT's ICP, ignored");
-      continue;
-    }
-    if (const std::string problem = value_problem(k->second, e.value); !problem.empty())
+    if (k != keys.end())
+      if (const std::string problem = value_problem(k->second, e.value); !problem.empty())
+        throw RobotError(where + " = '" + e.value + "' " + problem);
+    if (const std::string problem = range_problem(lower(e.section) + "/" + lower(e.key), e.value); !problem.empty())
       throw RobotError(where + " = '" + e.value + "' " + problem);
+    if (k == keys.end() && lower(e.section) == "icp") warnings.push_back(where + ": not a setting of MRPT's ICP, ignored");
   }
   if (!has_mapping || !has_icp)
     throw RobotError(ini.string() + ": an icp-slam config needs [MappingApplication] and [ICP] sections");

@@ -32,6 +32,7 @@
 #include "mrpt_convert.hpp"
 #include "projbot/config/isolated_read.hpp"
 #include "projbot/config/output_file.hpp"
+#include "projbot/config/paths.hpp"
 
 namespace projbot::robot {
 namespace {
@@ -271,16 +272,36 @@ std::vector<TrajectoryPoint> read_trajectory(const std::filesystem::path& path) 
     if (!(fields >> p.timestamp_s >> p.pose.x_m >> p.pose.y_m >> p.pose.theta_rad) || (fields >> extra) ||
         !std::isfinite(p.timestamp_s + p.pose.x_m + p.pose.y_m + p.pose.theta_rad))
       throw RobotError(path.string() + ":" + std::to_string(number) + ": expected 'timestamp x y phi' (4 finite numbers)");
+    // Checked, not only typed: x = 1e308 or time running backwards was once compared as if it were right.
+    if (std::abs(p.pose.x_m) > 1e6 || std::abs(p.pose.y_m) > 1e6 || std::abs(p.pose.theta_rad) > 1e3)
+      throw RobotError(path.string() + ":" + std::to_string(number) +
+                       ": x and y must lie within 1000 km (|x|, |y| <= 1e6 m) and |phi| <= 1000 rad");
+    if (!out.empty() && !(p.timestamp_s > out.back().timestamp_s))
+      throw RobotError(path.string() + ":" + std::to_string(number) + ": timestamp " + std::to_string(p.timestamp_s) +
+                       " does not come after the line before's (" + std::to_string(out.back().timestamp_s) +
+                       "): timestamps must increase");
     out.push_back(p);
   }
   if (out.empty()) throw RobotError(path.string() + ": no trajectory lines");
   return out;
 }
 
+const std::set<std::string>& map_folder_files() {
+  static const std::set<std::string> files{"map.simplemap.gz", "grid.png", "grid.yaml"};
+  return files;
+}
+
 SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,
                      const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested, bool verbose,
                      const Pose2D& start) {
   const auto t0 = Clock::now();
+  std::filesystem::path final_dir = out_dir.lexically_normal();
+  if (!final_dir.has_filename()) final_dir = final_dir.parent_path();  // "map/" names the folder "map"
+  try {
+    config::check_replaceable_folder(final_dir, map_folder_files());
+  } catch (const config::OutputError& e) {
+    throw RobotError(e.what());
+  }
   mrpt::slam::CMetricMapBuilderICP builder;
   // MRPT logs to stdout, where our results go: its lines go to stderr, and only with --verbose.
   builder.logging_enable_console_output = false;
@@ -310,16 +331,21 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
   builder.initialize();
 
   SlamResult result;
-  for (const RawlogStep& step : steps) {
-    if (stop_requested && stop_requested()) {
-      result.interrupted = true;
-      break;
+  try {  // an MRPT exception is one line naming the config, never its banner and call stack
+    for (const RawlogStep& step : steps) {
+      if (stop_requested && stop_requested()) {
+        result.interrupted = true;
+        break;
+      }
+      mrpt::obs::CSensoryFrame frame;
+      frame.insert(detail::to_mrpt(step.scan));
+      builder.processActionObservation(*odometry_action(step.odometry_increment.value_or(Pose2D{}), step.timestamp_s), frame);
+      const Pose2D mapped = detail::from_mrpt(builder.getCurrentPoseEstimation()->getMeanVal());
+      result.trajectory.push_back({step.timestamp_s, compose(start, mapped)});
     }
-    mrpt::obs::CSensoryFrame frame;
-    frame.insert(detail::to_mrpt(step.scan));
-    builder.processActionObservation(*odometry_action(step.odometry_increment.value_or(Pose2D{}), step.timestamp_s), frame);
-    const Pose2D mapped = detail::from_mrpt(builder.getCurrentPoseEstimation()->getMeanVal());
-    result.trajectory.push_back({step.timestamp_s, compose(start, mapped)});
+  } catch (const std::exception& e) {
+    throw RobotError((ini ? ini->string() : std::string("default icp-slam config")) + ": MRPT's ICP-SLAM failed at scan " +
+                     std::to_string(result.trajectory.size() + 1) + ": " + first_line(e));
   }
   mrpt::maps::CSimpleMap keyframes;
   builder.getCurrentlyBuiltMap(keyframes);
@@ -334,8 +360,7 @@ SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<s
 
   // The map is written whole into a folder beside out_dir, then swapped in: an old map stays usable
   // until the new one is complete, and a failed write leaves it untouched.
-  std::filesystem::path final_dir = out_dir.lexically_normal();
-  if (!final_dir.has_filename()) final_dir = final_dir.parent_path();  // "map/" names the folder "map"
+  if (result.trajectory.empty()) return result;  // stopped before the first scan: nothing to write
   const std::filesystem::path work_dir = final_dir.string() + ".tmp-" + std::to_string(::getpid());
   std::error_code ec;
   std::filesystem::remove_all(work_dir, ec);

@@ -123,8 +123,9 @@ const Command kAlign{
     "the depth measured inside its silhouette; where the camera sees through the model (more than 10 % of\n"
     "the silhouette), the pose is rejected however well it fits.\n"
     "Exit status: 0 when the pose passed the quality gate, 3 when it did not, 1 or 2 on bad input.\n",
-    {{"model", "FILE", "target model: .gltf / .glb / .obj / .stl / .ply mesh (surface-sampled), or .pcd / .ply cloud"},
-     {"scan", "FILE", "scan: .pcd / .ply cloud, or .png / .tiff 16-bit depth image"},
+    {{"model", "FILE", "target model: .gltf / .glb / .obj / .stl / .ply mesh (surface-sampled), or .pcd / .ply cloud",
+      cli::PathRole::input_file},
+     {"scan", "FILE", "scan: .pcd / .ply cloud, or .png / .tiff 16-bit depth image", cli::PathRole::input_file},
      {"intrinsics", "fx,fy,cx,cy", "depth camera intrinsics in pixels (default: Kinect v1)"},
      {"depth-scale", "K", "depth units per metre: 1000 for millimetres (default), 5000 for TUM"},
      {"init-matrix", "m00,...,m33", "initial T_scan_model, 16 numbers, row-major, metres"},

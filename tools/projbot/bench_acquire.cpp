@@ -131,7 +131,7 @@ const Command kBenchAcquire{
     "the content they put on the surfaces the camera sees is the truth's (shape and colour: a textured box\n"
     "turned onto a face with the same texture, which neither depth nor colour can tell apart).\n"
     "Without --scene, assets/scenes/shop.yaml runs. Ctrl-C prints the rows finished.\n",
-    {{"scene", "FILE", "scene with a tour (default: assets/scenes/shop.yaml)"},
+    {{"scene", "FILE", "scene with a tour (default: assets/scenes/shop.yaml)", cli::PathRole::input_file},
      {"trials", "N", "acquisitions per target and kind of guess (default 20)"},
      {"guess-error", "CM,DEG", "the guess's error (default 5,10)"},
      {"seed", "K", "seed of the guesses and the depth noise (default 1)"}},

@@ -331,7 +331,6 @@ void write_report(const fs::path& file, const std::vector<Row>& rows, bool inter
 void check_report_apart(const cli::Args& args, const fs::path& dir) {
   const auto report = args.get("report");
   if (!report) return;
-  args.check_output_files({"report"});
   std::error_code ec;
   const fs::path out = fs::weakly_canonical(fs::absolute(*report), ec), in = fs::weakly_canonical(fs::absolute(dir), ec);
   const auto rel = out.lexically_relative(in);
@@ -415,7 +414,7 @@ const Command kBenchDataset{
      {"max-instances", "N", "stop after N instances (default: all)"},
      {"model-scale", "S", "model units to metres (default 0.001: BOP's millimetres)"},
      {"track", "", "follow each scene's objects frame by frame from one perturbed start on its first image"},
-     {"report", "FILE", "JSON report, one row per estimate"}},
+     {"report", "FILE", "JSON report, one row per estimate", cli::PathRole::output_file}},
     run_bench_dataset};
 
 }  // namespace projbot::tools

@@ -63,7 +63,7 @@ const Command kBenchMotion{
     "--scene, assets/scenes/motion.yaml runs (still, 0.5 m/s with 90 deg/s, 1 m/s, accelerating starts up\n"
     "to 1 m/s with 180 deg/s, sudden stops, a target carried away). Markers the projector lights edge-on\n"
     "are not measured. Ctrl-C prints the visits finished so far.\n",
-    {{"scene", "FILE", "scene with scripted motions (default: assets/scenes/motion.yaml)"},
+    {{"scene", "FILE", "scene with scripted motions (default: assets/scenes/motion.yaml)", cli::PathRole::input_file},
      {"visits", "N", "visits, cycling through the scene's list (default: the list once)"},
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
      {"dwell", "S", "simulated seconds of projection per visit (default 3)"},

@@ -24,6 +24,18 @@ constexpr const char* kDefaultBoard = "charuco:10x7:0.06:0.045:DICT_4X4_50";
 
 // The twin's colour camera lens: the Kinect v1 depth camera's pinhole (colour registered to it) with a
 // moderate barrel distortion of a webcam-class lens, so the solve has one to find.
+// --board (default kDefaultBoard); a bad one is a usage error naming the option.
+calibrate::Board board_option(const cli::Args& args) {
+  const std::string spec = args.get_or("board", kDefaultBoard);
+  try {
+    return calibrate::Board::parse(spec);
+  } catch (const calibrate::CalibrationError& e) {
+    std::string why = e.what();
+    if (const std::string head = "board '" + spec + "': "; why.rfind(head, 0) == 0) why = why.substr(head.size());
+    throw cli::UsageError("--board '" + spec + "': " + why);
+  }
+}
+
 calibrate::Lens twin_colour_lens(const config::Scene& scene) {
   calibrate::Lens l;
   l.pinhole = scene.depth_camera;
@@ -42,7 +54,7 @@ calibrate::SimulationConfig simulation_config(const cli::Args& args, const confi
     c.poses = static_cast<int>(c.scripted.size());
   }
   c.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
-  c.board = calibrate::Board::parse(args.get_or("board", kDefaultBoard));
+  c.board = board_option(args);
   c.camera = twin_colour_lens(scene);
   c.projector = scene.projector;
   c.T_projector_camera = scene.pan_tilt.T_projector_camera;
@@ -54,8 +66,8 @@ calibrate::SimulationConfig simulation_config(const cli::Args& args, const confi
 int run_simulate(const cli::Args& args) {
   const auto out = args.get("out");
   if (!out) throw cli::UsageError("--out DIR is required");
-  args.check_output_folders({"out"});
   const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
+  args.check_paths({{"the default scene", scene_path, false}});
   const config::Scene scene = config::load_scene(scene_path);
   const calibrate::SimulationConfig c = simulation_config(args, scene);
   Progress progress("pose", c.poses);
@@ -146,10 +158,9 @@ int run_solve(const cli::Args& args) {
   const std::filesystem::path dir = args.positional().front();
   const auto out = args.get("out");
   if (!out) throw cli::UsageError("--out FILE is required");
-  args.check_output_files({"out"});
   calibrate::SolveOptions o;
   if (const auto s = args.get("projector")) o.projector_size = parse_size(*s);
-  if (const auto b = args.get("board")) o.board = calibrate::Board::parse(*b);
+  if (args.get("board")) o.board = board_option(args);
   o.projector_distortion = args.flag("projector-distortion");
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<Progress> progress;
@@ -202,8 +213,8 @@ calibrate::CaptureSummary capture_on_devices(const cli::Args& args, const config
 int run_capture(const cli::Args& args) {
   const auto out = args.get("out");
   if (!out) throw cli::UsageError("--out DIR is required");
-  args.check_output_folders({"out"});
   const std::string scene_path = args.get_or("config", (asset_dir() / "scenes" / "shop.yaml").string());
+  args.check_paths({{"the default scene", scene_path, false}});
   const config::Scene scene = config::load_scene(scene_path);
   const bool sim = args.flag("sim");
   if (!sim && !scene.devices.camera)
@@ -213,7 +224,7 @@ int run_capture(const cli::Args& args) {
   calibrate::CaptureOptions o;
   o.projector_width = scene.projector.width_px;
   o.projector_height = scene.projector.height_px;
-  o.board = calibrate::Board::parse(args.get_or("board", kDefaultBoard));
+  o.board = board_option(args);
   o.poses = args.get_int("poses", 10, 1, 100);
   catch_interrupts();  // Ctrl-C: the poses kept so far are written as the capture
   calibrate::CaptureSummary s;
@@ -262,11 +273,13 @@ const Command kCalibrateCapture{
     "The projector and camera are the config's `devices.projector` and `devices.camera`; --sim runs the session\n"
     "in the twin (the engine draws each pattern, the twin's board and camera take it; DIR/truth.yaml beside).\n"
     "Ctrl-C writes the poses kept so far as the capture and exits 130.\n",
-    {{"out", "DIR", "the capture folder to write (new or empty)"},
-     {"config", "FILE", "site or scene file with devices.camera and devices.projector (default: assets/scenes/shop.yaml)"},
+    {{"out", "DIR", "the capture folder to write (new or empty)", cli::PathRole::output_folder},
+     {"config", "FILE", "site or scene file with devices.camera and devices.projector (default: assets/scenes/shop.yaml)",
+      cli::PathRole::input_file},
      {"sim", "", "the twin's board, projector and camera"},
      {"poses", "N", "board poses to keep (default 10)"},
-     {"poses-file", "FILE", "--sim: the board's poses from a script, as calibrate simulate takes them"},
+     {"poses-file", "FILE", "--sim: the board's poses from a script, as calibrate simulate takes them",
+      cli::PathRole::input_file},
      {"board", "SPEC", std::string("board (default ") + kDefaultBoard + "; or checkerboard:9x7:0.05)"},
      {"seed", "K", "--sim: seed of the poses' jitter and the noise (default 1)"},
      {"noise", "LEVELS", "--sim: camera noise sigma, grey levels (default 1.5)"},
@@ -289,11 +302,12 @@ const Command kCalibrateSimulate{
     "  DIR/truth.yaml     the values the images were made with, in calib.yaml's format\n"
     "Then: projbot calibrate solve DIR --out calib.yaml (it compares itself with truth.yaml).\n"
     "Ctrl-C writes the poses rendered so far as the capture and exits 130.\n",
-    {{"out", "DIR", "the capture folder to write (new or empty)"},
-     {"scene", "FILE", "scene giving the projector and camera (default: assets/scenes/shop.yaml)"},
+    {{"out", "DIR", "the capture folder to write (new or empty)", cli::PathRole::output_folder},
+     {"scene", "FILE", "scene giving the projector and camera (default: assets/scenes/shop.yaml)", cli::PathRole::input_file},
      {"poses", "N", "board poses (default 10), spread over the projector's image, 0.8-1.3 m, tilted up to 30 degrees"},
      {"poses-file", "FILE",
-      "the board's poses from a script: poses: [{centre: [x, y, z], tilt_deg: [a, b, c]}, ...] (camera frame)"},
+      "the board's poses from a script: poses: [{centre: [x, y, z], tilt_deg: [a, b, c]}, ...] (camera frame)",
+      cli::PathRole::input_file},
      {"board", "SPEC", std::string("board (default ") + kDefaultBoard + "; or checkerboard:9x7:0.05)"},
      {"seed", "K", "seed of the poses' jitter and the noise (default 1)"},
      {"noise", "LEVELS", "camera noise sigma, grey levels (default 1.5)"}},
@@ -316,12 +330,12 @@ const Command kCalibrateSolve{
     "the projector area the corners covered, and warnings. A scene uses it as `calibration: calib.yaml`.\n"
     "The projector is fitted as a pinhole unless --projector-distortion; with it, the renderer pre-distorts its\n"
     "image by the lens found, so that straight content lands straight.\n",
-    {{"out", "FILE", "the calibration to write (YAML)"},
+    {{"out", "FILE", "the calibration to write (YAML)", cli::PathRole::output_file},
      {"projector", "WxH", "projector size in pixels (for a folder without capture.yaml)"},
      {"board", "SPEC", "the board (for a folder without capture.yaml)"},
      {"projector-distortion", "",
       "also fit the projector's radial distortion k1, k2 (for a projector lens that bends straight lines)"},
-     {"truth", "FILE", "compare with this calibration (default: DIR/truth.yaml when present)"}},
+     {"truth", "FILE", "compare with this calibration (default: DIR/truth.yaml when present)", cli::PathRole::input_file}},
     run_solve};
 
 }  // namespace projbot::tools

@@ -30,6 +30,7 @@ Args::Args(const std::vector<OptionSpec>& specs, int argc, char** argv, int firs
     for (const auto& s : specs)
       if (s.name == name) spec = &s;
     if (spec == nullptr) throw UsageError("unknown option --" + name);
+    if (spec->role != PathRole::none) roles_[name] = spec->role;
     if (spec->value.empty()) {
       if (inline_value) throw UsageError("--" + name + " takes no value");
       values_[name] = "1";
@@ -80,41 +81,53 @@ int Args::get_int(const std::string& name, int fallback, int min_value, int max_
   return out;
 }
 
-void Args::check_output_files(const std::vector<std::string>& names) const {
-  for (const auto& name : names)
-    if (const auto value = get(name)) try {
-        config::check_writable(*value);
+void Args::check_outputs() const {
+  namespace fs = std::filesystem;
+  for (const auto& [name, role] : roles_) {
+    const auto value = get(name);
+    if (!value) continue;
+    const auto check = [&](const auto& how, const fs::path& p) {
+      try {
+        how(p);
       } catch (const config::OutputError& e) {
         throw UsageError("--" + name + " " + e.what());
       }
-}
-
-void Args::check_output_folders(const std::vector<std::string>& names) const {
-  namespace fs = std::filesystem;
-  for (const auto& name : names) {
-    const auto value = get(name);
-    if (!value) continue;
+    };
+    if (role == PathRole::output_file) check(config::check_writable, *value);
+    if (role != PathRole::output_folder) continue;
     std::error_code ec;
     const fs::path dir = fs::path(*value).lexically_normal();
     if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
       throw UsageError("--" + name + " " + *value + ": exists and is not a folder");
-    const auto check = [&](const fs::path& folder) {
-      try {
-        config::check_folder_writable(folder);
-      } catch (const config::OutputError& e) {
-        throw UsageError("--" + name + " " + *value + ": " + e.what());
-      }
-    };
-    if (fs::is_directory(dir, ec)) {
-      check(dir);
-      continue;
+    fs::path parent = dir;
+    if (!fs::is_directory(dir, ec)) {
+      parent = dir.has_filename() ? dir.parent_path() : dir.parent_path().parent_path();
+      if (parent.empty()) parent = ".";
+      if (!fs::is_directory(parent, ec))
+        throw UsageError("--" + name + " " + *value + ": its parent folder " + parent.string() + " does not exist");
     }
-    fs::path parent = dir.has_filename() ? dir.parent_path() : dir.parent_path().parent_path();
-    if (parent.empty()) parent = ".";
-    if (!fs::is_directory(parent, ec))
-      throw UsageError("--" + name + " " + *value + ": its parent folder " + parent.string() + " does not exist");
-    check(parent);
+    check(config::check_folder_writable, parent);
   }
+}
+
+void Args::check_paths(const std::vector<config::NamedPath>& more_inputs) const {
+  std::vector<config::NamedPath> inputs = more_inputs, outputs;
+  for (const auto& [name, role] : roles_) {
+    const auto value = get(name);
+    if (!value || role == PathRole::none) continue;
+    const bool folder = role == PathRole::input_folder || role == PathRole::output_folder;
+    if (role == PathRole::input_file || role == PathRole::input_folder) {
+      // A FIFO, device or socket is refused here, before anything opens it (open() on a FIFO blocks,
+      // /dev/zero never ends); a missing file or a folder is left to the reader, which names it.
+      const std::string problem = config::input_file_problem(*value);
+      if (problem.find("not a regular file") != std::string::npos) throw InputError("--" + name + " " + *value + ": " + problem);
+      inputs.push_back({"--" + name, *value, folder});
+    } else {
+      outputs.push_back({"--" + name, *value, folder});
+    }
+  }
+  check_outputs();
+  if (const auto clash = config::find_path_clash(inputs, outputs)) throw UsageError(*clash);
 }
 
 double Args::get_double(const std::string& name, double fallback) const {

@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "projbot/config/paths.hpp"
+
 namespace projbot::cli {
 
 /// A wrong command line: printed with a pointer to --help, exit code 2.
@@ -17,10 +19,20 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// What an option's value names on disk, so every command checks its paths the same way before work.
+enum class PathRole { none, input_file, input_folder, output_file, output_folder };
+
+/// An input that cannot be read as named (a FIFO or a device for a file): exit code 1, as a bad file.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 struct OptionSpec {
   std::string name;   ///< without the leading dashes
   std::string value;  ///< placeholder shown in help ("FILE"); empty for a flag
   std::string help;
+  PathRole role = PathRole::none;
 };
 
 class Args {
@@ -36,13 +48,16 @@ class Args {
   int get_int(const std::string& name, int fallback, int min_value, int max_value) const;
   double get_double(const std::string& name, double fallback) const;
   const std::vector<std::string>& positional() const { return positional_; }
-  /// Before long work: each given file option (`out`, `report`, ...) can be written (its folder exists
-  /// and is writable, it is no folder). Throws UsageError naming the option and the problem.
-  void check_output_files(const std::vector<std::string>& names) const;
-  /// Each given folder option exists as a folder, or can be created (its parent exists and is writable).
-  void check_output_folders(const std::vector<std::string>& names) const;
+  /// Before any work, the paths of the options with a PathRole: no input is a FIFO, device or socket
+  /// (InputError; a missing file is the reader's to name); each output file can be written (its folder
+  /// exists and is writable, it is no folder) and each output folder exists or can be created; and no
+  /// output clashes with an input (those options' and `more_inputs`: defaults, arguments) or another
+  /// output (config::find_path_clash). Throws UsageError naming the option(s) and the problem.
+  void check_paths(const std::vector<config::NamedPath>& more_inputs = {}) const;
 
  private:
+  void check_outputs() const;
+  std::map<std::string, PathRole> roles_;
   std::map<std::string, std::string> values_;
   std::map<std::string, std::vector<std::string>> all_;
   std::vector<std::string> positional_;

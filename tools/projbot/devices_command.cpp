@@ -207,7 +207,7 @@ const Command kDevices{"devices",
                        "                                  # map: projbot slam's folder, which run localises against\n"
                        "    base: {driver: ros2-dds, domain: 0, cmd_vel: cmd_vel, odom: odom}\n"
                        "    projector: {monitor: 1, fullscreen: true}\n",
-                       {{"config", "FILE", "a scene whose `devices:` section to check"},
+                       {{"config", "FILE", "a scene whose `devices:` section to check", cli::PathRole::input_file},
                         {"domain", "N", "the DDS domain to listen on (default: devices.base.domain, else 0)"}},
                        [](const cli::Args& args) {
                          std::optional<config::Scene> scene;
@@ -248,7 +248,7 @@ const Command kSimBase{"sim-base",
                        "stands, the scanner 0.25 m ahead of the base (pose_x: 0.25). With --true-start the base truly starts\n"
                        "there (metres, metres, radians) while its odometry starts at robot.start: a robot set down off its\n"
                        "place, which only the laser can tell.\n",
-                       {{"config", "FILE", "scene whose devices.base, robot.start and room to use"},
+                       {{"config", "FILE", "scene whose devices.base, robot.start and room to use", cli::PathRole::input_file},
                         {"domain", "N", "DDS domain id 0..232 (overrides devices.base.domain)"},
                         {"seconds", "S", "stop after S seconds (default 0: until Ctrl-C)"},
                         {"rate", "HZ", "odometry messages per second (default 50)"},

@@ -42,4 +42,9 @@ int benchmark_interrupted(const std::string& where) {
   return interrupt_exit_code();
 }
 
+int nothing_written(const std::string& when) {
+  std::cout << "interrupted " << when << "; nothing written (the outputs, if they existed, are unchanged)" << std::endl;
+  return interrupt_exit_code();
+}
+
 }  // namespace projbot::tools

@@ -16,5 +16,7 @@ int interrupt_exit_code();
 /// A benchmark stopped by a signal: prints "interrupted WHERE; the rows above are complete" (the rows
 /// printed are whole measurements, the one under way is dropped) and returns interrupt_exit_code().
 int benchmark_interrupted(const std::string& where);
+/// Says that a command stopped before it had produced anything, so it wrote nothing; the exit code.
+int nothing_written(const std::string& when);
 
 }  // namespace projbot::tools

@@ -8,8 +8,12 @@
 #include <cstring>
 #include <iostream>
 #include <new>
+#include <sstream>
+#include <string>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
+#include "projbot/robot/error.hpp"
 
 namespace {
 
@@ -135,7 +139,13 @@ static int dispatch(int argc, char** argv, std::string& name) {
     const bool takes_folder = cmd == &projbot::tools::kCalibrateSolve || cmd == &projbot::tools::kBenchDataset;
     if (args.positional().size() > (takes_folder ? 1U : 0U))
       throw projbot::cli::UsageError("unexpected argument '" + args.positional().back() + "'");
+    // Every command's paths, before any work: inputs that are files, outputs that clash with nothing.
+    std::vector<projbot::config::NamedPath> folder;
+    if (takes_folder && !args.positional().empty()) folder.push_back({"the folder", args.positional().front(), true});
+    args.check_paths(folder);
     return cmd->run(args);
+  } catch (const projbot::robot::SetupInterrupted& e) {  // SIGTERM while the twin was built: nothing made
+    return projbot::tools::nothing_written(std::string("while building the twin (") + e.what() + ")");
   } catch (const std::bad_alloc&) {
     std::cerr << "projbot " << name << ": out of memory: an input is larger than this machine can hold\n";
     return 1;
@@ -143,7 +153,12 @@ static int dispatch(int argc, char** argv, std::string& name) {
     std::cerr << "projbot " << name << ": " << e.what() << " (see projbot " << name << " --help)\n";
     return 2;
   } catch (const std::exception& e) {  // ConfigError, AssetError, AlignmentError, EngineError: one clear line
-    std::cerr << "projbot " << name << ": " << e.what() << '\n';
+    // A third-party text that slipped through (a banner, a call stack): its first line that says something.
+    std::istringstream text(e.what());
+    std::string line, said;
+    while (said.empty() && std::getline(text, line))
+      if (line.find_first_not_of(" \t=") != std::string::npos) said = line;
+    std::cerr << "projbot " << name << ": " << said << '\n';
     return 1;
   }
 }

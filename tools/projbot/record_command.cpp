@@ -122,8 +122,8 @@ const Command kRecord{
     "camera alone is read with the twin's robot; none, or --sim, is the twin's. Depth is kept to\n"
     "the Kinect's disparity steps, for the trackers too. Ctrl-C ends the stop in progress and keeps every\n"
     "stop recorded.\n",
-    {{"out", "DIR", "the recording's folder (new or empty)"},
-     {"config", "FILE", "scene (default: assets/scenes/tour.yaml)"},
+    {{"out", "DIR", "the recording's folder (new or empty)", cli::PathRole::output_folder},
+     {"config", "FILE", "scene (default: assets/scenes/tour.yaml)", cli::PathRole::input_file},
      {"sim", "", "record the twin's camera whatever `devices:` configures"},
      {"visits", "N", "visits, cycling through the tour (default: the list once)"},
      {"dwell", "S", "seconds at each stop (default 2)"},
@@ -134,7 +134,7 @@ const Command kRecord{
       const double dwell_s = args.get_double("dwell", 2.0);
       if (!(dwell_s > 0.0 && dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
       const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
-      args.check_output_folders({"out"});
+      args.check_paths({{"the default scene", (asset_dir() / "scenes" / "tour.yaml"), false}});
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot record` needs a 'tour: {visits: [...]}' section");

@@ -47,13 +47,12 @@ const Command kRender{
     "writes the last frame as an RGBA PNG: exactly the image the projector must show. With --model\n"
     "alone the model is framed whole, seen from its front (glTF +Z). Exit status 3: the frame came\n"
     "out empty (written all the same).\n",
-    with_scene_options({{"out", "FILE", "PNG to write (required)"},
+    with_scene_options({{"out", "FILE", "PNG to write (required)", cli::PathRole::output_file},
                         {"frames", "N", "frames to draw, for timing (default 1)"},
-                        {"profile", "FILE", "write one CSV row of timings per frame"}}),
+                        {"profile", "FILE", "write one CSV row of timings per frame", cli::PathRole::output_file}}),
     [](const cli::Args& args) {
       const auto out = args.get("out");
       if (!out) throw cli::UsageError("--out FILE is required");
-      args.check_output_files({"out", "profile"});
       if (std::filesystem::path(*out).extension() != ".png" && std::filesystem::path(*out).extension() != ".PNG")
         throw cli::UsageError("--out must name a .png file, got '" + *out + "'");
       const int frames = args.get_int("frames", 1, 1, 1000000);
@@ -71,40 +70,43 @@ const Command kRender{
                 << scene.targets.size() << " target" << (scene.targets.size() == 1 ? "" : "s") << ")\n";
       finish_profile(args, profiler);
       if (!report_validation(args, renderer)) return 1;
-      if (image.lit_pixels() == 0 && !scene.targets.empty()) {
-        std::cerr << "projbot render: warning: the frame is empty: no target is in the projector's view "
-                     "(check the poses, --near / --far and the intrinsics)\n";
+      if (image.lit_pixels() == 0) {  // "targets: []" too: a black frame is never a silent success
+        std::cerr << "projbot render: warning: the frame is empty: "
+                  << (scene.targets.empty() ? "the scene has no targets"
+                                            : "no target is in the projector's view (check the poses, --near / --far and "
+                                              "the intrinsics)")
+                  << '\n';
         return 3;
       }
       return 0;
     }};
 
-const Command kShow{"show", "open the projector output in a window (fullscreen on a projector, or a preview)",
-                    "projbot show [--scene S.yaml] [--fullscreen] [--monitor N] [--present-mode fifo|mailbox|immediate]\n\n"
-                    "Opens a window showing the projector image and redraws it every frame until the window is closed\n"
-                    "(or --frames have been drawn). Without --fullscreen the window has the projector's size.\n",
-                    with_scene_options({{"fullscreen", "", "fullscreen on --monitor (the projector)"},
-                                        {"monitor", "N", "monitor index for --fullscreen (default 0)"},
-                                        {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
-                                        {"frames", "N", "close after N frames (default: run until closed)"},
-                                        {"profile", "FILE", "write one CSV row of timings per frame"}}),
-                    [](const cli::Args& args) {
-                      const config::Scene scene = scene_from_args(args);
-                      const int frames = args.get_int("frames", 0, 0, 100000000);
-                      const engine::WindowOptions w = window_options(
-                          args, scene.projector,
-                          "projbot: " + (scene.source.empty() ? std::string("model") : scene.source.filename().string()));
-                      engine::Renderer renderer(renderer_options(args, true));
-                      std::cout << "device: " << renderer.device_info().name << '\n';
-                      const auto items = upload_scene(renderer, scene);
-                      auto window = open_window(renderer, w, scene.projector);
-                      engine::FrameProfiler profiler;
-                      int drawn = 0;
-                      while (!window->poll_close() && (frames == 0 || drawn < frames))
-                        if (renderer.draw_frame(*window, scene.projector, items, &profiler)) ++drawn;
-                      renderer.finish(*window);
-                      finish_profile(args, profiler);
-                      return report_validation(args, renderer) ? 0 : 1;
-                    }};
+const Command kShow{
+    "show", "open the projector output in a window (fullscreen on a projector, or a preview)",
+    "projbot show [--scene S.yaml] [--fullscreen] [--monitor N] [--present-mode fifo|mailbox|immediate]\n\n"
+    "Opens a window showing the projector image and redraws it every frame until the window is closed\n"
+    "(or --frames have been drawn). Without --fullscreen the window has the projector's size.\n",
+    with_scene_options({{"fullscreen", "", "fullscreen on --monitor (the projector)"},
+                        {"monitor", "N", "monitor index for --fullscreen (default 0)"},
+                        {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
+                        {"frames", "N", "close after N frames (default: run until closed)"},
+                        {"profile", "FILE", "write one CSV row of timings per frame", cli::PathRole::output_file}}),
+    [](const cli::Args& args) {
+      const config::Scene scene = scene_from_args(args);
+      const int frames = args.get_int("frames", 0, 0, 100000000);
+      const engine::WindowOptions w = window_options(
+          args, scene.projector, "projbot: " + (scene.source.empty() ? std::string("model") : scene.source.filename().string()));
+      engine::Renderer renderer(renderer_options(args, true));
+      std::cout << "device: " << renderer.device_info().name << '\n';
+      const auto items = upload_scene(renderer, scene);
+      auto window = open_window(renderer, w, scene.projector);
+      engine::FrameProfiler profiler;
+      int drawn = 0;
+      while (!window->poll_close() && (frames == 0 || drawn < frames))
+        if (renderer.draw_frame(*window, scene.projector, items, &profiler)) ++drawn;
+      renderer.finish(*window);
+      finish_profile(args, profiler);
+      return report_validation(args, renderer) ? 0 : 1;
+    }};
 
 }  // namespace projbot::tools

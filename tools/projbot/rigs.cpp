@@ -1,13 +1,16 @@
 #include "rigs.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <limits>
 #include <sstream>
 
+#include "interrupt.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/assets/model.hpp"
+#include "projbot/config/rigid.hpp"
 
 namespace projbot::tools {
 
@@ -46,6 +49,7 @@ TwinRig::TwinRig(const config::Scene& scene, const std::vector<session::Target>&
           [&] {
             twin::TwinOptions o;
             o.seed = seed;
+            o.stop_requested = [] { return interrupted(); };  // SIGTERM while the twin is built
             return o;
           }(),
           renderer_),
@@ -194,6 +198,17 @@ void PoseLog::add(const config::Scene& scene, const session::Stop& stop, int fra
   text_ += row.str();
 }
 
+namespace {
+
+// A whole number >= 0 written as digits only, or -1.
+int whole_number(const std::string& text) {
+  int out = -1;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
+  return ec == std::errc() && end == text.data() + text.size() && out >= 0 ? out : -1;
+}
+
+}  // namespace
+
 PoseCheck::PoseCheck(const std::filesystem::path& csv) {
   std::ifstream in(csv);
   if (!in) throw config::ConfigError(csv.string() + ": cannot read the recording's poses");
@@ -217,17 +232,28 @@ PoseCheck::PoseCheck(const std::filesystem::path& csv) {
         break;
       }
     }
-    if (v.size() != 14 || target.empty())
-      throw config::ConfigError(csv.string() + ":" + std::to_string(n) + ": expected visit, frame, target and 14 numbers");
+    const std::string where = csv.string() + ":" + std::to_string(n);
+    if (v.size() != 14 || target.empty()) throw config::ConfigError(where + ": expected visit, frame, target and 14 numbers");
+    // As strictly as any reader: a NaN or a non-rotation once replayed as "largest difference 0.0000 mm".
+    for (const double x : v)
+      if (!std::isfinite(x)) throw config::ConfigError(where + ": a value is not a finite number");
+    if ((v[0] != 0.0 && v[0] != 1.0) || (v[1] != 0.0 && v[1] != 1.0))
+      throw config::ConfigError(where + ": published and lost must be 0 or 1");
     r.published = v[0] != 0.0;
     r.lost = v[1] != 0.0;
     for (int i = 0; i < 12; ++i) r.T(i / 4, i % 4) = v[static_cast<std::size_t>(2 + i)];
-    try {
-      rows_[{std::stoi(visit), std::stoi(frame), target}] = r;
-    } catch (const std::exception&) {
-      throw config::ConfigError(csv.string() + ":" + std::to_string(n) + ": visit and frame must be integers");
-    }
+    r.T = config::orthonormalised_rigid(r.T, where + ": pose", 1e-6);  // written with 17 digits: exact to 1e-6
+    const int visit_n = whole_number(visit), frame_n = whole_number(frame);
+    if (visit_n < 0 || frame_n < 0) throw config::ConfigError(where + ": visit and frame must be whole numbers >= 0");
+    if (!rows_.emplace(std::make_tuple(visit_n, frame_n, target), r).second)
+      throw config::ConfigError(where + ": a second row for visit " + visit + ", frame " + frame + ", target " + target);
   }
+}
+
+int PoseCheck::unreached() const {
+  int n = 0;
+  for (const auto& [key, row] : rows_) n += !reached_.contains(key);
+  return n;
 }
 
 void PoseCheck::compare(const config::Scene& scene, const session::Stop& stop, int frame,
@@ -235,6 +261,7 @@ void PoseCheck::compare(const config::Scene& scene, const session::Stop& stop, i
   for (std::size_t j = 0; j < samples.size() && j < stop.lit.size(); ++j) {
     const std::string& name = scene.targets[static_cast<std::size_t>(stop.lit[j].target)].name;
     const auto it = rows_.find({stop.visit, frame, name});
+    if (it != rows_.end()) reached_.insert(it->first);
     if (it == rows_.end() || it->second.published != samples[j].has_value() ||
         (samples[j] && it->second.lost != samples[j]->lost)) {
       ++mismatched;

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <tuple>
 #include <vector>
 
@@ -136,6 +137,8 @@ class PoseCheck {
   int mismatched = 0;    ///< published or lost in one and not the other, or missing from the recording
   double max_mm = 0.0;   ///< largest translation difference, mm
   double max_deg = 0.0;  ///< largest rotation difference, degrees
+  /// Rows of the recording the replay never compared (frames it did not reach, or that do not exist).
+  int unreached() const;
 
  private:
   struct Row {
@@ -143,6 +146,7 @@ class PoseCheck {
     Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
   };
   std::map<std::tuple<int, int, std::string>, Row> rows_;  // visit, frame, target
+  std::set<std::tuple<int, int, std::string>> reached_;
 };
 
 }  // namespace projbot::tools

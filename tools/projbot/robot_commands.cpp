@@ -15,6 +15,8 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "progress.hpp"
+#include "projbot/config/output_file.hpp"
+#include "projbot/config/paths.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/localization.hpp"
 #include "projbot/robot/sim_tour.hpp"
@@ -90,18 +92,21 @@ const Command kSlam{
     "without a map), pass where it began as record prints it (the scene's robot.start, its heading in\n"
     "radians): the map is then in the scene's frame, where its targets, stops and robot.start are, and\n"
     "`projbot run` localises in it.\n",
-    {{"rawlog", "FILE", "MRPT rawlog (.rawlog, plain or gzip)"},
-     {"config", "FILE", "icp-slam .ini with [MappingApplication] and [ICP] sections"},
-     {"out-map", "DIR", "directory for the map (created)"},
-     {"out-trajectory", "FILE", "where to write the corrected trajectory"},
-     {"ground-truth", "FILE", "true trajectory to compare with (timestamp x y phi lines)"},
+    {{"rawlog", "FILE", "MRPT rawlog (.rawlog, plain or gzip)", cli::PathRole::input_file},
+     {"config", "FILE", "icp-slam .ini with [MappingApplication] and [ICP] sections", cli::PathRole::input_file},
+     {"out-map", "DIR", "directory for the map (created)", cli::PathRole::output_folder},
+     {"out-trajectory", "FILE", "where to write the corrected trajectory", cli::PathRole::output_file},
+     {"ground-truth", "FILE", "true trajectory to compare with (timestamp x y phi lines)", cli::PathRole::input_file},
      {"verbose", "", "let MRPT's own log lines (its map builder's) through to stderr"},
      {"start", "\"x y phi\"", "where the rawlog's first pose lies in the map (default 0 0 0)"}},
     [](const cli::Args& args) {
       for (const char* required : {"rawlog", "out-map", "out-trajectory"})
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
-      args.check_output_files({"out-trajectory"});
-      args.check_output_folders({"out-map"});
+      try {  // a folder of anything but an earlier map is refused, never emptied
+        config::check_replaceable_folder(*args.get("out-map"), robot::map_folder_files());
+      } catch (const config::OutputError& e) {
+        throw cli::UsageError("--out-map " + std::string(e.what()));
+      }
       std::optional<fs::path> ini;
       if (const auto c = args.get("config")) ini = *c;
       if (ini)
@@ -110,7 +115,9 @@ const Command kSlam{
       if (const auto gt = args.get("ground-truth")) truth = robot::read_trajectory(*gt);
       const Pose2D start = parse_pose(args.get_or("start", "0 0 0"), "--start");
       catch_interrupts();  // Ctrl-C: map and write the scans done so far, then exit 130
+      std::cout << "reading " << *args.get("rawlog") << "..." << std::endl;
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
+      if (interrupted()) return nothing_written("while reading the rawlog");
       std::cout << "mapping " << steps.size() << " scans (Ctrl-C stops and keeps the map of the scans done)..." << std::endl;
       Progress progress("scan", static_cast<int>(steps.size()));
       int asked = 0;  // build_map asks before each scan: the scans done so far are one fewer
@@ -121,6 +128,7 @@ const Command kSlam{
             return interrupted();
           },
           args.flag("verbose"), start);
+      if (r.trajectory.empty()) return nothing_written("before the first scan");
       robot::write_trajectory(*args.get("out-trajectory"), r.trajectory);
       if (r.interrupted) {
         std::cout << "ICP-SLAM interrupted after " << r.trajectory.size() << " of " << steps.size()
@@ -153,21 +161,21 @@ const Command kLocalize{
     "projbot localize --map DIR --rawlog R --out-trajectory T.txt [--initial \"x y phi\"] [--ground-truth GT.txt]\n\n"
     "Follows odometry between scans and corrects each scan by ICP (mrpt::slam::CICP) against the map that\n"
     "`projbot slam` wrote to DIR. The robot starts at --initial (metres, metres, radians; default 0 0 0).\n",
-    {{"map", "DIR", "map directory written by projbot slam"},
-     {"rawlog", "FILE", "MRPT rawlog of 2-D laser scans and odometry"},
-     {"out-trajectory", "FILE", "where to write the trajectory (timestamp x y phi)"},
+    {{"map", "DIR", "map directory written by projbot slam", cli::PathRole::input_folder},
+     {"rawlog", "FILE", "MRPT rawlog of 2-D laser scans and odometry", cli::PathRole::input_file},
+     {"out-trajectory", "FILE", "where to write the trajectory (timestamp x y phi)", cli::PathRole::output_file},
      {"initial", "\"x y phi\"", "start pose in the map (default 0 0 0)"},
-     {"ground-truth", "FILE", "true trajectory to compare with"}},
+     {"ground-truth", "FILE", "true trajectory to compare with", cli::PathRole::input_file}},
     [](const cli::Args& args) {
       for (const char* required : {"map", "rawlog", "out-trajectory"})
         if (!args.get(required)) throw cli::UsageError(std::string("--") + required + " is required");
-      args.check_output_files({"out-trajectory"});
       const Pose2D start = parse_pose(args.get_or("initial", "0 0 0"), "--initial");
       std::optional<std::vector<robot::TrajectoryPoint>> truth;  // read before the work
       if (const auto gt = args.get("ground-truth")) truth = robot::read_trajectory(*gt);
       catch_interrupts();  // Ctrl-C: write the trajectory of the scans done, then exit 130
       robot::Localizer loc = robot::Localizer::load(*args.get("map"));
       const auto steps = robot::read_rawlog(*args.get("rawlog"));
+      if (interrupted()) return nothing_written("while reading the map and the rawlog");
       std::cout << "localising " << steps.size() << " scans (Ctrl-C stops and keeps the trajectory of the scans done)..."
                 << std::endl;
       loc.reset(start);
@@ -184,6 +192,7 @@ const Command kLocalize{
         out.push_back({s.timestamp_s, loc.pose()});
         progress.step(static_cast<int>(out.size()));
       }
+      if (out.empty()) return nothing_written("before the first scan");
       robot::write_trajectory(*args.get("out-trajectory"), out);
       if (interrupted()) {
         std::cout << "localisation interrupted after " << out.size() << " of " << steps.size()
@@ -234,8 +243,8 @@ const Command kBenchLocalize{
     "range_030_bearing_015 dataset in ../shared/data/mrpt) and prints its trajectory error.\n",
     {{"stops", "N,N,...", "tour lengths (default 3,10,30)"},
      {"seed", "K", "random seed of the base's errors and the laser noise (default 1)"},
-     {"rawlog", "FILE", "rawlog with ground truth for the ICP-SLAM part"},
-     {"ground-truth", "FILE", "its true trajectory"}},
+     {"rawlog", "FILE", "rawlog with ground truth for the ICP-SLAM part", cli::PathRole::input_file},
+     {"ground-truth", "FILE", "its true trajectory", cli::PathRole::input_file}},
     [](const cli::Args& args) {
       std::vector<int> counts;
       {

@@ -282,14 +282,16 @@ const Command kRun{
     "and every pose is compared with the recording's (the largest difference is printed); no device and\n"
     "no twin is used, so nothing is measured against a truth.\n"
     "Without --config the shipped demo tour runs in the twin.\n",
-    {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)"},
+    {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)", cli::PathRole::input_file},
      {"sim", "", "run against the digital twin, whatever `devices:` configures (the default without one)"},
-     {"replay", "DIR", "run the session from a recording (projbot record): no device, no twin; its scene unless --config"},
+     {"replay", "DIR", "run the session from a recording (projbot record): no device, no twin; its scene unless --config",
+      cli::PathRole::input_folder},
      {"fullscreen", "", "fullscreen on --monitor (the projector)"},
      {"monitor", "N", "monitor index for --fullscreen (default 0)"},
      {"headless", "", "draw offscreen at 60 Hz instead of a window (profiling without a display)"},
      {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
-     {"profile", "FILE", "write one CSV row per frame: start, pose age, capture and display time, error"},
+     {"profile", "FILE", "write one CSV row per frame: start, pose age, capture and display time, error",
+      cli::PathRole::output_file},
      {"seconds", "S", "stop after S seconds (default 0: when the tour ends, the window is closed or Ctrl-C)"},
      {"visits", "N", "visits, cycling through the tour (default: the list once)"},
      {"dwell", "S", "seconds the robot projects at each stop (default 4)"},
@@ -298,8 +300,10 @@ const Command kRun{
     [](const cli::Args& args) {
       catch_interrupts();  // Ctrl-C / SIGTERM: leave the frame loop at the next frame, then write what was measured
       const std::optional<config::Recording> recording = replay_of(args);
-      const config::Scene scene = config::load_scene(
-          args.get_or("config", recording ? recording->scene.string() : (asset_dir() / "scenes" / "tour.yaml").string()));
+      const std::string scene_path =
+          args.get_or("config", recording ? recording->scene.string() : (asset_dir() / "scenes" / "tour.yaml").string());
+      args.check_paths({{recording ? "the recording's scene" : "the default scene", scene_path, false}});
+      const config::Scene scene = config::load_scene(scene_path);
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
       std::optional<PoseCheck> check;
@@ -315,7 +319,6 @@ const Command kRun{
       const bool headless = args.flag("headless");
       present_mode(args.get_or("present-mode", "fifo"));  // a bad mode is an error with --headless too
       args.get_int("monitor", 0, 0, 64);                  // so is a bad monitor
-      args.check_output_files({"profile"});
 
       engine::RendererOptions ro;
       ro.windowing = !headless;
@@ -469,7 +472,8 @@ const Command kRun{
                   << " stops, " << tracked
                   << " poses tracked in lockstep (each lit target's, every frame); against the recording's: " << check->compared
                   << " compared, largest difference " << std::setprecision(4) << check->max_mm << " mm, " << check->max_deg
-                  << " deg; " << check->mismatched << " found or lost in one and not the other\n";
+                  << " deg; " << check->mismatched << " found or lost in one and not the other; " << check->unreached()
+                  << " recorded rows for frames the replay did not reach\n";
       } else {
         if (devices.base)
           std::cout << "error at display: not measured (the configured robot: no truth to measure against)\n";

@@ -11,8 +11,9 @@ namespace projbot::tools {
 std::vector<cli::OptionSpec> with_scene_options(std::vector<cli::OptionSpec> own) {
   own.insert(own.end(),
              {
-                 {"scene", "FILE", "scene YAML (default: the shipped demo scene)"},
-                 {"model", "FILE", "glTF model for the scene's single target (without --scene: framed in view)"},
+                 {"scene", "FILE", "scene YAML (default: the shipped demo scene)", cli::PathRole::input_file},
+                 {"model", "FILE", "glTF model for the scene's single target (without --scene: framed in view)",
+                  cli::PathRole::input_file},
                  {"size", "WxH", "projector image size in pixels, e.g. 1920x1080"},
                  {"intrinsics", "fx,fy,cx,cy", "projector intrinsics in pixels (OpenCV pinhole)"},
                  {"near", "M", "near clipping distance, metres"},
@@ -52,6 +53,7 @@ config::Scene scene_from_args(const cli::Args& args) {
     scene.targets.push_back(target);
     frame_model = !args.get("pose-matrix");
   } else {
+    args.check_paths({{"the default scene", asset_dir() / "scenes" / "demo.yaml", false}});
     scene = config::load_scene(asset_dir() / "scenes" / "demo.yaml");
   }
 

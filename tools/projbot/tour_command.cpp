@@ -58,20 +58,22 @@ const Command kTour{
     "assets/scenes/paper.yaml is the paper's experiment).\n\n"
     "A line per visit is printed as it finishes. Ctrl-C stops after the visit in progress, prints and writes\n"
     "the finished visits (the report says \"interrupted\": true) and exits 130.\n",
-    {{"scene", "FILE", "tour scene (default: the shipped shop, assets/scenes/shop.yaml)"},
+    {{"scene", "FILE", "tour scene (default: the shipped shop, assets/scenes/shop.yaml)", cli::PathRole::input_file},
      {"visits", "N", "number of visits, cycling through the scene's list (default: the list once)"},
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
      {"mode", "M", "tracking | localized | odometry (default tracking)"},
-     {"report", "FILE", "write the per-visit report as JSON"},
+     {"report", "FILE", "write the per-visit report as JSON", cli::PathRole::output_file},
      {"frames", "DIR",
       "write per visit DIR/visitNN_TARGET.png (projector), _camera.png (RGB-D colour), _spectator.png (a visitor's view; "
-      "_spectator_end.png after a move)"},
+      "_spectator_end.png after a move)",
+      cli::PathRole::output_folder},
      {"dwell", "S", "simulated seconds of projection per visit in tracking mode or while a target moves (default 3)"},
      {"no-noise", "", "depth without the Kinect v1 noise model"},
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"},
      {"calibration", "FILE",
       "project with a calibration's A_p and R_cp, T_cp (projbot calibrate solve) while the twin's projector keeps the "
-      "scene's: what the calibration's error costs at the markers"}},
+      "scene's: what the calibration's error costs at the markers",
+      cli::PathRole::input_file}},
     [](const cli::Args& args) {
       twin::TourOptions o;
       const std::string mode = args.get_or("mode", "tracking");
@@ -90,9 +92,8 @@ const Command kTour{
       o.frames_dir = args.get_or("frames", "");
       o.depth_noise = !args.flag("no-noise");
       o.predict = !args.flag("no-predict");
-      args.check_output_files({"report"});
-      args.check_output_folders({"frames"});
       const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
+      args.check_paths({{"the default scene", scene_path, false}});
       const auto scene = config::load_scene(scene_path);
       if (const auto calibration = args.get("calibration")) {
         o.calibration = config::load_calibration(*calibration);

@@ -11,8 +11,10 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "projbot/assets/image.hpp"
 #include "projbot/calibrate/procam.hpp"
 #include "projbot/config/output_file.hpp"
+#include "projbot/config/yaml_keys.hpp"
 
 namespace projbot::calibrate {
 namespace fs = std::filesystem;
@@ -123,6 +125,8 @@ CaptureManifest read_manifest(const fs::path& dir, const SolveOptions& options) 
   if (fs::exists(file, ec)) {
     try {
       const YAML::Node y = YAML::LoadFile(file.string());
+      if (const std::string twice = config::duplicate_key_message(y, file.string()); !twice.empty())
+        throw CalibrationError(twice);
       if (!y.IsMap() || y["format"].as<std::string>("") != "projbot-procam-capture-1")
         throw CalibrationError(file.string() + ": not a projbot capture (format: projbot-procam-capture-1)");
       m.projector_width = y["projector"]["width"].as<int>();
@@ -157,6 +161,7 @@ std::vector<BoardPose> read_board_poses(const fs::path& path) {
   std::vector<BoardPose> out;
   try {
     const YAML::Node y = YAML::LoadFile(path.string());
+    if (const std::string twice = config::duplicate_key_message(y, path.string()); !twice.empty()) throw CalibrationError(twice);
     if (!y.IsMap() || !y["poses"] || !y["poses"].IsSequence() || y["poses"].size() == 0)
       throw CalibrationError(path.string() + ": expected 'poses: [{centre: [x, y, z], tilt_deg: [a, b, c]}, ...]'");
     for (const auto& p : y["poses"]) {
@@ -189,6 +194,11 @@ std::vector<cv::Mat> read_pose(const fs::path& folder, std::size_t expected) {
   std::vector<cv::Mat> images;
   for (const fs::path& f : files) {
     cv::Mat img;
+    try {
+      assets::check_png_structure(f);  // a reason of ours rather than libpng's line on stderr
+    } catch (const assets::AssetError& e) {
+      throw CalibrationError(e.what());
+    }
     try {
       img = cv::imread(f.string(), cv::IMREAD_GRAYSCALE);
     } catch (const cv::Exception&) {

@@ -752,6 +752,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   twin_options.pose_source = options.mode == TourMode::odometry ? robot::PoseSource::odometry : robot::PoseSource::localized;
   twin_options.seed = options.seed;
   twin_options.depth_noise = options.depth_noise;
+  twin_options.stop_requested = options.stop_requested;
   Twin twin(scene, twin_options, renderer);
   Tour tour(scene, options, renderer, twin);
   // The stop sequence (drive, aim, Eq. 1 for the visited target and its neighbours, capture, acquire,

@@ -120,7 +120,9 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     home_.push_back(tt.T_world_target_true);
     targets_.push_back(std::move(tt));
   }
-  robot_ = std::make_unique<robot::SimRobot>(robot_config(scene, options.pose_source, options.seed, footprints));
+  robot::SimTourConfig rc = robot_config(scene, options.pose_source, options.seed, footprints);
+  rc.stop_requested = options.stop_requested;
+  robot_ = std::make_unique<robot::SimRobot>(rc);
   depth_target_ = renderer_.make_depth_camera(camera_.width_px, camera_.height_px);
 }
 

@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -23,6 +24,7 @@ struct ModelCloud {
   /// RGB 0..1 per point, as the model's texture shows it (the projection content); empty when the model
   /// has none (a PCD / PLY cloud).
   std::vector<Eigen::Vector3f> colours;
+  std::string source;  ///< the file it came from, for messages; empty when built in memory
 };
 
 /// Model points: area-uniform surface samples of a mesh (glTF, OBJ, STL, a PLY with faces), or the points

@@ -44,6 +44,10 @@ void write_png(const std::filesystem::path& path, const Image& image);
 /// Reads a PNG or JPEG into RGBA8. Throws AssetError naming the file.
 Image read_image(const std::filesystem::path& path);
 
+/// Checks a PNG's structure before any decoder sees it: every chunk fits in the file and the last is
+/// IEND (a truncated capture image once gave only libpng's line). Other formats pass. Throws AssetError.
+void check_png_structure(const std::filesystem::path& path);
+
 /// Reads a 16-bit single-channel PNG. Throws AssetError naming the file (and, for another kind of PNG,
 /// its channels and bit depth).
 Gray16Image read_png_gray16(const std::filesystem::path& path);

@@ -12,4 +12,11 @@ class RobotError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Set-up work (surveying the simulated room's map) stopped on request (Ctrl-C, SIGTERM) before it was
+/// done: nothing was built.
+class SetupInterrupted : public RobotError {
+ public:
+  using RobotError::RobotError;
+};
+
 }  // namespace projbot::robot

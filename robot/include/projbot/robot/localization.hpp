@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -54,11 +55,16 @@ std::vector<std::string> check_icp_slam_config(const std::filesystem::path& ini)
 /// without one, the defaults of MRPT's icp-slam_demo_classic.ini apply. Writes to `out_dir`:
 /// map.simplemap.gz (keyframes: poses and scans), grid.png and grid.yaml (ROS map_server form).
 /// `stop_requested`, asked before each step, ends the run there (Ctrl-C): the steps done are mapped and
-/// written as for a whole run.
+/// written as for a whole run; stopped before the first step, nothing is written.
+/// `out_dir` is replaced only when it is new, empty or holds only a map's files (map_folder_files());
+/// anything else in it is refused (RobotError), before the work, never emptied.
 /// `verbose` lets MRPT's own log lines (its map builder's, at info level) through to stderr.
 /// `start` is where the rawlog's first pose lies in the map (its odometry holds increments only): the
 /// map and the trajectory are in that frame, so a mapping run begun at the scene's robot.start gives a
 /// map in the scene's world frame.
+/// The files build_map() writes into its folder, and all it may find there to replace.
+const std::set<std::string>& map_folder_files();
+
 SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,
                      const std::filesystem::path& out_dir, const std::function<bool()>& stop_requested = {}, bool verbose = false,
                      const Pose2D& start = {});

@@ -34,6 +34,9 @@ struct SimTourConfig {
   int settle_scans = 3;         ///< scans matched at rest after arrival
   double max_seconds_per_stop = 120.0;
   double survey_spacing_m = 1.0;  ///< the map: scans at true poses on this grid over free space
+  /// Asked before each survey scan (the set-up's long part: about 13 ms a scan, one a square metre):
+  /// true ends the construction with SetupInterrupted, so SIGTERM is heard within a scan.
+  std::function<bool()> stop_requested;
 };
 
 /// The simulated robot of a tour, one stop at a time: the room and its map, the drifting base, wheel

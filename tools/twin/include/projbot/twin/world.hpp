@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <set>
 #include <vector>
@@ -34,6 +35,8 @@ struct TwinOptions {
   std::uint64_t seed = 1;
   bool depth_noise = true;            ///< Kinect v1 noise on captured depth
   double marker_tolerance_m = 0.005;  ///< markers farther than this from the model's surface are an error
+  /// Asked while the robot's map is surveyed: true ends the construction (robot::SetupInterrupted).
+  std::function<bool()> stop_requested;
 };
 
 /// One target as the twin and the estimator know it.

@@ -1,0 +1,24 @@
+#pragma once
+// yaml-cpp keeps a key given twice in one mapping and answers the first, silently: every YAML reader of the
+// project asks here and refuses the file instead. Include only where yaml-cpp is a dependency already.
+
+#include <yaml-cpp/yaml.h>
+
+#include <optional>
+#include <string>
+
+namespace projbot::config {
+
+/// A key given twice in one mapping: its text and the 1-based line of its second appearance.
+struct DuplicateKey {
+  std::string key;
+  int line = 0;
+};
+
+/// The first duplicate key anywhere under `node` (walked without recursion: nesting depth costs no stack).
+std::optional<DuplicateKey> find_duplicate_key(const YAML::Node& node);
+
+/// "FILE:LINE: 'key' is given twice in one mapping (the second would be ignored)", or empty.
+std::string duplicate_key_message(const YAML::Node& node, const std::string& file);
+
+}  // namespace projbot::config

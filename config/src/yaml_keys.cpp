@@ -1,0 +1,33 @@
+#include "projbot/config/yaml_keys.hpp"
+
+#include <set>
+#include <vector>
+
+namespace projbot::config {
+
+std::optional<DuplicateKey> find_duplicate_key(const YAML::Node& node) {
+  std::vector<YAML::Node> todo{node};
+  while (!todo.empty()) {
+    const YAML::Node n = todo.back();
+    todo.pop_back();
+    if (n.IsMap()) {
+      std::set<std::string> seen;
+      for (auto it = n.begin(); it != n.end(); ++it) {
+        if (it->first.IsScalar() && !seen.insert(it->first.Scalar()).second)
+          return DuplicateKey{it->first.Scalar(), it->first.Mark().line + 1};
+        todo.push_back(it->second);
+      }
+    } else if (n.IsSequence()) {
+      for (auto it = n.begin(); it != n.end(); ++it) todo.push_back(*it);
+    }
+  }
+  return std::nullopt;
+}
+
+std::string duplicate_key_message(const YAML::Node& node, const std::string& file) {
+  const auto d = find_duplicate_key(node);
+  if (!d) return "";
+  return file + ":" + std::to_string(d->line) + ": '" + d->key + "' is given twice in one mapping (the second would be ignored)";
+}
+
+}  // namespace projbot::config
