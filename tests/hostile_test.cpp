@@ -974,6 +974,8 @@ std::vector<Hostile> all_cases() {
               {"--init-matrix: pose's rotation is not a proper rotation (orthonormality error 0.01"}},
       Hostile{"bench_dataset_missing", "bench dataset {dir}/none", "", 1, {"none: no such folder"}},
       Hostile{"bench_dataset_no_folder", "bench dataset", "", 2, {"give the BOP dataset's folder"}},
+      Hostile{"bench_sensor_missing", "bench sensor {dir}/none", "", 1, {"none: no such folder"}},
+      Hostile{"bench_sensor_no_folder", "bench sensor", "", 2, {"give the BOP dataset's folder: projbot bench sensor DIR"}},
       Hostile{"bench_dataset_broken_info",
               "bench dataset {dir}/bop",
               Files{{"bop/models/models_info.json", "{\"1\": {\"diameter\": 10"}, {"bop/test/000000/scene_camera.json", "{}"}},

@@ -114,3 +114,42 @@ TEST_F(RealFrames, AcquisitionMeetsTheGoalOnRealFramesOfTheSharedDataset) {
   EXPECT_EQ(false_accepts, 0) << r.output;
   EXPECT_LE(false_rejects * 20, n) << r.output;
 }
+
+namespace {
+
+// The cell of a bench sensor row that starts with `what`: its real (column 1) or twin (column 2) value.
+std::string sensor_cell(const std::string& output, const std::string& what, int column) {
+  const auto at = output.find("| " + what);
+  if (at == std::string::npos) return "";
+  std::string line = output.substr(at, output.find('\n', at) - at);
+  std::stringstream cells(line);
+  std::string cell;
+  for (int i = 0; i <= column + 1 && std::getline(cells, cell, '|');) ++i;
+  return cell;
+}
+
+double first_number(const std::string& cell) { return std::stod(cell.substr(cell.find_first_of("+-0123456789"))); }
+
+}  // namespace
+
+// The sensor comparison on one scene's first images, through the executable: the real frames agree with
+// the rendered ground truth to a few millimetres (the 2.2 mm median, an estimate's floor), the
+// twin's depth steps are its model's 2.87 mm per m^2 (1/8 px of disparity); the real ones are finer.
+TEST_F(RealFrames, BenchSensorComparesRealAndTwinAtTheGroundTruth) {
+  const CliRun r = run_projbot("bench sensor " + kYcbv.string() + " --scenes 000001 --max-images 2", 300);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("The real sensor and the twin's at the ground truth: "), std::string::npos) << r.output;
+  const std::string inside = "inside the silhouette: depth - truth";
+  const double real_median = first_number(sensor_cell(r.output, inside, 1));
+  EXPECT_GT(real_median, 0.1) << r.output;
+  EXPECT_LT(real_median, 4.0) << r.output;
+  EXPECT_LT(first_number(sensor_cell(r.output, inside, 2)), real_median) << "the twin is kinder inside: " << r.output;
+  const std::string steps = "depth step between neighbours / z^2";
+  EXPECT_NEAR(first_number(sensor_cell(r.output, steps, 2)), 2.87, 0.2) << r.output;
+  const double real_steps = first_number(sensor_cell(r.output, steps, 1));  // finer than 1/8 px: about 1 mm per m^2
+  EXPECT_GT(real_steps, 0.2) << r.output;
+  EXPECT_LT(real_steps, 4.0) << r.output;
+  const double missing = first_number(sensor_cell(r.output, "missing inside", 1));
+  EXPECT_GE(missing, 0.0);
+  EXPECT_LT(missing, 30.0) << r.output;
+}

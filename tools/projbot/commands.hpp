@@ -26,6 +26,7 @@ extern const Command kBenchTrack;
 extern const Command kBenchMotion;
 extern const Command kBenchAcquire;
 extern const Command kBenchDataset;
+extern const Command kBenchSensor;
 extern const Command kSlam;
 extern const Command kLocalize;
 extern const Command kBenchLocalize;

@@ -20,25 +20,16 @@ namespace {
 using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
-  static const std::vector<const Command*> all{&projbot::tools::kRender,
-                                               &projbot::tools::kShow,
-                                               &projbot::tools::kBenchRender,
-                                               &projbot::tools::kAlign,
-                                               &projbot::tools::kBenchTrack,
-                                               &projbot::tools::kBenchMotion,
-                                               &projbot::tools::kBenchAcquire,
-                                               &projbot::tools::kBenchDataset,
-                                               &projbot::tools::kSlam,
-                                               &projbot::tools::kLocalize,
-                                               &projbot::tools::kBenchLocalize,
-                                               &projbot::tools::kTour,
-                                               &projbot::tools::kRun,
-                                               &projbot::tools::kDevices,
-                                               &projbot::tools::kSimBase,
-                                               &projbot::tools::kRecord,
-                                               &projbot::tools::kCalibrateSimulate,
-                                               &projbot::tools::kCalibrateSolve,
-                                               &projbot::tools::kCalibrateCapture};
+  static const std::vector<const Command*> all{&projbot::tools::kRender,         &projbot::tools::kShow,
+                                               &projbot::tools::kBenchRender,    &projbot::tools::kAlign,
+                                               &projbot::tools::kBenchTrack,     &projbot::tools::kBenchMotion,
+                                               &projbot::tools::kBenchAcquire,   &projbot::tools::kBenchDataset,
+                                               &projbot::tools::kBenchSensor,    &projbot::tools::kSlam,
+                                               &projbot::tools::kLocalize,       &projbot::tools::kBenchLocalize,
+                                               &projbot::tools::kTour,           &projbot::tools::kRun,
+                                               &projbot::tools::kDevices,        &projbot::tools::kSimBase,
+                                               &projbot::tools::kRecord,         &projbot::tools::kCalibrateSimulate,
+                                               &projbot::tools::kCalibrateSolve, &projbot::tools::kCalibrateCapture};
   return all;
 }
 
@@ -102,10 +93,11 @@ static int dispatch(int argc, char** argv, std::string& name) {
   int first = 2;
   if (name == "bench") {  // "bench render", "bench track", ...: the benchmark of a subsystem
     const std::string what = argc < 3 ? std::string() : argv[2];
-    if (what != "render" && what != "track" && what != "motion" && what != "acquire" && what != "localize" && what != "dataset") {
+    if (what != "render" && what != "track" && what != "motion" && what != "acquire" && what != "localize" && what != "dataset" &&
+        what != "sensor") {
       std::cerr << "projbot bench: "
                 << (argc < 3 ? std::string("say what to benchmark") : "no benchmark '" + std::string(argv[2]) + "'")
-                << ": projbot bench render | track | motion | acquire | localize | dataset\n";
+                << ": projbot bench render | track | motion | acquire | localize | dataset | sensor\n";
       return 2;
     }
     name = std::string("bench ") + argv[2];
@@ -135,8 +127,9 @@ static int dispatch(int argc, char** argv, std::string& name) {
     }
   try {
     const projbot::cli::Args args(cmd->options, argc, argv, first);
-    // Only `calibrate solve DIR` and `bench dataset DIR` take an argument that is not an option.
-    const bool takes_folder = cmd == &projbot::tools::kCalibrateSolve || cmd == &projbot::tools::kBenchDataset;
+    // Only `calibrate solve DIR`, `bench dataset DIR` and `bench sensor DIR` take an argument that is not an option.
+    const bool takes_folder =
+        cmd == &projbot::tools::kCalibrateSolve || cmd == &projbot::tools::kBenchDataset || cmd == &projbot::tools::kBenchSensor;
     if (args.positional().size() > (takes_folder ? 1U : 0U))
       throw projbot::cli::UsageError("unexpected argument '" + args.positional().back() + "'");
     // Every command's paths, before any work: inputs that are files, outputs that clash with nothing.
