@@ -250,7 +250,8 @@ TEST(IcpSlam, ConfigValuesAreParsedStrictly) {
       {"smallestThresholdDist=0.05", "smallestThresholdDist = 0", "smallestThresholdDist = '0' must be 0.0001..100"},
       {"pointsMap_count=1", "pointsMap_count=-1", "pointsMap_count = '-1' must be 1..4"},
       {"pointsMap_count=1", "pointsMap_count=100000", "pointsMap_count = '100000' must be 1..4"},
-      {"pointsMap_count=1", "pointsMap_count=1\nlandmarksMap_count=9", "landmarksMap_count = '9' must be 0..4"}};
+      {"pointsMap_count=1", "pointsMap_count=1\nlandmarksMap_count=9", "landmarksMap_count = '9' must be 0..4"},
+      {"maxIterations    = 80", "maxIterations = 80\nmaxiterations = 8", "maxiterations is given twice (first on line 13)"}};
   for (const auto& [from, to, message] : cases) {
     std::string text = good;
     const auto at = text.find(from);

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <numbers>
 #include <thread>
 
@@ -94,6 +96,27 @@ TEST(UrgLaser, AMalformedCommandIsRefusedAndTheUnitAnswersOn) {
 
 TEST(UrgLaser, AnEmulatorRefusesAScanOfTheWrongSize) {
   EXPECT_THROW(UrgEmulator(std::vector<std::uint32_t>(100, 1000)), RobotError);
+}
+
+}  // namespace
+
+namespace {
+
+// A laser port that is no serial port (a file, /dev/null) is said to be one (issue 47: "did not answer").
+TEST(UrgLaser, APortThatIsNoSerialPortIsNamed) {
+  const std::string file = "/tmp/projbot_urg_" + std::to_string(::getpid());
+  std::ofstream(file) << "not a port\n";
+  for (const auto& [port, message] : std::vector<std::pair<std::string, std::string>>{
+           {"/dev/null", "not a terminal"}, {file, "is a regular file, not a serial port"}}) {
+    try {
+      projbot::robot::MrptLaser laser("CHokuyoURG", {{"COM_port_LIN", port}});
+      ADD_FAILURE() << "opened " << port;
+    } catch (const projbot::robot::RobotError& e) {
+      EXPECT_NE(std::string(e.what()).find("on " + port + ": "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+  std::remove(file.c_str());
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "ply_body.hpp"
 #include "projbot/alignment/depth.hpp"
 #include "projbot/config/isolated_read.hpp"
+#include "projbot/config/paths.hpp"
 
 namespace projbot::alignment {
 namespace {
@@ -67,7 +68,8 @@ int load_isolated(const std::filesystem::path& path, const std::string& kind, co
 PointCloud read_cloud(const std::filesystem::path& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw AlignmentError(path.string() + ": is a folder, not a point cloud file");
-  if (!std::filesystem::is_regular_file(path, ec)) throw AlignmentError(path.string() + ": no such point cloud file");
+  if (const std::string kind = config::input_file_problem(path); !kind.empty())  // a FIFO is named as one, not "no such"
+    throw AlignmentError(path.string() + (kind == "does not exist" ? std::string(": no such point cloud file") : ": " + kind));
   const std::string ext = detail::lower_extension(path);
   Cloud cloud;
   int rc = -1;

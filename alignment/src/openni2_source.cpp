@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "projbot/config/paths.hpp"
+
 namespace projbot::alignment {
 namespace {
 
@@ -86,7 +88,8 @@ OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_un
   // here, because another source may still use it.
   if (openni::OpenNI::initialize() != openni::STATUS_OK) fail(options.uri, "cannot initialise OpenNI2");
   const bool is_file = options.uri.size() > 4 && options.uri.substr(options.uri.size() - 4) == ".oni";
-  if (is_file && !std::filesystem::is_regular_file(options.uri)) throw AlignmentError(options.uri + ": no such .oni recording");
+  if (const std::string kind = is_file ? config::input_file_problem(options.uri) : std::string(); !kind.empty())
+    throw AlignmentError(options.uri + (kind == "does not exist" ? std::string(": no such .oni recording") : ": " + kind));
   std::string open_uri = options.uri;
   if (is_file && !oni_declares_cropping(options.uri)) {
     // The packaged player would deliver no frame of it (see the header): play a repaired copy.

@@ -15,6 +15,7 @@
 #include "default_material.hpp"
 #include "image_info.hpp"
 #include "projbot/assets/model.hpp"
+#include "projbot/config/paths.hpp"
 
 namespace projbot::assets {
 namespace {
@@ -461,19 +462,37 @@ bool load_checked_image(tinygltf::Image* image, const int index, std::string* er
   return tinygltf::LoadImageData(image, index, err, warn, width, height, bytes, size, user);
 }
 
+// Whether a file exists, without opening it (tinygltf's fopen()s it: on a FIFO that blocks).
+bool file_exists(const std::string& file, void*) {
+  std::error_code ec;
+  return std::filesystem::exists(file, ec);
+}
+
+// tinygltf's file reader, after a look at what the file is: a buffer or image URI naming a FIFO would
+// block in open(), /dev/zero read until memory ran out.
+bool read_regular_file(std::vector<unsigned char>* out, std::string* err, const std::string& file, void* user) {
+  if (const std::string kind = config::input_file_problem(file); !kind.empty()) {
+    if (err != nullptr) *err += "'" + file + "' " + kind + "\n";
+    return false;
+  }
+  return tinygltf::ReadWholeFile(out, err, file, user);
+}
+
 }  // namespace
 
 Model load_gltf(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw AssetError(file + ": is a folder, not a model file (.gltf or .glb)");
-  if (!std::filesystem::is_regular_file(path, ec)) throw AssetError(file + ": no such model file");
+  if (const std::string kind = config::input_file_problem(path); !kind.empty())
+    throw AssetError(file + (kind == "does not exist" ? std::string(": no such model file") : ": " + kind));
   std::string ext = path.extension().string();
   for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".glb" && !is_glb(path))
     throw AssetError(file + ": not a binary glTF: a .glb file starts with the bytes 'glTF' (wrong extension, or not a model?)");
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(load_checked_image, nullptr);
+  loader.SetFsCallbacks({&file_exists, &tinygltf::ExpandFilePath, &read_regular_file, &tinygltf::WriteWholeFile, nullptr});
   tinygltf::Model gltf;
   std::string err;
   std::string warn;

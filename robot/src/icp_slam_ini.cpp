@@ -14,6 +14,7 @@
 #include <map>
 #include <sstream>
 
+#include "projbot/config/paths.hpp"
 #include "projbot/robot/localization.hpp"
 
 namespace projbot::robot {
@@ -225,8 +226,8 @@ std::string range_problem(const std::string& key, const std::string& v) {
 }  // namespace
 
 std::vector<std::string> check_icp_slam_config(const std::filesystem::path& ini) {
-  std::error_code ec;  // the kind first: opening a FIFO would block
-  if (!std::filesystem::is_regular_file(ini, ec)) throw RobotError(ini.string() + ": no such icp-slam config");
+  if (const std::string kind = config::input_file_problem(ini); !kind.empty())
+    throw RobotError(ini.string() + (kind == "does not exist" ? std::string(": no such icp-slam config") : ": " + kind));
   std::ifstream in(ini);
   if (!in) throw RobotError(ini.string() + ": cannot open the icp-slam config");
   std::stringstream text;
@@ -235,7 +236,11 @@ std::vector<std::string> check_icp_slam_config(const std::filesystem::path& ini)
   const auto keys = known_keys();
   bool has_mapping = false, has_icp = false;
   std::vector<std::string> warnings;
+  std::map<std::string, int> first_line;  // "section/key" -> where it was first given
   for (const IniEntry& e : entries) {
+    if (const auto [at, added] = first_line.emplace(lower(e.section) + "/" + lower(e.key), e.line); !added)
+      throw RobotError(ini.string() + ":" + std::to_string(e.line) + ": [" + e.section + "] " + e.key +
+                       " is given twice (first on line " + std::to_string(at->second) + ")");
     has_mapping |= lower(e.section) == "mappingapplication";
     has_icp |= lower(e.section) == "icp";
     const auto k = keys.find(lower(e.section) + "/" + lower(e.key));

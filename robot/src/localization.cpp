@@ -204,7 +204,8 @@ void check_step(const std::filesystem::path& path, std::size_t index, const Rawl
 }  // namespace
 
 std::vector<RawlogStep> read_rawlog(const std::filesystem::path& path) {
-  if (!std::filesystem::is_regular_file(path)) throw RobotError(path.string() + ": no such rawlog file");
+  if (const std::string kind = config::input_file_problem(path); !kind.empty())
+    throw RobotError(path.string() + (kind == "does not exist" ? std::string(": no such rawlog file") : ": " + kind));
   // MRPT's deserialiser crashes on corrupt archives (flipped bits): it reads in a child process.
   const std::string bytes = read_isolated(path, {"MRPT rawlog", "MRPT's reader"}, [&](config::ReadProgress& progress) {
     config::Bytes out;
@@ -407,7 +408,9 @@ Localizer::Localizer(const std::vector<std::pair<Pose2D, LaserScan>>& keyframes,
 
 Localizer Localizer::load(const std::filesystem::path& map_dir, const LocalizerConfig& config) {
   const auto file = map_dir / "map.simplemap.gz";
-  if (!std::filesystem::is_regular_file(file)) throw RobotError(file.string() + ": no such map (run projbot slam first)");
+  if (const std::string kind = config::input_file_problem(file); !kind.empty())
+    throw RobotError(file.string() +
+                     (kind == "does not exist" ? std::string(": no such map (run projbot slam first)") : ": " + kind));
   // MRPT's deserialiser crashes on corrupt archives: the child reads the keyframes and builds the
   // points map; its points come back.
   const std::string bytes = read_isolated(file, {"MRPT simplemap", "MRPT's reader"}, [&](config::ReadProgress&) {

@@ -8,11 +8,13 @@
 #include <mrpt/hwdrivers/registerAllClasses.h>
 
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 #include <thread>
 
 #include "mrpt_convert.hpp"
+#include "serial_port.hpp"
 
 namespace projbot::robot {
 
@@ -64,7 +66,13 @@ MrptLaser::MrptLaser(const std::string& class_name, const std::map<std::string, 
   // The drivers' own chatter (a Hokuyo's product and version tables, at INFO) stays out of our output.
   laser->setMinLoggingLevel(mrpt::system::LVL_WARN);
   mrpt::config::CConfigFileMemory config;
-  for (const auto& [key, value] : params) config.write("LASER", key, value);
+  for (const auto& [key, value] : params) {
+    std::error_code ec;                                               // a missing port is left to MRPT's driver, which names it
+    if (key == "COM_port_LIN" && std::filesystem::exists(value, ec))  // a file, a folder, /dev/null: said so
+      if (const std::string problem = detail::serial_port_problem(value); !problem.empty())
+        throw RobotError(impl_->name + " on " + value + ": " + problem);
+    config.write("LASER", key, value);
+  }
   CaptureStderr said;
   try {
     impl_->sensor->loadConfig(config, "LASER");
