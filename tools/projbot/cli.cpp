@@ -83,7 +83,9 @@ int Args::get_int(const std::string& name, int fallback, int min_value, int max_
 
 void Args::check_outputs() const {
   namespace fs = std::filesystem;
-  for (const auto& [name, role] : roles_) {
+  for (const auto& entry : roles_) {
+    const std::string& name = entry.first;  // not a structured binding: clang 14 cannot capture one
+    const PathRole role = entry.second;
     const auto value = get(name);
     if (!value) continue;
     const auto check = [&](const auto& how, const fs::path& p) {
