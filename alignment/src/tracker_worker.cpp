@@ -317,6 +317,23 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   return last_attempt_;
 }
 
+std::optional<AlignmentResult> TargetFollower::first_acquisition(const DepthImage& frame, const assets::Image* colour) {
+  const auto deadline = acquire_deadline();  // the support's search counts against the budget, as in acquire()
+  if (find_support_) {
+    find_support_ = false;
+    if (const auto support = support_in_frame(model_, frame, k_, guess_, silhouette_grow_m_))
+      known_.floor = support->floor, known_.footing = support;
+  }
+  Known known = known_;
+  known.deadline = deadline;
+  try {
+    last_attempt_ = acquire_known(frame, guess_, known, silhouette_grow_m_, colour);
+  } catch (const AlignmentError&) {  // too little depth near the guess (an absent target): as attempt() says
+    return std::nullopt;
+  }
+  return last_attempt_;
+}
+
 std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
   // A moving target is looked for where its motion has taken it by this frame's capture: 1 m/s is
   // 3.3 cm between 30 Hz frames, most of the tracker's reach from the last pose.
@@ -385,9 +402,15 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame, const 
   }
   // Depth alone here: one bounded attempt per frame, and a held pose colour cannot place would cost a
   // second one in the same frame (acquire() holds weak directions for colour).
-  const auto a = attempt(frame, guess_, stage);
+  const bool acquiring = stats_.attempts == 0 && cfg_.first_search_acquires;
+  const auto a = acquiring ? first_acquisition(frame, colour) : attempt(frame, guess_, stage);
   elapsed();
-  if (a && a->converged && verified(frame, T = a->T_scan_model) && coloured(frame, colour, T)) {
+  if (acquiring && a && a->converged && verified(frame, T = a->T_scan_model)) {  // colour and the look-alike turn done
+    hold_.reset();
+    if (colour && std::isfinite(a->colour_agreement)) hold_ = T;
+    return found(frame, T, a->inlier_ratio, a->rmse_mm);
+  }
+  if (!acquiring && a && a->converged && verified(frame, T = a->T_scan_model) && coloured(frame, colour, T)) {
     T = nearest_guess(frame, T, guess_);  // a look-alike turn, as in acquire()
     if (hold_) hold_ = T;
     return found(frame, T, a->inlier_ratio, a->rmse_mm);

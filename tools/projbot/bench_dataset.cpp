@@ -195,7 +195,11 @@ class Bench {
   void follow(const alignment::BopScene& scene, const std::vector<alignment::DepthImage>& frames,
               const alignment::CameraIntrinsics& k, const ObjectModel& m, const alignment::BopInstance& start, std::size_t p,
               std::vector<Row>& rows) {
-    alignment::TargetFollower follower(m.cloud, k);
+    // The follower knows how far its guess may be off, as the acquisition without --track is told (grow).
+    alignment::WorkerConfig config;
+    config.guess_uncertainty_m = perturbations_[p].mm / 1000.0;
+    config.guess_uncertainty_deg = perturbations_[p].deg;
+    alignment::TargetFollower follower(m.cloud, k, config);
     const Eigen::Matrix4d T_start = perturbed(start.T_camera_model, m.centre, perturbations_[p],
                                               start_seed(seed_, scene.name, scene.images.front().id, start.gt_index, p));
     follower.set_initial_guess(T_start);

@@ -44,6 +44,10 @@ struct WorkerConfig {
   /// ...and at least long enough that searching takes no more than this share of the worker's time:
   /// an attempt of t ms is followed by t (1 / search_duty - 1) ms of frames (camera_hz) without one.
   double search_duty = 0.25;
+  /// The first search from a new guess (set_initial_guess) is the acquisition itself (acquire(): the
+  /// support found in the frame, the polish, colour): one pipeline for align, the benchmark and the
+  /// tracker. Later attempts are the bounded ones above. False: every attempt is a bounded one.
+  bool first_search_acquires = true;
   double camera_hz = 30.0;
   /// Every pose (tracked, refined or found) is checked against free space (verification.hpp): more than
   /// this share of the predicted silhouette seen through rejects it. A box fitted onto the bare pedestal
@@ -286,6 +290,8 @@ class TargetFollower {
   // r moved by colour where depth allows, and refused when colour disagrees (see acquire).
   void by_colour(const DepthImage& frame, const Known& known, const assets::Image& colour, AlignmentResult& r) const;
   std::optional<AlignmentResult> attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage);
+  /// The first search from a new guess: acquire() from guess_, with what is known (or found) of its support.
+  std::optional<AlignmentResult> first_acquisition(const DepthImage& frame, const assets::Image* colour);
 };
 
 /// What a projection session hands a lit target's frames to (session::Session::visit): the stop's initial
