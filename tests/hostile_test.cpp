@@ -541,6 +541,12 @@ const std::vector<Hostile> kFileCases{
             with(kTour, "start: [2, 2, 0]", "start: [-2, 2, 0]"),
             1,
             {"bad.yaml", "start"}},
+    // A set-up that fails (here: a device that is not there) leaves no recording folder behind.
+    Hostile{"record_absent_device_makes_no_folder",
+            "record --out {dir}/newrec --config {dir}/bad.yaml",
+            kTour + "devices:\n  pan_tilt: {port: /dev/ttyUSB97}\n  base: {domain: 3}\n",
+            1,
+            {"/dev/ttyUSB97"}},
     Hostile{"scene_start_in_obstacle",
             "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
             with(kTour, "start: [2, 2, 0]", "start: [0.5, 0.5, 0]"),

@@ -142,8 +142,7 @@ const Command kRecord{
       std::error_code ec;
       if (fs::exists(*out, ec) && !fs::is_empty(*out, ec))
         throw cli::UsageError(*out + ": not empty; a recording needs a new folder");
-      fs::create_directories(*out, ec);
-      if (ec) throw cli::UsageError(*out + ": cannot create: " + ec.message());
+      catch_interrupts();  // Ctrl-C: during set-up nothing is written; later, end the stop in progress, keep every stop
 
       Devices devices;
       config::Recording rec;
@@ -170,7 +169,9 @@ const Command kRecord{
         twin_rig = std::make_unique<TwinRig>(scene, trackers.targets, seed, devices.camera.get(), true);
       session::Session& session = robot ? device_rig->session() : twin_rig->session();
       session::Dwell dwell = robot ? device_rig->dwell(dwell_s, true) : twin_rig->dwell(dwell_s, true);
-      catch_interrupts();  // Ctrl-C: end the stop in progress, keep every stop recorded
+      if (interrupted()) return nothing_written("while setting up");  // no folder made
+      fs::create_directories(*out, ec);  // only now: a set-up that fails or is stopped leaves no folder behind
+      if (ec) throw cli::UsageError(*out + ": cannot create: " + ec.message());
       Progress progress("frame", static_cast<int>(std::ceil(visits * dwell_s * 30.0)));
       RecordObserver observer(scene, rec, *out, progress);
       // The robot's laser scans and wheel odometry, as an MRPT rawlog: the twin's, or the configured laser's.
