@@ -84,7 +84,7 @@ PointCloud read_cloud(const std::filesystem::path& path) {
         throw AlignmentError(path.string() + ": read " + std::to_string(cloud.size()) + " points, the header claims " +
                              std::to_string(header.points) + " (malformed data section?)");
     } else if (ext == ".ply") {
-      const std::uint64_t vertices = detail::check_ply_body(path);  // PCL reads the declared counts, ignores the rest
+      const std::uint64_t vertices = detail::check_ply_body(path).vertices;  // PCL reads the declared counts, ignores the rest
       rc = load_isolated(
           path, "PLY file", [&](Cloud& c) { return pcl::io::loadPLYFile(path.string(), c); }, cloud);
       if (rc >= 0 && cloud.size() != vertices)

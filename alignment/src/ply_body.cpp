@@ -129,14 +129,15 @@ std::uint64_t binary_body_bytes(std::ifstream& in, const Header& h, std::uint64_
 
 }  // namespace
 
-std::uint64_t check_ply_body(const std::filesystem::path& path) {
+PlyCounts check_ply_body(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw AlignmentError(file + ": cannot open");
   Header h = read_header(in, file);
-  std::uint64_t vertices = 0, total = 0;
+  std::uint64_t vertices = 0, faces = 0, total = 0;
   for (const Element& e : h.elements) {
     if (e.name == "vertex") vertices = e.count;
+    if (e.name == "face") faces = e.count;
     total += e.count;
   }
   std::error_code ec;
@@ -151,7 +152,7 @@ std::uint64_t check_ply_body(const std::filesystem::path& path) {
     if (lines != total)
       throw AlignmentError(file + ": the header declares " + std::to_string(total) + " elements (" + std::to_string(vertices) +
                            " vertices), the body holds " + std::to_string(lines) + " lines");
-    return vertices;
+    return {vertices, faces};
   }
   if (h.format != "binary_little_endian" && h.format != "binary_big_endian")
     throw AlignmentError(file + ": PLY format '" + h.format + "' is none of ascii, binary_little_endian, binary_big_endian");
@@ -161,7 +162,7 @@ std::uint64_t check_ply_body(const std::filesystem::path& path) {
                          std::to_string(total - vertices) + " other elements, " +
                          (end > size ? "more than the file holds" : "but " + std::to_string(size - end) + " bytes follow them") +
                          " (truncated, or more data than declared)");
-  return vertices;
+  return {vertices, faces};
 }
 
 }  // namespace projbot::alignment::detail

@@ -8,9 +8,15 @@
 
 namespace projbot::alignment::detail {
 
+/// What the header declares.
+struct PlyCounts {
+  std::uint64_t vertices = 0;
+  std::uint64_t faces = 0;
+};
+
 /// Walks the body element by element (list properties included) and throws AlignmentError naming the
 /// file unless it ends exactly where the header's counts say (ASCII: one line per element, blank lines
-/// aside). Returns the declared vertex count.
-std::uint64_t check_ply_body(const std::filesystem::path& path);
+/// aside). Returns the declared vertex and face counts.
+PlyCounts check_ply_body(const std::filesystem::path& path);
 
 }  // namespace projbot::alignment::detail

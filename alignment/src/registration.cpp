@@ -18,10 +18,8 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
-#include <fstream>
 #include <functional>
 #include <optional>
-#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -592,20 +590,6 @@ ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
 
 namespace {
 
-// Whether a PLY file's header declares faces: a mesh (sampled over its surface) rather than a cloud.
-bool ply_has_faces(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  for (int i = 0; i < 200 && std::getline(in, line); ++i) {
-    if (line.rfind("end_header", 0) == 0) break;
-    std::istringstream words(line);
-    std::string element, name;
-    long long count = 0;
-    if (words >> element >> name >> count && element == "element" && name == "face" && count > 0) return true;
-  }
-  return false;
-}
-
 ModelCloud cloud_model(const std::filesystem::path& path) {
   const PointCloud cloud = finite_points(read_cloud(path));
   if (cloud.points.size() < 10)
@@ -628,8 +612,10 @@ ModelCloud load_model_cloud(const std::filesystem::path& path, std::size_t sampl
   if (!(scale > 0.0) || !std::isfinite(scale) || scale < 1e-6 || scale > 1e6)
     throw AlignmentError(path.string() + ": model scale must be a finite number in [1e-6, 1e6], not " + std::to_string(scale));
   const std::string ext = detail::lower_extension(path);
-  const bool mesh = ext == ".gltf" || ext == ".glb" || ext == ".obj" || ext == ".stl" || (ext == ".ply" && ply_has_faces(path));
-  if (ext == ".ply") detail::check_ply_body(path);  // a mesh's counts too: Assimp ignores what follows them
+  // A PLY is a mesh (sampled over its surface) when its header declares faces; the same walk checks its
+  // body against its counts, which Assimp, like PCL, reads without looking at what follows them.
+  const bool mesh = ext == ".gltf" || ext == ".glb" || ext == ".obj" || ext == ".stl" ||
+                    (ext == ".ply" && detail::check_ply_body(path).faces > 0);
   if (mesh) {
     try {
       assets::Model model = assets::load_model(path);

@@ -57,14 +57,6 @@ std::string input_file_problem(const fs::path& path) {
   return kind_of(fs::status(path, ec));
 }
 
-std::string input_folder_problem(const fs::path& path) {
-  std::error_code ec;
-  const auto st = fs::status(path, ec);
-  if (st.type() == fs::file_type::directory) return "";
-  if (st.type() == fs::file_type::not_found) return "does not exist";
-  return "is not a folder";
-}
-
 std::optional<std::string> find_path_clash(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs) {
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const NamedPath& out = outputs[i];

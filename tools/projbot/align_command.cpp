@@ -13,6 +13,7 @@
 #include "projbot/alignment/verification.hpp"
 #include "projbot/config/rigid.hpp"
 #include "projbot/config/scene.hpp"
+#include "scene_setup.hpp"
 
 namespace projbot::tools {
 namespace {
@@ -143,8 +144,7 @@ const Command kAlign{
       cfg.crop = !args.flag("no-crop");
       cfg.voxel_m = args.get_double("voxel", cfg.voxel_m);
       if (!(cfg.voxel_m > 0.0) || cfg.voxel_m > 0.1) throw cli::UsageError("--voxel must be in (0, 0.1] metres");
-      const double model_scale = args.get_double("model-scale", 1.0);
-      if (!(model_scale >= 1e-6 && model_scale <= 1e6)) throw cli::UsageError("--model-scale must be in [1e-6, 1e6]");
+      const double model_scale = model_scale_option(args, 1.0);
       const alignment::ModelCloud model = alignment::load_model_cloud(*args.get("model"), 50000, model_scale);
       const double grow_m = guess_reach(args, model);
       const Scan loaded = load_scan(args);

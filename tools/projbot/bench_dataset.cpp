@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <set>
-#include <sstream>
 
 #include "commands.hpp"
 #include "interrupt.hpp"
@@ -21,6 +20,7 @@
 #include "projbot/alignment/verification.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/engine/frame_profiler.hpp"
+#include "scene_setup.hpp"
 
 namespace projbot::tools {
 namespace {
@@ -64,14 +64,6 @@ std::vector<Perturbation> parse_perturbations(const std::vector<std::string>& te
     out.push_back({mm, deg});
   }
   if (out.empty()) out.push_back(Perturbation{});
-  return out;
-}
-
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(item);
   return out;
 }
 
@@ -349,10 +341,9 @@ int run_bench_dataset(const cli::Args& args) {
   const int min_visible = args.get_int("min-visible", 1500, 0, 100000000);
   const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
   const int max_instances = args.get_int("max-instances", 1 << 30, 1, 1 << 30);
-  const double scale = args.get_double("model-scale", 0.001);
-  if (!(scale >= 1e-6 && scale <= 1e6)) throw cli::UsageError("--model-scale must be in [1e-6, 1e6]");
+  const double scale = model_scale_option(args, 0.001);
   check_report_apart(args, dir);
-  const alignment::BopDataset data = alignment::read_bop_dataset(dir, split_list(args.get_or("scenes", "")));
+  const alignment::BopDataset data = alignment::read_bop_dataset(dir, args.get_list("scenes"));
   catch_interrupts();
   Bench bench(data, scale, perturbations, seed);
   std::vector<Row> rows;

@@ -9,7 +9,6 @@
 #include <deque>
 #include <iostream>
 #include <map>
-#include <sstream>
 
 #include "commands.hpp"
 #include "interrupt.hpp"
@@ -17,7 +16,9 @@
 #include "projbot/alignment/bop.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/assets/model.hpp"
+#include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
+#include "scene_setup.hpp"
 
 namespace projbot::tools {
 namespace {
@@ -133,14 +134,6 @@ void add_outside(const Silhouette& s, const std::vector<float>& depth, Stats& ou
 
 config::ProjectorConfig camera_of(const alignment::CameraIntrinsics& k) { return config::ProjectorConfig(k, 0.1, 10.0); }
 
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 // Renders the dataset's models at their ground truth through each image's camera.
 class TwinSensor {
  public:
@@ -223,13 +216,6 @@ void measure_image(TwinSensor& sensor, const alignment::BopScene& scene, const a
   }
 }
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return NAN;
-  const auto at = static_cast<std::size_t>(std::lround(p * static_cast<double>(v.size() - 1)));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(at), v.end());
-  return v[at];
-}
-
 std::string share(long part, long whole) {
   char text[32];
   std::snprintf(text, sizeof text, whole > 0 ? "%.1f %%" : "-",
@@ -250,8 +236,8 @@ void print_row(const std::string& what, const std::string& real, const std::stri
 std::string residuals(const Stats& s) {
   std::vector<double> a;
   for (const double r : s.residual_mm) a.push_back(std::abs(r));
-  return number(percentile(a, 0.5), "%.2f") + " / " + number(percentile(a, 0.9), "%.2f") + " / " +
-         number(percentile(s.residual_mm, 0.5), "%+.2f");
+  return number(engine::percentile(a, 0.5), "%.2f") + " / " + number(engine::percentile(a, 0.9), "%.2f") + " / " +
+         number(engine::percentile(s.residual_mm, 0.5), "%+.2f");
 }
 
 void print_sensors(const Sensors& s) {
@@ -276,8 +262,8 @@ void print_sensors(const Sensors& s) {
             share(s.real.left_missing, s.real.left) + " / " + share(s.real.right_missing, s.real.right),
             share(s.twin.left_missing, s.twin.left) + " / " + share(s.twin.right_missing, s.twin.right));
   const auto steps = [](const Stats& t) {
-    return number(percentile(t.step_per_z2, 0.1) * 1000.0, "%.2f") + " / " +
-           number(percentile(t.step_per_z2, 0.5) * 1000.0, "%.2f");
+    return number(engine::percentile(t.step_per_z2, 0.1) * 1000.0, "%.2f") + " / " +
+           number(engine::percentile(t.step_per_z2, 0.5) * 1000.0, "%.2f");
   };
   print_row("depth step between neighbours / z^2, p10 / median, mm per m^2", steps(s.real), steps(s.twin));
 }
@@ -287,10 +273,8 @@ int run_bench_sensor(const cli::Args& args) {
   const int min_visible = args.get_int("min-visible", 1500, 0, 100000000);
   const int max_images = args.get_int("max-images", 1 << 30, 1, 1 << 30);
   const auto seed = static_cast<std::uint32_t>(args.get_int("seed", 1, 0, 1 << 30));
-  const double scale = args.get_double("model-scale", 0.001);
-  if (!(scale >= 1e-6 && scale <= 1e6)) throw cli::UsageError("--model-scale must be in [1e-6, 1e6]");
-  const alignment::BopDataset data =
-      alignment::read_bop_dataset(args.positional().front(), split_list(args.get_or("scenes", "")));
+  const double scale = model_scale_option(args, 0.001);
+  const alignment::BopDataset data = alignment::read_bop_dataset(args.positional().front(), args.get_list("scenes"));
   TwinSensor sensor(data, scale);
   catch_interrupts();
   int total = 0;

@@ -67,7 +67,7 @@ int run_simulate(const cli::Args& args) {
   const auto out = args.get("out");
   if (!out) throw cli::UsageError("--out DIR is required");
   const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
-  args.check_paths({{"the default scene", scene_path, false}});
+  args.check_clashes({{"the default scene", scene_path, false}});
   const config::Scene scene = config::load_scene(scene_path);
   const calibrate::SimulationConfig c = simulation_config(args, scene);
   Progress progress("pose", c.poses);
@@ -214,7 +214,7 @@ int run_capture(const cli::Args& args) {
   const auto out = args.get("out");
   if (!out) throw cli::UsageError("--out DIR is required");
   const std::string scene_path = args.get_or("config", (asset_dir() / "scenes" / "shop.yaml").string());
-  args.check_paths({{"the default scene", scene_path, false}});
+  args.check_clashes({{"the default scene", scene_path, false}});
   const config::Scene scene = config::load_scene(scene_path);
   const bool sim = args.flag("sim");
   if (!sim && !scene.devices.camera)

@@ -68,6 +68,14 @@ std::vector<std::string> Args::get_all(const std::string& name) const {
   return {};
 }
 
+std::vector<std::string> Args::get_list(const std::string& name) const {
+  std::vector<std::string> out;
+  std::stringstream in(get_or(name, ""));
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
 std::string Args::get_or(const std::string& name, const std::string& fallback) const { return get(name).value_or(fallback); }
 
 int Args::get_int(const std::string& name, int fallback, int min_value, int max_value) const {
@@ -112,23 +120,32 @@ void Args::check_outputs() const {
   }
 }
 
-void Args::check_paths(const std::vector<config::NamedPath>& more_inputs) const {
-  std::vector<config::NamedPath> inputs = more_inputs, outputs;
+void Args::named_paths(std::vector<config::NamedPath>& inputs, std::vector<config::NamedPath>& outputs) const {
   for (const auto& [name, role] : roles_) {
     const auto value = get(name);
     if (!value || role == PathRole::none) continue;
     const bool folder = role == PathRole::input_folder || role == PathRole::output_folder;
-    if (role == PathRole::input_file || role == PathRole::input_folder) {
-      // A FIFO, device or socket is refused here, before anything opens it (open() on a FIFO blocks,
-      // /dev/zero never ends); a missing file or a folder is left to the reader, which names it.
-      const std::string problem = config::input_file_problem(*value);
-      if (problem.find("not a regular file") != std::string::npos) throw InputError("--" + name + " " + *value + ": " + problem);
-      inputs.push_back({"--" + name, *value, folder});
-    } else {
-      outputs.push_back({"--" + name, *value, folder});
-    }
+    const bool input = role == PathRole::input_file || role == PathRole::input_folder;
+    (input ? inputs : outputs).push_back({"--" + name, *value, folder});
   }
+}
+
+void Args::check_paths(const std::vector<config::NamedPath>& more_inputs) const {
+  std::vector<config::NamedPath> inputs = more_inputs, outputs;
+  named_paths(inputs, outputs);
+  // A FIFO, device or socket is refused here, before anything opens it (open() on a FIFO blocks,
+  // /dev/zero never ends); a missing file or a folder is left to the reader, which names it.
+  for (std::size_t i = more_inputs.size(); i < inputs.size(); ++i)
+    if (const std::string problem = config::input_file_problem(inputs[i].path);
+        problem.find("not a regular file") != std::string::npos)
+      throw InputError(inputs[i].name + " " + inputs[i].path.string() + ": " + problem);
   check_outputs();
+  if (const auto clash = config::find_path_clash(inputs, outputs)) throw UsageError(*clash);
+}
+
+void Args::check_clashes(const std::vector<config::NamedPath>& more_inputs) const {
+  std::vector<config::NamedPath> inputs = more_inputs, outputs;
+  named_paths(inputs, outputs);
   if (const auto clash = config::find_path_clash(inputs, outputs)) throw UsageError(*clash);
 }
 

@@ -44,6 +44,8 @@ class Args {
   std::optional<std::string> get(const std::string& name) const;
   /// Every value of a repeatable option, in the order given (get() returns the last).
   std::vector<std::string> get_all(const std::string& name) const;
+  /// A comma-separated option ("--scenes A,B") as its non-empty items; empty when not given.
+  std::vector<std::string> get_list(const std::string& name) const;
   std::string get_or(const std::string& name, const std::string& fallback) const;
   int get_int(const std::string& name, int fallback, int min_value, int max_value) const;
   double get_double(const std::string& name, double fallback) const;
@@ -54,9 +56,13 @@ class Args {
   /// output clashes with an input (those options' and `more_inputs`: defaults, arguments) or another
   /// output (config::find_path_clash). Throws UsageError naming the option(s) and the problem.
   void check_paths(const std::vector<config::NamedPath>& more_inputs = {}) const;
+  /// Only the clash part of check_paths, for inputs a command learns after the dispatcher's check (a
+  /// default scene): the options' paths against `more_inputs` and each other. Throws UsageError.
+  void check_clashes(const std::vector<config::NamedPath>& more_inputs) const;
 
  private:
   void check_outputs() const;
+  void named_paths(std::vector<config::NamedPath>& inputs, std::vector<config::NamedPath>& outputs) const;
   std::map<std::string, PathRole> roles_;
   std::map<std::string, std::string> values_;
   std::map<std::string, std::vector<std::string>> all_;

@@ -134,7 +134,7 @@ const Command kRecord{
       const double dwell_s = args.get_double("dwell", 2.0);
       if (!(dwell_s > 0.0 && dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
       const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
-      args.check_paths({{"the default scene", (asset_dir() / "scenes" / "tour.yaml"), false}});
+      args.check_clashes({{"the default scene", (asset_dir() / "scenes" / "tour.yaml"), false}});
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot record` needs a 'tour: {visits: [...]}' section");

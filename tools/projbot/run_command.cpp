@@ -302,7 +302,7 @@ const Command kRun{
       const std::optional<config::Recording> recording = replay_of(args);
       const std::string scene_path =
           args.get_or("config", recording ? recording->scene.string() : (asset_dir() / "scenes" / "tour.yaml").string());
-      args.check_paths({{recording ? "the recording's scene" : "the default scene", scene_path, false}});
+      args.check_clashes({{recording ? "the recording's scene" : "the default scene", scene_path, false}});
       const config::Scene scene = config::load_scene(scene_path);
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");

@@ -30,6 +30,12 @@ std::filesystem::path asset_dir() {
   return PROJBOT_ASSET_DIR;
 }
 
+double model_scale_option(const cli::Args& args, double fallback) {
+  const double scale = args.get_double("model-scale", fallback);
+  if (!(scale >= 1e-6 && scale <= 1e6)) throw cli::UsageError("--model-scale must be in [1e-6, 1e6]");
+  return scale;
+}
+
 Eigen::Matrix4d framing_pose(const config::ProjectorConfig& p, double radius_m) {
   const double half_fov = std::atan(std::min(p.width_px / (2.0 * p.fx_px), p.height_px / (2.0 * p.fy_px)));
   const double distance = radius_m / std::sin(half_fov * 0.8);
@@ -53,7 +59,7 @@ config::Scene scene_from_args(const cli::Args& args) {
     scene.targets.push_back(target);
     frame_model = !args.get("pose-matrix");
   } else {
-    args.check_paths({{"the default scene", asset_dir() / "scenes" / "demo.yaml", false}});
+    args.check_clashes({{"the default scene", asset_dir() / "scenes" / "demo.yaml", false}});
     scene = config::load_scene(asset_dir() / "scenes" / "demo.yaml");
   }
 

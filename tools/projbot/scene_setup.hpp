@@ -19,6 +19,9 @@ std::vector<cli::OptionSpec> with_scene_options(std::vector<cli::OptionSpec> own
 /// The folder holding the shipped demo assets (PROJBOT_ASSETS overrides the built-in path).
 std::filesystem::path asset_dir();
 
+/// --model-scale (model units to metres), `fallback` when not given; a usage error outside [1e-6, 1e6].
+double model_scale_option(const cli::Args& args, double fallback);
+
 /// Loads --scene (or the demo scene) and applies --model, --size, --intrinsics, --near, --far and
 /// --pose-matrix. Throws config::ConfigError or cli::UsageError.
 config::Scene scene_from_args(const cli::Args& args);

@@ -93,7 +93,7 @@ const Command kTour{
       o.depth_noise = !args.flag("no-noise");
       o.predict = !args.flag("no-predict");
       const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
-      args.check_paths({{"the default scene", scene_path, false}});
+      args.check_clashes({{"the default scene", scene_path, false}});
       const auto scene = config::load_scene(scene_path);
       if (const auto calibration = args.get("calibration")) {
         o.calibration = config::load_calibration(*calibration);

@@ -21,8 +21,6 @@ struct NamedPath {
 /// Why `path` cannot be read as a file ("does not exist", "is a folder, not a file", "is a FIFO, not a
 /// regular file", ...), or empty when it is a regular file (links followed).
 std::string input_file_problem(const std::filesystem::path& path);
-/// The same for an input folder: empty when `path` is a folder.
-std::string input_folder_problem(const std::filesystem::path& path);
 
 /// The first clash between `inputs` and `outputs`, as one line naming both, or nothing:
 /// - an output on the same file as an input or another output;
