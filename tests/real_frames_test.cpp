@@ -115,6 +115,34 @@ TEST_F(RealFrames, AcquisitionMeetsTheGoalOnRealFramesOfTheSharedDataset) {
   EXPECT_LE(false_rejects * 20, n) << r.output;
 }
 
+// The cluttered scene: a banana leaning on a wood block, a gelatin box on top of it, a mustard bottle behind.
+// The block, half hidden, scored 0.62-0.68 of its points explained at its own ground truth (the banana
+// and the box in front counted against it) and was refused at every pose; ICP was pulled 10-15 mm onto
+// them. With occluders neutral in the gate and correspondences far past the median rejected, the block
+// of the first image is lit within 10 mm, 8 of the first two images' 12 instances are, none is lit wrong.
+TEST_F(RealFrames, AcquisitionHoldsAmongTouchingNeighbours) {
+  const fs::path report = dir_ / "clutter.json";
+  const CliRun r =
+      run_projbot("bench dataset " + kYcbv.string() + " --scenes 000002 --max-instances 12 --report " + report.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  int n = 0, within = 0, false_accepts = 0;
+  bool block_lit = false;
+  const auto j = read_json(report);
+  for (const auto& row : j.at("instances")) {
+    if (row.at("method").get<std::string>() != "projbot") continue;
+    ++n;
+    const double e = row.at("error_mm").get<double>();
+    const bool lit = row.at("accepted").get<bool>();
+    within += lit && e <= 10.0 ? 1 : 0;
+    false_accepts += lit && e > 20.0 ? 1 : 0;
+    if (row.at("image").get<int>() == 1 && row.at("obj_id").get<int>() == 16) block_lit = lit && e <= 10.0;
+  }
+  ASSERT_EQ(n, 12) << r.output;
+  EXPECT_TRUE(block_lit) << r.output;
+  EXPECT_GE(within, 8) << r.output;
+  EXPECT_EQ(false_accepts, 0) << r.output;
+}
+
 // --track on the scene whose potted meat can was once followed 60-70 mm off on its neighbour (its first
 // search was not the acquisition, and it was not told its guess's uncertainty): every object found on
 // the first image stays within 10 mm, nothing lit wrong.

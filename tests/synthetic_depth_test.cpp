@@ -138,6 +138,44 @@ TEST_F(SyntheticDepthTest, TheGateAllowsForTheSensorNoiseAtItsRange) {
   EXPECT_DOUBLE_EQ(aligner.score(close, near).tolerance_scale, 1.0);
 }
 
+TEST_F(SyntheticDepthTest, AnOccluderInFrontSaysNothingAgainstThePose) {
+  // A board 2.5 cm in front of the duck's left half (a neighbour leaning on it): those points are not
+  // the duck's, but they say nothing against its pose. Judged as occluders (the scan seen from its
+  // origin) the truth passes; judged as unexplained it does not. The duck pushed 10 cm back, behind
+  // its own surface, has most of the crop in front of it and is refused either way.
+  const Eigen::Matrix4d T = poses()[0];
+  DepthImage depth = render(T);
+  int left = depth.width, right = 0;
+  for (int y = 0; y < depth.height; ++y)
+    for (int x = 0; x < depth.width; ++x)
+      if (has_depth(depth.at(x, y))) left = std::min(left, x), right = std::max(right, x);
+  ASSERT_LT(left, right);
+  std::size_t boarded = 0, seen = 0;
+  for (int y = 0; y < depth.height; ++y)
+    for (int x = 0; x < depth.width; ++x) {
+      float& z = depth.depth_m[static_cast<std::size_t>(y) * depth.width + x];
+      if (!has_depth(z)) continue;
+      ++seen;
+      if (x < (left + right) / 2) z -= 0.025F, ++boarded;
+    }
+  ASSERT_GT(boarded * 5, seen) << "the board hides a good part of the duck";
+  const PointCloud scan = depth_to_cloud(depth, k_);
+  AcquisitionConfig every_point;
+  every_point.scan_from_origin = false;
+  const AlignmentResult judged_all = Aligner(*model_, every_point).score(scan, T);
+  const Aligner aligner(*model_);
+  const AlignmentResult occluded = aligner.score(scan, T);
+  EXPECT_FALSE(judged_all.converged) << "inliers " << judged_all.inlier_ratio;
+  EXPECT_TRUE(occluded.converged) << "inliers " << occluded.inlier_ratio << " neutral " << occluded.neutral_ratio;
+  EXPECT_GT(occluded.inlier_ratio, 0.95);
+  EXPECT_GT(occluded.neutral_ratio, 0.15);
+  EXPECT_LT(occluded.neutral_ratio, 0.6);
+  Eigen::Matrix4d behind = T;
+  behind(2, 3) += 0.10;
+  const AlignmentResult pushed = aligner.score(scan, behind);
+  EXPECT_FALSE(pushed.converged) << "inliers " << pushed.inlier_ratio << " neutral " << pushed.neutral_ratio;
+}
+
 TEST_F(SyntheticDepthTest, ABigScanIsThinnedToTheCapAndStaysAccurate) {
   // The duck at 0.8 m fills 20000 pixels; with a cap of 2000 points ICP and the gate work on a coarser
   // grid, and the pose stays within a millimetre.

@@ -9,6 +9,7 @@
 #include <pcl/filters/statistical_outlier_removal.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/registration/correspondence_rejection_median_distance.h>
 #include <pcl/registration/correspondence_rejection_surface_normal.h>
 #include <pcl/registration/icp.h>
 #include <pcl/registration/sample_consensus_prerejective.h>
@@ -360,6 +361,11 @@ struct Aligner::Impl {
         normals->setThreshold(std::cos(cfg.max_normal_angle_deg * M_PI / 180.0));
         icp.addCorrespondenceRejector(normals);
       }
+      if (cfg.icp_median_factor > 0.0) {  // PCL compares squared distances
+        auto median = pcl::make_shared<pcl::registration::CorrespondenceRejectorMedianDistance>();
+        median->setMedianFactor(cfg.icp_median_factor * cfg.icp_median_factor);
+        icp.addCorrespondenceRejector(median);
+      }
       icp.setInputSource(source);
       icp.setInputTarget(model_icp);
       icp.setSearchMethodTarget(model_icp_tree, true);
@@ -387,8 +393,70 @@ struct Aligner::Impl {
     return std::max(cfg.inlier_distance_m, cfg.inlier_sigmas * cfg.depth_sigma_coeff * zz);
   }
 
+  // Where the ray from `viewpoint` through q (both in the model frame) first meets the model's surface,
+  // as a distance along it from the viewpoint; infinity where it misses. Sphere tracing on the ICP
+  // samples (spacing voxel_m) through the model's bounding sphere.
+  float first_hit(const Eigen::Vector3f& q, const Eigen::Vector3f& viewpoint) const {
+    const Eigen::Vector3f dir = (q - viewpoint).normalized();
+    const float along = (extent.centroid - viewpoint).dot(dir);
+    const float miss2 = (extent.centroid - viewpoint - along * dir).squaredNorm();
+    const auto radius = static_cast<float>(extent.radius) + static_cast<float>(cfg.voxel_m);
+    if (miss2 >= radius * radius) return std::numeric_limits<float>::infinity();
+    const float half = std::sqrt(radius * radius - miss2);
+    const auto hit = static_cast<float>(cfg.voxel_m);
+    PointN x;
+    pcl::Indices index(1);
+    std::vector<float> dist2(1);
+    for (float t = std::max(0.0F, along - half); t < along + half;) {
+      x.getVector3fMap() = viewpoint + t * dir;
+      if (model_icp_tree->nearestKSearch(x, 1, index, dist2) < 1) break;
+      const float d = std::sqrt(dist2[0]);
+      if (d < hit) return t;
+      t += std::max(d - hit, 0.5F * hit);
+    }
+    return std::numeric_limits<float>::infinity();
+  }
+
+  // Whether a scan point the model does not explain says nothing about the pose: it stands in front of
+  // the model along its ray (an occluder: a neighbour leaning on the target, a box on top of it), or
+  // its ray misses the model and it lies farther than the model's surface beside it (a neighbour or
+  // the background behind the target's outline). A point seen through the model, or beside it at its
+  // own depth (the target's own surface outside a shifted estimate), counts against.
+  bool neutral(const Eigen::Vector3f& q, const Eigen::Vector3f& viewpoint, double tolerance) const {
+    const float range = (q - viewpoint).norm();
+    const float t = first_hit(q, viewpoint);
+    if (std::isfinite(t)) return t > range + static_cast<float>(tolerance);
+    // Beside the outline: against the nearest of the model's samples that face the viewpoint (its seen
+    // surface; a neighbour touching the target's far side is as far as that side).
+    PointN x;
+    x.getVector3fMap() = q;
+    pcl::Indices index;
+    std::vector<float> dist2;
+    model_icp_tree->nearestKSearch(x, 16, index, dist2);
+    for (const auto i : index) {
+      const PointN& m = (*model_icp)[static_cast<std::size_t>(i)];
+      const Eigen::Vector3f to_view = viewpoint - m.getVector3fMap();
+      if (m.getNormalVector3fMap().dot(to_view) <= 0.0F) continue;
+      return range > to_view.norm() + static_cast<float>(tolerance);
+    }
+    return true;  // only the model's far side near it: behind what the camera sees of the model
+  }
+
+  // Whether q (model frame) lies on the model: within `tolerance` of the nearest sample's plane (and
+  // within twice that of the sample); `d` is that point-to-plane distance.
+  bool explained(const PointN& q, double tolerance, double& d) const {
+    pcl::Indices index(1);
+    std::vector<float> dist2(1);
+    if (model_tree->nearestKSearch(q, 1, index, dist2) < 1) return false;
+    if (dist2[0] > static_cast<float>(4.0 * tolerance * tolerance)) return false;
+    const PointN& m = (*model)[static_cast<std::size_t>(index[0])];
+    d = std::abs((q.getVector3fMap() - m.getVector3fMap()).dot(m.getNormalVector3fMap()));
+    return d <= tolerance;
+  }
+
   // Quality of a pose: scan points near the posed model are inliers when their point-to-plane distance
-  // to the nearest model sample is within their tolerance (tolerance_m).
+  // to the nearest model sample is within their tolerance (tolerance_m). Scan points in front of the
+  // model along their rays, or beyond its outline (scan_from_origin: neutral()), count for nothing.
   void evaluate(const pcl::PointCloud<pcl::PointXYZ>& near, const Eigen::Matrix4d& T, AlignmentResult& r) const {
     r.scan_points = near.size();
     if (near.empty()) {
@@ -397,31 +465,32 @@ struct Aligner::Impl {
       return;
     }
     const Eigen::Matrix4f inv = rigid_inverse(T).cast<float>();
-    std::size_t inliers = 0;
-    double sum2 = 0.0, scale_sum = 0.0;
-    pcl::Indices index(1);
-    std::vector<float> dist2(1);
+    const Eigen::Vector3f viewpoint = inv.topRightCorner<3, 1>();  // the scan's origin in the model frame
+    std::size_t inliers = 0, neutrals = 0;
+    double sum2 = 0.0, scale_sum = 0.0, d = 0.0;
     for (const auto& p : near) {
       PointN q;
       q.getVector3fMap() = (inv * Eigen::Vector4f(p.x, p.y, p.z, 1.0F)).head<3>();
       if (!q.getVector3fMap().allFinite()) continue;
       const double tolerance = tolerance_m(p.z);
       scale_sum += tolerance / cfg.inlier_distance_m;
-      if (model_tree->nearestKSearch(q, 1, index, dist2) < 1) continue;
-      if (dist2[0] > static_cast<float>(4.0 * tolerance * tolerance)) continue;
-      const PointN& m = (*model)[static_cast<std::size_t>(index[0])];
-      const double d = std::abs((q.getVector3fMap() - m.getVector3fMap()).dot(m.getNormalVector3fMap()));
-      if (d > tolerance) continue;
+      if (!explained(q, tolerance, d)) {
+        if (cfg.scan_from_origin && neutral(q.getVector3fMap(), viewpoint, tolerance)) ++neutrals;
+        continue;
+      }
       ++inliers;
       sum2 += d * d;
     }
-    r.inlier_ratio = static_cast<double>(inliers) / static_cast<double>(near.size());
+    const std::size_t judged = near.size() - neutrals;
+    r.inlier_ratio = judged > 0 ? static_cast<double>(inliers) / static_cast<double>(judged) : 0.0;
+    r.neutral_ratio = static_cast<double>(neutrals) / static_cast<double>(near.size());
     r.rmse_mm = inliers > 0 ? 1000.0 * std::sqrt(sum2 / static_cast<double>(inliers)) : std::numeric_limits<double>::infinity();
     r.tolerance_scale = std::max(1.0, scale_sum / static_cast<double>(near.size()));
   }
 
   bool passes(const AlignmentResult& r) const {
-    return r.inlier_ratio >= cfg.min_inlier_ratio && r.rmse_mm <= cfg.max_rmse_mm * r.tolerance_scale;
+    return r.inlier_ratio >= cfg.min_inlier_ratio && r.rmse_mm <= cfg.max_rmse_mm * r.tolerance_scale &&
+           r.neutral_ratio <= cfg.max_neutral_ratio;
   }
 
   // The model's lowest point (over all its samples, as footing_in_camera measures it) above the
@@ -465,7 +534,10 @@ struct Aligner::Impl {
     const double cosine = std::clamp(up.normalized().dot(footing.floor.normal), -1.0, 1.0);
     r.footing_height_error_mm = 1000.0 * (h - footing.height_m);
     r.footing_tilt_deg = std::acos(cosine) * 180.0 / M_PI;
-    r.stands = std::abs(h - footing.height_m) <= cfg.footing_height_m &&
+    const double above = h - footing.height_m;
+    // A support found in the frame says the target rests on it: not floating above it.
+    const double float_limit = footing.upright_known ? cfg.footing_height_m : cfg.support_float_m;
+    r.stands = above <= float_limit && -above <= cfg.footing_height_m &&
                (!footing.upright_known || r.footing_tilt_deg <= cfg.footing_tilt_deg);
     return r.stands;
   }
@@ -580,6 +652,8 @@ AcquisitionConfig pcl_pipeline_config(bool pcl_search) {
   c.icp_flag_decides = true;
   c.min_inlier_ratio = 0.0;  // no gate: PCL reports convergence, not whether the pose is right
   c.max_rmse_mm = 1e9;
+  c.scan_from_origin = false;
+  c.icp_median_factor = 0.0;  // ICP as PCL sets it up: its distance threshold and nothing else
   return c;
 }
 

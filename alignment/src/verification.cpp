@@ -184,6 +184,8 @@ FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& 
         ++c.behind;
       else if (measured < z - tolerance)
         ++c.in_front;
+      else
+        ++c.agree;
     }
   return c;
 }

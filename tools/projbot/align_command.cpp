@@ -132,7 +132,9 @@ const Command kAlign{
      {"init-matrix", "m00,...,m33", "initial T_scan_model, 16 numbers, row-major, metres"},
      {"init", "\"x y z r p y\"", "initial pose: metres and degrees, R = Rz(yaw) Ry(pitch) Rx(roll)"},
      {"no-crop", "", "use the whole scan, not only the region around the initial guess (clouds)"},
-     {"guess-error", "MM,DEG", "how far the initial guess may be off (depth images; default 50,15)"},
+     {"guess-error", "MM,DEG",
+      "how far the initial guess may be off (depth images; default 50,15): the crop, and the bound past which an estimate is "
+      "refused"},
      {"model-scale", "S", "model units to metres (default 1; 0.001 for a model in millimetres, as BOP's)"},
      {"voxel", "M", "downsampling voxel size in metres (default 0.004)"},
      {"json", "", "print one JSON object instead of text"}},
@@ -162,6 +164,7 @@ const Command kAlign{
         // the model at the estimate, it is in the wrong place, however well it fits.
         alignment::WorkerConfig worker;
         worker.acquisition = cfg;
+        worker.reach_margin_m = 0.02;  // --guess-error is a bound: an estimate beyond it is something else
         const alignment::TargetFollower follower(model, loaded.k, worker);
         try {
           r = follower.acquire(*loaded.depth, T_init, grow_m);
@@ -173,6 +176,7 @@ const Command kAlign{
       } else {
         // A cloud's frame is unknown: its z is no range, and the depth camera's noise at a range says nothing.
         cfg.depth_sigma_coeff = 0.0;
+        cfg.scan_from_origin = false;  // nor is its origin where it was seen from
         r = alignment::Aligner(model, cfg).align(scan, T_init);
       }
       const bool accepted = r.converged && (!free_space || free_space->passes(limit));
@@ -187,6 +191,9 @@ const Command kAlign{
                                     {"iterations", r.iterations},
                                     {"time_ms", r.time_ms},
                                     {"reinitialised", r.reinitialised},
+                                    {"neutral_ratio", r.neutral_ratio},
+                                    {"stands", r.stands},
+                                    {"support_height_mm", r.footing_height_error_mm},
                                     {"scan_valid_points", scan.finite_count()},
                                     {"scan_points_used", r.scan_points},
                                     {"free_space", free_space_json(free_space, limit)},

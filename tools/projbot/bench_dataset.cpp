@@ -47,7 +47,7 @@ struct Row {
   Eigen::Matrix4d T_start = Eigen::Matrix4d::Identity(), T_est = Eigen::Matrix4d::Identity();
   bool accepted = false;
   double time_ms = 0.0, error_mm = 0.0;
-  double inlier_ratio = 0.0, rmse_mm = 0.0, behind_ratio = 0.0;  // what the gate and the free-space check saw
+  double inlier_ratio = 0.0, rmse_mm = 0.0, behind_ratio = 0.0, agree_ratio = 0.0;  // what the gate and the free-space check saw
 };
 
 Row row_for(const std::string& scene, const char* mode, int image, int gt_index, int obj_id, const Perturbation& p) {
@@ -118,6 +118,14 @@ double timed_ms(F&& f) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// The starts' error is known (the perturbation): an estimate beyond it is something else that fits.
+constexpr double kReachMarginM = 0.02;
+alignment::WorkerConfig bounded_guess() {
+  alignment::WorkerConfig c;
+  c.reach_margin_m = kReachMarginM;
+  return c;
+}
+
 // The estimators of one object for one camera, made when first needed.
 struct Estimators {
   alignment::TargetFollower ours;
@@ -153,6 +161,7 @@ class Bench {
           const alignment::FreeSpaceCheck check = e.ours.verify(depth, r.T_scan_model);
           row.accepted = r.converged && e.ours.passes(check);
           row.behind_ratio = check.behind_ratio();
+          row.agree_ratio = check.agree_ratio();
         });
         row.inlier_ratio = r.inlier_ratio, row.rmse_mm = r.rmse_mm;
         row.T_est = r.T_scan_model;
@@ -191,6 +200,7 @@ class Bench {
     alignment::WorkerConfig config;
     config.guess_uncertainty_m = perturbations_[p].mm / 1000.0;
     config.guess_uncertainty_deg = perturbations_[p].deg;
+    config.reach_margin_m = kReachMarginM;
     alignment::TargetFollower follower(m.cloud, k, config);
     const Eigen::Matrix4d T_start = perturbed(start.T_camera_model, m.centre, perturbations_[p],
                                               start_seed(seed_, scene.name, scene.images.front().id, start.gt_index, p));
@@ -242,7 +252,7 @@ class Bench {
     if (it == estimators_.end())
       it = estimators_
                .emplace(m.info->id,
-                        std::make_pair(k, Estimators{alignment::TargetFollower(m.cloud, k),
+                        std::make_pair(k, Estimators{alignment::TargetFollower(m.cloud, k, bounded_guess()),
                                                      alignment::Aligner(m.cloud, alignment::pcl_pipeline_config(true))}))
                .first;
     return it->second.second;
@@ -319,6 +329,7 @@ void write_report(const fs::path& file, const std::vector<Row>& rows, bool inter
                                 {"inlier_ratio", r.inlier_ratio},
                                 {"rmse_mm", std::isfinite(r.rmse_mm) ? nlohmann::json(r.rmse_mm) : nlohmann::json(nullptr)},
                                 {"behind_ratio", r.behind_ratio},
+                                {"agree_ratio", r.agree_ratio},
                                 {"time_ms", r.time_ms}});
   config::write_file_atomically(file, out.dump(1) + "\n");
 }

@@ -462,6 +462,7 @@ alignment::WorkerConfig follower_config(const TourOptions& options) {
     acquisition.icp_distances_m = {0.05};
     acquisition.icp_iterations = 30;
     acquisition.max_normal_angle_deg = 180.0;
+    acquisition.icp_median_factor = 0.0;
   }
   return follow;
 }

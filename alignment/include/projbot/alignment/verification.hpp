@@ -20,8 +20,11 @@ struct FreeSpaceCheck {
   std::size_t predicted = 0;  ///< interior silhouette pixels with a measurement
   std::size_t behind = 0;     ///< measured farther than the model's surface by more than the tolerance
   std::size_t in_front = 0;   ///< measured nearer: occluded, neutral
+  std::size_t agree = 0;      ///< measured within the tolerance of the model's surface
   /// Share of the predicted pixels where the camera looks through the model; 0 with nothing predicted.
   double behind_ratio() const { return predicted == 0 ? 0.0 : static_cast<double>(behind) / static_cast<double>(predicted); }
+  /// Share of the predicted pixels where the measured surface is the model's.
+  double agree_ratio() const { return predicted == 0 ? 0.0 : static_cast<double>(agree) / static_cast<double>(predicted); }
   /// Fewer predicted pixels than this and the check cannot vouch for an estimate (the model is out of
   /// view, or nearly so, there).
   static constexpr std::size_t kMinPredicted = 50;
