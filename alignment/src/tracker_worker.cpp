@@ -255,7 +255,7 @@ AlignmentResult TargetFollower::acquire_known(const DepthImage& frame, const Eig
       // frames, a can fitted onto the box beside it, 167 mm away, with 0.88 of its points explained and
       // nothing seen through it). The centre, not every point: a symmetric shape (a can turned about its
       // axis) is right in any of its equivalent poses.
-      if (r.converged && cfg_.reach_margin_m >= 0.0 &&
+      if (r.converged && cfg_.guess_bounds_estimate &&
           centre_move_m(model_, guess, r.T_scan_model) > grow_m + cfg_.reach_margin_m)
         r.converged = false;
       return r;

@@ -164,7 +164,7 @@ const Command kAlign{
         // the model at the estimate, it is in the wrong place, however well it fits.
         alignment::WorkerConfig worker;
         worker.acquisition = cfg;
-        worker.reach_margin_m = 0.02;  // --guess-error is a bound: an estimate beyond it is something else
+        worker.guess_bounds_estimate = true;  // --guess-error is a bound: an estimate beyond it is something else
         const alignment::TargetFollower follower(model, loaded.k, worker);
         try {
           r = follower.acquire(*loaded.depth, T_init, grow_m);

@@ -119,10 +119,9 @@ double timed_ms(F&& f) {
 }
 
 // The starts' error is known (the perturbation): an estimate beyond it is something else that fits.
-constexpr double kReachMarginM = 0.02;
 alignment::WorkerConfig bounded_guess() {
   alignment::WorkerConfig c;
-  c.reach_margin_m = kReachMarginM;
+  c.guess_bounds_estimate = true;
   return c;
 }
 
@@ -197,10 +196,9 @@ class Bench {
               const alignment::CameraIntrinsics& k, const ObjectModel& m, const alignment::BopInstance& start, std::size_t p,
               std::vector<Row>& rows) {
     // The follower knows how far its guess may be off, as the acquisition without --track is told (grow).
-    alignment::WorkerConfig config;
+    alignment::WorkerConfig config = bounded_guess();
     config.guess_uncertainty_m = perturbations_[p].mm / 1000.0;
     config.guess_uncertainty_deg = perturbations_[p].deg;
-    config.reach_margin_m = kReachMarginM;
     alignment::TargetFollower follower(m.cloud, k, config);
     const Eigen::Matrix4d T_start = perturbed(start.T_camera_model, m.centre, perturbations_[p],
                                               start_seed(seed_, scene.name, scene.images.front().id, start.gt_index, p));

@@ -85,12 +85,14 @@ struct WorkerConfig {
   /// ...and once ICP has an estimate, the depth is cropped again at it, grown by this, and ICP refines
   /// from there on what is left (what stood beside the target inside the first crop drops out).
   double recrop_m = 0.03;
-  /// Where the guess's uncertainty is a bound (a user's stated guess error: `align --guess-error`,
-  /// `bench dataset`'s perturbations), an acquisition's estimate may put the model's centroid no farther
-  /// from where the guess put it than that uncertainty (the silhouette's growth) plus this: beyond it, it
-  /// is something else that fits. Negative (the default): no such bound, as for a map's guess of a
-  /// target that may have been moved (the tour finds its moved box 10 cm and 15 degrees away).
-  double reach_margin_m = -1.0;
+  /// Whether the guess's uncertainty is a bound (a user's stated guess error: `align --guess-error`,
+  /// `bench dataset`'s perturbations): an acquisition's estimate may then put the model's centroid no
+  /// farther from where the guess put it than that uncertainty (the silhouette's growth) plus
+  /// reach_margin_m; beyond it, it is something else that fits. False (the default): no such bound, as
+  /// for a map's guess of a target that may have been moved (the tour finds its moved box 10 cm and 15
+  /// degrees away).
+  bool guess_bounds_estimate = false;
+  double reach_margin_m = 0.02;
   /// Colour at acquisition (acquire with a colour image): a move along the weakest slides is taken only
   /// if the depth's RMS error at the moved pose grows by at most this share...
   double colour_max_rmse_growth = 0.10;
@@ -242,11 +244,11 @@ class TargetFollower {
   /// acquire()'s body, with what is known at this stop.
   AlignmentResult acquire_known(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
                                 const assets::Image* colour) const;
-  /// acquire() without colour's move: align_near, then the projective polish.
   /// Whether the projective polish's pose stands as ICP's did: no more of it seen through, and with a
   /// footing, still passing the gate.
   bool polish_kept(const DepthImage& frame, const Known& known, const Eigen::Matrix4d& before,
                    const Eigen::Matrix4d& after) const;
+  /// acquire() without colour's move: align_near, then the projective polish.
   AlignmentResult acquired(const DepthImage& frame, const DepthImage& near, const PointCloud& near_cloud,
                            const Eigen::Matrix4d& guess, const Known& known, double grow_m, Weak weak) const;
   /// r refined by ICP (`stage`: refine or icp_only) on the depth near its estimate, grown by recrop_m;
