@@ -690,6 +690,19 @@ TEST_F(CliTest, TourRunsTheShopInTrackingModeByDefault) {
   EXPECT_NE(r.output.find("181/181"), std::string::npos) << r.output;                  // lit all along
 }
 
+// The twin with the depth camera fitted to real frames (bench sensor): the same tour runs and reports
+// the figure lit, its error measured as ever (what it costs is the closing note's figure, not a test's).
+TEST_F(CliTest, TourRunsWithTheDepthModelFittedToRealFrames) {
+  const CliRun r = run_projbot("tour --visits 1 --mode localized --depth-model fitted --report " + (dir_ / "r.json").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("| visit | figure | paper target 1 |"), std::string::npos) << r.output;
+  std::ifstream in(dir_ / "r.json");
+  const auto report = nlohmann::json::parse(in);
+  EXPECT_EQ(report.at("depth_model"), "fitted");
+  ASSERT_EQ(report.at("visits").size(), 1U);
+  EXPECT_TRUE(std::isfinite(report.at("visits")[0].at("mean_mm").get<double>()));
+}
+
 // Two targets side by side: at the duck's stop the box is lit in the same projector frames, on the
 // right of the duck (the box stands 0.6 m east of it).
 TEST_F(CliTest, TourLightsANeighbourInTheSameFrame) {

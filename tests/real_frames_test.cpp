@@ -185,7 +185,8 @@ double first_number(const std::string& cell) { return std::stod(cell.substr(cell
 
 // The sensor comparison on one scene's first images, through the executable: the real frames agree with
 // the rendered ground truth to a few millimetres (the 2.2 mm median, an estimate's floor), the
-// twin's depth steps are its model's 2.87 mm per m^2 (1/8 px of disparity); the real ones are finer.
+// twin's depth steps are its model's 2.87 mm per m^2 (1/8 px of disparity); the real ones are finer, and
+// the model fitted to them has their 1.8 mm per m^2 and their smooth noise.
 TEST_F(RealFrames, BenchSensorComparesRealAndTwinAtTheGroundTruth) {
   const CliRun r = run_projbot("bench sensor " + kYcbv.string() + " --scenes 000001 --max-images 2", 300);
   ASSERT_EQ(r.code, 0) << r.output;
@@ -197,6 +198,10 @@ TEST_F(RealFrames, BenchSensorComparesRealAndTwinAtTheGroundTruth) {
   EXPECT_LT(first_number(sensor_cell(r.output, inside, 2)), real_median) << "the twin is kinder inside: " << r.output;
   const std::string steps = "depth step between neighbours / z^2";
   EXPECT_NEAR(first_number(sensor_cell(r.output, steps, 2)), 2.87, 0.2) << r.output;
+  EXPECT_NEAR(first_number(sensor_cell(r.output, steps, 3)), 1.82, 0.15) << r.output;
+  const std::string alike = "that noise's correlation with the pixel 1 / 3 / 8 px";
+  EXPECT_LT(first_number(sensor_cell(r.output, alike, 2)), 0.5) << "the published model's noise is per pixel: " << r.output;
+  EXPECT_GT(first_number(sensor_cell(r.output, alike, 3)), 0.8) << "the fitted model's is smooth: " << r.output;
   const double real_steps = first_number(sensor_cell(r.output, steps, 1));  // finer than 1/8 px: about 1 mm per m^2
   EXPECT_GT(real_steps, 0.2) << r.output;
   EXPECT_LT(real_steps, 4.0) << r.output;

@@ -2,11 +2,13 @@
 // (issue 41): what the real sensor does that the twin's Kinect model does or does not (noise inside the
 // silhouette, missing pixels, the band of mixed pixels and the shadow outside it, depth quantisation).
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <deque>
+#include <functional>
 #include <iostream>
 #include <map>
 
@@ -36,7 +38,12 @@ struct Stats {
   std::array<long, kRings + 1> ring{}, ring_missing{}, ring_object{}, ring_between{};
   long left = 0, left_missing = 0, right = 0, right_missing = 0;  // rings 1..3, by side of the silhouette
   std::vector<double> step_per_z2;                                // nonzero depth steps between neighbours / z^2
+  std::vector<double> offset_mm;  // per instance: the median residual (what the ground truth's own error explains)
+  std::vector<double> noise_mm;   // residuals less their instance's plane (offset and tilt): the sensor's noise
+  std::array<std::vector<double>, 3> lag_difference;  // |noise - noise kLags[i] px to the right|
 };
+
+constexpr std::array<int, 3> kLags{1, 3, 8};
 
 // One instance's pixels: its visible silhouette, the truth's depth there, and the rings around it.
 struct Silhouette {
@@ -82,8 +89,43 @@ bool interior(const Silhouette& s, int x, int y) {
   return true;
 }
 
+// The instance's residuals less the plane through them (least squares in the pixel coordinates): what is
+// left is the sensor's noise, not a few tenths of a degree or millimetres of error in the ground truth.
+// Also how the noise differs kLags px apart along a row (the sensor's correlation window smooths it).
+void add_noise(const Silhouette& s, const std::vector<float>& residual_mm, Stats& out) {
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  std::vector<double> all;
+  for (int i = 0; i < s.width * s.height; ++i) {
+    const float r = residual_mm[static_cast<std::size_t>(i)];
+    if (std::isnan(r)) continue;
+    const Eigen::Vector3d a(1.0, (i % s.width) / 100.0, (i / s.width) / 100.0);
+    normal += a * a.transpose();
+    rhs += a * r;
+    all.push_back(r);
+  }
+  if (all.size() < 100) return;
+  out.offset_mm.push_back(engine::percentile(all, 0.5));
+  const Eigen::Vector3d plane = normal.ldlt().solve(rhs);
+  std::vector<float> noise(residual_mm.size(), std::nanf(""));
+  for (int i = 0; i < s.width * s.height; ++i) {
+    const float r = residual_mm[static_cast<std::size_t>(i)];
+    if (std::isnan(r)) continue;
+    const double n = r - plane.dot(Eigen::Vector3d(1.0, (i % s.width) / 100.0, (i / s.width) / 100.0));
+    noise[static_cast<std::size_t>(i)] = static_cast<float>(n);
+    out.noise_mm.push_back(n);
+  }
+  for (std::size_t l = 0; l < kLags.size(); ++l)
+    for (int i = 0; i + kLags[l] < s.width * s.height; ++i) {
+      const float a = noise[static_cast<std::size_t>(i)], b = noise[static_cast<std::size_t>(i + kLags[l])];
+      if (std::isnan(a) || std::isnan(b) || i % s.width + kLags[l] >= s.width) continue;
+      out.lag_difference[l].push_back(std::abs(static_cast<double>(a) - b));
+    }
+}
+
 // Inside the silhouette: residuals against the truth, missing pixels, depth steps.
 void add_inside(const Silhouette& s, const std::vector<float>& depth, Stats& out) {
+  std::vector<float> residual(depth.size(), std::nanf(""));
   for (int y = 0; y < s.height; ++y)
     for (int x = 0; x < s.width; ++x) {
       const auto i = static_cast<std::size_t>(y * s.width + x);
@@ -96,11 +138,13 @@ void add_inside(const Silhouette& s, const std::vector<float>& depth, Stats& out
       }
       if (!inner) continue;
       out.residual_mm.push_back(1000.0 * (depth[i] - s.truth_m[i]));
+      residual[i] = static_cast<float>(out.residual_mm.back());
       const float right = depth[i + 1];
       const double step = std::abs(static_cast<double>(right) - depth[i]);
       if (x + 1 < s.width && s.mask[i + 1] && right > 0.0F && step > 1e-5 && step < 0.01)
         out.step_per_z2.push_back(step / (static_cast<double>(depth[i]) * depth[i]));
     }
+  add_noise(s, residual, out);
 }
 
 // Outside it, ring by ring: missing, the object's depth bled outward, depths between object and background.
@@ -172,7 +216,8 @@ namespace {
 // any model at the farthest depth of its 9 x 9 neighbourhood, so that none of the real frame's edge
 // pixels come with it; then the twin's Kinect model over the whole.
 alignment::DepthImage twin_view(const std::vector<float>& models, const alignment::DepthImage& real,
-                                const alignment::CameraIntrinsics& k, std::uint32_t seed) {
+                                const alignment::CameraIntrinsics& k, const alignment::KinectNoiseConfig& model,
+                                std::uint32_t seed) {
   const int w = real.width, h = real.height;
   alignment::DepthImage clean{w, h, models, 0.0};
   for (int y = 0; y < h; ++y)
@@ -188,11 +233,11 @@ alignment::DepthImage twin_view(const std::vector<float>& models, const alignmen
         }
       clean.depth_m[i] = near_model ? far : real.depth_m[i];
     }
-  return alignment::apply_kinect_v1_noise(clean, k, alignment::KinectNoiseConfig{}, seed);
+  return alignment::apply_kinect_v1_noise(clean, k, model, seed);
 }
 
 struct Sensors {
-  Stats real, twin;
+  Stats real, twin, fitted;  // the twin's published Kinect model, and the one fitted to real frames
   int instances = 0, images = 0;
 };
 
@@ -202,7 +247,9 @@ void measure_image(TwinSensor& sensor, const alignment::BopScene& scene, const a
   for (const auto& inst : image.instances) all.push_back(&inst);
   const alignment::DepthImage real = alignment::read_bop_depth(image);
   const std::vector<float> models = sensor.render(image, all);
-  const alignment::DepthImage twin = twin_view(models, real, image.k, seed ^ static_cast<std::uint32_t>(image.id));
+  const auto image_seed = seed ^ static_cast<std::uint32_t>(image.id);
+  const alignment::DepthImage twin = twin_view(models, real, image.k, alignment::KinectNoiseConfig{}, image_seed);
+  const alignment::DepthImage fitted = twin_view(models, real, image.k, alignment::KinectNoiseConfig::fitted(), image_seed);
   ++out.images;
   for (const auto* inst : all) {
     if (inst->visible_px >= 0 && inst->visible_px < min_visible) continue;
@@ -210,8 +257,10 @@ void measure_image(TwinSensor& sensor, const alignment::BopScene& scene, const a
     find_rings(s);
     add_inside(s, real.depth_m, out.real);
     add_inside(s, twin.depth_m, out.twin);
+    add_inside(s, fitted.depth_m, out.fitted);
     add_outside(s, real.depth_m, out.real);
     add_outside(s, twin.depth_m, out.twin);
+    add_outside(s, fitted.depth_m, out.fitted);
     ++out.instances;
   }
 }
@@ -229,8 +278,10 @@ std::string number(double v, const char* format) {
   return text;
 }
 
-void print_row(const std::string& what, const std::string& real, const std::string& twin) {
-  std::cout << "| " << what << " | " << real << " | " << twin << " |\n";
+using Cell = std::function<std::string(const Stats&)>;
+
+void print_row(const std::string& what, const Sensors& s, const Cell& cell) {
+  std::cout << "| " << what << " | " << cell(s.real) << " | " << cell(s.twin) << " | " << cell(s.fitted) << " |\n";
 }
 
 std::string residuals(const Stats& s) {
@@ -240,32 +291,70 @@ std::string residuals(const Stats& s) {
          number(engine::percentile(s.residual_mm, 0.5), "%+.2f");
 }
 
+double typical_noise(const Stats& t) {
+  std::vector<double> size;
+  for (const double r : t.noise_mm) size.push_back(std::abs(r));
+  return engine::percentile(size, 0.5);
+}
+
+std::string noise(const Stats& t) {
+  std::vector<double> a, o;
+  for (const double r : t.noise_mm) a.push_back(std::abs(r));
+  for (const double r : t.offset_mm) o.push_back(std::abs(r));
+  return number(engine::percentile(o, 0.5), "%.2f") + " / " + number(engine::percentile(a, 0.5), "%.2f") + " / " +
+         number(engine::percentile(a, 0.9), "%.2f");
+}
+
+// Robustly, from medians (the edges' outliers would rule a mean): for a normal field with correlation rho,
+// |a - b| has median sqrt(2 (1 - rho)) times that of |a|.
+std::string alike(const Stats& t) {
+  const double typical = typical_noise(t);
+  std::string text;
+  for (std::size_t l = 0; l < kLags.size(); ++l) {
+    const double ratio = engine::percentile(t.lag_difference[l], 0.5) / typical;
+    text += (l ? " / " : "") + number(typical > 0.0 ? 1.0 - 0.5 * ratio * ratio : NAN, "%.2f");
+  }
+  return text;
+}
+
+std::string steps(const Stats& t) {
+  return number(engine::percentile(t.step_per_z2, 0.1) * 1000.0, "%.2f") + " / " +
+         number(engine::percentile(t.step_per_z2, 0.5) * 1000.0, "%.2f");
+}
+
+// The fitted model's noise inside a surface is nearly all smooth: its size scales with the smooth coefficient.
+void print_needed_noise(const Sensors& s) {
+  const double real = typical_noise(s.real), fitted = typical_noise(s.fitted);
+  if (!(real > 0.0) || !(fitted > 0.0)) return;
+  const double coeff = alignment::KinectNoiseConfig::fitted().smooth_sigma_z_coeff;
+  std::printf(
+      "\nThe real frames' noise (less each instance's plane) is %.2f times the fitted model's: its smooth noise\n"
+      "would match with sigma = %.2e z^2 (it has %.2e z^2; the real figure holds the ground truth's own error too).\n",
+      real / fitted, coeff * real / fitted, coeff);
+}
+
 void print_sensors(const Sensors& s) {
   std::cout << "\nThe real sensor and the twin's at the ground truth: " << s.instances << " instances in " << s.images
-            << " images\n| | real | twin |\n|---|---|---|\n";
-  print_row("inside the silhouette: depth - truth, median of its size / p90 of its size / median, mm", residuals(s.real),
-            residuals(s.twin));
-  print_row("missing inside (2 px from the edge and more)", share(s.real.interior_missing, s.real.interior),
-            share(s.twin.interior_missing, s.twin.interior));
-  print_row("missing at the silhouette's edge (its outer 2 px)", share(s.real.edge_missing, s.real.edge),
-            share(s.twin.edge_missing, s.twin.edge));
-  for (int d = 1; d <= kRings; ++d) {
-    const auto ring = [&](const Stats& t) {
-      const auto i = static_cast<std::size_t>(d);
-      return share(t.ring_missing[i], t.ring[i]) + " / " + share(t.ring_object[i], t.ring[i]) + " / " +
-             share(t.ring_between[i], t.ring[i]);
-    };
-    print_row(std::to_string(d) + " px outside: missing / object's depth / between object and background", ring(s.real),
-              ring(s.twin));
-  }
-  print_row("missing 1-3 px outside, left of the object / right",
-            share(s.real.left_missing, s.real.left) + " / " + share(s.real.right_missing, s.real.right),
-            share(s.twin.left_missing, s.twin.left) + " / " + share(s.twin.right_missing, s.twin.right));
-  const auto steps = [](const Stats& t) {
-    return number(engine::percentile(t.step_per_z2, 0.1) * 1000.0, "%.2f") + " / " +
-           number(engine::percentile(t.step_per_z2, 0.5) * 1000.0, "%.2f");
-  };
-  print_row("depth step between neighbours / z^2, p10 / median, mm per m^2", steps(s.real), steps(s.twin));
+            << " images\n| | real | twin (published Kinect v1 model, the twin's) | twin (fitted to real frames) |\n"
+            << "|---|---|---|---|\n";
+  print_row("inside the silhouette: depth - truth, median of its size / p90 of its size / median, mm", s, residuals);
+  print_row("per instance: size of its median residual (median) / the rest less its plane, median / p90 of its size, mm", s,
+            noise);
+  print_row("that noise's correlation with the pixel 1 / 3 / 8 px to the right", s, alike);
+  print_row("missing inside (2 px from the edge and more)", s,
+            [](const Stats& t) { return share(t.interior_missing, t.interior); });
+  print_row("missing at the silhouette's edge (its outer 2 px)", s, [](const Stats& t) { return share(t.edge_missing, t.edge); });
+  for (int d = 1; d <= kRings; ++d)
+    print_row(std::to_string(d) + " px outside: missing / object's depth / between object and background", s,
+              [d](const Stats& t) {
+                const auto i = static_cast<std::size_t>(d);
+                return share(t.ring_missing[i], t.ring[i]) + " / " + share(t.ring_object[i], t.ring[i]) + " / " +
+                       share(t.ring_between[i], t.ring[i]);
+              });
+  print_row("missing 1-3 px outside, left of the object / right", s,
+            [](const Stats& t) { return share(t.left_missing, t.left) + " / " + share(t.right_missing, t.right); });
+  print_row("depth step between neighbours / z^2, p10 / median, mm per m^2", s, steps);
+  print_needed_noise(s);
 }
 
 int run_bench_sensor(const cli::Args& args) {
@@ -300,13 +389,18 @@ const Command kBenchSensor{
     "projbot bench sensor DIR [--scenes A,B] [--max-images N] [--min-visible PX] [--model-scale S] [--seed K]\n\n"
     "DIR is a BOP dataset (as for bench dataset). Each image's models are rendered at their ground truth through\n"
     "its camera; the twin's depth is that render with the real frame's background behind it (the twin has no\n"
-    "table) under the twin's Kinect v1 model (noise, disparity steps, edge and grazing-angle dropouts). For every\n"
+    "table) under the twin's Kinect v1 model (noise, disparity steps, edge and grazing-angle dropouts), and under\n"
+    "the model fitted to real frames (smooth noise, finer steps, the shadow band, bleeding, holes). For every\n"
     "instance with at least PX visible pixels (default 1500), real and twin side by side: inside the visible\n"
     "silhouette the depth minus the rendered truth and the missing pixels (inside, and on its outer 2 px); in the\n"
     "rings 1-4 px outside it, the pixels missing, those at the object's depth (it bleeds outward) and those\n"
     "between the object and the background (mixed pixels); on which side the missing pixels lie (the IR\n"
     "projector's shadow); and the depth steps between neighbours over z^2 (the disparity quantisation: the\n"
-    "twin's is 1000 x 0.125 / (580 x 0.075) = 2.87 mm per m^2). Ctrl-C prints the images measured.\n",
+    "twin's is 1000 x 0.125 / (580 x 0.075) = 2.87 mm per m^2, the fitted one's 1.82). Inside, each instance's residuals less "
+    "the\n"
+    "plane through them (the ground truth's offset and tilt) are the sensor's noise: its size, and how alike\n"
+    "it is 1, 3 and 8 px apart (1 - d^2 / 2, d the median difference over the median size: a correlation\n"
+    "not ruled by outliers). Ctrl-C prints the images measured.\n",
     {{"scenes", "A,B", "scenes to measure (default: all)"},
      {"max-images", "N", "stop after N images"},
      {"min-visible", "PX", "instances with fewer visible pixels are left out (default 1500)"},

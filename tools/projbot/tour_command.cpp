@@ -35,7 +35,8 @@ const Command kTour{
     "tour",
     "drive the stops in the digital twin and measure the projection error (the paper's Table 1)",
     "projbot tour [--scene S.yaml] [--visits N] [--seed K] [--mode odometry|localized|tracking] [--report R.json]\n"
-    "             [--frames DIR] [--dwell S] [--no-noise] [--no-predict]\n\n"
+    "             [--frames DIR] [--dwell S] [--no-noise] [--no-predict]\n"
+    "             [--depth-model kinect|fitted]\n\n"
     "Runs the tour of the scene's `tour.visits` in the digital twin (simulated youBot with wheel drift, laser,\n"
     "MRPT localisation, pan-tilt, Kinect v1 depth camera, projector). At each stop the robot aims at the\n"
     "middle of the target as surveyed, captures depth, takes the initial guess from its pose (Eq. 1), refines it by\n"
@@ -69,6 +70,9 @@ const Command kTour{
       cli::PathRole::output_folder},
      {"dwell", "S", "simulated seconds of projection per visit in tracking mode or while a target moves (default 3)"},
      {"no-noise", "", "depth without the Kinect v1 noise model"},
+     {"depth-model", "M",
+      "the twin's depth camera: kinect (the published Kinect v1 model, default) or fitted (fitted to\n"
+      "real PrimeSense frames by bench sensor: smooth noise 2.7x larger, the IR shadow's band)"},
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"},
      {"calibration", "FILE",
       "project with a calibration's A_p and R_cp, T_cp (projbot calibrate solve) while the twin's projector keeps the "
@@ -91,6 +95,10 @@ const Command kTour{
       if (!(o.dwell_s >= 0.0 && o.dwell_s <= 600.0)) throw cli::UsageError("--dwell must be 0..600 seconds");
       o.frames_dir = args.get_or("frames", "");
       o.depth_noise = !args.flag("no-noise");
+      const std::string depth_model = args.get_or("depth-model", "kinect");
+      o.fitted_depth = depth_model == "fitted";
+      if (depth_model != "fitted" && depth_model != "kinect")
+        throw cli::UsageError("--depth-model must be kinect or fitted, not '" + depth_model + "'");
       o.predict = !args.flag("no-predict");
       const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
       args.check_clashes({{"the default scene", scene_path, false}});

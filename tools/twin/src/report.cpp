@@ -246,6 +246,7 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
   const nlohmann::json out = {
       {"mode", to_string(report.mode)},
       {"predict", report.predict},
+      {"depth_model", report.depth_model},
       {"seed", report.seed},
       {"projector",
        {{"width", k.width_px}, {"height", k.height_px}, {"fx", k.fx_px}, {"fy", k.fy_px}, {"cx", k.cx_px}, {"cy", k.cy_px}}},

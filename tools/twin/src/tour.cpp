@@ -753,6 +753,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   twin_options.pose_source = options.mode == TourMode::odometry ? robot::PoseSource::odometry : robot::PoseSource::localized;
   twin_options.seed = options.seed;
   twin_options.depth_noise = options.depth_noise;
+  if (options.fitted_depth) twin_options.depth_model = alignment::KinectNoiseConfig::fitted();
   twin_options.stop_requested = options.stop_requested;
   Twin twin(scene, twin_options, renderer);
   Tour tour(scene, options, renderer, twin);
@@ -765,6 +766,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   report.mode = options.mode;
   report.seed = options.seed;
   report.predict = options.predict;
+  report.depth_model = !options.depth_noise ? "none" : options.fitted_depth ? "fitted" : "kinect";
   report.projector = scene.projector;
   const int visits = options.visits > 0 ? options.visits : static_cast<int>(scene.visits.size());
   const auto stop_requested = [&] { return options.stop_requested && options.stop_requested(); };

@@ -272,7 +272,7 @@ alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::
   const engine::DepthMap map = depth_target_->read_back_depth();
   alignment::DepthImage clean{map.width, map.height, map.z_m, 0.0};
   if (!options_.depth_noise) return clean;
-  return alignment::apply_kinect_v1_noise(clean, camera_, alignment::KinectNoiseConfig{}, noise_seed);
+  return alignment::apply_kinect_v1_noise(clean, camera_, options_.depth_model, noise_seed);
 }
 
 std::vector<PlacedMesh> Twin::true_scene(const Eigen::Matrix4d& T_frame_world) const {

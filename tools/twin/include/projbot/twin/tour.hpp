@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/config/scene.hpp"
@@ -43,6 +44,7 @@ struct TourOptions {
   /// time this machine took to render the frame (the twin's sensor) and track it, as `projbot run` sees.
   std::optional<double> processing_ms;
   bool depth_noise = true;
+  bool fitted_depth = false;  ///< the depth camera: KinectNoiseConfig::fitted() instead of the published model
   /// Asked between visits and between tracking frames: true ends the tour there, keeping the visits
   /// finished so far (the unfinished one is dropped) and marking the report interrupted.
   std::function<bool()> stop_requested;
@@ -134,7 +136,8 @@ struct VisitReport {
 struct TourReport {
   TourMode mode = TourMode::localized;
   std::uint64_t seed = 1;
-  bool predict = true;  ///< TourOptions::predict
+  bool predict = true;                 ///< TourOptions::predict
+  std::string depth_model = "kinect";  ///< the twin's depth camera: "kinect" (published), "fitted" or "none"
   config::ProjectorConfig projector;
   std::vector<VisitReport> visits;  ///< the finished visits
   double wall_s = 0.0;

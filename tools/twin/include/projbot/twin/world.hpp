@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/scene.hpp"
@@ -33,8 +34,9 @@ class TwinError : public std::runtime_error {
 struct TwinOptions {
   robot::PoseSource pose_source = robot::PoseSource::localized;
   std::uint64_t seed = 1;
-  bool depth_noise = true;            ///< Kinect v1 noise on captured depth
-  double marker_tolerance_m = 0.005;  ///< markers farther than this from the model's surface are an error
+  bool depth_noise = true;                   ///< Kinect v1 noise on captured depth...
+  alignment::KinectNoiseConfig depth_model;  ///< ...this model of it (KinectNoiseConfig::fitted(): the real frames')
+  double marker_tolerance_m = 0.005;         ///< markers farther than this from the model's surface are an error
   /// Asked while the robot's map is surveyed: true ends the construction (robot::SetupInterrupted).
   std::function<bool()> stop_requested;
 };
