@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "projbot/alignment/equations.hpp"
 
@@ -43,12 +44,16 @@ Eigen::Matrix4d predict_pose(const MotionState& state, double t_s) {
   return T;
 }
 
-MotionFilter::MotionFilter(MotionModelConfig config) : cfg_(config) {}
+MotionFilter::MotionFilter(MotionModelConfig config)
+    : cfg_(config), position_noise_(cfg_.position_noise_m), rotation_noise_(cfg_.rotation_noise_rad) {}
 
 void MotionFilter::reset() {
   count_ = 0;
   measured_ = filtered_ = Eigen::Matrix4d::Identity();
   window_.clear();
+  history_.clear();
+  position_noise_ = cfg_.position_noise_m;
+  rotation_noise_ = cfg_.rotation_noise_rad;
   translation_ = {};
   rotation_ = {};
 }
@@ -56,8 +61,8 @@ void MotionFilter::reset() {
 void MotionFilter::restart_velocity(const Eigen::Matrix4d& T, double dt) {
   translation_.rate = (T.topRightCorner<3, 1>() - measured_.topRightCorner<3, 1>()) / dt;
   rotation_.rate = log_so3(T.topLeftCorner<3, 3>() * measured_.topLeftCorner<3, 3>().transpose()) / dt;
-  translation_.P = two_point_covariance(cfg_.position_noise_m, dt);
-  rotation_.P = two_point_covariance(cfg_.rotation_noise_rad, dt);
+  translation_.P = two_point_covariance(position_noise_, dt);
+  rotation_.P = two_point_covariance(rotation_noise_, dt);
   filtered_ = T;
 }
 
@@ -90,8 +95,8 @@ void MotionFilter::update(const Eigen::Matrix4d& T, double t_s) {
     // Innovations: the measured pose against the predicted one (rotation as a rotation vector).
     const Eigen::Vector3d y_t = T.topRightCorner<3, 1>() - filtered_.topRightCorner<3, 1>();
     const Eigen::Vector3d y_r = log_so3(T.topLeftCorner<3, 3>() * filtered_.topLeftCorner<3, 3>().transpose());
-    const double s_t = translation_.P(0, 0) + cfg_.position_noise_m * cfg_.position_noise_m;
-    const double s_r = rotation_.P(0, 0) + cfg_.rotation_noise_rad * cfg_.rotation_noise_rad;
+    const double s_t = translation_.P(0, 0) + position_noise_ * position_noise_;
+    const double s_r = rotation_.P(0, 0) + rotation_noise_ * rotation_noise_;
     if (y_t.squaredNorm() / s_t > cfg_.maneuver_gate || y_r.squaredNorm() / s_r > cfg_.maneuver_gate) {
       ++maneuvers_;
       restart_velocity(T, dt);  // a start or a stop: what the last frame interval says, nothing older
@@ -110,6 +115,34 @@ void MotionFilter::update(const Eigen::Matrix4d& T, double t_s) {
   ++count_;
   window_.push_back({t_s, T});
   while (window_.size() > 2 && t_s - window_[1].t_s >= cfg_.stillness_window_s) window_.pop_front();
+  history_.push_back({t_s, T});
+  while (history_.size() > static_cast<std::size_t>(std::max(cfg_.noise_window, 0))) history_.pop_front();
+  measure_noise();
+}
+
+void MotionFilter::measure_noise() {
+  // Second differences, a - b - r (b - c) with r the ratio of the frame intervals: zero for a steady
+  // motion, 1 + (1 + r)^2 + r^2 times the per-frame variance for noise (6 at even intervals). The norm of
+  // a 3-D normal vector with sigma s per axis has median 1.538 s.
+  if (history_.size() < 5) return;
+  std::vector<double> moves, turns;
+  for (std::size_t i = 2; i < history_.size(); ++i) {
+    const Stamped &a = history_[i], &b = history_[i - 1], &c = history_[i - 2];
+    const double r = (a.t_s - b.t_s) / (b.t_s - c.t_s);
+    const double spread = std::sqrt(1.0 + (1.0 + r) * (1.0 + r) + r * r);
+    const Eigen::Vector3d move =
+        a.T.topRightCorner<3, 1>() - b.T.topRightCorner<3, 1>() - r * (b.T.topRightCorner<3, 1>() - c.T.topRightCorner<3, 1>());
+    const Eigen::Vector3d turn = log_so3(a.T.topLeftCorner<3, 3>() * b.T.topLeftCorner<3, 3>().transpose()) -
+                                 r * log_so3(b.T.topLeftCorner<3, 3>() * c.T.topLeftCorner<3, 3>().transpose());
+    moves.push_back(move.norm() / spread);
+    turns.push_back(turn.norm() / spread);
+  }
+  const auto median = [](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  position_noise_ = std::max(cfg_.position_noise_m, median(moves) / 1.538);
+  rotation_noise_ = std::max(cfg_.rotation_noise_rad, median(turns) / 1.538);
 }
 
 MotionState MotionFilter::state() const {
@@ -125,9 +158,20 @@ MotionState MotionFilter::state() const {
   const double span_s = t_ - window_.front().t_s;
   const double moved_m = (measured_.topRightCorner<3, 1>() - oldest.topRightCorner<3, 1>()).norm();
   const double turned_rad = log_so3(measured_.topLeftCorner<3, 3>() * oldest.topLeftCorner<3, 3>().transpose()).norm();
-  const bool translating = moved_m > std::max(cfg_.still_sigmas * M_SQRT2 * cfg_.position_noise_m, cfg_.min_speed_m_s * span_s);
+  const bool translating = moved_m > std::max(cfg_.still_sigmas * M_SQRT2 * position_noise_, cfg_.min_speed_m_s * span_s);
   const bool turning =
-      turned_rad > std::max(cfg_.still_sigmas * M_SQRT2 * cfg_.rotation_noise_rad, cfg_.min_rate_deg_s * M_PI / 180.0 * span_s);
+      turned_rad > std::max(cfg_.still_sigmas * M_SQRT2 * rotation_noise_, cfg_.min_rate_deg_s * M_PI / 180.0 * span_s);
+  // A still part whose measured noise is well above the configured one: the mean of the window's poses.
+  if (!translating && position_noise_ > cfg_.average_above * cfg_.position_noise_m) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto& w : window_) sum += w.T.topRightCorner<3, 1>();
+    s.T.topRightCorner<3, 1>() = sum / static_cast<double>(window_.size());
+  }
+  if (!turning && rotation_noise_ > cfg_.average_above * cfg_.rotation_noise_rad) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto& w : window_) sum += log_so3(w.T.topLeftCorner<3, 3>() * measured_.topLeftCorner<3, 3>().transpose());
+    s.T.topLeftCorner<3, 3>() = exp_so3(sum / static_cast<double>(window_.size())) * measured_.topLeftCorner<3, 3>();
+  }
   if (translating) {
     s.T.topRightCorner<3, 1>() = filtered_.topRightCorner<3, 1>();
     s.velocity_m_s = clamp_norm(translation_.rate, cfg_.max_speed_m_s);

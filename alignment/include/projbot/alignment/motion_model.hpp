@@ -16,8 +16,19 @@ struct MotionModelConfig {
   /// filter lets a target change speed; tuned in the twin on scripted motions (`projbot bench motion`).
   double accel_noise = 1.0;          ///< m s^-1.5
   double angular_accel_noise = 3.0;  ///< rad s^-1.5
-  double position_noise_m = 0.0007;  ///< the tracker's pose noise per frame (1 sigma, each axis)
+  double position_noise_m = 0.0007;  ///< the tracker's pose noise per frame (1 sigma, each axis), at least
   double rotation_noise_rad = 0.002;
+  /// The noise is also measured, from the second differences of the last noise_window poses (a steady
+  /// motion cancels out of them), and the larger of the two used: a depth camera whose error is smooth
+  /// rather than per pixel (KinectNoiseConfig::fitted(), as the real PrimeSense's) moves the tracked pose
+  /// by millimetres from frame to frame, which at 0.7 mm read as motion and was extrapolated (the
+  /// display tour's duck at rest was drawn 12 mm off on average, 4 mm without prediction). 0: not measured.
+  int noise_window = 16;
+  /// Once the measured noise is this many times the configured, a still part is drawn at the mean of
+  /// the stillness window's poses instead of the newest (one frame's smooth error is not the next one's:
+  /// the display tour's duck 1.8-2.2 mm instead of 4.4-5.0 under the fitted depth model). Below it the
+  /// newest as measured, bit for bit (a tracker at its configured noise gains nothing from the lag).
+  double average_above = 2.0;
   /// A pose this far outside the prediction (normalised innovation squared, 3 degrees of freedom;
   /// 16.3 is the 99.9 % point) means the target started or stopped: the velocity restarts from the
   /// newest two poses instead of coasting on, so a sudden stop overshoots for two frames at most.
@@ -81,6 +92,9 @@ class MotionFilter {
   /// Velocity restarts since the last reset (starts and stops detected), for tests and statistics.
   int maneuvers() const { return maneuvers_; }
   const MotionModelConfig& config() const { return cfg_; }
+  /// The tracker's pose noise per frame in use (1 sigma, each axis): configured, or measured if larger.
+  double position_noise_m() const { return position_noise_; }
+  double rotation_noise_rad() const { return rotation_noise_; }
 
  private:
   // One group of three axes (translation, or rotation as a rotation vector) sharing a 2x2 covariance
@@ -105,7 +119,10 @@ class MotionFilter {
   Group translation_, rotation_;
   int maneuvers_ = 0;
   int jumps_ = 0;
-  std::deque<Stamped> window_;  // the measured poses of the last stillness_window_s, oldest first
+  std::deque<Stamped> window_;                          // the measured poses of the last stillness_window_s, oldest first
+  std::deque<Stamped> history_;                         // the last noise_window measured poses, oldest first
+  double position_noise_ = 0.0, rotation_noise_ = 0.0;  // in use: the configured or the measured, larger
+  void measure_noise();
 };
 
 }  // namespace projbot::alignment
