@@ -440,6 +440,8 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame, const 
   if (acquiring && a && a->converged && verified(frame, T = a->T_scan_model)) {  // colour and the look-alike turn done
     hold_.reset();
     if (colour && std::isfinite(a->colour_agreement)) hold_ = T;
+    stats_.colour_shift_mm = a->colour_shift_mm;  // as coloured() reports it on the other paths
+    stats_.colour_agreement = a->colour_agreement;
     return found(frame, T, a->inlier_ratio, a->rmse_mm);
   }
   if (!acquiring && a && a->converged && verified(frame, T = a->T_scan_model) && coloured(frame, colour, T)) {
