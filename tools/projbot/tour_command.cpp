@@ -70,9 +70,7 @@ const Command kTour{
       cli::PathRole::output_folder},
      {"dwell", "S", "simulated seconds of projection per visit in tracking mode or while a target moves (default 3)"},
      {"no-noise", "", "depth without the Kinect v1 noise model"},
-     {"depth-model", "M",
-      "the twin's depth camera: kinect (the published Kinect v1 model, default) or fitted (fitted to\n"
-      "real PrimeSense frames by bench sensor: smooth noise 2.7x larger, the IR shadow's band)"},
+     {"depth-model", "M", "the twin's depth camera: kinect (the published model, default) or fitted (to real frames)"},
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"},
      {"calibration", "FILE",
       "project with a calibration's A_p and R_cp, T_cp (projbot calibrate solve) while the twin's projector keeps the "
