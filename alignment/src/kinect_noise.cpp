@@ -160,9 +160,11 @@ DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics
         z_out = 0.0F;
         continue;
       }
-      const EdgeSide e = edges ? edge_side(zin, x, y, w, h, cfg) : EdgeSide{};
-      const bool bled = e.bleed_z > 0.0F && chance(rng, cfg.bleed);
-      if (!bled && ((e.near && chance(rng, cfg.edge_drop)) || (e.lost > 0.0F && chance(rng, e.lost)))) {
+      // Always looked at: with edges kept (edge_jump_m off) a missing neighbour still leaves the slope
+      // unknown for the grazing test.
+      const EdgeSide e = edge_side(zin, x, y, w, h, cfg);
+      const bool bled = edges && e.bleed_z > 0.0F && chance(rng, cfg.bleed);
+      if (edges && !bled && ((e.near && chance(rng, cfg.edge_drop)) || (e.lost > 0.0F && chance(rng, e.lost)))) {
         z_out = 0.0F;
         continue;
       }

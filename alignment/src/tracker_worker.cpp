@@ -26,12 +26,15 @@ TrackerConfig polish(const WorkerConfig& c, bool colour_contrast) {
   return t;
 }
 
-// How far the model's centroid moves between poses A and B (a symmetric shape's equivalent poses
-// share it).
-double centre_move_m(const ModelCloud& model, const Eigen::Matrix4d& A, const Eigen::Matrix4d& B) {
+Eigen::Vector3d centroid_of(const ModelCloud& model) {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   for (const auto& p : model.points) c += p.cast<double>();
-  c /= static_cast<double>(std::max<std::size_t>(model.points.size(), 1));
+  return c / static_cast<double>(std::max<std::size_t>(model.points.size(), 1));
+}
+
+// How far the model's centroid c moves between poses A and B (a symmetric shape's equivalent poses
+// share it).
+double centre_move_m(const Eigen::Vector3d& c, const Eigen::Matrix4d& A, const Eigen::Matrix4d& B) {
   return ((A - B).topLeftCorner<3, 3>() * c + (A - B).topRightCorner<3, 1>()).norm();
 }
 
@@ -60,6 +63,7 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
       filter_(cfg_.motion),
       silhouette_grow_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)),
       model_radius_m_(guess_reach_m(model_, 0.0, 60.0)),  // a 60 degree turn moves the farthest point by the radius
+      model_centre_(centroid_of(model_)),
       turns_(colour_contrast_ ? box_turns(model_) : std::vector<Eigen::Matrix4d>{}) {}
 
 Eigen::Matrix4d TargetFollower::nearest_guess(const DepthImage& frame, const Eigen::Matrix4d& T,
@@ -256,7 +260,7 @@ AlignmentResult TargetFollower::acquire_known(const DepthImage& frame, const Eig
       // nothing seen through it). The centre, not every point: a symmetric shape (a can turned about its
       // axis) is right in any of its equivalent poses.
       if (r.converged && cfg_.guess_bounds_estimate &&
-          centre_move_m(model_, guess, r.T_scan_model) > grow_m + cfg_.reach_margin_m)
+          centre_move_m(model_centre_, guess, r.T_scan_model) > grow_m + cfg_.reach_margin_m)
         r.converged = false;
       return r;
     }

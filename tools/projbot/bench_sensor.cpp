@@ -211,13 +211,11 @@ class TwinSensor {
 
 namespace {
 
-// The twin's view of the image: the models rendered at their ground truth, and behind them the real
-// frame's background (the table, the wall: the twin has no geometry for them), taken 4 px and more from
-// any model at the farthest depth of its 9 x 9 neighbourhood, so that none of the real frame's edge
-// pixels come with it; then the twin's Kinect model over the whole.
-alignment::DepthImage twin_view(const std::vector<float>& models, const alignment::DepthImage& real,
-                                const alignment::CameraIntrinsics& k, const alignment::KinectNoiseConfig& model,
-                                std::uint32_t seed) {
+// The twin's scene of the image, before its Kinect model: the models rendered at their ground truth, and
+// behind them the real frame's background (the table, the wall: the twin has no geometry for them), taken
+// 4 px and more from any model at the farthest depth of its 9 x 9 neighbourhood, so that none of the real
+// frame's edge pixels come with it.
+alignment::DepthImage twin_scene(const std::vector<float>& models, const alignment::DepthImage& real) {
   const int w = real.width, h = real.height;
   alignment::DepthImage clean{w, h, models, 0.0};
   for (int y = 0; y < h; ++y)
@@ -233,7 +231,7 @@ alignment::DepthImage twin_view(const std::vector<float>& models, const alignmen
         }
       clean.depth_m[i] = near_model ? far : real.depth_m[i];
     }
-  return alignment::apply_kinect_v1_noise(clean, k, model, seed);
+  return clean;
 }
 
 struct Sensors {
@@ -248,8 +246,10 @@ void measure_image(TwinSensor& sensor, const alignment::BopScene& scene, const a
   const alignment::DepthImage real = alignment::read_bop_depth(image);
   const std::vector<float> models = sensor.render(image, all);
   const auto image_seed = seed ^ static_cast<std::uint32_t>(image.id);
-  const alignment::DepthImage twin = twin_view(models, real, image.k, alignment::KinectNoiseConfig{}, image_seed);
-  const alignment::DepthImage fitted = twin_view(models, real, image.k, alignment::KinectNoiseConfig::fitted(), image_seed);
+  const alignment::DepthImage scene_depth = twin_scene(models, real);  // one scene, under each Kinect model
+  const alignment::DepthImage twin = alignment::apply_kinect_v1_noise(scene_depth, image.k, {}, image_seed);
+  const alignment::DepthImage fitted =
+      alignment::apply_kinect_v1_noise(scene_depth, image.k, alignment::KinectNoiseConfig::fitted(), image_seed);
   ++out.images;
   for (const auto* inst : all) {
     if (inst->visible_px >= 0 && inst->visible_px < min_visible) continue;

@@ -276,11 +276,12 @@ class TargetFollower {
   SearchStats stats_;
   std::optional<AlignmentResult> last_attempt_;
   FreeSpaceCheck check_;
-  Known known_;                // this stop's floor and footing
-  MotionFilter filter_;        // fed with every pose found, reset when the target is lost or a stop begins
-  double silhouette_grow_m_;   // how far the guess's configured uncertainty reaches
-  double model_radius_m_;      // the model's farthest point from its origin
-  double last_found_s_ = 0.0;  // capture time of the newest pose found
+  Known known_;                   // this stop's floor and footing
+  MotionFilter filter_;           // fed with every pose found, reset when the target is lost or a stop begins
+  double silhouette_grow_m_;      // how far the guess's configured uncertainty reaches
+  double model_radius_m_;         // the model's farthest point from its origin
+  Eigen::Vector3d model_centre_;  // its centroid (guess_bounds_estimate bounds how far it moves)
+  double last_found_s_ = 0.0;     // capture time of the newest pose found
   // Where a textured model may look like itself turned (box_turns; none without colour contrast): a
   // found pose is turned to the look-alike nearest the stop's guess (nearest_look_alike).
   std::vector<Eigen::Matrix4d> turns_;

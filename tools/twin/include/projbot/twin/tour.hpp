@@ -14,7 +14,6 @@
 #include <string>
 #include <vector>
 
-#include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/config/scene.hpp"
