@@ -119,7 +119,10 @@ TEST_F(RealFrames, AcquisitionMeetsTheGoalOnRealFramesOfTheSharedDataset) {
 // The block, half hidden, scored 0.62-0.68 of its points explained at its own ground truth (the banana
 // and the box in front counted against it) and was refused at every pose; ICP was pulled 10-15 mm onto
 // them. With occluders neutral in the gate and correspondences far past the median rejected, the block
-// of the first image is lit within 10 mm, 8 of the first two images' 12 instances are, none is lit wrong.
+// of the first image is lit within 10 mm. The banana, within 2 mm, was refused (0.65 of its points
+// explained: the block's top beside it, at its depth, counted against it) until a close guess's gate
+// left out what lies beside the outline more than two tolerances from the model: now it is lit in both
+// images, 11 of the 12 instances are (the pudding box on the block, refused once), none is lit wrong.
 TEST_F(RealFrames, AcquisitionHoldsAmongTouchingNeighbours) {
   const fs::path report = dir_ / "clutter.json";
   const CliRun r =
@@ -127,6 +130,7 @@ TEST_F(RealFrames, AcquisitionHoldsAmongTouchingNeighbours) {
   ASSERT_EQ(r.code, 0) << r.output;
   int n = 0, within = 0, false_accepts = 0;
   bool block_lit = false;
+  int banana_lit = 0;
   const auto j = read_json(report);
   for (const auto& row : j.at("instances")) {
     if (row.at("method").get<std::string>() != "projbot") continue;
@@ -136,33 +140,38 @@ TEST_F(RealFrames, AcquisitionHoldsAmongTouchingNeighbours) {
     within += lit && e <= 10.0 ? 1 : 0;
     false_accepts += lit && e > 20.0 ? 1 : 0;
     if (row.at("image").get<int>() == 1 && row.at("obj_id").get<int>() == 16) block_lit = lit && e <= 10.0;
+    if (row.at("obj_id").get<int>() == 10) banana_lit += lit && e <= 10.0 ? 1 : 0;
   }
   ASSERT_EQ(n, 12) << r.output;
   EXPECT_TRUE(block_lit) << r.output;
-  EXPECT_GE(within, 8) << r.output;
+  EXPECT_EQ(banana_lit, 2) << r.output;
+  EXPECT_GE(within, 10) << r.output;
   EXPECT_EQ(false_accepts, 0) << r.output;
 }
 
 // --track on the scene whose potted meat can was once followed 60-70 mm off on its neighbour (its first
 // search was not the acquisition, and it was not told its guess's uncertainty): every object found on
-// the first image stays within 10 mm, nothing lit wrong.
+// the first image stays within 10 mm, nothing lit wrong; the banana leaning on the block, refused on the
+// first image until the gate of a close guess left its neighbour out, found there and followed.
 TEST_F(RealFrames, TrackingFollowsWhatTheFirstImageFinds) {
   const fs::path report = dir_ / "t.json";
   const CliRun r = run_projbot("bench dataset " + kYcbv.string() + " --scenes 000002 --track --report " + report.string(), 600);
   ASSERT_EQ(r.code, 0) << r.output;
-  int potted_meat = 0, potted_meat_within = 0, false_accepts = 0;
+  int potted_meat = 0, potted_meat_within = 0, banana_within = 0, false_accepts = 0;
   const auto j = read_json(report);
   for (const auto& row : j.at("instances")) {
     EXPECT_EQ(row.at("mode").get<std::string>(), "track");
     const double e = row.at("error_mm").get<double>();
     const bool lit = row.at("accepted").get<bool>();
     false_accepts += lit && e > 20.0 ? 1 : 0;
+    if (row.at("obj_id").get<int>() == 10) banana_within += lit && e <= 10.0 ? 1 : 0;
     if (row.at("obj_id").get<int>() != 9) continue;
     ++potted_meat;
     potted_meat_within += lit && e <= 10.0 ? 1 : 0;
   }
   EXPECT_EQ(potted_meat, 20) << r.output;
   EXPECT_GE(potted_meat_within, 19) << r.output;
+  EXPECT_GE(banana_within, 19) << r.output;
   EXPECT_EQ(false_accepts, 0) << r.output;
 }
 

@@ -148,8 +148,7 @@ DepthImage TargetFollower::near_guess(const DepthImage& frame, const Eigen::Matr
   double cut_m = known.footing && !known.footing->upright_known ? cfg_.frame_support_margin_m : cfg_.floor_margin_m;
   if (known.footing && known.footing->height_m > cut_m) cut_m = std::max(cut_m, known.footing->height_m + cfg_.support_margin_m);
   DepthImage left = known.floor ? without_plane(frame, k_, *known.floor, cut_m) : frame;
-  if (grow_m)
-    left = crop_to_silhouette(left, k_, model_, from, *grow_m, cfg_.cluster_neighbours && *grow_m < 0.5 * model_radius_m_);
+  if (grow_m) left = crop_to_silhouette(left, k_, model_, from, *grow_m, cfg_.cluster_neighbours && close_guess(*grow_m));
   return left;
 }
 
@@ -162,8 +161,8 @@ AlignmentResult TargetFollower::recropped(const DepthImage& frame, const Alignme
   const PointCloud tight = depth_to_cloud(near_guess(frame, r.T_scan_model, known, cfg_.recrop_m), k_);
   if (tight.finite_count() < aligner_.config().min_points) return r;
   // From a converged estimate only ICP's finest stage: the coarse ones would find it where it is.
-  AlignmentResult again =
-      aligner_.align(tight, r.T_scan_model, r.converged ? SearchStage::finish : stage, known.footing, hold, known.deadline);
+  AlignmentResult again = aligner_.align(tight, r.T_scan_model, r.converged ? SearchStage::finish : stage, known.footing, hold,
+                                         known.deadline, known.close);
   again.iterations += r.iterations;
   again.time_ms += r.time_ms;
   return again.converged || !r.converged ? again : r;
@@ -178,7 +177,7 @@ std::optional<AlignmentResult> TargetFollower::projective_first(const DepthImage
   if (!T.allFinite()) return std::nullopt;
   const PointCloud tight = depth_to_cloud(near_guess(frame, T, known, cfg_.recrop_m), k_);
   if (tight.finite_count() < aligner_.config().min_points) return std::nullopt;
-  AlignmentResult r = aligner_.align(tight, T, SearchStage::finish, known.footing, hold, known.deadline);
+  AlignmentResult r = aligner_.align(tight, T, SearchStage::finish, known.footing, hold, known.deadline, known.close);
   if (!r.converged) return std::nullopt;
   // Without colour, the projective association settled up to a degree turned along a weak direction,
   // which ICP's finest stage keeps: ICP coarse to fine then (a box-only shop, 5 cm / 10 degree guesses:
@@ -198,23 +197,23 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthI
   const bool hold = weak != Weak::depth;
   // Too little near the guess: the aligner's error says so.
   if (!(grow_m > cfg_.recrop_m) || near.finite_count() < aligner_.config().min_points)
-    return aligner_.align(near, guess, stage, known.footing, hold, known.deadline);
+    return aligner_.align(near, guess, stage, known.footing, hold, known.deadline, known.close);
   // The projective tracker's association reaches a 5 cm / 10 degree guess in a few passes of a few ms;
   // ICP's coarse stages took 0.5-1.5 s of the shop figure's acquisition for the same estimate.
   // Only from a guess known to within half the model's size: from a gross one it could settle on a box's
   // other face, which stands as surveyed too.
-  if (grow_m < 0.5 * model_radius_m_ && weak != Weak::coarse_colour)
+  if (close_guess(grow_m) && weak != Weak::coarse_colour)
     if (auto fast = projective_first(frame, near_depth, guess, known, hold)) return *fast;
   // ICP from the guess and the refine on the tighter crop: the restarts and the global search of
   // `stage` only when that fails.
   // (Bounded when `stage` is: a tracking-mode search runs one attempt per frame.)
   const SearchStage first = stage == SearchStage::full ? SearchStage::icp_only : SearchStage::refine;
   AlignmentResult r =
-      recropped(frame, aligner_.align(near, guess, first, known.footing, hold, known.deadline), known, first, hold);
+      recropped(frame, aligner_.align(near, guess, first, known.footing, hold, known.deadline, known.close), known, first, hold);
   if (r.converged || stage == SearchStage::refine || stage == SearchStage::icp_only) return r;
   if (ThreadCpuClock::past(known.deadline)) return r;
   AlignmentResult wider =
-      recropped(frame, aligner_.align(near, guess, stage, known.footing, hold, known.deadline), known, first, hold);
+      recropped(frame, aligner_.align(near, guess, stage, known.footing, hold, known.deadline, known.close), known, first, hold);
   wider.iterations += r.iterations;
   wider.time_ms += r.time_ms;
   return wider;
@@ -237,8 +236,10 @@ AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Ma
                        grow_m, colour);
 }
 
-AlignmentResult TargetFollower::acquire_known(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known,
+AlignmentResult TargetFollower::acquire_known(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& given,
                                               double grow_m, const assets::Image* colour) const {
+  Known known = given;
+  known.close = close_guess(grow_m);
   const DepthImage near = near_guess(frame, guess, known, grow_m);
   const PointCloud near_cloud = depth_to_cloud(near, k_);
   // Colour places what ICP held, where the model has colours to place it by (not the figure's one grey
@@ -299,7 +300,8 @@ bool TargetFollower::polish_kept(const DepthImage& frame, const Known& known, co
   if (verify(frame, after).behind_ratio() > std::max(was, 0.5 * cfg_.max_behind_ratio)) return false;
   if (!known.footing) return true;
   const PointCloud tight = depth_to_cloud(near_guess(frame, after, known, cfg_.recrop_m), k_);
-  return tight.finite_count() >= aligner_.config().min_points && aligner_.score(tight, after, known.footing).converged;
+  return tight.finite_count() >= aligner_.config().min_points &&
+         aligner_.score(tight, after, known.footing, known.close).converged;
 }
 
 void TargetFollower::by_colour(const DepthImage& frame, const Known& known, const assets::Image& colour,
@@ -319,9 +321,9 @@ void TargetFollower::by_colour(const DepthImage& frame, const Known& known, cons
     if (!c.moved()) break;
     if (!tight) {
       tight = depth_to_cloud(near_guess(frame, r.T_scan_model, known, cfg_.recrop_m), k_);
-      before = aligner_.score(*tight, r.T_scan_model);
+      before = aligner_.score(*tight, r.T_scan_model, std::nullopt, known.close);
     }
-    const AlignmentResult after = aligner_.score(*tight, c.T_camera_model);
+    const AlignmentResult after = aligner_.score(*tight, c.T_camera_model, std::nullopt, known.close);
     if (!(after.rmse_mm <= before.rmse_mm * (1.0 + cfg_.colour_max_rmse_growth) &&
           after.inlier_ratio >= before.inlier_ratio - 0.02))
       break;
@@ -348,7 +350,9 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   const DepthImage near = near_guess(frame, from, known_, grow_m);
   const PointCloud scan = depth_to_cloud(near, k_);
   if (scan.finite_count() < aligner_.config().min_points) return std::nullopt;
-  last_attempt_ = grow_m ? align_near(frame, near, scan, from, known_, *grow_m, stage, Weak::depth)
+  Known known = known_;
+  known.close = grow_m && close_guess(*grow_m);
+  last_attempt_ = grow_m ? align_near(frame, near, scan, from, known, *grow_m, stage, Weak::depth)
                          : aligner_.align(scan, from, stage, known_.footing);
   return last_attempt_;
 }

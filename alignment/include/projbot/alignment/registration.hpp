@@ -246,13 +246,16 @@ class Aligner {
   /// With a `deadline` (the caller's whole budget: one acquisition's, on the calling thread's CPU
   /// clock), no ICP stage after the first, restart or RANSAC round starts after it either, whatever the
   /// stage, and a global search keeps to max_global_points.
+  /// With `close_guess` (T_init known to within half the model's size), the gate counts for nothing the
+  /// scan points beside the model's outline more than two inlier tolerances from its seen surface: a
+  /// neighbour the target touches, where a shifted estimate's own surface could not be.
   AlignmentResult align(const PointCloud& scan, const Eigen::Matrix4d& T_init, SearchStage stage = SearchStage::full,
                         const std::optional<Footing>& footing = std::nullopt, bool hold_weak = false,
-                        std::optional<ThreadCpuClock::time_point> deadline = std::nullopt) const;
+                        std::optional<ThreadCpuClock::time_point> deadline = std::nullopt, bool close_guess = false) const;
 
   /// The quality-gate numbers of a given pose, without refining it (converged: the gate passes).
   AlignmentResult score(const PointCloud& scan, const Eigen::Matrix4d& T_scan_model,
-                        const std::optional<Footing>& footing = std::nullopt) const;
+                        const std::optional<Footing>& footing = std::nullopt, bool close_guess = false) const;
 
   const AcquisitionConfig& config() const;
   /// How often the model's FPFH features were computed: once per Aligner, at its first global search.

@@ -220,6 +220,7 @@ class TargetFollower {
     std::optional<Plane> floor;
     std::optional<Footing> footing;
     std::optional<ThreadCpuClock::time_point> deadline;  // acquire()'s: no new search step after it
+    bool close = false;  // the guess is known to within half the model's size (Aligner::align's close_guess)
   };
   /// How an acquisition places the view's weak directions (a box seen face-on, along its face).
   enum class Weak {
@@ -286,6 +287,9 @@ class TargetFollower {
   // found pose is turned to the look-alike nearest the stop's guess (nearest_look_alike).
   std::vector<Eigen::Matrix4d> turns_;
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
+  // A guess known to within half the model's size: touching neighbours can be told from the target
+  // (clustered apart, and not counted against it by the gate), and the projective tracker goes first.
+  bool close_guess(double grow_m) const { return grow_m < 0.5 * model_radius_m_; }
   // T, or the pose nearest `guess` among those that look like T on the faces the camera sees.
   Eigen::Matrix4d nearest_guess(const DepthImage& frame, const Eigen::Matrix4d& T, const Eigen::Matrix4d& guess) const;
   // The frame without the known floor and, with grow_m, cropped to the silhouette at `from` grown by it.
