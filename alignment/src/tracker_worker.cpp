@@ -80,12 +80,14 @@ void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, c
   guess_ = T_camera_target;
   known_ = Known{floor, std::nullopt, std::nullopt};
   find_support_ = !floor;  // no map: the first search looks for what the target rests on in the frame
+  map_floor_ = floor.has_value();
   have_guess_ = true;
   pose_.reset();
   rejected_ = 0;
   lost_reported_ = false;
   wait_ = 0;
   stats_ = {};
+  search_attempts_ = 0;
   second_passes_ = 0;
   last_attempt_.reset();
   filter_.reset();
@@ -408,6 +410,11 @@ std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
   pose_.reset();
   filter_.reset();
   wait_ = 0;
+  search_attempts_ = 0;  // a new search: from the first stage, the first one an acquisition
+  if (!map_floor_) {     // a support found in an earlier frame is where it was then: the camera may have moved
+    known_ = Known{};
+    find_support_ = true;
+  }
   lost_reported_ = true;
   return still_sample(guess_, frame.capture_time_s, true, w.inlier_ratio, w.rmse_mm);
 }
@@ -420,11 +427,12 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame, const 
   }
   static constexpr SearchStage kEscalation[] = {SearchStage::local, SearchStage::global_near, SearchStage::global_wide};
   // Without global re-initialisation (AcquisitionConfig::reinitialise) every attempt is a local one.
-  const SearchStage stage = aligner_.config().reinitialise ? kEscalation[stats_.attempts % 3] : SearchStage::local;
+  const SearchStage stage = aligner_.config().reinitialise ? kEscalation[search_attempts_ % 3] : SearchStage::local;
   const auto t0 = std::chrono::steady_clock::now();
   const auto elapsed = [&] {
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ++stats_.attempts;
+    ++search_attempts_;
     stats_.last_attempt_ms = ms;
     stats_.total_ms += ms;
     stats_.max_attempt_ms = std::max(stats_.max_attempt_ms, ms);
@@ -442,7 +450,7 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame, const 
   }
   // Depth alone here: one bounded attempt per frame, and a held pose colour cannot place would cost a
   // second one in the same frame (acquire() holds weak directions for colour).
-  const bool acquiring = stats_.attempts == 0 && cfg_.first_search_acquires;
+  const bool acquiring = search_attempts_ == 0 && cfg_.first_search_acquires;
   const auto a = acquiring ? first_acquisition(frame, colour) : attempt(frame, guess_, stage);
   elapsed();
   if (acquiring && a && a->converged && verified(frame, T = a->T_scan_model)) {  // colour and the look-alike turn done
@@ -458,7 +466,7 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame, const 
     return found(frame, T, a->inlier_ratio, a->rmse_mm);
   }
   const auto& spacing = cfg_.search_spacing_frames;
-  if (!spacing.empty()) wait_ = spacing[std::min(static_cast<std::size_t>(stats_.attempts - 1), spacing.size() - 1)];
+  if (!spacing.empty()) wait_ = spacing[std::min(static_cast<std::size_t>(search_attempts_ - 1), spacing.size() - 1)];
   const double last_ms = stats_.last_attempt_ms;
   if (cfg_.search_duty > 0.0 && cfg_.search_duty < 1.0)
     wait_ = std::max(wait_, static_cast<int>(std::ceil(last_ms * (1.0 / cfg_.search_duty - 1.0) * cfg_.camera_hz / 1000.0)));

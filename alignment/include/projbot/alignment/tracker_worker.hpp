@@ -258,6 +258,7 @@ class TargetFollower {
                             bool hold) const;
   ModelCloud model_;           // for the free-space check
   bool find_support_ = false;  // a guess without a map: the next local search finds the support in the frame
+  bool map_floor_ = false;     // the floor came from the map (and the camera's pose), not from a frame
   bool colour_contrast_;       // the model's colours can say where it is (has_colour_contrast)
   Aligner aligner_;
   ProjectiveTracker tracker_;
@@ -275,6 +276,7 @@ class TargetFollower {
   bool lost_reported_ = false;
   int wait_ = 0;  // frames until the next search attempt
   SearchStats stats_;
+  int search_attempts_ = 0;  // attempts since this search began (a new guess, or the target lost)
   std::optional<AlignmentResult> last_attempt_;
   FreeSpaceCheck check_;
   Known known_;                   // this stop's floor and footing
