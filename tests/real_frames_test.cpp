@@ -152,12 +152,14 @@ TEST_F(RealFrames, AcquisitionHoldsAmongTouchingNeighbours) {
 // --track on the scene whose potted meat can was once followed 60-70 mm off on its neighbour (its first
 // search was not the acquisition, and it was not told its guess's uncertainty): every object found on
 // the first image stays within 10 mm, nothing lit wrong; the banana leaning on the block, refused on the
-// first image until the gate of a close guess left its neighbour out, found there and followed.
+// first image until the gate of a close guess left its neighbour out, found there and followed; the wood
+// block, which the tracker loses where the banana and the box it carries pull it, found again (before the
+// support was found afresh for each search, the first image's refused it from the fifth on: 4 of 20).
 TEST_F(RealFrames, TrackingFollowsWhatTheFirstImageFinds) {
   const fs::path report = dir_ / "t.json";
   const CliRun r = run_projbot("bench dataset " + kYcbv.string() + " --scenes 000002 --track --report " + report.string(), 600);
   ASSERT_EQ(r.code, 0) << r.output;
-  int potted_meat = 0, potted_meat_within = 0, banana_within = 0, false_accepts = 0;
+  int potted_meat = 0, potted_meat_within = 0, banana_within = 0, block_within = 0, false_accepts = 0;
   const auto j = read_json(report);
   for (const auto& row : j.at("instances")) {
     EXPECT_EQ(row.at("mode").get<std::string>(), "track");
@@ -165,6 +167,7 @@ TEST_F(RealFrames, TrackingFollowsWhatTheFirstImageFinds) {
     const bool lit = row.at("accepted").get<bool>();
     false_accepts += lit && e > 20.0 ? 1 : 0;
     if (row.at("obj_id").get<int>() == 10) banana_within += lit && e <= 10.0 ? 1 : 0;
+    if (row.at("obj_id").get<int>() == 16) block_within += lit && e <= 10.0 ? 1 : 0;
     if (row.at("obj_id").get<int>() != 9) continue;
     ++potted_meat;
     potted_meat_within += lit && e <= 10.0 ? 1 : 0;
@@ -172,6 +175,7 @@ TEST_F(RealFrames, TrackingFollowsWhatTheFirstImageFinds) {
   EXPECT_EQ(potted_meat, 20) << r.output;
   EXPECT_GE(potted_meat_within, 19) << r.output;
   EXPECT_GE(banana_within, 19) << r.output;
+  EXPECT_GE(block_within, 16) << r.output;
   EXPECT_EQ(false_accepts, 0) << r.output;
 }
 
