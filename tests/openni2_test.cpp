@@ -14,6 +14,7 @@
 #include <iterator>
 
 #include "projbot/alignment/openni2_source.hpp"
+#include "projbot/config/clock.hpp"
 
 namespace fs = std::filesystem;
 using namespace projbot::alignment;
@@ -48,7 +49,7 @@ TEST(OpenNi2Test, DummyDeviceDeliversColourOnTheHostClock) {
   double last = -1.0;
   for (int i = 0; i < 5; ++i) {
     const RgbdFrame f = source.next_frame();
-    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    const double now = projbot::config::steady_now_s();
     ASSERT_EQ(f.colour.width, 320);
     ASSERT_EQ(f.colour.height, 240);
     ASSERT_EQ(f.colour.rgba.size(), 320U * 240U * 4U);

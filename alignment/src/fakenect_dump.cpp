@@ -10,11 +10,10 @@
 
 #include "kinect_frames.hpp"
 #include "projbot/alignment/freenect_source.hpp"
+#include "projbot/config/clock.hpp"
 
 namespace projbot::alignment {
 namespace {
-
-double steady_now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 // "d-1234.500000-0001000000.pgm": kind, time (s) and the device's stamp; false when it is not such a name.
 bool parse_name(const std::string& name, char kind, double& time_s, std::uint32_t& stamp) {
@@ -123,10 +122,10 @@ RgbdFrame FakenectDumpReader::next() {
   std::memcpy(raw.data(), bytes.data(), bytes.size());  // as fakenect hands it to the driver: the host's byte order
   kinect_depth_from_raw(raw.data(), f.depth);
   kinect_colour_from_rgb(reinterpret_cast<const std::uint8_t*>(read_pnm(folder_ / e.colour, "P6", 255, 3).data()), f.colour);
-  if (next_ == 0) offset_s_ = steady_now_s() - e.time_s;
+  if (next_ == 0) offset_s_ = config::steady_now_s() - e.time_s;
   f.depth.capture_time_s = e.time_s + offset_s_;
   if (realtime_) {
-    const double wait_s = f.depth.capture_time_s - steady_now_s();
+    const double wait_s = f.depth.capture_time_s - config::steady_now_s();
     if (wait_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
   }
   f.depth_timestamp = e.depth_stamp;

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "kinect_frames.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/config/output_file.hpp"
 
 namespace projbot::alignment {
@@ -25,8 +26,6 @@ constexpr double kA = 3.3309495161;
 constexpr double kB = -0.0030711016;
 constexpr double kMinM = 0.3;
 constexpr double kMaxM = 10.0;
-
-double steady_now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 std::string kinect_name(int index) { return "Kinect v1 #" + std::to_string(index) + " (libfreenect)"; }
 
@@ -64,7 +63,7 @@ struct FreenectSource::Impl {
 
   void on_depth(const void* data, std::uint32_t timestamp) {
     DepthImage& d = pending.depth;
-    d.capture_time_s = steady_now_s();  // its arrival, before the conversion below: that counts in a pose's age
+    d.capture_time_s = config::steady_now_s();  // its arrival, before the conversion below: that counts in a pose's age
     const auto* raw = static_cast<const std::uint16_t*>(data);
     if (options.registered) {
       d.width = kWidth;
@@ -145,9 +144,9 @@ RgbdFrame FreenectSource::next() {
   Impl& m = *impl_;
   const std::string who = kinect_name(m.options.index);
   m.have_depth = m.have_colour = false;
-  const double give_up_s = steady_now_s() + m.options.timeout_ms / 1000.0;
+  const double give_up_s = config::steady_now_s() + m.options.timeout_ms / 1000.0;
   while (!(m.have_depth && m.have_colour)) {
-    if (steady_now_s() > give_up_s)
+    if (config::steady_now_s() > give_up_s)
       throw AlignmentError(who + ": no depth and colour frame within " + std::to_string(m.options.timeout_ms) + " ms");
     timeval wait{0, 100000};
     if (freenect_process_events_timeout(m.context, &wait) < 0)

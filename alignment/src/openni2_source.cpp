@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "projbot/config/clock.hpp"
 #include "projbot/config/paths.hpp"
 
 namespace projbot::alignment {
@@ -180,7 +181,7 @@ DepthImage OpenNi2Source::next() {
   int ready = -1;
   if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, m.options.timeout_ms) != openni::STATUS_OK)
     throw AlignmentError(describe(m.options.uri) + ": no depth frame within " + std::to_string(m.options.timeout_ms) + " ms");
-  m.arrival_s = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  m.arrival_s = config::steady_now_s();
   openni::VideoFrameRef frame;
   if (m.depth.readFrame(&frame) != openni::STATUS_OK || !frame.isValid()) fail(m.options.uri, "cannot read a depth frame");
   ++m.frames_read;

@@ -1,13 +1,10 @@
 #include <chrono>
 #include <thread>
 
+#include "projbot/config/clock.hpp"
 #include "projbot/robot/ros2_base.hpp"
 
 namespace projbot::robot {
-namespace {
-double steady_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-}  // namespace
-
 Ros2Navigator::Ros2Navigator(Ros2Base& base, const Pose2D& start_in_map, const ControllerConfig& controller, double rate_hz,
                              double timeout_s)
     : base_(base), controller_(controller), rate_hz_(rate_hz), timeout_s_(timeout_s), last_(base.odometry(2.0)) {
@@ -18,7 +15,7 @@ Ros2Navigator::Ros2Navigator(Ros2Base& base, const Pose2D& start_in_map, const C
 void Ros2Navigator::use_laser(LaserSource& laser, Localizer* map) {
   laser_ = &laser;
   map_ = map;
-  double last_change = steady_s();
+  double last_change = config::steady_now_s();
   Corrections c;
   for (int i = 0; i < 3; ++i) correct(last_change, c);  // a robot set down a few centimetres off its start is found
 }
@@ -49,7 +46,7 @@ void Ros2Navigator::correct(double& last_change_s, Corrections& c) {
 // The newest odometry; throws when its stamp has not moved for a second (the driver stopped).
 Odometry2D Ros2Navigator::fresh(double& last_change_s) {
   const Odometry2D o = base_.odometry(1.0);
-  const double now = steady_s();
+  const double now = config::steady_now_s();
   if (o.stamp_s != last_.stamp_s) last_change_s = now;
   if (now - last_change_s > 1.0) {
     base_.send({});
@@ -64,7 +61,7 @@ StopReport Ros2Navigator::drive_to(const Pose2D& goal, int index) {
   r.index = index;
   r.goal = goal;
   controller_.reset();
-  const double t0 = steady_s();
+  const double t0 = config::steady_now_s();
   double last_change = t0, last_step = t0;
   Corrections c;
   const auto period = std::chrono::duration<double>(1.0 / rate_hz_);
@@ -73,7 +70,7 @@ StopReport Ros2Navigator::drive_to(const Pose2D& goal, int index) {
     std::this_thread::sleep_until(tick);
     fresh(last_change);
     correct(last_change, c);  // the laser's scan waits at most one of its periods (40 Hz: 25 ms)
-    const double now = steady_s();
+    const double now = config::steady_now_s();
     const BaseTwist cmd = controller_.update(believed_pose(), goal, now - last_step);
     last_step = now;
     if (controller_.arrived() || now - t0 > timeout_s_) break;
@@ -84,7 +81,7 @@ StopReport Ros2Navigator::drive_to(const Pose2D& goal, int index) {
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // let it stop, then read where it stands
   fresh(last_change);
   for (int i = 0; i < 3 && laser_; ++i) correct(last_change, c);  // standing still: the stop's best fix
-  r.drive_seconds = steady_s() - t0;
+  r.drive_seconds = config::steady_now_s() - t0;
   r.estimate = believed_pose();
   r.odometry = compose(T_map_odom_start_, last_.pose);
   r.corrections = c.count;

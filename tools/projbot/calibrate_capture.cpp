@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "projbot/calibrate/procam.hpp"
+#include "projbot/config/clock.hpp"
 
 namespace projbot::tools {
 namespace {
@@ -56,8 +57,6 @@ cv::Mat grey_of(const assets::Image& colour) {
   return out;
 }
 
-double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
 class DeviceRig final : public calibrate::CaptureRig {
  public:
   DeviceRig(PatternScreen& screen, engine::Renderer& renderer, engine::RenderTarget& window, alignment::RgbdCamera& camera,
@@ -82,7 +81,7 @@ class DeviceRig final : public calibrate::CaptureRig {
 
   cv::Mat show_and_capture(std::size_t index, const cv::Mat& /*pattern*/) override {
     show(index);
-    const double shown = now_s();
+    const double shown = config::steady_now_s();
     std::this_thread::sleep_for(std::chrono::duration<double>(settle_s_ + lag_s_));
     for (int tries = 0; tries < 100; ++tries) {  // frames taken before the light changed are dropped
       alignment::RgbdFrame f = camera_.next();

@@ -19,6 +19,7 @@
 #include "projbot/alignment/latest_value.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
@@ -32,7 +33,6 @@ namespace projbot::tools {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double now_s() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
 
 // A target the robot projects onto at a stop: the visited one, or a neighbour it expects in the
 // projector's view there (issue 11, item 5).
@@ -130,7 +130,7 @@ class RunObserver final : public session::StopObserver {
   RunObserver(const config::Scene& scene, alignment::LatestValue<RobotState>& state, Handoffs& handoffs, twin::Twin* twin,
               PoseCheck* check)
       : scene_(scene), state_(state), handoffs_(handoffs), twin_(twin), check_(check) {}
-  void driving(int visit) override { state_.publish({.lit = {}, .since_s = now_s(), .visit = visit + 1}); }
+  void driving(int visit) override { state_.publish({.lit = {}, .since_s = config::steady_now_s(), .visit = visit + 1}); }
   void lit(const session::Stop& stop, double since_s) override {
     std::cout << "visit " << stop.visit + 1 << ": " << scene_.targets[static_cast<std::size_t>(stop.target)].name << ", drove "
               << std::fixed << std::setprecision(1) << stop.drive.drive_seconds << " s"
@@ -153,7 +153,7 @@ class RunObserver final : public session::StopObserver {
   void frame(const session::Stop& stop, int k, const alignment::RgbdFrame& f,
              const std::vector<std::optional<alignment::PoseSample>>& samples) override {
     if (samples.empty()) {  // live: at the hand-off
-      const double now = now_s();
+      const double now = config::steady_now_s();
       handoffs_.from_capture_ms.push_back(1000.0 * (now - f.depth.capture_time_s));
       handoffs_.in_session_ms.push_back(1000.0 * (now - f.delivered_s));
       handoffs_.last_s = now;
@@ -194,7 +194,7 @@ void drive(const config::Scene& scene, const RunOptions& o, SceneTrackers& track
   }
   RobotState last;
   state.read(last);
-  state.publish({.lit = {}, .since_s = now_s(), .visit = last.visit, .done = true});
+  state.publish({.lit = {}, .since_s = config::steady_now_s(), .visit = last.visit, .done = true});
 }
 
 // Without --sim: the devices the config names, opened and read once (each absent one an error naming it);
@@ -371,11 +371,12 @@ const Command kRun{
         Eigen::Matrix4d T_camera_target;
       };
       RobotState robot;
-      const double t0 = now_s();
+      const double t0 = config::steady_now_s();
       std::size_t blank = 0, frames_with_neighbours = 0, silent = 0;
       double stale_before_s = 0.0;  // poses captured before the camera last went quiet are not drawn
       auto next_frame = Clock::now();
-      while (!interrupted() && !target->poll_close() && !robot_done && (seconds == 0.0 || now_s() - t0 < seconds)) {
+      while (!interrupted() && !target->poll_close() && !robot_done &&
+             (seconds == 0.0 || config::steady_now_s() - t0 < seconds)) {
         state.read(robot);
         std::vector<Drawn> drawn;  // this frame's lit targets, the visited one first
         const auto read_poses = [&](std::vector<engine::DrawItem>& out) {
@@ -384,10 +385,10 @@ const Command kRun{
           // Drawn where each target will be when this frame is lit: one frame period after it starts (FIFO
           // presents at the next vblank; the period as measured) plus the projector's input lag (issue 14).
           const double display_s =
-              now_s() + cadence.period_s(1.0 / scene.projector.refresh_hz) + 1e-3 * scene.projector.input_lag_ms;
-          if (!recording && !robot.lit.empty() && now_s() - handoffs.last_s > kSilentCameraS) {
-            ++silent;                  // the camera has gone quiet: blank rather than show what it saw last...
-            stale_before_s = now_s();  // ...and, once it is back, only what it sees from then on
+              config::steady_now_s() + cadence.period_s(1.0 / scene.projector.refresh_hz) + 1e-3 * scene.projector.input_lag_ms;
+          if (!recording && !robot.lit.empty() && config::steady_now_s() - handoffs.last_s > kSilentCameraS) {
+            ++silent;                                 // the camera has gone quiet: blank rather than show what it saw last...
+            stale_before_s = config::steady_now_s();  // ...and, once it is back, only what it sees from then on
             return;
           }
           for (const LitTarget& lit : robot.lit) {
@@ -407,7 +408,7 @@ const Command kRun{
           std::this_thread::sleep_until(next_frame);
           if (Clock::now() > next_frame + std::chrono::milliseconds(50)) next_frame = Clock::now();
         }
-        const double start_ms = profiler.now_ms(), start_s = now_s();
+        const double start_ms = profiler.now_ms(), start_s = config::steady_now_s();
         cadence.frame_started(start_s);
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
         const double nan = std::nan("");
@@ -432,7 +433,7 @@ const Command kRun{
         }
         if (drawn.size() > 1) ++frames_with_neighbours;
         const Drawn& first = drawn.front();
-        const double age_ms = 1000.0 * (std::max(now_s(), first.display_s) - first.capture_s);
+        const double age_ms = 1000.0 * (std::max(config::steady_now_s(), first.display_s) - first.capture_s);
         ages_ms.push_back(age_ms);
         rows.push_back({start_ms, age_ms, start_ms + 1000.0 * (first.capture_s - start_s),
                         start_ms + 1000.0 * (first.display_s - start_s), row_error.front(), first.lit->target});

@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "projbot/alignment/equations.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/robot/error.hpp"
 
 namespace projbot::session {
@@ -117,12 +118,11 @@ Stop Session::visit(int visit, const std::vector<alignment::PoseTracker*>& worke
                          " but has no tracker worker");
     lit.push_back(workers[t]);
   }
-  const auto now_s = [] { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); };
-  const double since = now_s();
+  const double since = config::steady_now_s();
   alignment::RgbdCamera& camera = dwell.camera(at, since);
   const auto read = [&] {
     auto f = std::make_shared<alignment::RgbdFrame>(camera.next());
-    f->delivered_s = now_s();
+    f->delivered_s = config::steady_now_s();
     return f;
   };
   // The first frame's colour, taken before anything is lit, guides each lit target's acquisition.
@@ -142,7 +142,7 @@ Stop Session::visit(int visit, const std::vector<alignment::PoseTracker*>& worke
       else
         w->submit(depth);
     observer.frame(at, k, *frame, samples);
-    if (stop.stop_requested() || dwell.over(at, k + 1, now_s() - since)) break;
+    if (stop.stop_requested() || dwell.over(at, k + 1, config::steady_now_s() - since)) break;
     frame = read();
   }
   observer.left(at);

@@ -2,10 +2,11 @@
 
 #include <thread>
 
+#include "projbot/config/clock.hpp"
+
 namespace projbot::twin {
 namespace {
 using Clock = std::chrono::steady_clock;
-double now_s() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
 }  // namespace
 
 void TwinCamera::at_stop(std::size_t target, int target_visit, int visit, double since_s) {
@@ -23,7 +24,7 @@ alignment::RgbdFrame TwinCamera::next() {
     std::this_thread::sleep_until(tick_);
     if (Clock::now() > tick_ + std::chrono::milliseconds(100)) tick_ = Clock::now();
   }
-  const double captured = now_s();
+  const double captured = config::steady_now_s();
   twin_.targets().at(target_).T_world_target_true = twin_.scripted_pose(target_, target_visit_, captured - since_s_);
   const Eigen::Matrix4d T_world_camera = twin_.true_head().T_world_camera.matrix();
   alignment::RgbdFrame f;
@@ -32,7 +33,7 @@ alignment::RgbdFrame TwinCamera::next() {
     f.colour = twin_.capture_colour(T_world_camera, static_cast<std::uint32_t>(seed_ * 7919 + visit_ * 1009 + frame_));
   f.depth.capture_time_s = captured;
   f.depth_timestamp = f.colour_timestamp = frame_++;
-  last_capture_ms_ = 1000.0 * (now_s() - captured);
+  last_capture_ms_ = 1000.0 * (config::steady_now_s() - captured);
   return f;
 }
 

@@ -1,0 +1,14 @@
+// The steady clock in seconds: the one time base of the live loop, the devices' arrival stamps and the
+// measurements (capture, display and pose times are all on it).
+#pragma once
+
+#include <chrono>
+
+namespace projbot::config {
+
+/// Seconds on std::chrono::steady_clock (monotonic; its epoch is arbitrary, differences are what count).
+inline double steady_now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace projbot::config
