@@ -220,7 +220,7 @@ TEST(SceneTest, TourSectionsAndTheirDefaults) {
   EXPECT_DOUBLE_EQ(s.room.obstacles[0][2], 1.0);
   EXPECT_NEAR(s.robot_start.z(), M_PI / 2, 1e-12);
   EXPECT_DOUBLE_EQ(s.drift.slip_scale, 0.02);
-  EXPECT_DOUBLE_EQ(s.drift.wheel_scale_sigma, projbot::config::DriftSpec{}.wheel_scale_sigma);
+  EXPECT_DOUBLE_EQ(s.drift.wheel_scale_sigma, projbot::config::OdometryDrift::good_floor().wheel_scale_sigma);
   // A camera with a bad intrinsic is named like the projector.
   EXPECT_THROW(parse_scene(std::string(kGood) + "camera: {fx: -1}\n", "/scenes/s.yaml"), projbot::config::ConfigError);
 }

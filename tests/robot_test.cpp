@@ -87,7 +87,7 @@ TEST(Pose2D, ComposeInverseBetween) {
 
 // Drives a simulated base through a square (1 m forward, turn 90 degrees, four times) by
 // commanded twists; returns {truth, odometry} at the end.
-std::pair<Pose2D, Pose2D> drive_square(const BaseErrorModel& errors) {
+std::pair<Pose2D, Pose2D> drive_square(const projbot::config::OdometryDrift& errors) {
   SimulatedBase base({0, 0, 0}, errors);
   WheelOdometry odo(base.geometry());
   odo.update(base.read_encoders());
@@ -108,7 +108,7 @@ std::pair<Pose2D, Pose2D> drive_square(const BaseErrorModel& errors) {
 }
 
 TEST(WheelOdometry, SquareClosesOnAnIdealBase) {
-  const auto [truth, odo] = drive_square(BaseErrorModel::none());
+  const auto [truth, odo] = drive_square(projbot::config::OdometryDrift::none());
   // Encoder quantisation (61 urad of wheel per tick, 3 um at the rim) is all that remains.
   EXPECT_NEAR(truth.x_m, 0.0, 1e-6);
   EXPECT_NEAR(truth.y_m, 0.0, 1e-6);
@@ -118,7 +118,7 @@ TEST(WheelOdometry, SquareClosesOnAnIdealBase) {
 }
 
 TEST(WheelOdometry, DriftsFromTruthOnASlippingBase) {
-  BaseErrorModel errors;  // defaults: 2 % slip, 1 % wheel radii, yaw bias
+  projbot::config::OdometryDrift errors;  // defaults: 2 % slip, 1 % wheel radii, yaw bias
   errors.seed = 3;
   const auto [truth, odo] = drive_square(errors);
   // Odometry still believes it closed the square, within its own wheel-radius errors ...
@@ -130,7 +130,7 @@ TEST(WheelOdometry, DriftsFromTruthOnASlippingBase) {
 
 TEST(BaseController, ReachesAGoalWithinLimitsAndTolerance) {
   ControllerConfig cfg;
-  SimulatedBase base({0, 0, 0}, BaseErrorModel::none());
+  SimulatedBase base({0, 0, 0}, projbot::config::OdometryDrift::none());
   BaseController ctl(cfg);
   const Pose2D goal{2.0, -1.0, deg(120)};
   const double dt = 0.02;

@@ -125,7 +125,7 @@ double distance(const Pose2D& a, const Pose2D& b) { return std::hypot(a.x_m - b.
 
 // The twin's youBot served over DDS, stepped in real time (100 Hz) until destroyed.
 struct ServedBase {
-  ServedBase(const projbot::config::BaseDevice& config, const Pose2D& truly, const projbot::robot::BaseErrorModel& errors)
+  ServedBase(const projbot::config::BaseDevice& config, const Pose2D& truly, const projbot::config::OdometryDrift& errors)
       : server(config, truly, errors), simulation([this](const std::stop_token& stop) {
           const double dt = 0.01;
           for (int i = 0; !stop.stop_requested(); ++i) {
@@ -159,7 +159,7 @@ TEST(Ros2Navigator, LocalisesOnTheLaserWhereOdometryAloneIsOff) {
   const auto room = projbot::robot::OccupancyMap::from_room(room_config);
   auto map = surveyed(room, room_config);
   const Pose2D start{1.0, 1.0, 0.0}, truly{1.05, 0.97, -0.035}, goal{2.0, 1.5, 0.5};
-  ServedBase served(config, truly, projbot::robot::BaseErrorModel{});
+  ServedBase served(config, truly, projbot::config::OdometryDrift{});
   projbot::robot::Ros2Base base(config);
   projbot::robot::Ros2Navigator navigator(base, start, {}, 20.0, 30.0);
   TwinLaser laser(served.server, served.stepping, room);
@@ -191,7 +191,7 @@ TEST(Ros2Navigator, WithoutAMapTheLaserIsOnlyRecorded) {
   room_config.width_m = 4.0;
   room_config.depth_m = 3.0;
   const auto room = projbot::robot::OccupancyMap::from_room(room_config);
-  ServedBase served(config, {1.05, 0.97, 0.0}, projbot::robot::BaseErrorModel::none());
+  ServedBase served(config, {1.05, 0.97, 0.0}, projbot::config::OdometryDrift::none());
   projbot::robot::Ros2Base base(config);
   projbot::robot::Ros2Navigator navigator(base, {1.0, 1.0, 0.0});
   TwinLaser laser(served.server, served.stepping, room);

@@ -212,7 +212,7 @@ PanTiltConfig read_robot(MapReader& root, Scene& scene) {
   }
   if (YAML::Node dn = r.child("drift", false)) {
     MapReader d(dn, "robot.drift", root.file());
-    DriftSpec& s = scene.drift;
+    OdometryDrift& s = scene.drift;
     // Fractions of the distance or turn travelled: beyond 0.5 no base drives (slip_scale 1e308 once gave an
     // infinite base error and a report of 0.0 mm over 0 lit frames).
     const auto bounded = [&](const char* key, double& value, double lo) {

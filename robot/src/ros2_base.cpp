@@ -138,7 +138,7 @@ struct Ros2BaseServer::Impl {
   BaseTwist command;
   double command_at_s = -1e9;
   int commands = 0;
-  Impl(const config::BaseDevice& c, const Pose2D& start, const BaseErrorModel& errors)
+  Impl(const config::BaseDevice& c, const Pose2D& start, const config::OdometryDrift& errors)
       : dds(c, "the twin's base (ros2-dds, domain " + std::to_string(c.domain) + ")", &nav_msgs_msg_dds__Odometry__desc, c.odom,
             &geometry_msgs_msg_dds__Twist__desc, c.cmd_vel),
         base(start, errors),
@@ -147,7 +147,7 @@ struct Ros2BaseServer::Impl {
   }
 };
 
-Ros2BaseServer::Ros2BaseServer(const config::BaseDevice& c, const Pose2D& start, const BaseErrorModel& errors)
+Ros2BaseServer::Ros2BaseServer(const config::BaseDevice& c, const Pose2D& start, const config::OdometryDrift& errors)
     : impl_(std::make_unique<Impl>(c, start, errors)) {}
 
 Ros2BaseServer::~Ros2BaseServer() = default;

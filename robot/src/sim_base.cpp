@@ -4,7 +4,7 @@
 
 namespace projbot::robot {
 
-SimulatedBase::SimulatedBase(const Pose2D& true_start, const BaseErrorModel& errors, const YoubotGeometry& geometry)
+SimulatedBase::SimulatedBase(const Pose2D& true_start, const config::OdometryDrift& errors, const YoubotGeometry& geometry)
     : geometry_(geometry), errors_(errors), rng_(errors.seed), true_pose_(true_start) {
   std::normal_distribution<double> n(0.0, 1.0);
   for (double& s : wheel_scale_) s = 1.0 + errors_.wheel_scale_sigma * n(rng_);

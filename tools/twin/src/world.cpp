@@ -62,13 +62,8 @@ robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource 
   for (const auto& o : scene.room.obstacles) c.room.obstacles.push_back({o[0], o[1], o[2], o[3]});
   for (const auto& f : footprints) c.room.obstacles.push_back({f[0], f[1], f[2], f[3]});
   c.start = {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()};
+  c.errors = scene.drift;
   c.errors.seed = seed;
-  c.errors.wheel_scale_sigma = scene.drift.wheel_scale_sigma;
-  c.errors.slip_scale = scene.drift.slip_scale;
-  c.errors.heading_bias_rad_per_m = scene.drift.heading_bias_rad_per_m;
-  c.errors.heading_bias_rad_per_rad = scene.drift.heading_bias_rad_per_rad;
-  c.errors.random_translation_sigma = scene.drift.random_translation_sigma;
-  c.errors.random_rotation_sigma = scene.drift.random_rotation_sigma;
   c.source = source;
   return c;
 }

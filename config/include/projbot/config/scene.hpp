@@ -12,6 +12,7 @@
 
 #include "projbot/config/devices.hpp"
 #include "projbot/config/lens.hpp"
+#include "projbot/config/odometry_drift.hpp"
 #include "projbot/config/pinhole.hpp"
 #include "projbot/config/robot.hpp"
 
@@ -136,17 +137,6 @@ struct RoomSpec {
   double wall_height_m = 2.5;
 };
 
-/// Wheel-odometry error of the simulated base (see robot::BaseErrorModel for the meaning of each).
-/// Defaults are milder than the robot bench's: a base on a good floor.
-struct DriftSpec {
-  double wheel_scale_sigma = 0.005;
-  double slip_scale = 0.01;
-  double heading_bias_rad_per_m = 0.005;
-  double heading_bias_rad_per_rad = 0.005;
-  double random_translation_sigma = 0.002;
-  double random_rotation_sigma = 0.002;
-};
-
 /// A whole scene file.
 struct Scene {
   std::filesystem::path source;  ///< the file it came from (empty when parsed from a string)
@@ -158,7 +148,7 @@ struct Scene {
   // The tour (optional sections):
   RoomSpec room;                                            ///< `room:`
   Eigen::Vector3d robot_start{1.0, 1.0, 0.0};               ///< `robot.start: [x, y, heading_deg]`
-  DriftSpec drift;                                          ///< `robot.drift:`
+  OdometryDrift drift = OdometryDrift::good_floor();        ///< `robot.drift:` (its seed is the run's)
   ProjectorConfig depth_camera = kinect_v1_depth_camera();  ///< `camera:`, the RGB-D camera's depth intrinsics
   std::vector<std::string> visits;                          ///< `tour.visits:` target names in order
   std::vector<PropConfig> props;                            ///< `props:` the twin's static non-targets

@@ -101,7 +101,8 @@ class Ros2Navigator final : public Navigator {
 /// (stopping when none came for 0.5 s, as base drivers do) and publishes its wheel odometry on `odom`.
 class Ros2BaseServer {
  public:
-  Ros2BaseServer(const config::BaseDevice& config, const Pose2D& start, const BaseErrorModel& errors = BaseErrorModel::none());
+  Ros2BaseServer(const config::BaseDevice& config, const Pose2D& start,
+                 const config::OdometryDrift& errors = config::OdometryDrift::none());
   ~Ros2BaseServer();
   Ros2BaseServer(const Ros2BaseServer&) = delete;
   Ros2BaseServer& operator=(const Ros2BaseServer&) = delete;

@@ -4,31 +4,16 @@
 #include <cstdint>
 #include <random>
 
+#include "projbot/config/odometry_drift.hpp"
 #include "projbot/robot/base.hpp"
 
 namespace projbot::robot {
-
-/// Error model of the simulated base. Systematic terms stay fixed for a run, as a real base's
-/// do (wheel radius tolerance, carpet slip, a misaligned roller); random terms are per step.
-struct BaseErrorModel {
-  std::uint64_t seed = 1;
-  double wheel_scale_sigma = 0.01;         ///< per-wheel effective radius error, relative (1 sigma, drawn once)
-  double slip_scale = 0.02;                ///< ground motion short of wheel motion, relative (systematic)
-  double heading_bias_rad_per_m = 0.01;    ///< systematic yaw drift per metre travelled
-  double heading_bias_rad_per_rad = 0.01;  ///< systematic yaw drift per radian turned
-  /// Random walks, independent of the step size: variance grows with the motion (per metre
-  /// travelled plus radian turned), as for a real base.
-  double random_translation_sigma = 0.003;  ///< metres per sqrt(metre + radian)
-  double random_rotation_sigma = 0.003;     ///< radians per sqrt(metre + radian)
-  /// An error-free base (odometry equals truth up to encoder quantisation).
-  static BaseErrorModel none() { return {0, 0, 0, 0, 0, 0, 0}; }
-};
 
 /// Simulated base. Time advances only through advance(). Encoders count the wheels' true
 /// rotation; the ground motion differs by slip and bias, so wheel odometry drifts.
 class SimulatedBase final : public MobileBase {
  public:
-  SimulatedBase(const Pose2D& true_start, const BaseErrorModel& errors = {}, const YoubotGeometry& geometry = {});
+  SimulatedBase(const Pose2D& true_start, const config::OdometryDrift& errors = {}, const YoubotGeometry& geometry = {});
   void set_wheel_speeds(const WheelSpeeds& speeds) override;
   WheelTicks read_encoders() override;
   const YoubotGeometry& geometry() const override { return geometry_; }
@@ -42,7 +27,7 @@ class SimulatedBase final : public MobileBase {
 
  private:
   YoubotGeometry geometry_;
-  BaseErrorModel errors_;
+  config::OdometryDrift errors_;
   std::mt19937_64 rng_;
   std::array<double, 4> wheel_scale_{1, 1, 1, 1};
   Pose2D true_pose_;

@@ -24,7 +24,7 @@ struct SimTourConfig {
   std::vector<Pose2D> stops;  ///< visited in order, `stop_count` in all (cycling)
   int stop_count = 10;
   Pose2D start;  ///< true and believed start pose
-  BaseErrorModel errors;
+  config::OdometryDrift errors;
   LaserConfig laser;
   ControllerConfig controller;
   LocalizerConfig localizer;
