@@ -217,7 +217,7 @@ TEST(SceneTest, TourSectionsAndTheirDefaults) {
   EXPECT_EQ(s.depth_camera.height_px, 480);
   EXPECT_DOUBLE_EQ(s.room.width_m, 5.0);
   ASSERT_EQ(s.room.obstacles.size(), 1U);
-  EXPECT_DOUBLE_EQ(s.room.obstacles[0][2], 1.0);
+  EXPECT_DOUBLE_EQ(s.room.obstacles[0].max_x_m, 1.0);
   EXPECT_NEAR(s.robot_start.z(), M_PI / 2, 1e-12);
   EXPECT_DOUBLE_EQ(s.drift.slip_scale, 0.02);
   EXPECT_DOUBLE_EQ(s.drift.wheel_scale_sigma, projbot::config::OdometryDrift::good_floor().wheel_scale_sigma);

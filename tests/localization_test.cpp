@@ -324,7 +324,7 @@ TEST(IcpSlam, BadConfigAndMapAreNamed) {
 }
 
 TEST(SimulatedLaser, RangesMatchTheRoomGeometry) {
-  RoomConfig room;
+  projbot::config::Room room;
   room.width_m = 6;
   room.depth_m = 4;
   const OccupancyMap map = OccupancyMap::from_room(room);

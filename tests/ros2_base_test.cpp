@@ -111,7 +111,7 @@ class TwinLaser final : public projbot::robot::LaserSource {
 };
 
 // The room's map as a survey makes it: scans at known poses every 0.5 m.
-projbot::robot::Localizer surveyed(const projbot::robot::OccupancyMap& room, const projbot::robot::RoomConfig& c) {
+projbot::robot::Localizer surveyed(const projbot::robot::OccupancyMap& room, const projbot::config::Room& c) {
   std::mt19937_64 rng(3);
   std::vector<std::pair<Pose2D, projbot::robot::LaserScan>> keyframes;
   for (double y = 0.5; y < c.depth_m; y += 0.5)
@@ -152,7 +152,7 @@ struct ServedBase {
 // carries the start's error to the stop.
 TEST(Ros2Navigator, LocalisesOnTheLaserWhereOdometryAloneIsOff) {
   const auto config = base_on_own_domain();
-  projbot::robot::RoomConfig room_config;
+  projbot::config::Room room_config;
   room_config.width_m = 4.0;
   room_config.depth_m = 3.0;
   room_config.obstacles = {{2.6, 2.2, 3.2, 3.0}, {0.0, 2.0, 0.6, 3.0}};
@@ -187,7 +187,7 @@ TEST(Ros2Navigator, LocalisesOnTheLaserWhereOdometryAloneIsOff) {
 // and the robot's belief stays odometry's.
 TEST(Ros2Navigator, WithoutAMapTheLaserIsOnlyRecorded) {
   const auto config = base_on_own_domain();
-  projbot::robot::RoomConfig room_config;
+  projbot::config::Room room_config;
   room_config.width_m = 4.0;
   room_config.depth_m = 3.0;
   const auto room = projbot::robot::OccupancyMap::from_room(room_config);

@@ -99,12 +99,13 @@ std::string metres(double v) {
   return out.str();
 }
 
-std::string place_problem(const RoomSpec& room, double x, double y) {
+std::string place_problem(const Room& room, double x, double y) {
   if (!(x > 0.0 && x < room.width_m && y > 0.0 && y < room.depth_m))
     return "lies outside the room (0.." + metres(room.width_m) + " x 0.." + metres(room.depth_m) + " m)";
   for (std::size_t i = 0; i < room.obstacles.size(); ++i) {
     const auto& o = room.obstacles[i];
-    if (x >= o[0] && x <= o[2] && y >= o[1] && y <= o[3]) return "lies inside room.obstacles[" + std::to_string(i) + "]";
+    if (x >= o.min_x_m && x <= o.max_x_m && y >= o.min_y_m && y <= o.max_y_m)
+      return "lies inside room.obstacles[" + std::to_string(i) + "]";
   }
   return {};
 }

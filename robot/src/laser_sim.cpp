@@ -19,7 +19,7 @@ OccupancyMap& OccupancyMap::operator=(const OccupancyMap& other) {
 }
 OccupancyMap::~OccupancyMap() = default;
 
-OccupancyMap OccupancyMap::from_room(const RoomConfig& room) {
+OccupancyMap OccupancyMap::from_room(const config::Room& room) {
   if (!(room.width_m > 0.5) || !(room.depth_m > 0.5) || !(room.resolution_m > 0.001) || !(room.wall_thickness_m > 0))
     throw RobotError("room: width and depth must be > 0.5 m, resolution > 1 mm, walls thicker than 0");
   const double margin = room.wall_thickness_m + 0.2;
@@ -36,7 +36,7 @@ OccupancyMap OccupancyMap::from_room(const RoomConfig& room) {
   const double t = room.wall_thickness_m, w = room.width_m, d = room.depth_m;
   fill_box(-t, -t, w + t, d + t, 0.0f);  // walls (value = probability of free)
   fill_box(0.0, 0.0, w - 1e-9, d - 1e-9, 1.0f);
-  for (const Box2D& b : room.obstacles) {
+  for (const config::Box2D& b : room.obstacles) {
     if (!(b.max_x_m > b.min_x_m) || !(b.max_y_m > b.min_y_m))
       throw RobotError("room: an obstacle box needs min < max on both axes");
     fill_box(b.min_x_m, b.min_y_m, b.max_x_m - 1e-9, b.max_y_m - 1e-9, 0.0f);

@@ -124,11 +124,9 @@ class SimBaseLaser {
   int scans_sent() const { return unit_.scans_sent(); }
 
  private:
-  static robot::RoomConfig room(const config::Scene& scene) {
-    robot::RoomConfig r;
-    r.width_m = scene.room.width_m;
-    r.depth_m = scene.room.depth_m;
-    for (const auto& o : scene.room.obstacles) r.obstacles.push_back({o[0], o[1], o[2], o[3]});
+  // The scene's room and its box props: what a laser at this height sees.
+  static config::Room room(const config::Scene& scene) {
+    config::Room r = scene.room;
     for (const auto& p : scene.props)
       if (p.is_box()) r.obstacles.push_back({p.box_min_m.x(), p.box_min_m.y(), p.box_max_m.x(), p.box_max_m.y()});
     return r;

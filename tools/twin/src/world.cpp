@@ -45,7 +45,8 @@ assets::Model room_model(const config::Scene& scene) {
   append(room, assets::make_box({-t, d, 0.0}, {w + t, d + t, h}, wall));
   append(room, assets::make_box({-t, 0.0, 0.0}, {0.0, d, h}, wall));
   append(room, assets::make_box({w, 0.0, 0.0}, {w + t, d, h}, wall));
-  for (const auto& o : scene.room.obstacles) append(room, assets::make_box({o[0], o[1], 0.0}, {o[2], o[3], h}, wall));
+  for (const auto& o : scene.room.obstacles)
+    append(room, assets::make_box({o.min_x_m, o.min_y_m, 0.0}, {o.max_x_m, o.max_y_m, h}, wall));
   for (const auto& p : scene.props)
     if (p.is_box()) append(room, assets::make_box(p.box_min_m, p.box_max_m, {p.colour[0], p.colour[1], p.colour[2], 1.0F}));
   room.source = "room";
@@ -57,9 +58,7 @@ assets::Model room_model(const config::Scene& scene) {
 robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed,
                                   const std::vector<std::array<double, 4>>& footprints) {
   robot::SimTourConfig c;
-  c.room.width_m = scene.room.width_m;
-  c.room.depth_m = scene.room.depth_m;
-  for (const auto& o : scene.room.obstacles) c.room.obstacles.push_back({o[0], o[1], o[2], o[3]});
+  c.room = scene.room;
   for (const auto& f : footprints) c.room.obstacles.push_back({f[0], f[1], f[2], f[3]});
   c.start = {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()};
   c.errors = scene.drift;

@@ -15,6 +15,7 @@
 #include "projbot/config/odometry_drift.hpp"
 #include "projbot/config/pinhole.hpp"
 #include "projbot/config/robot.hpp"
+#include "projbot/config/room.hpp"
 
 namespace projbot::config {
 
@@ -128,15 +129,6 @@ struct TargetConfig {
   }
 };
 
-/// The twin's room: an axis-aligned rectangle with box obstacles (metres, map frame).
-struct RoomSpec {
-  double width_m = 8.0;
-  double depth_m = 6.0;
-  std::vector<std::array<double, 4>> obstacles;  ///< x0, y0, x1, y1
-  /// The outline and the obstacles stand this high (metres) in the twin's depth and projector light.
-  double wall_height_m = 2.5;
-};
-
 /// A whole scene file.
 struct Scene {
   std::filesystem::path source;  ///< the file it came from (empty when parsed from a string)
@@ -146,7 +138,7 @@ struct Scene {
   PanTiltConfig pan_tilt = default_pan_tilt();
 
   // The tour (optional sections):
-  RoomSpec room;                                            ///< `room:`
+  Room room;                                                ///< `room:`
   Eigen::Vector3d robot_start{1.0, 1.0, 0.0};               ///< `robot.start: [x, y, heading_deg]`
   OdometryDrift drift = OdometryDrift::good_floor();        ///< `robot.drift:` (its seed is the run's)
   ProjectorConfig depth_camera = kinect_v1_depth_camera();  ///< `camera:`, the RGB-D camera's depth intrinsics

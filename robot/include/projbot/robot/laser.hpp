@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "projbot/config/room.hpp"
 #include "projbot/robot/error.hpp"
 #include "projbot/robot/pose2d.hpp"
 
@@ -41,27 +42,11 @@ class LaserSource {
   virtual LaserScan next(double timeout_s) = 0;
 };
 
-/// An axis-aligned box in the world frame, metres.
-struct Box2D {
-  double min_x_m, min_y_m, max_x_m, max_y_m;
-};
-
-/// A rectangular room from (0, 0) to (width, depth) with walls and furniture.
-struct RoomConfig {
-  double width_m = 10.0;
-  double depth_m = 8.0;
-  /// Grid cell size. MRPT's ray tracer reads walls about one cell too far (1.2-1.6 cm at 1 cm cells,
-  /// measured), the same for the map and for live scans.
-  double resolution_m = 0.01;
-  double wall_thickness_m = 0.1;
-  std::vector<Box2D> obstacles;
-};
-
 /// An occupancy grid (mrpt::maps::COccupancyGridMap2D underneath). Copyable, not thread-safe.
 class OccupancyMap {
  public:
   /// Rasterises a room.
-  static OccupancyMap from_room(const RoomConfig& room);
+  static OccupancyMap from_room(const config::Room& room);
   OccupancyMap(const OccupancyMap& other);
   OccupancyMap& operator=(const OccupancyMap& other);
   ~OccupancyMap();

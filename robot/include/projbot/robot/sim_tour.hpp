@@ -20,7 +20,7 @@ namespace projbot::robot {
 enum class PoseSource { odometry, localized };
 
 struct SimTourConfig {
-  RoomConfig room;
+  config::Room room;
   std::vector<Pose2D> stops;  ///< visited in order, `stop_count` in all (cycling)
   int stop_count = 10;
   Pose2D start;  ///< true and believed start pose
