@@ -513,7 +513,7 @@ Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Tw
 // frame's error measured against the target's true pose at its display time.
 class TourStop final : public session::StopObserver {
  public:
-  TourStop(Tour& tour, int visit) : t_(tour), visit_(visit) {}
+  TourStop(Tour& tour, int visit) : tour_(tour), visit_(visit) {}
   // Dwell::camera: the robot has arrived and aimed; the camera is set for the stop.
   alignment::RgbdCamera& arrived(const session::Stop& at);
   void frame(const session::Stop& at, int k, const alignment::RgbdFrame& f,
@@ -522,8 +522,8 @@ class TourStop final : public session::StopObserver {
   bool over() const { return interrupted || !dwelling_ || next_ > frames_; }
   // After the session's visit: the neighbours' reports, and a moved target's last picture.
   void finish();
-  std::size_t target() const { return i_; }  // index into Twin::targets()
-  VisitReport r;
+  std::size_t target() const { return target_index_; }  // index into Twin::targets()
+  VisitReport report;
   bool interrupted = false;  // the tour was asked to stop in the middle of the dwell
 
  private:
@@ -534,14 +534,14 @@ class TourStop final : public session::StopObserver {
   void project(double start_s);
   void end_dwell();
 
-  Tour& t_;
+  Tour& tour_;
   int visit_;
-  std::size_t i_ = 0;             // the visited target, in Twin::targets()
+  std::size_t target_index_ = 0;  // the visited target, in Twin::targets()
   std::vector<std::size_t> lit_;  // the stop's lit targets, likewise: the visited one first
   robot::HeadPoses truth_;
   std::uint32_t noise_seed_ = 0;
   std::vector<NeighbourLight> lights_;
-  std::optional<DwellContext> c_;
+  std::optional<DwellContext> dwell_;
   // The dwell.
   bool dwelling_ = false;
   int frames_ = 0, next_ = 1;  // projector frames: in all, and the next to measure (1-based)
@@ -555,31 +555,31 @@ class TourStop final : public session::StopObserver {
 };
 
 alignment::RgbdCamera& TourStop::arrived(const session::Stop& at) {
-  const std::string& name = t_.scene.targets[static_cast<std::size_t>(at.target)].name;
-  i_ = t_.twin.target_index(name);
-  r.visit = visit_ + 1;
-  r.target_visit = at.target_visit;
-  r.target = name;
-  r.drive_s = at.drive.drive_seconds;
-  r.base_error_cm = 100.0 * at.drive.error_m;
-  r.base_error_deg = at.drive.error_rad * 180.0 / M_PI;
-  r.odometry_error_cm = 100.0 * at.drive.odometry_error_m;
-  truth_ = t_.twin.true_head();
-  TwinTarget& target = t_.twin.targets()[i_];
-  target.in_world = t_.twin.scripted_presence(i_, r.target_visit, 0.0);
-  r.target_present = target.in_world;
-  r.moved = target.config.motion_on(r.target_visit) != nullptr;
-  const bool tracking = t_.options.mode == TourMode::tracking;
-  dwelling_ = tracking || r.moved;
+  const std::string& name = tour_.scene.targets[static_cast<std::size_t>(at.target)].name;
+  target_index_ = tour_.twin.target_index(name);
+  report.visit = visit_ + 1;
+  report.target_visit = at.target_visit;
+  report.target = name;
+  report.drive_s = at.drive.drive_seconds;
+  report.base_error_cm = 100.0 * at.drive.error_m;
+  report.base_error_deg = at.drive.error_rad * 180.0 / M_PI;
+  report.odometry_error_cm = 100.0 * at.drive.odometry_error_m;
+  truth_ = tour_.twin.true_head();
+  TwinTarget& target = tour_.twin.targets()[target_index_];
+  target.in_world = tour_.twin.scripted_presence(target_index_, report.target_visit, 0.0);
+  report.target_present = target.in_world;
+  report.moved = target.config.motion_on(report.target_visit) != nullptr;
+  const bool tracking = tour_.options.mode == TourMode::tracking;
+  dwelling_ = tracking || report.moved;
   for (const session::LitTarget& l : at.lit)
-    lit_.push_back(t_.twin.target_index(t_.scene.targets[static_cast<std::size_t>(l.target)].name));
-  noise_seed_ = static_cast<std::uint32_t>(t_.options.seed * 100003 + static_cast<std::uint64_t>(visit_) * 1009);
+    lit_.push_back(tour_.twin.target_index(tour_.scene.targets[static_cast<std::size_t>(l.target)].name));
+  noise_seed_ = static_cast<std::uint32_t>(tour_.options.seed * 100003 + static_cast<std::uint64_t>(visit_) * 1009);
   const auto wanted = [this](double t_s) {
-    return std::any_of(lit_.begin(), lit_.end(), [&](std::size_t j) { return t_.lanes[j].free_at(t_s); });
+    return std::any_of(lit_.begin(), lit_.end(), [&](std::size_t j) { return tour_.lanes[j].free_at(t_s); });
   };
-  t_.camera.at_stop({i_, r.target_visit, truth_.T_world_camera.matrix(), noise_seed_, t_.options.mode != TourMode::odometry,
-                     tracking, r.target_present, wanted});
-  return t_.camera;
+  tour_.camera.at_stop({target_index_, report.target_visit, truth_.T_world_camera.matrix(), noise_seed_,
+                        tour_.options.mode != TourMode::odometry, tracking, report.target_present, wanted});
+  return tour_.camera;
 }
 
 void TourStop::frame(const session::Stop& at, int k, const alignment::RgbdFrame& f,
@@ -589,7 +589,7 @@ void TourStop::frame(const session::Stop& at, int k, const alignment::RgbdFrame&
   // The projector frames that start before the next camera frame is taken.
   const double next_frame_s = (k + 1) / kCameraHz;
   for (; next_ <= frames_ && next_frame_s > next_ * period_s_ + 1e-9; ++next_) {
-    if (t_.options.stop_requested && t_.options.stop_requested()) {
+    if (tour_.options.stop_requested && tour_.options.stop_requested()) {
       interrupted = true;
       return;
     }
@@ -600,104 +600,104 @@ void TourStop::frame(const session::Stop& at, int k, const alignment::RgbdFrame&
 
 // Capture, Eq. 1, acquisition (the lanes', from the session), Eq. 2, and the errors at the markers.
 void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f) {
-  const TwinTarget& target = t_.twin.targets()[i_];
-  r.capture_ms = t_.camera.arrival_ms();
-  std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth_, target, at.lit.front().T_camera_target_guess);
-  const Acquired& a = t_.lanes[i_].acquired();
-  r.icp = a.icp;
-  r.free_space = a.free_space;
-  r.projected = a.projected;
-  r.align_ms = a.align_ms;
-  if (r.projected) {
-    r.first_light_s = 0.0;
-    r.first_light_wall_ms = r.align_ms;
-    r.lit_frames = 1;
+  const TwinTarget& target = tour_.twin.targets()[target_index_];
+  report.capture_ms = tour_.camera.arrival_ms();
+  std::tie(report.guess_error_cm, report.guess_error_deg) = guess_error(truth_, target, at.lit.front().T_camera_target_guess);
+  const Acquired& a = tour_.lanes[target_index_].acquired();
+  report.icp = a.icp;
+  report.free_space = a.free_space;
+  report.projected = a.projected;
+  report.align_ms = a.align_ms;
+  if (report.projected) {
+    report.first_light_s = 0.0;
+    report.first_light_wall_ms = report.align_ms;
+    report.lit_frames = 1;
   }
   const Eigen::Matrix4d T_world_projector = truth_.T_world_projector.matrix();
-  r.view = alignment::view_constraints(target.cloud, r.icp.T_scan_model, t_.twin.camera());
-  r.T_projector_target_estimated = t_.models.projector_from_target(r.icp.T_scan_model);
-  r.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;
-  const Errors e = marker_errors(t_.twin, i_, t_.models, T_world_projector, r.icp.T_scan_model);
-  r.markers = e.markers;
-  r.mean_mm = e.mean_mm;
-  r.max_mm = e.max_mm;
+  report.view = alignment::view_constraints(target.cloud, report.icp.T_scan_model, tour_.twin.camera());
+  report.T_projector_target_estimated = tour_.models.projector_from_target(report.icp.T_scan_model);
+  report.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;
+  const Errors e = marker_errors(tour_.twin, target_index_, tour_.models, T_world_projector, report.icp.T_scan_model);
+  report.markers = e.markers;
+  report.mean_mm = e.mean_mm;
+  report.max_mm = e.max_mm;
   for (std::size_t k = 1; k < at.lit.size(); ++k)
-    lights_.push_back(neighbour_light(t_.twin, t_.lanes[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, t_.models));
-  if (t_.projector_frame) write_pictures(f.colour);
+    lights_.push_back(neighbour_light(tour_.twin, tour_.lanes[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, tour_.models));
+  if (tour_.projector_frame) write_pictures(f.colour);
 
-  c_.emplace(DwellContext{t_.twin, i_, t_.models, truth_, t_.options, lights_});
-  period_s_ = 1.0 / t_.models.truth.refresh_hz;
-  display_delay_s_ = period_s_ + 1e-3 * t_.models.truth.input_lag_ms;
-  drawn_.T_camera_target = drawn_.motion.T = r.icp.T_scan_model;
-  shown_ = r.projected;
-  wall_to_light_ms_ = r.align_ms;
-  const config::TargetMotion* motion = target.config.motion_on(r.target_visit);
+  dwell_.emplace(DwellContext{tour_.twin, target_index_, tour_.models, truth_, tour_.options, lights_});
+  period_s_ = 1.0 / tour_.models.truth.refresh_hz;
+  display_delay_s_ = period_s_ + 1e-3 * tour_.models.truth.input_lag_ms;
+  drawn_.T_camera_target = drawn_.motion.T = report.icp.T_scan_model;
+  shown_ = report.projected;
+  wall_to_light_ms_ = report.align_ms;
+  const config::TargetMotion* motion = target.config.motion_on(report.target_visit);
   motion_end_s_ = motion ? motion->end_s() : 0.0;
-  frames_ = static_cast<int>(std::lround(t_.options.dwell_s * t_.models.truth.refresh_hz));
+  frames_ = static_cast<int>(std::lround(tour_.options.dwell_s * tour_.models.truth.refresh_hz));
 }
 
 // The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else
 // all black.
 assets::Image TourStop::projector_image(bool lit, const Eigen::Matrix4d& T_projector_target) {
   std::vector<engine::DrawItem> items;
-  if (lit) items.push_back({t_.twin.target_model_ids()[i_], T_projector_target});
+  if (lit) items.push_back({tour_.twin.target_model_ids()[target_index_], T_projector_target});
   for (const NeighbourLight& n : lights_)
     if (n.shown)
-      items.push_back({t_.twin.target_model_ids()[n.target], t_.models.projector_from_target(n.drawn.T_camera_target)});
-  t_.renderer.draw_frame(*t_.projector_frame, t_.models.believed, items);
-  return t_.projector_frame->read_back();
+      items.push_back({tour_.twin.target_model_ids()[n.target], tour_.models.projector_from_target(n.drawn.T_camera_target)});
+  tour_.renderer.draw_frame(*tour_.projector_frame, tour_.models.believed, items);
+  return tour_.projector_frame->read_back();
 }
 
 // What a visitor beside the robot sees of the projector's frame, looking at the target where it truly
 // stands now.
 assets::Image TourStop::spectator_picture(const assets::Image& projector) {
-  const TwinTarget& target = t_.twin.targets()[i_];
+  const TwinTarget& target = tour_.twin.targets()[target_index_];
   const Eigen::Matrix4d T_world_spectator =
       spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
-  return t_.spectator->draw(t_.twin, T_world_spectator, truth_.T_world_projector.matrix(), projector);
+  return tour_.spectator->draw(tour_.twin, T_world_spectator, truth_.T_world_projector.matrix(), projector);
 }
 
 // --frames at arrival: the projector's frame, the RGB-D camera's colour (registered to the depth that
 // was used) and the visitor's view.
 void TourStop::write_pictures(const assets::Image& colour) {
   const auto t0 = Clock::now();
-  const auto image = projector_image(r.projected, r.T_projector_target_estimated);
-  r.frame_ms = ms_since(t0);
-  assets::write_png(frame_path(t_.options, r, ""), image);
-  assets::write_png(frame_path(t_.options, r, "_camera"),
-                    !colour.rgba.empty() ? colour : t_.twin.capture_colour(truth_.T_world_camera.matrix(), noise_seed_));
-  assets::write_png(frame_path(t_.options, r, "_spectator"), spectator_picture(image));
+  const auto image = projector_image(report.projected, report.T_projector_target_estimated);
+  report.frame_ms = ms_since(t0);
+  assets::write_png(frame_path(tour_.options, report, ""), image);
+  assets::write_png(frame_path(tour_.options, report, "_camera"),
+                    !colour.rgba.empty() ? colour : tour_.twin.capture_colour(truth_.T_world_camera.matrix(), noise_seed_));
+  assets::write_png(frame_path(tour_.options, report, "_spectator"), spectator_picture(image));
 }
 
 // One projector frame of the dwell, starting at start_s: the newest results ready by then drawn
 // (tracking mode), and the frame's error measured at its display time.
 void TourStop::project(double start_s) {
-  const DwellContext& c = *c_;
-  if (t_.options.mode == TourMode::tracking) {
+  const DwellContext& c = *dwell_;
+  if (tour_.options.mode == TourMode::tracking) {
     for (std::size_t k = 0; k < lit_.size(); ++k)
-      for (const auto& sample : t_.lanes[lit_[k]].ready_by(start_s)) {
+      for (const auto& sample : tour_.lanes[lit_[k]].ready_by(start_s)) {
         bool& shown = k == 0 ? shown_ : lights_[k - 1].shown;
         shown = !sample.lost;
         if (shown) (k == 0 ? drawn_ : lights_[k - 1].drawn) = sample;
       }
-    const double track_ms = t_.lanes[i_].track_ms();  // the visited target's frames tracked since the last
-    if (r.first_light_s < 0.0) wall_to_light_ms_ += track_ms - seen_track_ms_;
+    const double track_ms = tour_.lanes[target_index_].track_ms();  // the visited target's frames tracked since the last
+    if (report.first_light_s < 0.0) wall_to_light_ms_ += track_ms - seen_track_ms_;
     seen_track_ms_ = track_ms;
   }
-  const TimelineSample s = measure_frame(c, r, start_s + display_delay_s_, shown_, drawn_, t_.options.predict);
+  const TimelineSample s = measure_frame(c, report, start_s + display_delay_s_, shown_, drawn_, tour_.options.predict);
   for (NeighbourLight& n : lights_) measure_neighbour(c, n, start_s + display_delay_s_);
-  r.timeline.push_back(s);
-  r.lit_frames += shown_ ? 1 : 0;
-  if (shown_ && r.first_light_s < 0.0) {
-    r.first_light_s = s.t_s;
-    r.first_light_wall_ms = wall_to_light_ms_;
+  report.timeline.push_back(s);
+  report.lit_frames += shown_ ? 1 : 0;
+  if (shown_ && report.first_light_s < 0.0) {
+    report.first_light_s = s.t_s;
+    report.first_light_wall_ms = wall_to_light_ms_;
   }
-  const double gone_s = t_.camera.gone_s();
-  if (!shown_ && gone_s >= 0.0 && r.blank_after_removal_s < 0.0) r.blank_after_removal_s = s.t_s - gone_s;
-  if (s.moving) r.max_mm_moving = std::max(r.max_mm_moving, s.mean_mm);
+  const double gone_s = tour_.camera.gone_s();
+  if (!shown_ && gone_s >= 0.0 && report.blank_after_removal_s < 0.0) report.blank_after_removal_s = s.t_s - gone_s;
+  if (s.moving) report.max_mm_moving = std::max(report.max_mm_moving, s.mean_mm);
   if (std::isnan(s.mean_mm) && shown_) return;  // no marker in the projector's light: nothing measured
   const bool good = shown_ && s.mean_mm <= kConvergedMm;
-  if (!good && t_.twin.targets()[i_].in_world) {
+  if (!good && tour_.twin.targets()[target_index_].in_world) {
     ever_over_ = true;
     back_under_ = -1.0;
   } else if (good && back_under_ < 0.0 && s.t_s >= motion_end_s_) {
@@ -707,28 +707,28 @@ void TourStop::project(double start_s) {
 
 // The dwell's figures once its last projector frame is measured.
 void TourStop::end_dwell() {
-  const bool tracking = t_.options.mode == TourMode::tracking;
-  Lane& lane = t_.lanes[i_];
-  r.shown_at_end = shown_;
-  r.T_camera_target_at_end = drawn_.T_camera_target;
-  r.track_ms_mean = tracking && lane.tracked() > 0 ? lane.track_ms() / lane.tracked() : 0.0;
-  r.tracked_frames = lane.tracked();
-  r.dropped_frames = t_.camera.frames() - lane.tracked();
+  const bool tracking = tour_.options.mode == TourMode::tracking;
+  Lane& lane = tour_.lanes[target_index_];
+  report.shown_at_end = shown_;
+  report.T_camera_target_at_end = drawn_.T_camera_target;
+  report.track_ms_mean = tracking && lane.tracked() > 0 ? lane.track_ms() / lane.tracked() : 0.0;
+  report.tracked_frames = lane.tracked();
+  report.dropped_frames = tour_.camera.frames() - lane.tracked();
   if (tracking) {
-    r.search = lane.follower().search_stats();
-    r.second_pass_frames = lane.follower().second_passes();
+    report.search = lane.follower().search_stats();
+    report.second_pass_frames = lane.follower().second_passes();
   }
-  r.reconverge_s = !ever_over_ ? 0.0 : back_under_ >= 0.0 ? std::max(0.0, back_under_ - motion_end_s_) : -1.0;
-  summarise_timeline(r);
+  report.reconverge_s = !ever_over_ ? 0.0 : back_under_ >= 0.0 ? std::max(0.0, back_under_ - motion_end_s_) : -1.0;
+  summarise_timeline(report);
 }
 
 void TourStop::finish() {
-  for (const NeighbourLight& l : lights_) r.neighbours.push_back(finished(l));
-  if (t_.spectator && r.moved && !interrupted) {
+  for (const NeighbourLight& l : lights_) report.neighbours.push_back(finished(l));
+  if (tour_.spectator && report.moved && !interrupted) {
     // A moved target: what the visitor sees at the end of the dwell, where the target went and where
     // the light went (followed, or left where the target was).
-    const auto image = projector_image(r.shown_at_end, t_.models.projector_from_target(r.T_camera_target_at_end));
-    assets::write_png(frame_path(t_.options, r, "_spectator_end"), spectator_picture(image));
+    const auto image = projector_image(report.shown_at_end, tour_.models.projector_from_target(report.T_camera_target_at_end));
+    assets::write_png(frame_path(tour_.options, report, "_spectator_end"), spectator_picture(image));
   }
 }
 
@@ -779,10 +779,10 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
     dwell.lockstep = true;
     session.visit(v, tour.by_scene, dwell, stop, never.get_token());
     stop.finish();
-    twin.end_visit(stop.target(), stop.r.target_visit);  // back home, or left where it was moved
-    if ((report.interrupted = stop.interrupted)) break;  // this visit did not finish: keep the finished ones only
-    if (options.on_visit) options.on_visit(stop.r);
-    report.visits.push_back(std::move(stop.r));
+    twin.end_visit(stop.target(), stop.report.target_visit);  // back home, or left where it was moved
+    if ((report.interrupted = stop.interrupted)) break;       // this visit did not finish: keep the finished ones only
+    if (options.on_visit) options.on_visit(stop.report);
+    report.visits.push_back(std::move(stop.report));
   }
   report.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   return report;
