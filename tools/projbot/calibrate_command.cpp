@@ -9,12 +9,12 @@
 
 #include "calibrate_capture.hpp"
 #include "commands.hpp"
-#include "devices.hpp"
 #include "interrupt.hpp"
 #include "progress.hpp"
 #include "projbot/calibrate/calibrate.hpp"
 #include "projbot/calibrate/capture.hpp"
 #include "projbot/config/scene.hpp"
+#include "projbot/hardware/devices.hpp"
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
@@ -190,8 +190,9 @@ calibrate::CaptureSummary capture_on_devices(const cli::Args& args, const config
   config::DevicesConfig wanted;
   wanted.camera = scene.devices.camera;
   wanted.projector = scene.devices.projector;
-  std::vector<DeviceCheck> checks;
-  Devices devices = open_devices(wanted, checks, true);  // an absent device: an error naming it, before anything is shown
+  std::vector<hardware::DeviceCheck> checks;
+  hardware::Devices devices =
+      hardware::open_devices(wanted, checks, true);  // an absent device: an error naming it, before anything is shown
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
   engine::RendererOptions ro;  // after the monitors were checked: that check starts and stops GLFW
   ro.windowing = true;

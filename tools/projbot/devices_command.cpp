@@ -11,10 +11,10 @@
 #include <thread>
 
 #include "commands.hpp"
-#include "devices.hpp"
 #include "interrupt.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
+#include "projbot/hardware/devices.hpp"
 #include "projbot/robot/laser.hpp"
 #include "projbot/robot/pose2d.hpp"
 #include "projbot/robot/ros2_base.hpp"
@@ -220,8 +220,8 @@ const Command kDevices{"devices",
                            std::cout << "  no `devices:` section: every device is the digital twin's (projbot run --sim)\n";
                            return 0;
                          }
-                         std::vector<DeviceCheck> checks;
-                         open_devices(scene->devices, checks, false);
+                         std::vector<hardware::DeviceCheck> checks;
+                         hardware::open_devices(scene->devices, checks, false);
                          bool all_ok = true;
                          for (const auto& c : checks) {
                            std::cout << "  " << c.config << ": " << (c.ok ? "ok, " : "FAILED: ") << c.detail << "\n";

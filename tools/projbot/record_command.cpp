@@ -9,11 +9,11 @@
 #include <sstream>
 
 #include "commands.hpp"
-#include "devices.hpp"
 #include "interrupt.hpp"
 #include "progress.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/config/recording.hpp"
+#include "projbot/hardware/devices.hpp"
 #include "projbot/robot/localization.hpp"
 #include "rigs.hpp"
 #include "scene_setup.hpp"
@@ -31,7 +31,7 @@ class QuantisedCamera final : public alignment::RgbdCamera {
   alignment::RgbdFrame next() override {
     alignment::RgbdFrame f = inner->next();
     if (f.colour.rgba.empty())
-      throw DeviceError("the camera delivers no colour, and a fakenect dump holds depth and colour together");
+      throw hardware::DeviceError("the camera delivers no colour, and a fakenect dump holds depth and colour together");
     f.depth = alignment::kinect_quantised(std::move(f.depth));
     return f;
   }
@@ -144,14 +144,14 @@ const Command kRecord{
         throw cli::UsageError(*out + ": not empty; a recording needs a new folder");
       catch_interrupts();  // Ctrl-C: during set-up nothing is written; later, end the stop in progress, keep every stop
 
-      Devices devices;
+      hardware::Devices devices;
       config::Recording rec;
       rec.camera = "the twin's camera";
       bool robot = false;
       if (!args.flag("sim")) {
         config::DevicesConfig wanted = scene.devices;
         wanted.projector.reset();  // nothing is projected while recording
-        std::vector<DeviceCheck> checks;
+        std::vector<hardware::DeviceCheck> checks;
         devices = open_session_devices(wanted, checks, robot, false);  // a laser without a map: a mapping run
         for (const auto& c : checks)
           if (c.role == "camera") rec.camera = c.config;

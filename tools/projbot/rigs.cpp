@@ -75,11 +75,11 @@ namespace {
 // either, the config is incomplete (said before any device is opened).
 void check_laser(const config::DevicesConfig& d, bool laser_needs_map) {
   if (d.laser && !d.base)
-    throw DeviceError(
+    throw hardware::DeviceError(
         "devices.laser localises the configured base, and devices.base is not configured (the twin's robot "
         "localises on the twin's laser): configure the base, or leave the laser out");
   if (laser_needs_map && d.laser && d.laser->map.empty())
-    throw DeviceError(
+    throw hardware::DeviceError(
         "devices.laser localises the base against a map, and devices.laser.map names none: map the site "
         "(projbot slam --out-map DIR) and name DIR there");
 }
@@ -94,23 +94,24 @@ bool configured_robot(const config::DevicesConfig& d) {
                                     {"camera", d.camera.has_value()}})
     if (!there) missing += std::string(missing.empty() ? "" : " and ") + "devices." + name;
   if (!missing.empty())
-    throw DeviceError("a real robot needs its base, pan_tilt and camera configured together, and " + missing +
-                      (missing.find(" and ") != std::string::npos ? " are" : " is") +
-                      " not (the twin cannot stand in for part of a real robot); configure it, or run the twin with --sim");
+    throw hardware::DeviceError(
+        "a real robot needs its base, pan_tilt and camera configured together, and " + missing +
+        (missing.find(" and ") != std::string::npos ? " are" : " is") +
+        " not (the twin cannot stand in for part of a real robot); configure it, or run the twin with --sim");
   return true;
 }
 
-Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot,
-                             bool laser_needs_map) {
+hardware::Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<hardware::DeviceCheck>& checks,
+                                       bool& robot, bool laser_needs_map) {
   robot = false;
   if (!wanted.any()) return {};
   check_laser(wanted, laser_needs_map);
-  Devices devices = open_devices(wanted, checks, true);
+  hardware::Devices devices = hardware::open_devices(wanted, checks, true);
   robot = configured_robot(wanted);  // after opening: an absent device is named before a missing one
   return devices;
 }
 
-DeviceRig::DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, Devices& devices)
+DeviceRig::DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, hardware::Devices& devices)
     : map_(devices.laser && scene.devices.laser
                ? std::optional<robot::Localizer>(robot::Localizer::load(scene.devices.laser->map))
                : std::nullopt),

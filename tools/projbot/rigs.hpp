@@ -13,12 +13,12 @@
 #include <tuple>
 #include <vector>
 
-#include "devices.hpp"
 #include "projbot/alignment/freenect_source.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/config/recording.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
+#include "projbot/hardware/devices.hpp"
 #include "projbot/session/session.hpp"
 #include "projbot/twin/camera.hpp"
 #include "projbot/twin/world.hpp"
@@ -60,16 +60,16 @@ class TwinRig {
 
 /// Whether the config's devices make up the whole robot: a base, a pan-tilt and a camera, configured
 /// together (the session then drives them, and no twin). False when none of the base and pan-tilt is
-/// configured (the twin serves the robot). Throws DeviceError naming what is missing for part of a robot
+/// configured (the twin serves the robot). Throws hardware::DeviceError naming what is missing for part of a robot
 /// (the twin's camera cannot see where a real base went), and for a laser, which no session drives yet.
 bool configured_robot(const config::DevicesConfig& devices);
 
-/// The config's devices for a session, each opened and read once (the first that fails a DeviceError
+/// The config's devices for a session, each opened and read once (the first that fails a hardware::DeviceError
 /// naming it), then checked to make a whole robot or a camera alone (configured_robot): `robot` says which.
 /// None configured: no device, `robot` false. A laser needs a base, and a map unless `laser_needs_map` is
 /// false (record's mapping run).
-Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot,
-                             bool laser_needs_map = true);
+hardware::Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<hardware::DeviceCheck>& checks,
+                                       bool& robot, bool laser_needs_map = true);
 
 /// The configured devices serving the whole session: the base over ROS 2 topics (closing the loop on its
 /// odometry, started at the scene's robot.start), the PTU-D46 and the camera. No twin, so no truth.
@@ -79,7 +79,7 @@ class DeviceRig {
   /// laser, the base localises on it against the scene's devices.laser.map (without a map its scans are
   /// only recorded: a mapping run). Throws RobotError when the
   /// base sends no odometry, the laser no scan or the map cannot be read.
-  DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, Devices& devices);
+  DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, hardware::Devices& devices);
   session::Session& session() { return session_; }
   session::Dwell dwell(double dwell_s, bool lockstep);
   robot::Ros2Navigator& navigator() { return navigator_; }

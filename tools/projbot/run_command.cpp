@@ -13,7 +13,6 @@
 #include <thread>
 
 #include "commands.hpp"
-#include "devices.hpp"
 #include "interrupt.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/latest_value.hpp"
@@ -23,6 +22,7 @@
 #include "projbot/config/output_file.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
+#include "projbot/hardware/devices.hpp"
 #include "projbot/session/session.hpp"
 #include "projbot/twin/camera.hpp"
 #include "projbot/twin/world.hpp"
@@ -176,7 +176,8 @@ class RunObserver final : public session::StopObserver {
 // The robot thread: the session at each stop of the tour (the twin's robot, the configured camera or the
 // twin's), or at each stop of a recording (`replay`, in lockstep, checked by `check`).
 void drive(const config::Scene& scene, const RunOptions& o, SceneTrackers& trackers, alignment::LatestValue<RobotState>& state,
-           Handoffs& handoffs, const std::stop_token& stop, Devices& devices, const config::Recording* replay, PoseCheck* check) {
+           Handoffs& handoffs, const std::stop_token& stop, hardware::Devices& devices, const config::Recording* replay,
+           PoseCheck* check) {
   const auto tour = [&](session::Session& session, const session::Dwell& dwell, twin::Twin* twin, int visits) {
     RunObserver observer(scene, state, handoffs, twin, check);
     for (int v = 0; v < visits && !stop.stop_requested(); ++v) session.visit(v, trackers.workers, dwell, observer, stop);
@@ -199,7 +200,7 @@ void drive(const config::Scene& scene, const RunOptions& o, SceneTrackers& track
 
 // Without --sim: the devices the config names, opened and read once (each absent one an error naming it);
 // the twin serves the rest. A config naming none runs the twin and says so.
-Devices open_configured(const config::Scene& scene, bool headless) {
+hardware::Devices open_configured(const config::Scene& scene, bool headless) {
   config::DevicesConfig wanted = scene.devices;
   if (headless && wanted.projector) {  // drawn offscreen: no monitor to check
     std::cout << "devices.projector is not used with --headless" << std::endl;
@@ -213,9 +214,10 @@ Devices open_configured(const config::Scene& scene, bool headless) {
           << std::endl;
     return {};
   }
-  std::vector<DeviceCheck> checks;
+  std::vector<hardware::DeviceCheck> checks;
   bool robot = false;
-  Devices devices = open_session_devices(wanted, checks, robot);  // an absent device, part of a robot or a laser: refused
+  hardware::Devices devices =
+      open_session_devices(wanted, checks, robot);  // an absent device, part of a robot or a laser: refused
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
   if (robot)
     std::cout << "the configured base, pan-tilt and camera serve the session"
@@ -308,7 +310,8 @@ const Command kRun{
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
       std::optional<PoseCheck> check;
       if (recording) check.emplace(recording->folder() / "poses.csv");
-      Devices devices = args.flag("sim") || recording ? Devices{} : open_configured(scene, args.flag("headless"));
+      hardware::Devices devices =
+          args.flag("sim") || recording ? hardware::Devices{} : open_configured(scene, args.flag("headless"));
       RunOptions o;
       o.visits = args.get_int("visits", 0, 1, 1000);
       o.dwell_s = args.get_double("dwell", 4.0);

@@ -1,4 +1,4 @@
-#include "devices.hpp"
+#include "projbot/hardware/devices.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "projbot/engine/renderer.hpp"
 
-namespace projbot::tools {
+namespace projbot::hardware {
 namespace {
 
 // "640x480 depth, 87% valid, 0.62-3.90 m": what a first frame says about a camera that works.
@@ -126,4 +126,4 @@ Devices open_devices(const config::DevicesConfig& config, std::vector<DeviceChec
   return out;
 }
 
-}  // namespace projbot::tools
+}  // namespace projbot::hardware

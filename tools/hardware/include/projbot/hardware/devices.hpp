@@ -16,7 +16,7 @@
 #include "projbot/robot/ptu_d46.hpp"
 #include "projbot/robot/ros2_base.hpp"
 
-namespace projbot::tools {
+namespace projbot::hardware {
 
 /// A configured device that could not be opened or read: "devices.camera (freenect #0): not found ...".
 class DeviceError : public std::runtime_error {
@@ -45,4 +45,4 @@ struct DeviceCheck {
 /// first failure; otherwise every device is tried and `checks` says how each went.
 Devices open_devices(const config::DevicesConfig& config, std::vector<DeviceCheck>& checks, bool stop_at_first);
 
-}  // namespace projbot::tools
+}  // namespace projbot::hardware
