@@ -34,9 +34,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A target the robot projects onto at a stop: the visited one, or a neighbour it expects in the
-// projector's view there (issue 11, item 5).
-struct LitTarget {
+// What the render thread draws at a stop (session::LitTarget, as the render thread needs it): the visited
+// target or a neighbour expected in the projector's view there (issue 11, item 5), with the twin's truth.
+struct DrawnTarget {
   int target = -1;  // scene index: its worker and draw item
   // The twin's truth, so the render thread can measure each frame at its display time:
   int target_visit = 0;                                        // this target's n-th visit (its motion script); 0: still
@@ -46,7 +46,7 @@ struct LitTarget {
 // What the robot thread tells the render thread: which targets the robot is projecting onto (none while
 // it drives; the visited one first) and since when; poses captured before that belong to an earlier stop.
 struct RobotState {
-  std::vector<LitTarget> lit;
+  std::vector<DrawnTarget> lit;
   double since_s = 0.0;
   int visit = 0;
   bool done = false;
@@ -93,7 +93,7 @@ struct DisplayErrors {
 
 // The mean marker error of a target drawn at T_camera_target, against the twin's truth at display_s.
 // Returns NaN for a target without markers; sets `moving` when its motion script runs at that instant.
-double marker_error_mm(const config::TargetConfig& target, const RobotState& robot, const LitTarget& lit,
+double marker_error_mm(const config::TargetConfig& target, const RobotState& robot, const DrawnTarget& lit,
                        const Eigen::Matrix4d& T_camera_target, double display_s, bool& moving) {
   const double t = display_s - robot.since_s;
   const config::TargetMotion* m = target.motion_on(lit.target_visit);
@@ -142,7 +142,7 @@ class RunObserver final : public session::StopObserver {
                 << " rejected), odometry alone " << std::setprecision(0)
                 << 1000.0 * robot::distance_m(stop.drive.estimate, stop.drive.odometry) << " mm away";
     std::cout << std::endl;
-    std::vector<LitTarget> lit;
+    std::vector<DrawnTarget> lit;
     for (const session::LitTarget& l : stop.lit)
       lit.push_back({l.target, l.target == stop.target ? stop.target_visit : 0,
                      twin_ ? twin_->home(twin_index(l.target)) : Eigen::Matrix4d::Identity()});
@@ -369,7 +369,7 @@ const Command kRun{
       };
       std::vector<Row> rows;
       struct Drawn {  // a target drawn in this frame: from which capture, for which display time, where
-        const LitTarget* lit;
+        const DrawnTarget* lit;
         double capture_s, display_s;
         Eigen::Matrix4d T_camera_target;
       };
@@ -394,7 +394,7 @@ const Command kRun{
             stale_before_s = config::steady_now_s();  // ...and, once it is back, only what it sees from then on
             return;
           }
-          for (const LitTarget& lit : robot.lit) {
+          for (const DrawnTarget& lit : robot.lit) {
             alignment::PoseSample pose;
             auto& worker = *workers[static_cast<std::size_t>(lit.target)];
             if (!worker.latest(pose) || pose.lost || pose.capture_time_s < std::max(robot.since_s, stale_before_s))

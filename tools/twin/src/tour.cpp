@@ -185,8 +185,8 @@ struct InFlight {
   double ready_s = 0.0;
 };
 
-// The tour's simulated clock as its camera and its lanes share it: how long the camera's last frame took
-// to render (wall time; a lane starts on a frame that long after its exposure, the twin's rendering
+// The tour's simulated clock as its camera and its trackers share it: how long the camera's last frame took
+// to render (wall time; a tracker starts on a frame that long after its exposure, the twin's rendering
 // standing in for the camera's readout), unless options.processing_ms fixes each frame's whole
 // processing time.
 struct SimClock {
@@ -197,12 +197,12 @@ struct SimClock {
 // One target's tracker worker on the tour's simulated clock: what Session::visit hands a lit target's
 // frames to in the tour, as `projbot run` hands them to alignment::TrackerWorker. The stop's first frame
 // is its acquisition (the mode's, acquire()). Later frames (tracking mode) are tracked by the follower,
-// the policy the engine's worker runs: a frame that comes while the lane is still busy with an earlier
+// the policy the engine's worker runs: a frame that comes while the tracker is still busy with an earlier
 // one is dropped (a worker always takes the newest), and a result is ready on the simulated clock when
 // its step ends: after the frame's capture, its measured wall time, or processing_ms for both together.
-class Lane final : public alignment::PoseTracker {
+class SimClockTracker final : public alignment::PoseTracker {
  public:
-  Lane(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const SimClock& clock)
+  SimClockTracker(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const SimClock& clock)
       : mode_(mode), follower_(follower), twin_(twin), clock_(clock) {}
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const alignment::Footing& footing,
                          std::shared_ptr<const assets::Image> colour) override;
@@ -236,8 +236,8 @@ class Lane final : public alignment::PoseTracker {
   int tracked_ = 0;
 };
 
-void Lane::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const alignment::Footing& footing,
-                             std::shared_ptr<const assets::Image> colour) {
+void SimClockTracker::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const alignment::Footing& footing,
+                                        std::shared_ptr<const assets::Image> colour) {
   start_ = Start{T_camera_target, footing, std::move(colour)};
   acquired_ = Acquired{};
   in_flight_.clear();
@@ -245,7 +245,7 @@ void Lane::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const align
   tracked_ = 0;
 }
 
-std::optional<alignment::PoseSample> Lane::track(std::shared_ptr<const alignment::DepthImage> frame) {
+std::optional<alignment::PoseSample> SimClockTracker::track(std::shared_ptr<const alignment::DepthImage> frame) {
   if (start_) {
     acquired_ = acquire(mode_, follower_, twin_, *frame, start_->T_camera_target, start_->footing, start_->colour.get());
     start_.reset();
@@ -255,7 +255,7 @@ std::optional<alignment::PoseSample> Lane::track(std::shared_ptr<const alignment
     return s;
   }
   const double t_k = frame->capture_time_s;
-  // Not rendered (nothing is tracked in this mode, or every lane was busy), or this one is still busy
+  // Not rendered (nothing is tracked in this mode, or every tracker was busy), or this one is still busy
   // when the next frame comes: dropped.
   if (frame->width == 0 || free_s_ > t_k + 1.0 / kCameraHz) return std::nullopt;
   const auto t0 = Clock::now();
@@ -269,7 +269,7 @@ std::optional<alignment::PoseSample> Lane::track(std::shared_ptr<const alignment
   return f.sample;
 }
 
-std::vector<alignment::PoseSample> Lane::ready_by(double t_s) {
+std::vector<alignment::PoseSample> SimClockTracker::ready_by(double t_s) {
   std::vector<alignment::PoseSample> out;
   while (!in_flight_.empty() && in_flight_.front().ready_s <= t_s + 1e-9) {
     if (in_flight_.front().sample) out.push_back(*in_flight_.front().sample);
@@ -281,7 +281,7 @@ std::vector<alignment::PoseSample> Lane::ready_by(double t_s) {
 // The twin's RGB-D camera on the tour's simulated clock, as Session::visit reads one. A stop's first
 // frame is the arrival's capture: depth, and the colour registered to it unless the mode is odometry
 // (the paper's set-up has none). Then, in tracking mode, a frame every 1/30 s, the visited target moved
-// by its motion script to the frame's instant first; it is rendered only when a lit target's lane will
+// by its motion script to the frame's instant first; it is rendered only when a lit target's tracker will
 // take it (one is free before the next frame comes), else its depth is empty. In the other modes nothing
 // is tracked while the robot dwells, and nothing is rendered.
 class TourCamera final : public alignment::RgbdCamera {
@@ -293,7 +293,7 @@ class TourCamera final : public alignment::RgbdCamera {
     std::uint32_t noise_seed = 0;                                  // the arrival's; frame k's is noise_seed + k
     bool colour = true, tracking = true;
     bool present = true;                 // the target was there at arrival
-    std::function<bool(double)> wanted;  // whether a lit target's lane takes a frame arriving at t_s
+    std::function<bool(double)> wanted;  // whether a lit target's tracker takes a frame arriving at t_s
   };
   TourCamera(Twin& twin, SimClock& clock) : twin_(twin), clock_(clock) {}
   void at_stop(Stop stop) {
@@ -414,7 +414,7 @@ std::filesystem::path frame_path(const TourOptions& options, const VisitReport& 
 }
 
 // A neighbour at arrival: acquired from the stop's capture (and colour) from its own Eq. 1 guess, as
-// the visited target is (its lane's acquisition), and its error at the markers measured.
+// the visited target is (its tracker's acquisition), and its error at the markers measured.
 NeighbourLight neighbour_light(const Twin& twin, const Acquired& a, std::size_t target, const session::LitTarget& n,
                                const robot::HeadPoses& truth, const ProjectorModels& models) {
   const TwinTarget& t = twin.targets()[target];
@@ -468,7 +468,7 @@ alignment::WorkerConfig follower_config(const TourOptions& options) {
 }
 
 // What every stop of a tour shares: the twin, its camera on the simulated clock, and a follower and its
-// lane per target (the follower's aligner acquires at each stop, its policy tracks while projecting: the
+// tracker per target (the follower's aligner acquires at each stop, its policy tracks while projecting: the
 // same one the live engine's TrackerWorker runs).
 struct Tour {
   Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Twin& t);
@@ -480,8 +480,8 @@ struct Tour {
   SimClock clock;
   TourCamera camera{twin, clock};
   std::vector<alignment::TargetFollower> followers;       // by index into Twin::targets()
-  std::vector<Lane> lanes;                                // likewise
-  std::vector<alignment::PoseTracker*> by_scene;          // the lanes by scene index, for Session::visit
+  std::vector<SimClockTracker> trackers;                  // likewise
+  std::vector<alignment::PoseTracker*> by_scene;          // the trackers by scene index, for Session::visit
   std::unique_ptr<engine::RenderTarget> projector_frame;  // with --frames
   std::unique_ptr<SpectatorView> spectator;
 };
@@ -492,12 +492,12 @@ Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Tw
   const alignment::WorkerConfig follow = follower_config(options);
   followers.reserve(twin.targets().size());
   for (const auto& target : twin.targets()) followers.emplace_back(target.cloud, twin.camera(), follow);
-  lanes.reserve(followers.size());
-  for (auto& f : followers) lanes.emplace_back(options.mode, f, twin, clock);
+  trackers.reserve(followers.size());
+  for (auto& f : followers) trackers.emplace_back(options.mode, f, twin, clock);
   by_scene.assign(scene.targets.size(), nullptr);
   for (const session::Target& target : twin.session_targets())
     by_scene[static_cast<std::size_t>(target.scene_index)] =
-        &lanes[twin.target_index(scene.targets[static_cast<std::size_t>(target.scene_index)].name)];
+        &trackers[twin.target_index(scene.targets[static_cast<std::size_t>(target.scene_index)].name)];
   if (!options.frames_dir.empty()) {
     std::filesystem::create_directories(options.frames_dir);
     projector_frame = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
@@ -575,7 +575,7 @@ alignment::RgbdCamera& TourStop::arrived(const session::Stop& at) {
     lit_.push_back(tour_.twin.target_index(tour_.scene.targets[static_cast<std::size_t>(l.target)].name));
   noise_seed_ = static_cast<std::uint32_t>(tour_.options.seed * 100003 + static_cast<std::uint64_t>(visit_) * 1009);
   const auto wanted = [this](double t_s) {
-    return std::any_of(lit_.begin(), lit_.end(), [&](std::size_t j) { return tour_.lanes[j].free_at(t_s); });
+    return std::any_of(lit_.begin(), lit_.end(), [&](std::size_t j) { return tour_.trackers[j].free_at(t_s); });
   };
   tour_.camera.at_stop({target_index_, report.target_visit, truth_.T_world_camera.matrix(), noise_seed_,
                         tour_.options.mode != TourMode::odometry, tracking, report.target_present, wanted});
@@ -583,7 +583,7 @@ alignment::RgbdCamera& TourStop::arrived(const session::Stop& at) {
 }
 
 void TourStop::frame(const session::Stop& at, int k, const alignment::RgbdFrame& f,
-                     const std::vector<std::optional<alignment::PoseSample>>& /*samples: ready later, see Lane*/) {
+                     const std::vector<std::optional<alignment::PoseSample>>& /*samples: ready later, see SimClockTracker*/) {
   if (k == 0) at_arrival(at, f);
   if (!dwelling_) return;
   // The projector frames that start before the next camera frame is taken.
@@ -598,12 +598,12 @@ void TourStop::frame(const session::Stop& at, int k, const alignment::RgbdFrame&
   if (next_ > frames_) end_dwell();
 }
 
-// Capture, Eq. 1, acquisition (the lanes', from the session), Eq. 2, and the errors at the markers.
+// Capture, Eq. 1, acquisition (the trackers', from the session), Eq. 2, and the errors at the markers.
 void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f) {
   const TwinTarget& target = tour_.twin.targets()[target_index_];
   report.capture_ms = tour_.camera.arrival_ms();
   std::tie(report.guess_error_cm, report.guess_error_deg) = guess_error(truth_, target, at.lit.front().T_camera_target_guess);
-  const Acquired& a = tour_.lanes[target_index_].acquired();
+  const Acquired& a = tour_.trackers[target_index_].acquired();
   report.icp = a.icp;
   report.free_space = a.free_space;
   report.projected = a.projected;
@@ -622,7 +622,7 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
   report.mean_mm = e.mean_mm;
   report.max_mm = e.max_mm;
   for (std::size_t k = 1; k < at.lit.size(); ++k)
-    lights_.push_back(neighbour_light(tour_.twin, tour_.lanes[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, tour_.models));
+    lights_.push_back(neighbour_light(tour_.twin, tour_.trackers[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, tour_.models));
   if (tour_.projector_frame) write_pictures(f.colour);
 
   dwell_.emplace(DwellContext{tour_.twin, target_index_, tour_.models, truth_, tour_.options, lights_});
@@ -675,12 +675,12 @@ void TourStop::project(double start_s) {
   const DwellContext& c = *dwell_;
   if (tour_.options.mode == TourMode::tracking) {
     for (std::size_t k = 0; k < lit_.size(); ++k)
-      for (const auto& sample : tour_.lanes[lit_[k]].ready_by(start_s)) {
+      for (const auto& sample : tour_.trackers[lit_[k]].ready_by(start_s)) {
         bool& shown = k == 0 ? shown_ : lights_[k - 1].shown;
         shown = !sample.lost;
         if (shown) (k == 0 ? drawn_ : lights_[k - 1].drawn) = sample;
       }
-    const double track_ms = tour_.lanes[target_index_].track_ms();  // the visited target's frames tracked since the last
+    const double track_ms = tour_.trackers[target_index_].track_ms();  // the visited target's frames tracked since the last
     if (report.first_light_s < 0.0) wall_to_light_ms_ += track_ms - seen_track_ms_;
     seen_track_ms_ = track_ms;
   }
@@ -708,15 +708,15 @@ void TourStop::project(double start_s) {
 // The dwell's figures once its last projector frame is measured.
 void TourStop::end_dwell() {
   const bool tracking = tour_.options.mode == TourMode::tracking;
-  Lane& lane = tour_.lanes[target_index_];
+  SimClockTracker& tracker = tour_.trackers[target_index_];
   report.shown_at_end = shown_;
   report.T_camera_target_at_end = drawn_.T_camera_target;
-  report.track_ms_mean = tracking && lane.tracked() > 0 ? lane.track_ms() / lane.tracked() : 0.0;
-  report.tracked_frames = lane.tracked();
-  report.dropped_frames = tour_.camera.frames() - lane.tracked();
+  report.track_ms_mean = tracking && tracker.tracked() > 0 ? tracker.track_ms() / tracker.tracked() : 0.0;
+  report.tracked_frames = tracker.tracked();
+  report.dropped_frames = tour_.camera.frames() - tracker.tracked();
   if (tracking) {
-    report.search = lane.follower().search_stats();
-    report.second_pass_frames = lane.follower().second_passes();
+    report.search = tracker.follower().search_stats();
+    report.second_pass_frames = tracker.follower().second_passes();
   }
   report.reconverge_s = !ever_over_ ? 0.0 : back_under_ >= 0.0 ? std::max(0.0, back_under_ - motion_end_s_) : -1.0;
   summarise_timeline(report);
@@ -759,7 +759,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   Tour tour(scene, options, renderer, twin);
   // The stop sequence (drive, aim, Eq. 1 for the visited target and its neighbours, capture, acquire,
   // track) is the session's, as in `projbot run`; the twin serves its base, pan-tilt and camera, and
-  // the tour's lanes track on the simulated clock.
+  // the tour's trackers track on the simulated clock.
   session::Session session(scene, twin.session_targets(), twin.robot(), twin.pan_tilt());
 
   TourReport report;
