@@ -176,11 +176,11 @@ class RunObserver final : public session::StopObserver {
 // The robot thread: the session at each stop of the tour (the twin's robot, the configured camera or the
 // twin's), or at each stop of a recording (`replay`, in lockstep, checked by `check`).
 void drive(const config::Scene& scene, const RunOptions& o, SceneTrackers& trackers, alignment::LatestValue<RobotState>& state,
-           Handoffs& handoffs, const std::stop_token& stop, hardware::Devices& devices, const config::Recording* replay,
+           Handoffs& handoffs, const std::stop_token& cancel, hardware::Devices& devices, const config::Recording* replay,
            PoseCheck* check) {
   const auto tour = [&](session::Session& session, const session::Dwell& dwell, twin::Twin* twin, int visits) {
     RunObserver observer(scene, state, handoffs, twin, check);
-    for (int v = 0; v < visits && !stop.stop_requested(); ++v) session.visit(v, trackers.workers, dwell, observer, stop);
+    for (int v = 0; v < visits && !cancel.stop_requested(); ++v) session.visit(v, trackers.workers, dwell, observer, cancel);
   };
   const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
   if (devices.base) {  // the configured robot: no twin
@@ -351,9 +351,10 @@ const Command kRun{
       std::exception_ptr robot_error;
       std::atomic<bool> robot_done{false};
       Handoffs handoffs;  // the robot thread's until it is joined
-      std::jthread robot_thread([&](std::stop_token stop) {
+      std::jthread robot_thread([&](std::stop_token cancel) {
         try {
-          drive(scene, o, trackers, state, handoffs, stop, devices, recording ? &*recording : nullptr, check ? &*check : nullptr);
+          drive(scene, o, trackers, state, handoffs, cancel, devices, recording ? &*recording : nullptr,
+                check ? &*check : nullptr);
         } catch (...) {
           robot_error = std::current_exception();
         }

@@ -107,7 +107,7 @@ Stop Session::arrive(int visit) {
 }
 
 Stop Session::visit(int visit, const std::vector<alignment::PoseTracker*>& workers, const Dwell& dwell, StopObserver& observer,
-                    const std::stop_token& stop) {
+                    const std::stop_token& cancel) {
   observer.driving(visit);
   Stop at = arrive(visit);
   std::vector<alignment::PoseTracker*> lit;
@@ -142,7 +142,7 @@ Stop Session::visit(int visit, const std::vector<alignment::PoseTracker*>& worke
       else
         w->submit(depth);
     observer.frame(at, k, *frame, samples);
-    if (stop.stop_requested() || dwell.over(at, k + 1, config::steady_now_s() - since)) break;
+    if (cancel.stop_requested() || dwell.over(at, k + 1, config::steady_now_s() - since)) break;
     frame = read();
   }
   observer.left(at);

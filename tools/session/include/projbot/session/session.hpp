@@ -107,10 +107,10 @@ class Session {
   Stop arrive(int visit);
   /// The whole `visit`-th stop: arrive, give each lit target's tracker (`workers`, by scene index) its
   /// guess, footing and the colour of the stop's first frame, then hand the camera's frames to them until
-  /// the dwell is over or `stop` is requested. Throws SessionError for a lit target without a worker, and
-  /// what a device throws.
+  /// the dwell is over or `cancel` is requested (Ctrl-C, the window closed). Throws SessionError for a
+  /// lit target without a worker, and what a device throws.
   Stop visit(int visit, const std::vector<alignment::PoseTracker*>& workers, const Dwell& dwell, StopObserver& observer,
-             const std::stop_token& stop);
+             const std::stop_token& cancel);
   /// The targets besides the visited one that a robot with this believed head expects to share the
   /// view: each one's surveyed middle 0.3-5 m in front of the camera, inside the depth camera's image
   /// and the projector's. Nearest first.
