@@ -163,85 +163,96 @@ void print_table(const TourReport& report, std::ostream& out) {
       << (report.interrupted ? " (interrupted: the finished visits only)" : "") << ".\n";
 }
 
+namespace {
+
+nlohmann::json markers_json(const VisitReport& v) {
+  nlohmann::json markers = nlohmann::json::array();
+  for (const auto& m : v.markers)
+    markers.push_back({{"model_m", {m.marker_m.x(), m.marker_m.y(), m.marker_m.z()}},
+                       {"pixel", {m.pixel.x(), m.pixel.y()}},
+                       {"in_image", m.in_image},
+                       {"landed", m.landed},
+                       {"error_mm", m.error_mm}});
+  return markers;
+}
+
+nlohmann::json timeline_json(const VisitReport& v) {
+  nlohmann::json timeline = nlohmann::json::array();
+  for (const auto& s : v.timeline)
+    timeline.push_back({{"t_s", s.t_s},
+                        {"mean_mm", finite_or_null(s.mean_mm)},
+                        {"max_mm", finite_or_null(s.max_mm)},
+                        {"moving", s.moving},
+                        {"shown", s.shown},
+                        {"pose_age_ms", s.age_ms}});
+  return timeline;
+}
+
+// One visit's object: a data table, field by field.
+nlohmann::json visit_json(const VisitReport& v) {
+  return {
+      {"visit", v.visit},
+      {"target", v.target},
+      {"target_visit", v.target_visit},
+      {"projected", v.projected},
+      {"T_projector_target_true", matrix_json(v.T_projector_target_true)},
+      {"T_projector_target_estimated", matrix_json(v.T_projector_target_estimated)},
+      {"markers", markers_json(v)},
+      {"mean_mm", finite_or_null(v.mean_mm)},
+      {"max_mm", finite_or_null(v.max_mm)},
+      {"icp",
+       {{"converged", v.icp.converged},
+        {"inlier_ratio", v.icp.inlier_ratio},
+        {"rmse_mm", finite_or_null(v.icp.rmse_mm)},
+        {"iterations", v.icp.iterations},
+        {"reinitialised", v.icp.reinitialised},
+        {"footing_height_error_mm", v.icp.footing_height_error_mm},
+        {"footing_tilt_deg", v.icp.footing_tilt_deg},
+        {"colour_shift_mm", v.icp.colour_shift_mm},
+        {"colour_agreement", finite_or_null(v.icp.colour_agreement)}}},
+      {"free_space",
+       {{"predicted_px", v.free_space.predicted},
+        {"behind_px", v.free_space.behind},
+        {"in_front_px", v.free_space.in_front},
+        {"behind_ratio", v.free_space.behind_ratio()}}},
+      {"view", view_json(v.view)},
+      {"robot",
+       {{"base_error_cm", v.base_error_cm},
+        {"base_error_deg", v.base_error_deg},
+        {"odometry_error_cm", v.odometry_error_cm},
+        {"guess_error_cm", v.guess_error_cm},
+        {"guess_error_deg", v.guess_error_deg},
+        {"drive_s", v.drive_s}}},
+      {"timings_ms",
+       {{"capture", v.capture_ms}, {"align", v.align_ms}, {"projector_frame", v.frame_ms}, {"track_per_frame", v.track_ms_mean}}},
+      {"tracking", {{"frames", v.tracked_frames}, {"dropped_frames", v.dropped_frames}, {"second_passes", v.second_pass_frames}}},
+      {"moved", v.moved},
+      {"max_mean_mm_while_moving", v.max_mm_moving},
+      {"while_moving_mm", {{"mean", finite_or_null(v.moving_mean_mm)}, {"p95", finite_or_null(v.moving_p95_mm)}}},
+      {"blank_frames_while_moving", v.moving_blank_frames},
+      {"recovery_s", v.recovery_s},
+      {"still_mean_mm", v.still_mean_mm},
+      {"pose_age_at_display_ms", {{"p50", finite_or_null(v.age_p50_ms)}, {"p95", finite_or_null(v.age_p95_ms)}}},
+      {"reconverge_s", v.reconverge_s},
+      {"target_present", v.target_present},
+      {"lit_frames", v.lit_frames},
+      {"first_light_s", v.first_light_s},
+      {"first_light_wall_ms", v.first_light_wall_ms},
+      {"search",
+       {{"attempts", v.search.attempts},
+        {"total_ms", v.search.total_ms},
+        {"max_attempt_ms", v.search.max_attempt_ms},
+        {"frames_waited", v.search.frames_waited}}},
+      {"blank_after_removal_s", v.blank_after_removal_s},
+      {"neighbours", neighbours_json(v.neighbours)},
+      {"timeline", timeline_json(v)}};
+}
+
+}  // namespace
+
 void write_report_json(const TourReport& report, const std::filesystem::path& path) {
   nlohmann::json visits = nlohmann::json::array();
-  for (const auto& v : report.visits) {
-    nlohmann::json markers = nlohmann::json::array();
-    for (const auto& m : v.markers)
-      markers.push_back({{"model_m", {m.marker_m.x(), m.marker_m.y(), m.marker_m.z()}},
-                         {"pixel", {m.pixel.x(), m.pixel.y()}},
-                         {"in_image", m.in_image},
-                         {"landed", m.landed},
-                         {"error_mm", m.error_mm}});
-    nlohmann::json timeline = nlohmann::json::array();
-    for (const auto& s : v.timeline)
-      timeline.push_back({{"t_s", s.t_s},
-                          {"mean_mm", finite_or_null(s.mean_mm)},
-                          {"max_mm", finite_or_null(s.max_mm)},
-                          {"moving", s.moving},
-                          {"shown", s.shown},
-                          {"pose_age_ms", s.age_ms}});
-    visits.push_back(
-        {{"visit", v.visit},
-         {"target", v.target},
-         {"target_visit", v.target_visit},
-         {"projected", v.projected},
-         {"T_projector_target_true", matrix_json(v.T_projector_target_true)},
-         {"T_projector_target_estimated", matrix_json(v.T_projector_target_estimated)},
-         {"markers", markers},
-         {"mean_mm", finite_or_null(v.mean_mm)},
-         {"max_mm", finite_or_null(v.max_mm)},
-         {"icp",
-          {{"converged", v.icp.converged},
-           {"inlier_ratio", v.icp.inlier_ratio},
-           {"rmse_mm", finite_or_null(v.icp.rmse_mm)},
-           {"iterations", v.icp.iterations},
-           {"reinitialised", v.icp.reinitialised},
-           {"footing_height_error_mm", v.icp.footing_height_error_mm},
-           {"footing_tilt_deg", v.icp.footing_tilt_deg},
-           {"colour_shift_mm", v.icp.colour_shift_mm},
-           {"colour_agreement", finite_or_null(v.icp.colour_agreement)}}},
-         {"free_space",
-          {{"predicted_px", v.free_space.predicted},
-           {"behind_px", v.free_space.behind},
-           {"in_front_px", v.free_space.in_front},
-           {"behind_ratio", v.free_space.behind_ratio()}}},
-         {"view", view_json(v.view)},
-         {"robot",
-          {{"base_error_cm", v.base_error_cm},
-           {"base_error_deg", v.base_error_deg},
-           {"odometry_error_cm", v.odometry_error_cm},
-           {"guess_error_cm", v.guess_error_cm},
-           {"guess_error_deg", v.guess_error_deg},
-           {"drive_s", v.drive_s}}},
-         {"timings_ms",
-          {{"capture", v.capture_ms},
-           {"align", v.align_ms},
-           {"projector_frame", v.frame_ms},
-           {"track_per_frame", v.track_ms_mean}}},
-         {"tracking",
-          {{"frames", v.tracked_frames}, {"dropped_frames", v.dropped_frames}, {"second_passes", v.second_pass_frames}}},
-         {"moved", v.moved},
-         {"max_mean_mm_while_moving", v.max_mm_moving},
-         {"while_moving_mm", {{"mean", finite_or_null(v.moving_mean_mm)}, {"p95", finite_or_null(v.moving_p95_mm)}}},
-         {"blank_frames_while_moving", v.moving_blank_frames},
-         {"recovery_s", v.recovery_s},
-         {"still_mean_mm", v.still_mean_mm},
-         {"pose_age_at_display_ms", {{"p50", finite_or_null(v.age_p50_ms)}, {"p95", finite_or_null(v.age_p95_ms)}}},
-         {"reconverge_s", v.reconverge_s},
-         {"target_present", v.target_present},
-         {"lit_frames", v.lit_frames},
-         {"first_light_s", v.first_light_s},
-         {"first_light_wall_ms", v.first_light_wall_ms},
-         {"search",
-          {{"attempts", v.search.attempts},
-           {"total_ms", v.search.total_ms},
-           {"max_attempt_ms", v.search.max_attempt_ms},
-           {"frames_waited", v.search.frames_waited}}},
-         {"blank_after_removal_s", v.blank_after_removal_s},
-         {"neighbours", neighbours_json(v.neighbours)},
-         {"timeline", timeline}});
-  }
+  for (const auto& v : report.visits) visits.push_back(visit_json(v));
   const auto& k = report.projector;
   const nlohmann::json out = {
       {"mode", to_string(report.mode)},
