@@ -516,6 +516,124 @@ void validate_projector(const ProjectorConfig& p, std::string_view where) {
 
 namespace {
 
+// `room:`: its size, wall height and obstacles.
+void read_room(MapReader& r, const std::string& file, Scene& scene) {
+  YAML::Node room = r.child("room", false);
+  if (!room) return;
+  MapReader m(room, "room", file);
+  scene.room.width_m = m.get<double>("width", 0.0, true);
+  scene.room.depth_m = m.get<double>("depth", 0.0, true);
+  if (!(scene.room.width_m > 0.5) || !(scene.room.depth_m > 0.5) || scene.room.width_m > 200 || scene.room.depth_m > 200)
+    m.fail(room, "room", "width and depth must be 0.5..200 m");
+  scene.room.wall_height_m = m.get<double>("wall_height", scene.room.wall_height_m);
+  if (!(scene.room.wall_height_m >= 0.1 && scene.room.wall_height_m <= 50.0))
+    m.fail(room["wall_height"], "room.wall_height", "must be 0.1..50 m");
+  if (YAML::Node obs = m.child("obstacles", false)) {
+    if (!obs.IsSequence()) m.fail(obs, "room.obstacles", "expected a list of [x0, y0, x1, y1]");
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      const auto v = m.numbers(obs[i], "room.obstacles[" + std::to_string(i) + "]", 4);
+      if (!(v[0] < v[2]) || !(v[1] < v[3]))
+        m.fail(obs[i], "room.obstacles[" + std::to_string(i) + "]", "need x0 < x1 and y0 < y1");
+      scene.room.obstacles.push_back({v[0], v[1], v[2], v[3]});
+    }
+  }
+  m.reject_unknown();
+}
+
+// A target's `markers:` and `motion:` (one scripted move, or a list of them, one per visit at most).
+void read_markers_and_motions(MapReader& t, const std::string& path, const std::string& file, TargetConfig& target) {
+  if (YAML::Node mk = t.child("markers", false)) {
+    if (!mk.IsSequence() || mk.size() == 0) t.fail(mk, path + ".markers", "expected a non-empty list of [x, y, z]");
+    for (std::size_t k = 0; k < mk.size(); ++k)
+      target.markers_m.push_back(t.vector3(mk[k], path + ".markers[" + std::to_string(k) + "]"));
+  }
+  if (YAML::Node mo = t.child("motion", false)) {
+    const bool list = mo.IsSequence();
+    for (std::size_t k = 0; k < (list ? mo.size() : 1); ++k) {
+      const std::string where = path + ".motion" + (list ? "[" + std::to_string(k) + "]" : "");
+      TargetMotion motion = read_motion(list ? mo[k] : mo, where, file);
+      if (target.motion_on(motion.visit))
+        t.fail(list ? mo[k] : mo, where, "visit " + std::to_string(motion.visit) + " already has a motion");
+      target.motions.push_back(motion);
+    }
+  }
+}
+
+// One entry of `targets:` (`names` so far: a duplicate is refused).
+TargetConfig read_target(const YAML::Node& node, const std::string& path, const std::string& file,
+                         const std::filesystem::path& base, const Scene& scene, std::set<std::string>& names) {
+  MapReader t(node, path, file);
+  TargetConfig target;
+  target.name = t.get<std::string>("name", "", true);
+  if (target.name.empty()) t.fail(node, path + ".name", "must not be empty");
+  if (!names.insert(target.name).second) t.fail(node, path + ".name", "duplicate target name '" + target.name + "'");
+  read_model_ref(t, node, path, base, target.model, target.scale, target.recenter);
+  target.present = t.get<bool>("present", true);
+  target.support = read_support(t, path + ".support");
+  target.T_projector_target = read_pose(t, path + ".pose");
+  if (t.has("world_pose")) target.T_world_target = read_pose(t, path + ".world_pose", "world_pose");
+  if (t.has("map_pose")) {
+    if (!target.T_world_target) t.fail(node["map_pose"], path + ".map_pose", "needs world_pose too");
+    target.T_map_target = read_pose(t, path + ".map_pose", "map_pose");
+  }
+  if (YAML::Node st = t.child("stop", false)) {
+    target.stop = t.vector3(st, path + ".stop");
+    target.stop->z() *= std::numbers::pi / 180.0;
+    if (const std::string why = place_problem(scene.room, target.stop->x(), target.stop->y()); !why.empty())
+      t.fail(st, path + ".stop", "the robot's stop for '" + target.name + "' " + why);
+  }
+  read_markers_and_motions(t, path, file, target);
+  t.reject_unknown();
+  return target;
+}
+
+// `targets:`, each with a pose or a world pose.
+void read_targets(MapReader& r, const std::string& file, const std::filesystem::path& base, Scene& scene) {
+  YAML::Node targets = r.child("targets", true);
+  if (!targets.IsSequence()) r.fail(targets, "targets", "expected a list of targets");
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < targets.size(); ++i)
+    scene.targets.push_back(read_target(targets[i], "targets[" + std::to_string(i) + "]", file, base, scene, names));
+  for (std::size_t i = 0; i < targets.size(); ++i)  // after the keys and names are known to be right
+    if (!targets[i]["pose"] && !scene.targets[i].T_world_target)
+      r.fail(targets[i], "targets[" + std::to_string(i) + "]",
+             "needs a pose (where it stands in the projector frame) or a world_pose (a tour's map frame)");
+}
+
+// `props:`, named apart from the targets and each other.
+void read_props(MapReader& r, const std::string& file, const std::filesystem::path& base, Scene& scene) {
+  YAML::Node props = r.child("props", false);
+  if (!props) return;
+  if (!props.IsSequence()) r.fail(props, "props", "expected a list of props");
+  std::set<std::string> prop_names;
+  for (std::size_t i = 0; i < props.size(); ++i) {
+    const std::string path = "props[" + std::to_string(i) + "]";
+    scene.props.push_back(read_prop(props[i], path, file, base));
+    if (!prop_names.insert(scene.props.back().name).second || scene.target_index(scene.props.back().name) >= 0)
+      r.fail(props[i], path + ".name", "'" + scene.props.back().name + "' is already the name of a target or prop");
+  }
+}
+
+// `tour: {visits: [...]}`: targets by name, each with a world pose and a stop.
+void read_tour(MapReader& r, const std::string& file, Scene& scene) {
+  YAML::Node tour = r.child("tour", false);
+  if (!tour) return;
+  MapReader m(tour, "tour", file);
+  YAML::Node visits = m.child("visits", true);
+  if (!visits.IsSequence() || visits.size() == 0) m.fail(visits, "tour.visits", "expected a non-empty list of target names");
+  for (std::size_t i = 0; i < visits.size(); ++i) {
+    const std::string name = visits[i].IsScalar() ? visits[i].Scalar() : std::string();
+    const int index = scene.target_index(name);
+    if (index < 0) m.fail(visits[i], "tour.visits[" + std::to_string(i) + "]", "no target named '" + name + "'");
+    const TargetConfig& t = scene.targets[static_cast<std::size_t>(index)];
+    if (!t.T_world_target || !t.stop)
+      m.fail(visits[i], "tour.visits[" + std::to_string(i) + "]",
+             "target '" + name + "' needs world_pose and stop to be visited");
+    scene.visits.push_back(name);
+  }
+  m.reject_unknown();
+}
+
 Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path& source) {
   const std::string file = source.empty() ? std::string("<scene>") : source.string();
   YAML::Node root;
@@ -534,109 +652,17 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
       read_pinhole(r, "projector", r.has("calibration") ? std::optional<ProjectorConfig>(ProjectorConfig{}) : std::nullopt);
   scene.pan_tilt = read_robot(r, scene);
   scene.depth_camera = read_pinhole(r, "camera", Scene::kinect_v1_depth_camera());
-  if (YAML::Node room = r.child("room", false)) {
-    MapReader m(room, "room", file);
-    scene.room.width_m = m.get<double>("width", 0.0, true);
-    scene.room.depth_m = m.get<double>("depth", 0.0, true);
-    if (!(scene.room.width_m > 0.5) || !(scene.room.depth_m > 0.5) || scene.room.width_m > 200 || scene.room.depth_m > 200)
-      m.fail(room, "room", "width and depth must be 0.5..200 m");
-    scene.room.wall_height_m = m.get<double>("wall_height", scene.room.wall_height_m);
-    if (!(scene.room.wall_height_m >= 0.1 && scene.room.wall_height_m <= 50.0))
-      m.fail(room["wall_height"], "room.wall_height", "must be 0.1..50 m");
-    if (YAML::Node obs = m.child("obstacles", false)) {
-      if (!obs.IsSequence()) m.fail(obs, "room.obstacles", "expected a list of [x0, y0, x1, y1]");
-      for (std::size_t i = 0; i < obs.size(); ++i) {
-        const auto v = m.numbers(obs[i], "room.obstacles[" + std::to_string(i) + "]", 4);
-        if (!(v[0] < v[2]) || !(v[1] < v[3]))
-          m.fail(obs[i], "room.obstacles[" + std::to_string(i) + "]", "need x0 < x1 and y0 < y1");
-        scene.room.obstacles.push_back({v[0], v[1], v[2], v[3]});
-      }
-    }
-    m.reject_unknown();
-  }
+  read_room(r, file, scene);
   if (root["robot"] && root["robot"].IsMap() && root["robot"]["start"]) {
     if (const std::string why = place_problem(scene.room, scene.robot_start.x(), scene.robot_start.y()); !why.empty())
       r.fail(root["robot"]["start"], "robot.start", "the robot's start " + why);
   }
-
-  YAML::Node targets = r.child("targets", true);
-  if (!targets.IsSequence()) r.fail(targets, "targets", "expected a list of targets");
   const std::filesystem::path base = source.empty() ? std::filesystem::path() : source.parent_path();
-  std::set<std::string> names;
-  for (std::size_t i = 0; i < targets.size(); ++i) {
-    const std::string path = "targets[" + std::to_string(i) + "]";
-    MapReader t(targets[i], path, file);
-    TargetConfig target;
-    target.name = t.get<std::string>("name", "", true);
-    if (target.name.empty()) t.fail(targets[i], path + ".name", "must not be empty");
-    if (!names.insert(target.name).second) t.fail(targets[i], path + ".name", "duplicate target name '" + target.name + "'");
-    read_model_ref(t, targets[i], path, base, target.model, target.scale, target.recenter);
-    target.present = t.get<bool>("present", true);
-    target.support = read_support(t, path + ".support");
-    target.T_projector_target = read_pose(t, path + ".pose");
-    if (t.has("world_pose")) target.T_world_target = read_pose(t, path + ".world_pose", "world_pose");
-    if (t.has("map_pose")) {
-      if (!target.T_world_target) t.fail(targets[i]["map_pose"], path + ".map_pose", "needs world_pose too");
-      target.T_map_target = read_pose(t, path + ".map_pose", "map_pose");
-    }
-    if (YAML::Node st = t.child("stop", false)) {
-      target.stop = t.vector3(st, path + ".stop");
-      target.stop->z() *= std::numbers::pi / 180.0;
-      if (const std::string why = place_problem(scene.room, target.stop->x(), target.stop->y()); !why.empty())
-        t.fail(st, path + ".stop", "the robot's stop for '" + target.name + "' " + why);
-    }
-    if (YAML::Node mk = t.child("markers", false)) {
-      if (!mk.IsSequence() || mk.size() == 0) t.fail(mk, path + ".markers", "expected a non-empty list of [x, y, z]");
-      for (std::size_t k = 0; k < mk.size(); ++k) {
-        target.markers_m.push_back(t.vector3(mk[k], path + ".markers[" + std::to_string(k) + "]"));
-      }
-    }
-    // `motion:` one scripted move, or a list of them (one per visit at most).
-    if (YAML::Node mo = t.child("motion", false)) {
-      const bool list = mo.IsSequence();
-      for (std::size_t k = 0; k < (list ? mo.size() : 1); ++k) {
-        const std::string where = path + ".motion" + (list ? "[" + std::to_string(k) + "]" : "");
-        TargetMotion motion = read_motion(list ? mo[k] : mo, where, file);
-        if (target.motion_on(motion.visit))
-          t.fail(list ? mo[k] : mo, where, "visit " + std::to_string(motion.visit) + " already has a motion");
-        target.motions.push_back(motion);
-      }
-    }
-    t.reject_unknown();
-    scene.targets.push_back(std::move(target));
-  }
-  for (std::size_t i = 0; i < targets.size(); ++i)  // after the keys and names are known to be right
-    if (!targets[i]["pose"] && !scene.targets[i].T_world_target)
-      r.fail(targets[i], "targets[" + std::to_string(i) + "]",
-             "needs a pose (where it stands in the projector frame) or a world_pose (a tour's map frame)");
-  if (YAML::Node props = r.child("props", false)) {
-    if (!props.IsSequence()) r.fail(props, "props", "expected a list of props");
-    std::set<std::string> prop_names;
-    for (std::size_t i = 0; i < props.size(); ++i) {
-      const std::string path = "props[" + std::to_string(i) + "]";
-      scene.props.push_back(read_prop(props[i], path, file, base));
-      if (!prop_names.insert(scene.props.back().name).second || scene.target_index(scene.props.back().name) >= 0)
-        r.fail(props[i], path + ".name", "'" + scene.props.back().name + "' is already the name of a target or prop");
-    }
-  }
+  read_targets(r, file, base, scene);
+  read_props(r, file, base, scene);
   scene.devices = read_devices(r);
   apply_calibration(r, scene, base);
-  if (YAML::Node tour = r.child("tour", false)) {
-    MapReader m(tour, "tour", file);
-    YAML::Node visits = m.child("visits", true);
-    if (!visits.IsSequence() || visits.size() == 0) m.fail(visits, "tour.visits", "expected a non-empty list of target names");
-    for (std::size_t i = 0; i < visits.size(); ++i) {
-      const std::string name = visits[i].IsScalar() ? visits[i].Scalar() : std::string();
-      const int index = scene.target_index(name);
-      if (index < 0) m.fail(visits[i], "tour.visits[" + std::to_string(i) + "]", "no target named '" + name + "'");
-      const TargetConfig& t = scene.targets[static_cast<std::size_t>(index)];
-      if (!t.T_world_target || !t.stop)
-        m.fail(visits[i], "tour.visits[" + std::to_string(i) + "]",
-               "target '" + name + "' needs world_pose and stop to be visited");
-      scene.visits.push_back(name);
-    }
-    m.reject_unknown();
-  }
+  read_tour(r, file, scene);
   r.reject_unknown();
   // Last, so that a value the reader refuses is named first: a key given twice reads as its first.
   if (const std::string twice = duplicate_key_message(root, file); !twice.empty()) throw ConfigError(twice);
