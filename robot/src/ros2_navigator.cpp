@@ -7,7 +7,12 @@
 namespace projbot::robot {
 Ros2Navigator::Ros2Navigator(Ros2Base& base, const Pose2D& start_in_map, const ControllerConfig& controller, double rate_hz,
                              double timeout_s)
-    : base_(base), controller_(controller), rate_hz_(rate_hz), timeout_s_(timeout_s), last_(base.odometry(2.0)) {
+    : base_(base),
+      controller_(controller),
+      settle_scans_(controller.settle_scans),
+      rate_hz_(rate_hz),
+      timeout_s_(timeout_s),
+      last_(base.odometry(2.0)) {
   T_map_odom_ = compose(start_in_map, inverse(last_.pose));  // the robot stands at start_in_map now
   T_map_odom_start_ = T_map_odom_;
 }
@@ -17,7 +22,7 @@ void Ros2Navigator::use_laser(LaserSource& laser, Localizer* map) {
   map_ = map;
   double last_change = config::steady_now_s();
   Corrections c;
-  for (int i = 0; i < 3; ++i) correct(last_change, c);  // a robot set down a few centimetres off its start is found
+  for (int i = 0; i < settle_scans_; ++i) correct(last_change, c);  // a robot set down a few centimetres off its start is found
 }
 
 void Ros2Navigator::correct(double& last_change_s, Corrections& c) {
@@ -80,7 +85,7 @@ StopReport Ros2Navigator::drive_to(const Pose2D& goal, int index) {
   r.arrived = controller_.arrived();
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // let it stop, then read where it stands
   fresh(last_change);
-  for (int i = 0; i < 3 && laser_; ++i) correct(last_change, c);  // standing still: the stop's best fix
+  for (int i = 0; i < settle_scans_ && laser_; ++i) correct(last_change, c);  // standing still: the stop's best fix
   r.drive_seconds = config::steady_now_s() - t0;
   r.estimate = believed_pose();
   r.odometry = compose(T_map_odom_start_, last_.pose);

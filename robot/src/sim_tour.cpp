@@ -87,7 +87,7 @@ StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
   base_.set_wheel_speeds({});
   r.arrived = controller_.arrived();
   if (c_.source == PoseSource::localized)
-    for (int k = 0; k < c_.settle_scans; ++k) {  // at rest, one scan per laser period (the control period)
+    for (int k = 0; k < c_.controller.settle_scans; ++k) {  // at rest, one scan per laser period (the control period)
       time_s_ += c_.control_dt_s;
       scan_and_correct();
     }

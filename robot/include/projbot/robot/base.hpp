@@ -31,6 +31,9 @@ struct ControllerConfig {
   double position_tolerance_m = 0.01;     ///< arrived when closer than this ...
   double heading_tolerance_rad = 0.0087;  ///< ... and within this heading (0.5 degrees)
   double slow_down_gain = 1.2;            ///< proportional gain near the goal, 1/s
+  /// Laser scans matched against the map at rest after arrival, the stop's best fix (navigators with a
+  /// laser and a map: the twin's and the ROS 2 base's).
+  int settle_scans = 3;
 };
 
 /// Holonomic point-to-pose controller: a trapezoidal speed profile towards the goal with

@@ -70,8 +70,8 @@ class Ros2Navigator final : public Navigator {
   /// `estimate` where it believes it stands, with the laser's corrections counted and timed.
   StopReport drive_to(const Pose2D& goal, int index) override;
   Pose2D believed_pose() const override { return compose(T_map_odom_, last_.pose); }
-  /// Reads `laser` from now on: a scan at every control step while driving and three once stopped (and
-  /// three now). With a `map`, each is matched against it (from the configured start at first: a robot set
+  /// Reads `laser` from now on: a scan at every control step while driving and settle_scans (3) once
+  /// stopped (and as many now). With a `map`, each is matched against it (from the configured start at first: a robot set
   /// down a few centimetres off it is found); without, the scans are only handed to on_scan (a mapping run,
   /// recorded for projbot slam). Both outlive the navigator. Throws RobotError naming the laser when it
   /// sends no scan.
@@ -89,6 +89,7 @@ class Ros2Navigator final : public Navigator {
   void correct(double& last_change_s, Corrections& c);
   Ros2Base& base_;
   BaseController controller_;
+  int settle_scans_;
   double rate_hz_, timeout_s_;
   Pose2D T_map_odom_, T_map_odom_start_;
   Odometry2D last_;

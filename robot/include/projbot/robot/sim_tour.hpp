@@ -31,7 +31,6 @@ struct SimTourConfig {
   PoseSource source = PoseSource::localized;
   double control_dt_s = 0.025;  ///< control period (the laser's 40 Hz)
   int localize_every = 4;       ///< correct with every n-th scan while driving (10 Hz)
-  int settle_scans = 3;         ///< scans matched at rest after arrival
   double max_seconds_per_stop = 120.0;
   double survey_spacing_m = 1.0;  ///< the map: scans at true poses on this grid over free space
   /// Asked before each survey scan (the set-up's long part: about 13 ms a scan, one a square metre):
