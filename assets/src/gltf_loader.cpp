@@ -204,85 +204,109 @@ class Loader {
     p.vertices.resize(n);
     const Eigen::Matrix3d L = world.topLeftCorner<3, 3>();
     if (!(std::abs(L.determinant()) > 1e-18)) fail(what + ": node transform is singular");
-    const Eigen::Matrix3d normal_matrix = L.inverse().transpose();
-    for (std::size_t i = 0; i < n; ++i) {
+    read_positions(pos, world, what, p);
+    const bool have_normals = read_normals(prim, L.inverse().transpose(), what, p);
+    read_texcoords(prim, what, p);
+    read_colours(prim, what, p);
+    // A mirroring transform flips the winding back.
+    unroll_triangles(read_indices(prim, what, n), mode, L.determinant() < 0.0, what, p);
+    if (!have_normals) compute_normals(p);
+    if (prim.material >= 0) check_index(prim.material, g_.materials, what + ": material");
+    p.material = prim.material;
+    out.primitives.push_back(std::move(p));
+  }
+
+  void read_positions(const View& pos, const Eigen::Matrix4d& world, const std::string& what, Primitive& p) {
+    for (std::size_t i = 0; i < pos.count; ++i) {
       Eigen::Vector4d x(read_component(pos, i, 0), read_component(pos, i, 1), read_component(pos, i, 2), 1.0);
       if (!x.allFinite()) fail(what + ": POSITION " + std::to_string(i) + " is not finite");
       const Eigen::Vector4d w = world * x;
       p.vertices[i].position = {static_cast<float>(w.x()), static_cast<float>(w.y()), static_cast<float>(w.z())};
     }
+  }
 
-    bool have_normals = false;
-    if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
-      const View nv = float_attribute(it->second, what + " NORMAL", {TINYGLTF_TYPE_VEC3}, false);
-      if (nv.count != n) fail(what + ": NORMAL count differs from POSITION count");
-      have_normals = true;
-      for (std::size_t i = 0; i < n; ++i) {
-        Eigen::Vector3d nn(read_component(nv, i, 0), read_component(nv, i, 1), read_component(nv, i, 2));
-        nn = normal_matrix * nn;
-        if (!nn.allFinite() || nn.norm() < 1e-12) {
-          have_normals = false;  // degenerate normals in the file: recompute them all
-          break;
-        }
-        nn.normalize();
-        p.vertices[i].normal = {static_cast<float>(nn.x()), static_cast<float>(nn.y()), static_cast<float>(nn.z())};
-      }
+  // NORMAL, moved by the normal matrix; false when the file has none or a degenerate one (then all are
+  // computed from the faces).
+  bool read_normals(const tinygltf::Primitive& prim, const Eigen::Matrix3d& normal_matrix, const std::string& what,
+                    Primitive& p) {
+    const auto it = prim.attributes.find("NORMAL");
+    if (it == prim.attributes.end()) return false;
+    const View nv = float_attribute(it->second, what + " NORMAL", {TINYGLTF_TYPE_VEC3}, false);
+    if (nv.count != p.vertices.size()) fail(what + ": NORMAL count differs from POSITION count");
+    for (std::size_t i = 0; i < nv.count; ++i) {
+      Eigen::Vector3d nn(read_component(nv, i, 0), read_component(nv, i, 1), read_component(nv, i, 2));
+      nn = normal_matrix * nn;
+      if (!nn.allFinite() || nn.norm() < 1e-12) return false;  // degenerate normals in the file: recompute them all
+      nn.normalize();
+      p.vertices[i].normal = {static_cast<float>(nn.x()), static_cast<float>(nn.y()), static_cast<float>(nn.z())};
     }
-    if (auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
-      const View tv = float_attribute(it->second, what + " TEXCOORD_0", {TINYGLTF_TYPE_VEC2}, true);
-      if (tv.count != n) fail(what + ": TEXCOORD_0 count differs from POSITION count");
-      for (std::size_t i = 0; i < n; ++i) {
-        p.vertices[i].uv = {read_component(tv, i, 0), read_component(tv, i, 1)};
-        if (!std::isfinite(p.vertices[i].uv[0]) || !std::isfinite(p.vertices[i].uv[1]))
-          fail(what + ": TEXCOORD_0 " + std::to_string(i) + " is not finite");
-      }
-    }
-    if (auto it = prim.attributes.find("COLOR_0"); it != prim.attributes.end()) {
-      const View cv = float_attribute(it->second, what + " COLOR_0", {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, true);
-      if (cv.count != n) fail(what + ": COLOR_0 count differs from POSITION count");
-      const int comps = cv.type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
-      for (std::size_t i = 0; i < n; ++i)
-        for (int c = 0; c < comps; ++c) {
-          const float value = read_component(cv, i, c);
-          if (!std::isfinite(value)) fail(what + ": COLOR_0 " + std::to_string(i) + " is not finite");
-          p.vertices[i].color[static_cast<std::size_t>(c)] = value;
-        }
-    }
+    return true;
+  }
 
+  void read_texcoords(const tinygltf::Primitive& prim, const std::string& what, Primitive& p) {
+    const auto it = prim.attributes.find("TEXCOORD_0");
+    if (it == prim.attributes.end()) return;
+    const View tv = float_attribute(it->second, what + " TEXCOORD_0", {TINYGLTF_TYPE_VEC2}, true);
+    if (tv.count != p.vertices.size()) fail(what + ": TEXCOORD_0 count differs from POSITION count");
+    for (std::size_t i = 0; i < tv.count; ++i) {
+      p.vertices[i].uv = {read_component(tv, i, 0), read_component(tv, i, 1)};
+      if (!std::isfinite(p.vertices[i].uv[0]) || !std::isfinite(p.vertices[i].uv[1]))
+        fail(what + ": TEXCOORD_0 " + std::to_string(i) + " is not finite");
+    }
+  }
+
+  void read_colours(const tinygltf::Primitive& prim, const std::string& what, Primitive& p) {
+    const auto it = prim.attributes.find("COLOR_0");
+    if (it == prim.attributes.end()) return;
+    const View cv = float_attribute(it->second, what + " COLOR_0", {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, true);
+    if (cv.count != p.vertices.size()) fail(what + ": COLOR_0 count differs from POSITION count");
+    const int comps = cv.type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+    for (std::size_t i = 0; i < cv.count; ++i)
+      for (int c = 0; c < comps; ++c) {
+        const float value = read_component(cv, i, c);
+        if (!std::isfinite(value)) fail(what + ": COLOR_0 " + std::to_string(i) + " is not finite");
+        p.vertices[i].color[static_cast<std::size_t>(c)] = value;
+      }
+  }
+
+  // The primitive's indices, each checked against its n vertices; without an index accessor, 0..n-1.
+  std::vector<std::uint32_t> read_indices(const tinygltf::Primitive& prim, const std::string& what, std::size_t n) {
     std::vector<std::uint32_t> raw;
-    if (prim.indices >= 0) {
-      const View iv = accessor_view(prim.indices, what + " indices");
-      if (iv.type != TINYGLTF_TYPE_SCALAR) fail(what + ": indices must be scalars");
-      raw.resize(iv.count);
-      for (std::size_t i = 0; i < iv.count; ++i) {
-        const unsigned char* q = iv.base + iv.stride * i;
-        switch (iv.component_type) {
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-            raw[i] = q[0];
-            break;
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-            std::uint16_t s;
-            std::memcpy(&s, q, 2);
-            raw[i] = s;
-            break;
-          }
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-            std::memcpy(&raw[i], q, 4);
-            break;
-          default:
-            fail(what + ": index component type " + std::to_string(iv.component_type) + " is not an unsigned integer");
-        }
-        if (raw[i] >= n)
-          fail(what + ": index " + std::to_string(raw[i]) + " at position " + std::to_string(i) + " is out of range (" +
-               std::to_string(n) + " vertices)");
-      }
-    } else {
+    if (prim.indices < 0) {
       raw.resize(n);
       for (std::size_t i = 0; i < n; ++i) raw[i] = static_cast<std::uint32_t>(i);
+      return raw;
     }
+    const View iv = accessor_view(prim.indices, what + " indices");
+    if (iv.type != TINYGLTF_TYPE_SCALAR) fail(what + ": indices must be scalars");
+    raw.resize(iv.count);
+    for (std::size_t i = 0; i < iv.count; ++i) {
+      const unsigned char* q = iv.base + iv.stride * i;
+      switch (iv.component_type) {
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+          raw[i] = q[0];
+          break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+          std::uint16_t s;
+          std::memcpy(&s, q, 2);
+          raw[i] = s;
+          break;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+          std::memcpy(&raw[i], q, 4);
+          break;
+        default:
+          fail(what + ": index component type " + std::to_string(iv.component_type) + " is not an unsigned integer");
+      }
+      if (raw[i] >= n)
+        fail(what + ": index " + std::to_string(raw[i]) + " at position " + std::to_string(i) + " is out of range (" +
+             std::to_string(n) + " vertices)");
+    }
+    return raw;
+  }
 
-    // Triangle lists, with strips and fans unrolled; a mirroring transform flips the winding back.
-    const bool flip = L.determinant() < 0.0;
+  // Triangle lists, with strips and fans unrolled; `flip` swaps each triangle's winding.
+  void unroll_triangles(const std::vector<std::uint32_t>& raw, int mode, bool flip, const std::string& what, Primitive& p) {
     auto emit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
       if (flip) std::swap(b, c);
       p.indices.insert(p.indices.end(), {a, b, c});
@@ -296,11 +320,6 @@ class Loader {
     } else {
       for (std::size_t i = 1; i + 1 < raw.size(); ++i) emit(raw[0], raw[i], raw[i + 1]);
     }
-
-    if (!have_normals) compute_normals(p);
-    if (prim.material >= 0) check_index(prim.material, g_.materials, what + ": material");
-    p.material = prim.material;
-    out.primitives.push_back(std::move(p));
   }
 
   // Area-weighted vertex normals, for primitives without NORMAL.
