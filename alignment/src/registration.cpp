@@ -466,8 +466,7 @@ struct Aligner::Impl {
   // Quality of a pose: scan points near the posed model are inliers when their point-to-plane distance
   // to the nearest model sample is within their tolerance (tolerance_m). Scan points in front of the
   // model along their rays, or beyond its outline (scan_from_origin: neutral()), count for nothing.
-  void evaluate(const pcl::PointCloud<pcl::PointXYZ>& near, const Eigen::Matrix4d& T, AlignmentResult& r,
-                bool close = false) const {
+  void evaluate(const pcl::PointCloud<pcl::PointXYZ>& near, const Eigen::Matrix4d& T, AlignmentResult& r, bool close) const {
     r.scan_points = near.size();
     if (near.empty()) {
       r.inlier_ratio = 0.0;
