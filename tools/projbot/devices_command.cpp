@@ -128,7 +128,7 @@ class SimBaseLaser {
   static config::Room room(const config::Scene& scene) {
     config::Room r = scene.room;
     for (const auto& p : scene.props)
-      if (p.is_box()) r.obstacles.push_back({p.box_min_m.x(), p.box_min_m.y(), p.box_max_m.x(), p.box_max_m.y()});
+      if (p.is_box()) r.obstacles.push_back(p.box_footprint());
     return r;
   }
   robot::OccupancyMap map_;

@@ -23,7 +23,7 @@ Eigen::AlignedBox3d world_bounds(const assets::Model& model, const Eigen::Matrix
   return box;
 }
 
-std::array<double, 4> footprint(const Eigen::AlignedBox3d& b) { return {b.min().x(), b.min().y(), b.max().x(), b.max().y()}; }
+config::Box2D footprint(const Eigen::AlignedBox3d& b) { return {b.min().x(), b.min().y(), b.max().x(), b.max().y()}; }
 
 // Appends `part`'s primitives and materials to `into` (one mesh for the room's static surfaces).
 void append(assets::Model& into, const assets::Model& part) {
@@ -56,10 +56,10 @@ assets::Model room_model(const config::Scene& scene) {
 }  // namespace
 
 robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed,
-                                  const std::vector<std::array<double, 4>>& footprints) {
+                                  const std::vector<config::Box2D>& footprints) {
   robot::SimTourConfig c;
   c.room = scene.room;
-  for (const auto& f : footprints) c.room.obstacles.push_back({f[0], f[1], f[2], f[3]});
+  c.room.obstacles.insert(c.room.obstacles.end(), footprints.begin(), footprints.end());
   c.start = {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()};
   c.errors = scene.drift;
   c.errors.seed = seed;
@@ -74,10 +74,10 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
   const assets::Model room = room_model(scene);
   room_ray_ = std::make_unique<MeshRaycaster>(room);
   room_id_ = renderer_.add_model(room);
-  std::vector<std::array<double, 4>> footprints;  // for the laser: what stands on the floor
+  std::vector<config::Box2D> footprints;  // for the laser: what stands on the floor
   for (const auto& p : scene.props) {
     if (p.is_box()) {
-      footprints.push_back({p.box_min_m.x(), p.box_min_m.y(), p.box_max_m.x(), p.box_max_m.y()});
+      footprints.push_back(p.box_footprint());
       continue;
     }
     assets::Model model = assets::load_model(p.model);
@@ -120,7 +120,7 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
   depth_target_ = renderer_.make_depth_camera(camera_.width_px, camera_.height_px);
 }
 
-void Twin::place_support(TwinTarget& t, const std::string& where, std::vector<std::array<double, 4>>& footprints) {
+void Twin::place_support(TwinTarget& t, const std::string& where, std::vector<config::Box2D>& footprints) {
   const Eigen::AlignedBox3d bounds = world_bounds(t.model, t.T_world_target_true);
   const config::TargetSupport& support = t.config.support;
   if (support.floor) {

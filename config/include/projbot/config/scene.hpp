@@ -93,6 +93,8 @@ struct PropConfig {
   Eigen::Vector3d box_max_m = Eigen::Vector3d::Zero();
   std::array<float, 3> colour{0.6F, 0.6F, 0.6F};  ///< a box's colour, 0..1
   bool is_box() const { return model.empty(); }
+  /// A box's footprint on the floor (what a laser at its height sees of it).
+  Box2D box_footprint() const { return {box_min_m.x(), box_min_m.y(), box_max_m.x(), box_max_m.y()}; }
 };
 
 /// One target object: its textured model and its pose in the projector frame.

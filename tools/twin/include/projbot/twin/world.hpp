@@ -146,7 +146,7 @@ class Twin {
   std::vector<PlacedProp> props_;  // the glTF props
   std::vector<std::size_t> target_ids_;
   // Checks and builds a target's support; adds what stands on the floor to `footprints` (the laser's).
-  void place_support(TwinTarget& t, const std::string& where, std::vector<std::array<double, 4>>& footprints);
+  void place_support(TwinTarget& t, const std::string& where, std::vector<config::Box2D>& footprints);
   std::unique_ptr<robot::SimRobot> robot_;
   robot::SimulatedPanTilt pan_tilt_;
   alignment::CameraIntrinsics camera_;
@@ -163,9 +163,9 @@ Eigen::Matrix4d scripted_pose(const config::TargetConfig& target, const Eigen::M
 /// How far through a scripted motion (0..1) its profile is at the fraction x (0..1) of its duration.
 double motion_fraction(config::MotionProfile profile, double x);
 
-/// The twin's robot set-up for a scene: its room (with `footprints`, x0 y0 x1 y1, of what stands on the
+/// The twin's robot set-up for a scene: its room (with the `footprints` of what stands on the
 /// floor: supports, floor-standing targets, props), start pose and drift, closing the loop on `source`.
 robot::SimTourConfig robot_config(const config::Scene& scene, robot::PoseSource source, std::uint64_t seed,
-                                  const std::vector<std::array<double, 4>>& footprints);
+                                  const std::vector<config::Box2D>& footprints);
 
 }  // namespace projbot::twin
