@@ -9,6 +9,7 @@
 #include <chrono>
 #include <thread>
 
+#include "projbot/alignment/coarse_search.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/assets/model.hpp"
@@ -235,6 +236,37 @@ TEST(FreeSpaceTest, SeesThroughAWrongPoseNotThroughAnOccludedOne) {
   EXPECT_EQ(unseen.predicted, 0U);
   EXPECT_EQ(unseen.behind_ratio(), 0.0);
   EXPECT_FALSE(unseen.passes(0.2));
+}
+
+// A gross guess's candidates: the cube in front of a wall, guessed 45 mm off and turned 12 degrees. The
+// best candidate puts its centre within a grid step of the truth's (10 mm, plus the turn's share); a guess
+// that is not finite, or a frame of another size, gives none.
+TEST(CoarseSearchTest, TheBestCandidateOfAGrossGuessLiesAGridStepFromTheTruth) {
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  const ModelCloud model = cube_model();
+  const Eigen::Matrix4d truth = projbot::config::pose_from_xyz_rpy({0.05, -0.02, 1.2}, {20, 30, 10});
+  auto depth = cube_depth(truth, k, 0.0);
+  for (auto& z : depth->depth_m)
+    if (z == 0.0F) z = 1.6F;  // a wall behind
+  Eigen::Matrix4d guess = projbot::config::pose_from_xyz_rpy({0.05 + 0.03, -0.02 - 0.03, 1.2 + 0.015}, {20, 30, 22});
+  CoarseSearch search;
+  search.reach_m = 0.07;
+  const std::vector<CoarseCandidate> found = coarse_candidates(model, guess, *depth, k, search);
+  ASSERT_FALSE(found.empty());
+  ASSERT_LE(found.size(), search.count);
+  const Eigen::Vector3d centre = centroid_of(model);
+  const auto centre_in = [&](const Eigen::Matrix4d& T) { return (T * centre.homogeneous()).head<3>(); };
+  EXPECT_LT((centre_in(found.front().T_camera_model) - centre_in(truth)).norm(), 0.015);
+  EXPECT_GT((centre_in(guess) - centre_in(truth)).norm(), 0.04);
+  for (std::size_t i = 1; i < found.size(); ++i) {
+    EXPECT_LE(found[i].score, found[i - 1].score);
+    EXPECT_GE((centre_in(found[i].T_camera_model) - centre_in(found[0].T_camera_model)).norm(), search.separation_m - 1e-9);
+  }
+  guess(0, 0) = std::nan("");
+  EXPECT_TRUE(coarse_candidates(model, guess, *depth, k, search).empty());
+  DepthImage small;
+  small.width = 4, small.height = 4, small.depth_m.assign(16, 1.0F);
+  EXPECT_TRUE(coarse_candidates(model, truth, small, k, search).empty());
 }
 
 // Weak directions of a view: a cube face-on leaves its face's plane free (two slides and the turn about

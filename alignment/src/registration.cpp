@@ -666,6 +666,12 @@ AcquisitionConfig pcl_pipeline_config(bool pcl_search) {
   return c;
 }
 
+Eigen::Vector3d centroid_of(const ModelCloud& model) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : model.points) c += p.cast<double>();
+  return c / static_cast<double>(std::max<std::size_t>(model.points.size(), 1));
+}
+
 ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
   const auto s = assets::sample_surface(model, samples, 1);
   return {s.points, s.normals, s.colours, {}};

@@ -90,12 +90,10 @@ std::optional<Footing> support_among(Cloud::Ptr cloud, const ModelCloud& model, 
 std::optional<Footing> support_in_frame(const ModelCloud& model, const DepthImage& depth, const CameraIntrinsics& k,
                                         const Eigen::Matrix4d& T_camera_guess, double reach_m) {
   if (model.points.empty()) throw AlignmentError("support_in_frame: empty model");
-  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
-  for (const auto& p : model.points) centroid += p;
-  centroid /= static_cast<float>(model.points.size());
+  const Eigen::Vector3d centroid = centroid_of(model);
   double radius = 0.0;
-  for (const auto& p : model.points) radius = std::max(radius, static_cast<double>((p - centroid).norm()));
-  const Eigen::Vector3d centre = (T_camera_guess * centroid.cast<double>().homogeneous()).head<3>();
+  for (const auto& p : model.points) radius = std::max(radius, (p.cast<double>() - centroid).norm());
+  const Eigen::Vector3d centre = (T_camera_guess * centroid.homogeneous()).head<3>();
   return support_among(points_near(depth, k, centre, radius + reach_m + kBeyondSphereM), model, T_camera_guess, centre, reach_m);
 }
 

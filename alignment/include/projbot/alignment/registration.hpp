@@ -27,6 +27,9 @@ struct ModelCloud {
   std::string source;  ///< the file it came from, for messages; empty when built in memory
 };
 
+/// The mean of the model's points (its centre for bounds and searches); the origin for an empty model.
+Eigen::Vector3d centroid_of(const ModelCloud& model);
+
 /// Model points: area-uniform surface samples of a mesh (glTF, OBJ, STL, a PLY with faces), or the points
 /// of a cloud (PCD, a PLY without faces; normals estimated). `scale` multiplies the file's units into
 /// metres (0.001 for a model in millimetres, as BOP's); the origin stays the file's.
