@@ -228,7 +228,8 @@ AlignmentResult TargetFollower::acquire(const DepthImage& frame, const Eigen::Ma
                                         const assets::Image* colour) const {
   const auto deadline = acquire_deadline();  // the support's search counts against the budget too
   const std::optional<Footing> support = support_in_frame(model_, frame, k_, guess, grow_m);
-  return acquire_known(frame, guess, Known{support ? std::optional<Plane>(support->floor) : std::nullopt, support, deadline},
+  return acquire_known(frame, guess,
+                       Known{support ? std::optional<Plane>(support->floor) : std::nullopt, support, deadline, false, true},
                        grow_m, colour);
 }
 
@@ -252,7 +253,15 @@ std::optional<AlignmentResult> TargetFollower::from_candidates(const DepthImage&
   double spent_ms = 0.0;
   for (const auto& c : coarse_candidates(model_, guess, frame, k_, search)) {
     if (best && ThreadCpuClock::past(given.deadline)) break;
-    AlignmentResult r = acquire_at(frame, c.T_camera_model, given, close_grow, colour, SearchStage::icp_only);
+    // Without a map, the support is the one under the candidate: under a gross guess's wider reach
+    // another plane may qualify (a neighbour's top) that the target does not stand on.
+    Known known = given;
+    if (given.frame_support) {
+      const std::optional<Footing> support = support_in_frame(model_, frame, k_, c.T_camera_model, close_grow);
+      known.floor = support ? std::optional<Plane>(support->floor) : std::nullopt;
+      known.footing = support;
+    }
+    AlignmentResult r = acquire_at(frame, c.T_camera_model, known, close_grow, colour, SearchStage::icp_only);
     spent_ms += r.time_ms;
     r.time_ms = spent_ms;
     if (r.converged && cfg_.guess_bounds_estimate &&
@@ -374,6 +383,7 @@ std::optional<AlignmentResult> TargetFollower::attempt(const DepthImage& frame, 
   const auto grow_m = stage == SearchStage::local ? std::optional<double>(silhouette_grow_m_) : std::nullopt;
   if (find_support_ && grow_m) {  // as acquire() without a map does
     find_support_ = false;
+    known_.frame_support = true;
     if (const auto support = support_in_frame(model_, frame, k_, from, *grow_m))
       known_.floor = support->floor, known_.footing = support;
   }
@@ -391,6 +401,7 @@ std::optional<AlignmentResult> TargetFollower::first_acquisition(const DepthImag
   const auto deadline = acquire_deadline();  // the support's search counts against the budget, as in acquire()
   if (find_support_) {
     find_support_ = false;
+    known_.frame_support = true;
     if (const auto support = support_in_frame(model_, frame, k_, guess_, silhouette_grow_m_))
       known_.floor = support->floor, known_.footing = support;
   }

@@ -232,7 +232,8 @@ class TargetFollower {
     std::optional<Plane> floor;
     std::optional<Footing> footing;
     std::optional<ThreadCpuClock::time_point> deadline;  // acquire()'s: no new search step after it
-    bool close = false;  // the guess is known to within half the model's size (Aligner::align's close_guess)
+    bool close = false;          // the guess is known to within half the model's size (Aligner::align's close_guess)
+    bool frame_support = false;  // no map: the floor and footing are the support found in the frame
   };
   /// How an acquisition places the view's weak directions (a box seen face-on, along its face).
   enum class Weak {
