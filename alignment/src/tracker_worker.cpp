@@ -264,14 +264,16 @@ std::optional<AlignmentResult> TargetFollower::from_candidates(const DepthImage&
     AlignmentResult r = acquire_at(frame, c.T_camera_model, known, close_grow, colour, SearchStage::icp_only);
     spent_ms += r.time_ms;
     r.time_ms = spent_ms;
-    if (r.converged && cfg_.guess_bounds_estimate &&
-        centre_move_m(model_centre_, guess, r.T_scan_model) > grow_m + cfg_.reach_margin_m)
-      r.converged = false;
+    if (r.converged && beyond_bound(guess, r.T_scan_model, grow_m)) r.converged = false;
     if (r.converged) return r;
     if (!best || r.inlier_ratio > best->inlier_ratio) best = r;
   }
   if (best) best->time_ms = spent_ms;
   return best;
+}
+
+bool TargetFollower::beyond_bound(const Eigen::Matrix4d& guess, const Eigen::Matrix4d& T, double grow_m) const {
+  return cfg_.guess_bounds_estimate && centre_move_m(model_centre_, guess, T) > grow_m + cfg_.reach_margin_m;
 }
 
 AlignmentResult TargetFollower::acquire_at(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& given,
@@ -298,9 +300,7 @@ AlignmentResult TargetFollower::acquire_at(const DepthImage& frame, const Eigen:
       // frames, a can fitted onto the box beside it, 167 mm away, with 0.88 of its points explained and
       // nothing seen through it). The centre, not every point: a symmetric shape (a can turned about its
       // axis) is right in any of its equivalent poses.
-      if (r.converged && cfg_.guess_bounds_estimate &&
-          centre_move_m(model_centre_, guess, r.T_scan_model) > grow_m + cfg_.reach_margin_m)
-        r.converged = false;
+      if (r.converged && beyond_bound(guess, r.T_scan_model, grow_m)) r.converged = false;
       return r;
     }
     if (ThreadCpuClock::past(known.deadline)) {  // out of time to place it another way: not confirmed

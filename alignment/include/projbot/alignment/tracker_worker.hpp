@@ -264,6 +264,9 @@ class TargetFollower {
   /// unconverged one with the most inliers; nothing when there are no candidates.
   std::optional<AlignmentResult> from_candidates(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known,
                                                  double grow_m, const assets::Image* colour) const;
+  /// With guess_bounds_estimate: whether T puts the model's centroid farther from where `guess` put it
+  /// than grow_m (the guess's reach) plus reach_margin_m: something else that fits, not the target.
+  bool beyond_bound(const Eigen::Matrix4d& guess, const Eigen::Matrix4d& T, double grow_m) const;
   /// The acquisition from one guess.
   AlignmentResult acquire_at(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
                              const assets::Image* colour, SearchStage stage = SearchStage::full) const;
