@@ -115,6 +115,34 @@ TEST_F(RealFrames, AcquisitionMeetsTheGoalOnRealFramesOfTheSharedDataset) {
   EXPECT_LE(false_rejects * 20, n) << r.output;
 }
 
+// The red mug of scene 000000 with its handle hidden behind it, from 20 mm / 5 degree starts (its
+// first seven images): ICP from two of them was pulled onto the neighbours (refused, 100 mm off), and
+// the lit ones were turned 7-12 degrees about the mug's axis, which depth cannot see (6-8 mm by ADD).
+// The candidates around a close start where its ICP fails, and the guess's turn about an axis the view
+// leaves free: all seven lit within 10 mm, six within 5 mm, none lit wrong.
+TEST_F(RealFrames, AMugWithItsHandleHiddenKeepsItsGuessTurn) {
+  const fs::path report = dir_ / "mug.json";
+  const CliRun r =
+      run_projbot("bench dataset " + kYcbv.string() + " --scenes 000000 --max-instances 21 --report " + report.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  int mugs = 0, within_10 = 0, within_5 = 0, false_accepts = 0;
+  const auto j = read_json(report);
+  for (const auto& row : j.at("instances")) {
+    if (row.at("method").get<std::string>() != "projbot") continue;
+    const double e = row.at("error_mm").get<double>();
+    const bool lit = row.at("accepted").get<bool>();
+    false_accepts += lit && e > 20.0 ? 1 : 0;
+    if (row.at("obj_id").get<int>() != 14) continue;
+    ++mugs;
+    within_10 += lit && e <= 10.0 ? 1 : 0;
+    within_5 += lit && e <= 5.0 ? 1 : 0;
+  }
+  ASSERT_EQ(mugs, 7) << r.output;
+  EXPECT_EQ(within_10, 7) << r.output;
+  EXPECT_GE(within_5, 6) << r.output;
+  EXPECT_EQ(false_accepts, 0) << r.output;
+}
+
 // The cluttered scene: a banana leaning on a wood block, a gelatin box on top of it, a mustard bottle behind.
 // The block, half hidden, scored 0.62-0.68 of its points explained at its own ground truth (the banana
 // and the box in front counted against it) and was refused at every pose; ICP was pulled 10-15 mm onto

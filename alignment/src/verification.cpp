@@ -267,6 +267,8 @@ ViewConstraints view_constraints(const ModelCloud& model, const Eigen::Matrix4d&
   c.points = seen.size();
   if (seen.size() < 6) return c;
   const Spread s = spread(seen, [](const auto& point_normal) { return point_normal.first; });
+  c.centre = s.centre;
+  c.radius = s.radius;
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   for (const auto& [p, n] : seen) {
     const Eigen::Matrix<double, 6, 1> J = s.jacobian(p, n);
@@ -455,7 +457,6 @@ bool has_colour_contrast(const ModelCloud& model) {
   return n >= static_cast<double>(kMinColourSamples) && sum2 - sum * sum / n > 1e-6 * n;  // as correlation()'s test
 }
 
-namespace {
 // The model sample nearest `q` other than `skip` (brute force: a few hundred probes per call).
 std::size_t nearest_sample(const ModelCloud& model, const Eigen::Vector3f& q, std::size_t skip) {
   std::size_t best = skip;
@@ -466,7 +467,6 @@ std::size_t nearest_sample(const ModelCloud& model, const Eigen::Vector3f& q, st
   }
   return best;
 }
-}  // namespace
 
 bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, const std::vector<std::size_t>& probes) {
   const std::size_t n = model.points.size();

@@ -255,10 +255,14 @@ class TargetFollower {
                                                   const Known& known, bool hold) const;
   /// When an acquisition starting now must stop starting new steps (acquire_budget_ms of CPU time).
   ThreadCpuClock::time_point acquire_deadline() const;
-  /// acquire()'s body, with what is known at this stop: from a gross guess within coarse_max_reach_m
-  /// the candidates (from_candidates), else (or when there are none) from the guess itself (acquire_at).
+  /// acquire()'s body, with what is known at this stop: searched(), then, without colour to place it,
+  /// turned towards the guess about an axis the view leaves free (nearest_unseen_turn).
   AlignmentResult acquire_known(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
                                 const assets::Image* colour) const;
+  /// From a gross guess within coarse_max_reach_m the candidates (from_candidates); else, or when there
+  /// are none, from the guess itself (acquire_at), and the candidates when that fails within the budget.
+  AlignmentResult searched(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
+                           const assets::Image* colour) const;
   /// The close acquisition from each of coarse_candidates around `guess` (within grow_m) in turn: the
   /// first that converges (and, with guess_bounds_estimate, stays within grow_m of the guess), else the
   /// unconverged one with the most inliers; nothing when there are no candidates.

@@ -67,10 +67,12 @@ struct WeakDirection {
 
 /// How well the model's visible surface at T_camera_model pins each direction of motion down.
 struct ViewConstraints {
-  std::size_t points = 0;            ///< visible model samples used
-  std::array<double, 6> strength{};  ///< eigenvalues over the largest, ascending
-  std::vector<WeakDirection> weak;   ///< those with strength below kWeak, weakest first
-  std::vector<WeakDirection> all;    ///< every direction, weakest first
+  std::size_t points = 0;                            ///< visible model samples used
+  std::array<double, 6> strength{};                  ///< eigenvalues over the largest, ascending
+  std::vector<WeakDirection> weak;                   ///< those with strength below kWeak, weakest first
+  std::vector<WeakDirection> all;                    ///< every direction, weakest first
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< the seen samples' centre (camera frame, m): the rotations' pivot
+  double radius = 1e-3;                              ///< their RMS distance from it (m): the rotations' scale
   static constexpr double kWeak = kWeakStrength;
 };
 
@@ -104,6 +106,9 @@ inline constexpr std::size_t kMinColourSamples = 200;
 /// one plain material).
 bool has_colour_contrast(const ModelCloud& model);
 
+/// The model sample nearest `q` other than the one at index `skip` (model.points.size(): none skipped).
+std::size_t nearest_sample(const ModelCloud& model, const Eigen::Vector3f& q, std::size_t skip);
+
 /// Whether the model moved by `T_model_model` looks the same as unmoved at the model points `probes`
 /// (indices into model.points; empty: 300 spread over all of them): moved, they land on the model's
 /// surface (as near, on average, as a probe's nearest other sample) and carry the colour found there
@@ -133,6 +138,21 @@ Eigen::Matrix4d nearest_look_alike(const ModelCloud& model, const Eigen::Matrix4
 /// 1 cm of the depth measured there; at most `max` of them, spread over the model.
 std::vector<std::size_t> visible_samples(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
                                          const CameraIntrinsics& k, std::size_t max = 300);
+
+/// The turn about the axis of a weak rotation (`weak` from view_constraints at T_camera_model, a
+/// rotation rather than a slide) that brings T_camera_model's orientation nearest `prior`'s about that
+/// axis, as a T_camera_camera to apply on the left; identity for a slide. The axis passes through the
+/// point about which the weak motion is a pure turn (the axis of a mug seen with its handle hidden).
+Eigen::Matrix4d turn_towards(const ViewConstraints& view, const WeakDirection& weak, const Eigen::Matrix4d& T_camera_model,
+                             const Eigen::Matrix4d& prior);
+
+/// T, or T turned about an axis the view cannot fix towards `prior`, where the depth cannot tell the
+/// two apart: the samples seen at T, so turned, still lie on the model's surface (all but 2 %, each as
+/// near as twice its own neighbour's spacing plus 2 mm), and no more of the turned model is seen through
+/// (check_free_space: at most 1 % of its silhouette more). Depth alone says nothing about how far a body
+/// of revolution is turned about its axis (a plain mug with its handle hidden); the prior does.
+Eigen::Matrix4d nearest_unseen_turn(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const Eigen::Matrix4d& prior,
+                                    const DepthImage& depth, const CameraIntrinsics& k);
 
 /// A pose moved to where colour agrees best, in the plane of its two weakest slides.
 struct ColourRefinement {
