@@ -122,15 +122,15 @@ struct WorkerConfig {
   /// its attempts are (AcquisitionConfig::attempt_budget_ms), one a frame, escalating to global ones.
   double acquire_budget_ms = 1500.0;
   /// From a guess not known to within half the model's size (a gross one) whose reach (the silhouette's
-  /// growth) is at most coarse_max_reach_m, acquisition scores poses around it against the depth
-  /// (coarse_candidates: moves within that reach on coarse.step_m's grid, turns of coarse.turn_deg) and
-  /// acquires from the best coarse.count of them in turn, each as from a close guess; the first that
-  /// converges is the estimate, none: blank. ICP from such a guess settled on whatever was nearest, the
-  /// table or a neighbour (50 mm / 15 degree starts on the real YCB-V frames: 63 % lit within 10 mm, 4
-  /// lit wrong; with the candidates 86 %, none). Farther reaches (the twin's 30 cm / 40 degree guesses)
-  /// need turns a grid cannot cover: ICP's restarts and the global search from the guess, as before.
+  /// growth) is at most coarse_max_reach_m, and from a close guess whose own ICP fails, acquisition
+  /// scores poses around the guess against the depth (coarse_candidates) and acquires from the best
+  /// coarse.count of them in turn, each as from a close guess (from_candidates). Farther reaches (the
+  /// twin's 30 cm / 40 degree guesses) need turns a grid cannot cover: ICP's restarts and global search.
   bool coarse_search = true;
   double coarse_max_reach_m = 0.1;
+  /// Of the candidates that converge, the one whose centre lies nearest the guess is the estimate; the
+  /// search stops at one within this share of the guess's reach (a fit farther off may be a neighbour).
+  double nearest_candidate_share = 0.9;
   CoarseSearch coarse;
 };
 
@@ -263,9 +263,10 @@ class TargetFollower {
   /// are none, from the guess itself (acquire_at), and the candidates when that fails within the budget.
   AlignmentResult searched(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
                            const assets::Image* colour) const;
-  /// The close acquisition from each of coarse_candidates around `guess` (within grow_m) in turn: the
-  /// first that converges (and, with guess_bounds_estimate, stays within grow_m of the guess), else the
-  /// unconverged one with the most inliers; nothing when there are no candidates.
+  /// The close acquisition from each of coarse_candidates around `guess` (within grow_m) in turn: of
+  /// those that converge (and, with guess_bounds_estimate, stay within grow_m of the guess) the nearest
+  /// the guess, stopping at one within nearest_candidate_share of grow_m; else the unconverged one with
+  /// the most inliers; nothing when there are no candidates.
   std::optional<AlignmentResult> from_candidates(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known,
                                                  double grow_m, const assets::Image* colour) const;
   /// With guess_bounds_estimate: whether T puts the model's centroid farther from where `guess` put it
