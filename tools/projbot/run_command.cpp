@@ -2,10 +2,10 @@
 // pose of each target's tracker worker; the robot thread drives the tour, aims, hands each stop's
 // initial guess (Eq. 1) to the worker and, in the twin, plays the depth camera at 30 Hz.
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -23,6 +23,7 @@
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
 #include "projbot/hardware/devices.hpp"
+#include "projbot/session/projection.hpp"
 #include "projbot/session/session.hpp"
 #include "projbot/twin/camera.hpp"
 #include "projbot/twin/world.hpp"
@@ -52,25 +53,6 @@ struct RobotState {
   bool done = false;
   Eigen::Matrix4d T_camera_world = Eigen::Matrix4d::Identity();  // the camera's true pose at the stop (twin)
   bool measured = false;  // the truth above is known (the twin's robot), so each frame's error is measured
-};
-
-// The projector's frame period as the render loop sees it: the median interval between the last frame
-// starts (vsync paces them in FIFO mode), the configured refresh until enough frames have run.
-class PresentCadence {
- public:
-  void frame_started(double t_s) {
-    if (last_s_ > 0.0) intervals_.push_back(t_s - last_s_);
-    if (intervals_.size() > 31) intervals_.pop_front();
-    last_s_ = t_s;
-  }
-  double period_s(double configured_s) const {
-    if (intervals_.size() < 10) return configured_s;
-    return engine::percentile(std::vector<double>(intervals_.begin(), intervals_.end()), 0.5);
-  }
-
- private:
-  std::deque<double> intervals_;
-  double last_s_ = 0.0;
 };
 
 // The error of the frames drawn, against the twin's truth at each frame's display time: the mean
@@ -118,10 +100,6 @@ struct Handoffs {
   std::vector<double> from_capture_ms, in_session_ms;
   std::atomic<double> last_s{0.0};  // the newest live hand-off (steady clock), read by the render thread
 };
-
-// A live camera silent this long (no frame handed to the workers) blanks the projection: what was last
-// seen may no longer be there (issue 12: a camera that stops, lit no longer than this).
-constexpr double kSilentCameraS = 0.1;
 
 // What the robot thread tells the render thread at each step of the session, with the twin's truth when
 // the twin serves the robot; in a replay, each lockstep frame's poses are also checked against the recording's.
@@ -343,7 +321,13 @@ const Command kRun{
 
       // One tracker worker per target on the map.
       const bool predict = !args.flag("no-predict");
-      PresentCadence cadence;
+      session::ProjectionConfig pc;
+      pc.T_projector_camera = scene.pan_tilt.T_projector_camera;
+      pc.refresh_hz = scene.projector.refresh_hz;
+      pc.input_lag_ms = scene.projector.input_lag_ms;
+      pc.predict = predict;
+      pc.silent_camera_s = recording ? 0.0 : pc.silent_camera_s;  // a replay's frames play in lockstep
+      session::ProjectionFrames frames(pc);
       SceneTrackers trackers = make_trackers(scene, worker_config(predict, recording.has_value()));
       const auto& workers = trackers.owned;
 
@@ -376,8 +360,10 @@ const Command kRun{
       };
       RobotState robot;
       const double t0 = config::steady_now_s();
-      std::size_t blank = 0, frames_with_neighbours = 0, silent = 0;
-      double stale_before_s = 0.0;  // poses captured before the camera last went quiet are not drawn
+      std::size_t blank = 0, frames_with_neighbours = 0;
+      const session::PoseSource pose_of = [&](int index, alignment::PoseSample& pose) {
+        return workers[static_cast<std::size_t>(index)]->latest(pose);
+      };
       auto next_frame = Clock::now();
       while (!interrupted() && !target->poll_close() && !robot_done &&
              (seconds == 0.0 || config::steady_now_s() - t0 < seconds)) {
@@ -386,25 +372,13 @@ const Command kRun{
         const auto read_poses = [&](std::vector<engine::DrawItem>& out) {
           out.clear();
           drawn.clear();
-          // Drawn where each target will be when this frame is lit: one frame period after it starts (FIFO
-          // presents at the next vblank; the period as measured) plus the projector's input lag (issue 14).
-          const double display_s =
-              config::steady_now_s() + cadence.period_s(1.0 / scene.projector.refresh_hz) + 1e-3 * scene.projector.input_lag_ms;
-          if (!recording && !robot.lit.empty() && config::steady_now_s() - handoffs.last_s > kSilentCameraS) {
-            ++silent;                                 // the camera has gone quiet: blank rather than show what it saw last...
-            stale_before_s = config::steady_now_s();  // ...and, once it is back, only what it sees from then on
-            return;
-          }
-          for (const DrawnTarget& lit : robot.lit) {
-            alignment::PoseSample pose;
-            auto& worker = *workers[static_cast<std::size_t>(lit.target)];
-            if (!worker.latest(pose) || pose.lost || pose.capture_time_s < std::max(robot.since_s, stale_before_s))
-              continue;  // blanked on its own
-            const Eigen::Matrix4d T_camera_target =
-                predict ? alignment::predict_pose(pose.motion, display_s) : pose.T_camera_target;
-            out.push_back({items[static_cast<std::size_t>(lit.target)].model,
-                           alignment::projector_from_target(scene.pan_tilt.T_projector_camera, T_camera_target)});  // Eq. 2
-            drawn.push_back({&lit, pose.capture_time_s, display_s, T_camera_target});
+          session::LitNow now{{}, robot.since_s, handoffs.last_s};
+          for (const DrawnTarget& lit : robot.lit) now.targets.push_back(lit.target);
+          for (const session::DrawnPose& d : frames.compose(config::steady_now_s(), now, pose_of)) {
+            out.push_back({items[static_cast<std::size_t>(d.target)].model, d.T_projector_target});
+            const auto lit =
+                std::find_if(robot.lit.begin(), robot.lit.end(), [&](const DrawnTarget& l) { return l.target == d.target; });
+            drawn.push_back({&*lit, d.capture_s, d.display_s, d.T_camera_target});
           }
         };
         if (headless) {  // an offscreen target has no vsync: pace it like a 60 Hz projector
@@ -413,7 +387,7 @@ const Command kRun{
           if (Clock::now() > next_frame + std::chrono::milliseconds(50)) next_frame = Clock::now();
         }
         const double start_ms = profiler.now_ms(), start_s = config::steady_now_s();
-        cadence.frame_started(start_s);
+        frames.frame_started(start_s);
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
         const double nan = std::nan("");
         if (drawn.empty()) {
@@ -466,9 +440,9 @@ const Command kRun{
                 << engine::percentile(ages_ms, 0.95) << " ms, p99 " << engine::percentile(ages_ms, 0.99) << " ms, max "
                 << engine::percentile(ages_ms, 1.0) << " ms; " << blank << " frames blank (driving, acquiring or lost)";
       if (frames_with_neighbours > 0) std::cout << "; " << frames_with_neighbours << " frames lit a neighbour too";
-      if (silent > 0)
-        std::cout << "; " << silent << " frames blanked because the camera had handed over no frame for "
-                  << std::lround(1000.0 * kSilentCameraS) << " ms";
+      if (frames.silent_frames() > 0)
+        std::cout << "; " << frames.silent_frames() << " frames blanked because the camera had handed over no frame for "
+                  << std::lround(1000.0 * pc.silent_camera_s) << " ms";
       std::cout << "\n";
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
