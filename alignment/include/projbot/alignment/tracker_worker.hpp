@@ -21,111 +21,80 @@
 
 namespace projbot::alignment {
 
+/// The tracker worker's policy. Why each value is what it is (the measurements behind it) is in the
+/// commits that set it and in the README.
 struct WorkerConfig {
   AcquisitionConfig acquisition;
   TrackerConfig tracking;
-  /// The silhouette's edges in the projective polish that ends an acquisition (TrackerConfig::edge_weight),
-  /// for models without colour contrast (a textured one is placed along its free directions by colour).
-  /// Depth alone leaves the shop's figure, standing face-on, nearly free to turn in the image plane: the
-  /// polish ended 1.9 mm (median) and up to 3.2 mm off at its feet (bench acquire, seed 2); its outline's
-  /// sides hold it (0.49 and 0.88 mm). Not while tracking: there the face-on box's
-  /// outline shows one side only, and it pulled the held box 4-5 mm along its face (shop tour).
+  /// Weight of the silhouette's edges in the projective polish that ends an acquisition, for models
+  /// without colour contrast (TrackerConfig::edge_weight); not used while tracking.
   double polish_edge_weight = 1.0;
-  /// Consecutive frames in which neither tracking nor a second, wider tracking pass (on the same frame,
-  /// correspondences up to reach_m; and one ICP when frames were dropped since the last pose) found the
-  /// target, after which it is reported lost and blanked: 2 frames at 30 Hz blank within 100 ms of the
-  /// first depth frame that shows it gone.
+  /// Frames in a row in which neither tracking nor its second, wider pass (correspondences up to
+  /// reach_m, metres) found the target, after which it is reported lost and blanked.
   int lost_after = 2;
-  double reach_m = 0.10;  ///< the second tracking pass's correspondence distance, metres
-  /// A lost or not-yet-found target is searched for by bounded attempts, escalating SearchStage::local ->
-  /// global_near -> global_wide and round again, one attempt per frame at most. After the n-th failed
-  /// attempt the next one waits search_spacing_frames[min(n - 1, size - 1)] frames, so an absent target
-  /// costs a bounded share of the worker's time.
+  double reach_m = 0.10;
+  /// A lost or not-yet-found target is searched for by bounded attempts (SearchStage::local ->
+  /// global_near -> global_wide, round again), one per frame at most; after the n-th failed attempt the
+  /// next waits search_spacing_frames[min(n - 1, size - 1)] frames...
   std::vector<int> search_spacing_frames{0, 3, 9, 15, 30};
-  /// ...and at least long enough that searching takes no more than this share of the worker's time:
-  /// an attempt of t ms is followed by t (1 / search_duty - 1) ms of frames (camera_hz) without one.
+  /// ...and long enough that searching takes at most this share of the worker's time (an attempt of t
+  /// ms is followed by t (1 / search_duty - 1) ms of frames at camera_hz without one).
   double search_duty = 0.25;
-  /// The first search from a new guess (set_initial_guess) is the acquisition itself (acquire(): the
-  /// support found in the frame, the polish, colour): one pipeline for align, the benchmark and the
-  /// tracker. Later attempts are the bounded ones above. False: every attempt is a bounded one.
+  /// The first search from a new guess is the acquisition itself (acquire()); later ones are the bounded
+  /// attempts above. False: every attempt is a bounded one.
   bool first_search_acquires = true;
   double camera_hz = 30.0;
-  /// Every pose (tracked, refined or found) is checked against free space (verification.hpp): more than
-  /// this share of the predicted silhouette seen through rejects it. A box fitted onto the bare pedestal
-  /// it was taken from scores near 1; correct poses, partly occluded ones too, near 0. On real frames
-  /// (bench dataset, YCB-V) estimates within 5 mm scored at most 0.07 (98th percentile), while the mug
-  /// turned about its axis, lit 20-28 mm off at 0.96-0.99 inliers, scored 0.18-0.19: 0.2 let it through.
+  /// A pose whose predicted silhouette is seen through (check_free_space) over more than this share is
+  /// rejected, whether tracked, refined or found.
   double max_behind_ratio = 0.1;
-  /// Motion prediction (issue 14): tracking starts each frame from the motion filter's prediction at
-  /// the frame's capture time, and each sample carries the motion the renderer extrapolates to its
-  /// display time. False: tracking starts from the last pose and every sample is still.
+  /// Motion prediction: tracking starts each frame from the motion filter's prediction at its capture
+  /// time, and each sample carries the motion the renderer extrapolates to its display time. False:
+  /// tracking starts from the last pose and every sample is still.
   bool predict = true;
   MotionModelConfig motion;
-  /// Acquisition leaves out the scan points this close to a known floor (or under it): 2 cm is well
-  /// outside a localised camera's plane error (a 0.1 degree tilt is 3.5 mm at 2 m).
+  /// Acquisition leaves out the scan points within this of a known floor, or under it (m).
   double floor_margin_m = 0.02;
-  /// With a footing above the floor, acquisition also leaves out what lies below the support's top (the
-  /// target's surveyed lowest point) plus this: negative keeps the target's own lowest centimetre (the
-  /// face-on box's bottom edge, which pins it vertically) and drops most of the table top. With +0.5 cm,
-  /// one gross guess of the shop's box was lit wrong in 10 (bench acquire); with -0.5 cm none.
+  /// With a footing above the floor, also what lies below the support's top plus this (m; negative keeps
+  /// the target's own lowest centimetre, which pins it vertically).
   double support_margin_m = -0.005;
-  /// Without a map (acquire() with no footing): the support found in the frame (support_in_frame) is left
-  /// out up to this far above it: its RANSAC plane is good to a few mm, and a 3 cm box lying on a table
-  /// would lose most of its sides to the map's 2 cm.
+  /// Without a map: the support found in the frame (support_in_frame) is left out up to this above it (m).
   double frame_support_margin_m = 0.008;
-  /// Acquisition from a guess known to within half the model's size leaves out each surface that runs
-  /// on past the crop and lies mostly outside the silhouette (crop_to_silhouette's clustering): the
-  /// shelf beside the shop figure's hand, the vase beside the duck.
+  /// From a guess known to within half the model's size, surfaces that run on past the crop and lie
+  /// mostly outside the silhouette are left out (crop_to_silhouette's clustering).
   bool cluster_neighbours = true;
-  /// Local acquisition keeps the depth inside the guess's predicted silhouette grown by the guess's
-  /// uncertainty: this far, plus guess_uncertainty_deg turning the model's farthest point about its
-  /// origin (a tall figure turned 3 degrees about its feet moves its head 8 cm). A localised robot's
-  /// Eq. 1 guess is within about 1 cm and 0.2 degrees (the tour's table).
+  /// The guess's uncertainty: the depth is cropped to its predicted silhouette grown by this much (m)
+  /// plus this turn of the model's farthest point about its origin (degrees).
   double guess_uncertainty_m = 0.05;
   double guess_uncertainty_deg = 3.0;
-  /// ...and once ICP has an estimate, the depth is cropped again at it, grown by this, and ICP refines
-  /// from there on what is left (what stood beside the target inside the first crop drops out).
+  /// Once ICP has an estimate the depth is cropped again at it, grown by this (m), and ICP refines there.
   double recrop_m = 0.03;
-  /// Whether the guess's uncertainty is a bound (a user's stated guess error: `align --guess-error`,
-  /// `bench dataset`'s perturbations): an acquisition's estimate may then put the model's centroid no
-  /// farther from where the guess put it than that uncertainty (the silhouette's growth) plus
-  /// reach_margin_m; beyond it, it is something else that fits. False (the default): no such bound, as
-  /// for a map's guess of a target that may have been moved (the tour finds its moved box 10 cm and 15
-  /// degrees away).
+  /// Whether the guess's uncertainty is a bound (`align --guess-error`, `bench dataset`'s perturbations):
+  /// an estimate's centroid may then lie no farther from the guess's than that uncertainty plus
+  /// reach_margin_m (m). False: no bound (a map's guess of a target that may have been moved).
   bool guess_bounds_estimate = false;
   double reach_margin_m = 0.02;
-  /// Colour at acquisition (acquire with a colour image): a move along the weakest slides is taken only
-  /// if the depth's RMS error at the moved pose grows by at most this share...
+  /// Colour at acquisition: a move along the weakest slides is taken only if the depth's RMS error grows
+  /// by at most this share...
   double colour_max_rmse_growth = 0.10;
-  /// ...and a pose whose colours correlate with the image less than this is refused (when the model
-  /// has colour contrast at all). Correct poses in the twin: 0.95-0.99; the box fitted wrong from gross
-  /// guesses: 0.0-0.5.
+  /// ...a pose whose colours correlate with the image less than this is refused (models with colour
+  /// contrast)...
   double min_colour_agreement = 0.5;
   /// ...and where ICP held the view's weak directions for colour (AlignmentResult::weak_held), a pose
-  /// colour leaves agreeing less than this is found again by depth alone, coarse to fine: from a 5 cm
-  /// guess the face-on box's slide can lie past colour's reach (it ended at 0.14 and at 0.85, 6 mm off).
+  /// colour leaves agreeing less than this is found again by depth alone, coarse to fine.
   double min_held_colour_agreement = 0.9;
-  /// A pose that colour placed or confirmed (a stop's first, with a colour image) is held: tracking
-  /// pulls towards it (TrackerConfig::hold_prior) instead of its start, so it does not slide along the
-  /// directions depth leaves free (a face-on box, back 1.6-2.0 mm; the display's box seen from the
-  /// side, 0.6 -> 2.0 mm). Let go when the target is seen moving (the motion filter) or tracked this far
-  /// from it; from then on tracking is depth alone until the next stop.
+  /// A pose colour placed or confirmed is held (TrackerConfig::hold_prior) until the target is seen
+  /// moving or tracked this far from it (m, degrees).
   double hold_release_m = 0.003;
   double hold_release_deg = 1.0;
-  /// One acquisition (acquire(): the localized mode's one per stop) starts no further ICP stage,
-  /// restart, global round or colour retry after this many ms of its thread's CPU time (a loaded machine
-  /// slows it, does not cut it short), and blanks what it has not confirmed by
-  /// then: from gross guesses (30 cm, 40 degrees) it ran to 27 s (the standing figure: ICP restarts,
-  /// then up to 20000 RANSAC iterations over FPFH matches, 16-22 s alone) and 8 s (the box: the whole
-  /// search once for each way of placing its weak slides). The ICP stage running at the deadline ends
-  /// first, so an acquisition takes up to about twice this. Tracking mode's search is not bounded by it:
-  /// its attempts are (AcquisitionConfig::attempt_budget_ms), one a frame, escalating to global ones.
+  /// One acquisition starts no new ICP stage, restart, global round or colour retry after this many ms
+  /// of its thread's CPU time, and blanks what it has not confirmed by then; the stage running at the
+  /// deadline finishes. Tracking's search attempts have their own (AcquisitionConfig::attempt_budget_ms).
   double acquire_budget_ms = 1500.0;
   /// From a guess not known to within half the model's size (a gross one) whose reach (the silhouette's
   /// growth) is at most coarse_max_reach_m, and from a close guess whose own ICP fails, acquisition
   /// scores poses around the guess against the depth (coarse_candidates) and acquires from the best
-  /// coarse.count of them in turn, each as from a close guess (from_candidates). Farther reaches (the
-  /// twin's 30 cm / 40 degree guesses) need turns a grid cannot cover: ICP's restarts and global search.
+  /// coarse.count of them in turn, each as from a close guess (from_candidates). Farther reaches need
+  /// turns a grid cannot cover: ICP's restarts and global search.
   bool coarse_search = true;
   double coarse_max_reach_m = 0.1;
   /// Of the candidates that converge, the one whose centre lies nearest the guess is the estimate; the
@@ -204,19 +173,14 @@ class TargetFollower {
   Eigen::Matrix4d last_pose() const { return pose_.value_or(guess_); }
   const Aligner& aligner() const { return aligner_; }
   const MotionFilter& motion() const { return filter_; }
-  /// One whole acquisition (SearchStage::full) from `guess`, as the tour's localized mode runs it: the
-  /// footing's floor left out, only poses that stand as it says accepted, the depth cropped to the guess's silhouette grown by
-  /// grow_m (silhouette_grow_m(): how far the configured uncertainty reaches), then refined on the depth cropped again at the
-  /// estimate (recrop_m). A converged pose is then polished by up to three
-  /// projective tracking passes on the whole frame (model points against the pixels they fall on: a
-  /// neighbour touching the target pulls less than in ICP's nearest neighbours; the shop's figure, its
-  /// hand at a shelf, went from 2.7-3.6 mm to about 1 mm). The ICP's inlier ratio and rmse are of the
-  /// pose before the polish. With `colour` (registered to the frame), the pose is last moved along its
-  /// weakest slides to where the model's colours agree best (colour_refined: the shop's face-on box) as
-  /// far as the depth allows (colour_max_rmse_growth), and refused when its colours disagree
-  /// (min_colour_agreement). Bounded by WorkerConfig::acquire_budget_ms: what is not confirmed by then
-  /// is returned unconverged (blank).
-  /// Throws AlignmentError when too little depth is left.
+  /// One whole acquisition from `guess` (the tour's localized mode, a stop's first search): the footing's
+  /// floor left out and only poses that stand as it says accepted; the depth cropped to the guess's
+  /// silhouette grown by grow_m (silhouette_grow_m() for the configured uncertainty); ICP, refined on the
+  /// depth cropped again at the estimate (recrop_m); a converged pose polished by up to three projective
+  /// passes on the whole frame (inlier ratio and rmse are of the pose before the polish). With `colour`
+  /// (registered to the frame), moved along its weakest slides to where its colours agree best as far
+  /// as the depth allows, and refused when they disagree. Bounded by acquire_budget_ms: what is not
+  /// confirmed by then is returned unconverged (blank). Throws AlignmentError when too little depth is left.
   AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing, double grow_m,
                           const assets::Image* colour = nullptr) const;
   /// The same without a map (a real frame of objects on a table, `projbot align` on a depth image, a BOP
