@@ -68,3 +68,44 @@ TEST(Hardware, NothingConfiguredOpensNothing) {
   EXPECT_EQ(devices.camera, nullptr);
   EXPECT_EQ(devices.pan_tilt, nullptr);
 }
+
+// A session's devices (run, record): part of a robot is refused naming what is missing, and a laser
+// without the base it localises or without a map is refused before any device is opened (the absent
+// base of the last case would otherwise be named first).
+TEST(Hardware, ASessionNeedsAWholeRobotAndALaserItsBaseAndMap) {
+  using projbot::hardware::configured_robot;
+  using projbot::hardware::open_session_devices;
+  projbot::config::DevicesConfig d;
+  EXPECT_FALSE(configured_robot(d));  // nothing configured: the twin serves the robot
+  d.camera = projbot::config::CameraDevice{};
+  EXPECT_FALSE(configured_robot(d));  // a camera alone: the twin's robot, this camera
+  d.base = projbot::config::BaseDevice{};
+  const auto refusal = [](const auto& call) {
+    try {
+      call();
+    } catch (const DeviceError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(refusal([&] { configured_robot(d); }).find("and devices.pan_tilt is not"), std::string::npos);
+  d.pan_tilt = projbot::config::PanTiltDevice{};
+  EXPECT_TRUE(configured_robot(d));
+  d.camera.reset();
+  EXPECT_NE(refusal([&] { configured_robot(d); }).find("and devices.camera is not"), std::string::npos);
+
+  projbot::config::DevicesConfig laser_only;
+  laser_only.laser = projbot::config::LaserDevice{};
+  std::vector<DeviceCheck> checks;
+  bool robot = true;
+  EXPECT_NE(refusal([&] { open_session_devices(laser_only, checks, robot); }).find("devices.base is not configured"),
+            std::string::npos);
+  projbot::config::DevicesConfig no_map = laser_only;
+  no_map.base = projbot::config::BaseDevice{};
+  EXPECT_NE(refusal([&] { open_session_devices(no_map, checks, robot); }).find("devices.laser.map names none"),
+            std::string::npos);
+  EXPECT_TRUE(checks.empty());  // refused before anything was opened
+  const auto none = open_session_devices({}, checks, robot);
+  EXPECT_FALSE(robot);
+  EXPECT_EQ(none.camera, nullptr);
+}

@@ -152,7 +152,7 @@ const Command kRecord{
         config::DevicesConfig wanted = scene.devices;
         wanted.projector.reset();  // nothing is projected while recording
         std::vector<hardware::DeviceCheck> checks;
-        devices = open_session_devices(wanted, checks, robot, false);  // a laser without a map: a mapping run
+        devices = hardware::open_session_devices(wanted, checks, robot, false);  // a laser without a map: a mapping run
         for (const auto& c : checks)
           if (c.role == "camera") rec.camera = c.config;
       }

@@ -69,48 +69,6 @@ session::Dwell TwinRig::dwell(double dwell_s, bool lockstep) {
   return d;
 }
 
-namespace {
-
-// A laser localises a configured base against a map (a mapping run records it without one): without
-// either, the config is incomplete (said before any device is opened).
-void check_laser(const config::DevicesConfig& d, bool laser_needs_map) {
-  if (d.laser && !d.base)
-    throw hardware::DeviceError(
-        "devices.laser localises the configured base, and devices.base is not configured (the twin's robot "
-        "localises on the twin's laser): configure the base, or leave the laser out");
-  if (laser_needs_map && d.laser && d.laser->map.empty())
-    throw hardware::DeviceError(
-        "devices.laser localises the base against a map, and devices.laser.map names none: map the site "
-        "(projbot slam --out-map DIR) and name DIR there");
-}
-
-}  // namespace
-
-bool configured_robot(const config::DevicesConfig& d) {
-  if (!d.base && !d.pan_tilt) return false;
-  std::string missing;
-  for (const auto& [name, there] : {std::pair<const char*, bool>{"base", d.base.has_value()},
-                                    {"pan_tilt", d.pan_tilt.has_value()},
-                                    {"camera", d.camera.has_value()}})
-    if (!there) missing += std::string(missing.empty() ? "" : " and ") + "devices." + name;
-  if (!missing.empty())
-    throw hardware::DeviceError(
-        "a real robot needs its base, pan_tilt and camera configured together, and " + missing +
-        (missing.find(" and ") != std::string::npos ? " are" : " is") +
-        " not (the twin cannot stand in for part of a real robot); configure it, or run the twin with --sim");
-  return true;
-}
-
-hardware::Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<hardware::DeviceCheck>& checks,
-                                       bool& robot, bool laser_needs_map) {
-  robot = false;
-  if (!wanted.any()) return {};
-  check_laser(wanted, laser_needs_map);
-  hardware::Devices devices = hardware::open_devices(wanted, checks, true);
-  robot = configured_robot(wanted);  // after opening: an absent device is named before a missing one
-  return devices;
-}
-
 DeviceRig::DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, hardware::Devices& devices)
     : map_(devices.laser && scene.devices.laser
                ? std::optional<robot::Localizer>(robot::Localizer::load(scene.devices.laser->map))

@@ -58,19 +58,6 @@ class TwinRig {
   session::Session session_;
 };
 
-/// Whether the config's devices make up the whole robot: a base, a pan-tilt and a camera, configured
-/// together (the session then drives them, and no twin). False when none of the base and pan-tilt is
-/// configured (the twin serves the robot). Throws hardware::DeviceError naming what is missing for part of a robot
-/// (the twin's camera cannot see where a real base went), and for a laser, which no session drives yet.
-bool configured_robot(const config::DevicesConfig& devices);
-
-/// The config's devices for a session, each opened and read once (the first that fails a hardware::DeviceError
-/// naming it), then checked to make a whole robot or a camera alone (configured_robot): `robot` says which.
-/// None configured: no device, `robot` false. A laser needs a base, and a map unless `laser_needs_map` is
-/// false (record's mapping run).
-hardware::Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<hardware::DeviceCheck>& checks,
-                                       bool& robot, bool laser_needs_map = true);
-
 /// The configured devices serving the whole session: the base over ROS 2 topics (closing the loop on its
 /// odometry, started at the scene's robot.start), the PTU-D46 and the camera. No twin, so no truth.
 class DeviceRig {

@@ -195,7 +195,7 @@ hardware::Devices open_configured(const config::Scene& scene, bool headless) {
   std::vector<hardware::DeviceCheck> checks;
   bool robot = false;
   hardware::Devices devices =
-      open_session_devices(wanted, checks, robot);  // an absent device, part of a robot or a laser: refused
+      hardware::open_session_devices(wanted, checks, robot);  // an absent device, part of a robot or a laser: refused
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
   if (robot)
     std::cout << "the configured base, pan-tilt and camera serve the session"

@@ -45,4 +45,17 @@ struct DeviceCheck {
 /// first failure; otherwise every device is tried and `checks` says how each went.
 Devices open_devices(const config::DevicesConfig& config, std::vector<DeviceCheck>& checks, bool stop_at_first);
 
+/// Whether the config's devices make up the whole robot: a base, a pan-tilt and a camera, configured
+/// together (the session then drives them, and no twin). False when none of the base and pan-tilt is
+/// configured (the twin serves the robot). Throws DeviceError naming what is missing for part of a robot
+/// (the twin's camera cannot see where a real base went).
+bool configured_robot(const config::DevicesConfig& devices);
+
+/// The config's devices for a session, each opened and read once (the first that fails a DeviceError
+/// naming it), then checked to make a whole robot or a camera alone (configured_robot): `robot` says which.
+/// None configured: no device, `robot` false. A laser needs a base, and a map unless `laser_needs_map` is
+/// false (record's mapping run).
+Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot,
+                             bool laser_needs_map = true);
+
 }  // namespace projbot::hardware
