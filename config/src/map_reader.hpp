@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <sstream>
 #include <string>
@@ -107,5 +108,10 @@ class MapReader {
   const std::string& file_;
   std::set<std::string> used_;
 };
+
+// A file or folder as the scene names it: absolute, or relative to the scene's folder `base`.
+inline std::filesystem::path beside_scene(const std::string& named, const std::filesystem::path& base) {
+  return std::filesystem::path(named).is_absolute() ? std::filesystem::path(named) : base / named;
+}
 
 }  // namespace projbot::config
