@@ -51,92 +51,9 @@ Gpu::Gpu(const RendererOptions& options) : windowing(options.windowing) {
     }
   }
   try {
-    std::vector<const char*> extensions;
-    std::vector<const char*> layers;
-    if (windowing) {
-      std::uint32_t count = 0;
-      const char** names = glfwGetRequiredInstanceExtensions(&count);
-      extensions.assign(names, names + count);
-    }
-    if (options.validation) {
-      bool found = false;
-      for (const auto& layer : context.enumerateInstanceLayerProperties())
-        found = found || std::strcmp(layer.layerName, kValidationLayer) == 0;
-      if (!found)
-        throw EngineError(
-            "validation requested but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)");
-      layers.push_back(kValidationLayer);
-      extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-    }
-    if (context.enumerateInstanceVersion() < VK_API_VERSION_1_3)
-      throw EngineError("the Vulkan loader is older than 1.3; Projbot needs Vulkan 1.3");
-    vk::ApplicationInfo app("projbot", 1, "projbot", 1, VK_API_VERSION_1_3);
-    vk::DebugUtilsMessengerCreateInfoEXT messenger_info(
-        {}, vk::DebugUtilsMessageSeverityFlagBitsEXT::eWarning | vk::DebugUtilsMessageSeverityFlagBitsEXT::eError,
-        vk::DebugUtilsMessageTypeFlagBitsEXT::eGeneral | vk::DebugUtilsMessageTypeFlagBitsEXT::eValidation |
-            vk::DebugUtilsMessageTypeFlagBitsEXT::ePerformance,
-        &on_validation_message, this);
-    vk::InstanceCreateInfo instance_info({}, &app, layers, extensions);
-    if (options.validation) instance_info.pNext = &messenger_info;  // also covers instance creation itself
-    instance = vk::raii::Instance(context, instance_info);
-    if (options.validation) messenger = vk::raii::DebugUtilsMessengerEXT(instance, messenger_info);
-
-    vk::raii::PhysicalDevices devices(instance);
-    if (devices.empty()) throw EngineError("no Vulkan device found (install mesa-vulkan-drivers for the CPU renderer lavapipe)");
-    std::size_t chosen = devices.size();
-    if (options.device_index >= 0) {
-      if (static_cast<std::size_t>(options.device_index) >= devices.size())
-        throw EngineError("Vulkan device " + std::to_string(options.device_index) + " requested, but only " +
-                          std::to_string(devices.size()) + " found");
-      chosen = static_cast<std::size_t>(options.device_index);
-    } else {
-      int best = -1;
-      for (std::size_t i = 0; i < devices.size(); ++i) {
-        const auto props = devices[i].getProperties();
-        const int rank = props.apiVersion >= VK_API_VERSION_1_3 ? device_rank(props.deviceType) : -1;
-        if (rank > best) best = rank, chosen = i;
-      }
-      if (best < 0) throw EngineError("no Vulkan 1.3 device found");
-    }
-    physical = std::move(devices[chosen]);
-    const auto props2 = physical.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
-    const auto& props = props2.get<vk::PhysicalDeviceProperties2>().properties;
-    const auto& driver = props2.get<vk::PhysicalDeviceDriverProperties>();
-    if (props.apiVersion < VK_API_VERSION_1_3)
-      throw EngineError(std::string("Vulkan device '") + props.deviceName.data() + "' supports only Vulkan " +
-                        std::to_string(VK_API_VERSION_MAJOR(props.apiVersion)) + "." +
-                        std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + "; Projbot needs 1.3");
-    info.name = props.deviceName.data();
-    info.driver = std::string(driver.driverName.data()) + " " + driver.driverInfo.data();
-    info.api_version = props.apiVersion;
-
-    const auto families = physical.getQueueFamilyProperties();
-    bool found = false;
-    for (std::uint32_t i = 0; i < families.size(); ++i)
-      if (families[i].queueFlags & vk::QueueFlagBits::eGraphics) {
-        queue_family = i;
-        found = true;
-        break;
-      }
-    if (!found) throw EngineError(std::string("Vulkan device '") + info.name + "' has no graphics queue");
-    info.gpu_timestamps = families[queue_family].timestampValidBits > 0 && props.limits.timestampPeriod > 0.0F;
-    timestamp_period_ns = props.limits.timestampPeriod;
-
-    const auto features = physical.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan13Features>();
-    const auto& f13 = features.get<vk::PhysicalDeviceVulkan13Features>();
-    if (!f13.dynamicRendering || !f13.synchronization2)
-      throw EngineError("Vulkan device '" + info.name + "' lacks dynamicRendering or synchronization2");
-
-    const float priority = 1.0F;
-    vk::DeviceQueueCreateInfo queue_info({}, queue_family, 1, &priority);
-    std::vector<const char*> device_extensions;
-    if (windowing) device_extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
-    vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan13Features> device_info(
-        vk::DeviceCreateInfo({}, queue_info, {}, device_extensions), vk::PhysicalDeviceVulkan13Features());
-    device_info.get<vk::PhysicalDeviceVulkan13Features>().setDynamicRendering(VK_TRUE).setSynchronization2(VK_TRUE);
-    device = vk::raii::Device(physical, device_info.get<vk::DeviceCreateInfo>());
-    queue = vk::raii::Queue(device, queue_family, 0);
-    command_pool = vk::raii::CommandPool(device, {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, queue_family});
+    create_instance(options);
+    choose_device(options.device_index);
+    create_device();
   } catch (const vk::SystemError& e) {
     if (windowing) glfwTerminate();
     throw EngineError(std::string("Vulkan start-up failed: ") + e.what());
@@ -144,6 +61,99 @@ Gpu::Gpu(const RendererOptions& options) : windowing(options.windowing) {
     if (windowing) glfwTerminate();
     throw;
   }
+}
+
+void Gpu::create_instance(const RendererOptions& options) {
+  std::vector<const char*> extensions;
+  std::vector<const char*> layers;
+  if (windowing) {
+    std::uint32_t count = 0;
+    const char** names = glfwGetRequiredInstanceExtensions(&count);
+    extensions.assign(names, names + count);
+  }
+  if (options.validation) {
+    bool found = false;
+    for (const auto& layer : context.enumerateInstanceLayerProperties())
+      found = found || std::strcmp(layer.layerName, kValidationLayer) == 0;
+    if (!found)
+      throw EngineError(
+          "validation requested but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)");
+    layers.push_back(kValidationLayer);
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  if (context.enumerateInstanceVersion() < VK_API_VERSION_1_3)
+    throw EngineError("the Vulkan loader is older than 1.3; Projbot needs Vulkan 1.3");
+  vk::ApplicationInfo app("projbot", 1, "projbot", 1, VK_API_VERSION_1_3);
+  vk::DebugUtilsMessengerCreateInfoEXT messenger_info(
+      {}, vk::DebugUtilsMessageSeverityFlagBitsEXT::eWarning | vk::DebugUtilsMessageSeverityFlagBitsEXT::eError,
+      vk::DebugUtilsMessageTypeFlagBitsEXT::eGeneral | vk::DebugUtilsMessageTypeFlagBitsEXT::eValidation |
+          vk::DebugUtilsMessageTypeFlagBitsEXT::ePerformance,
+      &on_validation_message, this);
+  vk::InstanceCreateInfo instance_info({}, &app, layers, extensions);
+  if (options.validation) instance_info.pNext = &messenger_info;  // also covers instance creation itself
+  instance = vk::raii::Instance(context, instance_info);
+  if (options.validation) messenger = vk::raii::DebugUtilsMessengerEXT(instance, messenger_info);
+}
+
+void Gpu::choose_device(int device_index) {
+  vk::raii::PhysicalDevices devices(instance);
+  if (devices.empty()) throw EngineError("no Vulkan device found (install mesa-vulkan-drivers for the CPU renderer lavapipe)");
+  std::size_t chosen = devices.size();
+  if (device_index >= 0) {
+    if (static_cast<std::size_t>(device_index) >= devices.size())
+      throw EngineError("Vulkan device " + std::to_string(device_index) + " requested, but only " +
+                        std::to_string(devices.size()) + " found");
+    chosen = static_cast<std::size_t>(device_index);
+  } else {
+    int best = -1;
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+      const auto props = devices[i].getProperties();
+      const int rank = props.apiVersion >= VK_API_VERSION_1_3 ? device_rank(props.deviceType) : -1;
+      if (rank > best) best = rank, chosen = i;
+    }
+    if (best < 0) throw EngineError("no Vulkan 1.3 device found");
+  }
+  physical = std::move(devices[chosen]);
+  const auto props2 = physical.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
+  const auto& props = props2.get<vk::PhysicalDeviceProperties2>().properties;
+  const auto& driver = props2.get<vk::PhysicalDeviceDriverProperties>();
+  if (props.apiVersion < VK_API_VERSION_1_3)
+    throw EngineError(std::string("Vulkan device '") + props.deviceName.data() + "' supports only Vulkan " +
+                      std::to_string(VK_API_VERSION_MAJOR(props.apiVersion)) + "." +
+                      std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + "; Projbot needs 1.3");
+  info.name = props.deviceName.data();
+  info.driver = std::string(driver.driverName.data()) + " " + driver.driverInfo.data();
+  info.api_version = props.apiVersion;
+
+  const auto families = physical.getQueueFamilyProperties();
+  bool found = false;
+  for (std::uint32_t i = 0; i < families.size(); ++i)
+    if (families[i].queueFlags & vk::QueueFlagBits::eGraphics) {
+      queue_family = i;
+      found = true;
+      break;
+    }
+  if (!found) throw EngineError(std::string("Vulkan device '") + info.name + "' has no graphics queue");
+  info.gpu_timestamps = families[queue_family].timestampValidBits > 0 && props.limits.timestampPeriod > 0.0F;
+  timestamp_period_ns = props.limits.timestampPeriod;
+
+  const auto features = physical.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceVulkan13Features>();
+  const auto& f13 = features.get<vk::PhysicalDeviceVulkan13Features>();
+  if (!f13.dynamicRendering || !f13.synchronization2)
+    throw EngineError("Vulkan device '" + info.name + "' lacks dynamicRendering or synchronization2");
+}
+
+void Gpu::create_device() {
+  const float priority = 1.0F;
+  vk::DeviceQueueCreateInfo queue_info({}, queue_family, 1, &priority);
+  std::vector<const char*> device_extensions;
+  if (windowing) device_extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+  vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan13Features> device_info(
+      vk::DeviceCreateInfo({}, queue_info, {}, device_extensions), vk::PhysicalDeviceVulkan13Features());
+  device_info.get<vk::PhysicalDeviceVulkan13Features>().setDynamicRendering(VK_TRUE).setSynchronization2(VK_TRUE);
+  device = vk::raii::Device(physical, device_info.get<vk::DeviceCreateInfo>());
+  queue = vk::raii::Queue(device, queue_family, 0);
+  command_pool = vk::raii::CommandPool(device, {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, queue_family});
 }
 
 Gpu::~Gpu() {

@@ -59,6 +59,13 @@ class Gpu {
 
  private:
   std::uint32_t memory_type(std::uint32_t type_bits, vk::MemoryPropertyFlags props) const;
+  // Start-up, in this order: the instance (GLFW's extensions; the validation layer and its messenger
+  // when asked); the physical device (the one asked for, else the best Vulkan 1.3 one: info, the graphics
+  // queue family, timestamps; dynamic rendering and synchronization2 required); the logical device, its
+  // queue and command pool.
+  void create_instance(const RendererOptions& options);
+  void choose_device(int device_index);
+  void create_device();
 };
 
 /// An image layout transition with synchronization2, for the whole image.
