@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "projbot/alignment/equations.hpp"
@@ -9,23 +10,29 @@
 
 namespace projbot::alignment {
 
-Eigen::Matrix4d turn_towards(const ViewConstraints& view, const WeakDirection& weak, const Eigen::Matrix4d& T_camera_model,
-                             const Eigen::Matrix4d& prior) {
-  Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
-  if (weak.is_slide() || !T_camera_model.allFinite() || !prior.allFinite()) return turn;
+TurnAxis turn_axis(const ViewConstraints& view, const WeakDirection& weak) {
   // The weak motion moves a point p by t + w x (p - centre), w the rotation over the radius: a pure turn
   // about the axis through q = centre + (w x t) / |w|^2 (t's part along w is a slide along the axis).
   const Eigen::Vector3d w = weak.rotation / view.radius;
-  const Eigen::Vector3d axis = w.normalized();
-  const Eigen::Vector3d q = view.centre + w.cross(weak.translation) / w.squaredNorm();
+  return {view.centre + w.cross(weak.translation) / w.squaredNorm(), w.normalized()};
+}
+
+Eigen::Matrix4d TurnAxis::turn(double angle_rad) const {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(angle_rad, direction).toRotationMatrix();
+  T.topLeftCorner<3, 3>() = R;
+  T.topRightCorner<3, 1>() = point - R * point;
+  return T;
+}
+
+Eigen::Matrix4d turn_towards(const ViewConstraints& view, const WeakDirection& weak, const Eigen::Matrix4d& T_camera_model,
+                             const Eigen::Matrix4d& prior) {
+  if (weak.is_slide() || !T_camera_model.allFinite() || !prior.allFinite()) return Eigen::Matrix4d::Identity();
+  const TurnAxis axis = turn_axis(view, weak);
   // The prior's orientation relative to T's, split into a twist about the axis and the rest (swing).
   Eigen::Quaterniond relative(Eigen::Matrix3d(prior.topLeftCorner<3, 3>() * T_camera_model.topLeftCorner<3, 3>().transpose()));
   if (relative.w() < 0.0) relative.coeffs() = -relative.coeffs();
-  const double angle = 2.0 * std::atan2(relative.vec().dot(axis), relative.w());
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, axis).toRotationMatrix();
-  turn.topLeftCorner<3, 3>() = R;
-  turn.topRightCorner<3, 1>() = q - R * q;
-  return turn;
+  return axis.turn(2.0 * std::atan2(relative.vec().dot(axis.direction), relative.w()));
 }
 
 namespace {
@@ -59,19 +66,21 @@ Eigen::Matrix4d nearest_unseen_turn(const ModelCloud& model, const Eigen::Matrix
   constexpr double kMaxStrength = 0.1;
   if (model.points.size() < 2) return T_camera_model;
   const ViewConstraints view = view_constraints(model, T_camera_model, k);
+  std::vector<std::size_t> probes;         // the samples seen at T: found once a turn is worth checking
+  std::optional<FreeSpaceCheck> unturned;  // T's own free-space check: once, when a turn stays on the surface
   for (const WeakDirection& weak : view.all) {
     if (weak.strength > kMaxStrength) break;
     const Eigen::Matrix4d turn = turn_towards(view, weak, T_camera_model, prior);
     if (rotation_angle_deg(turn) < kMinTurnDeg) continue;
-    const std::vector<std::size_t> probes = visible_samples(model, T_camera_model, depth, k, kProbes);
+    if (probes.empty()) probes = visible_samples(model, T_camera_model, depth, k, kProbes);
     if (probes.size() < kProbes / 4) return T_camera_model;
     const Eigen::Matrix4d turned = turn * T_camera_model;
     // A point seen at T (T p) lies on the turned model where it draws turned^-1 T p.
     if (!stays_on_surface(model, rigid_inverse(turned) * T_camera_model, probes)) continue;
-    const FreeSpaceCheck before = check_free_space(model, T_camera_model, depth, k);
+    if (!unturned) unturned = check_free_space(model, T_camera_model, depth, k);
     const FreeSpaceCheck after = check_free_space(model, turned, depth, k);
     if (after.predicted == 0 ||
-        static_cast<double>(after.behind) > static_cast<double>(before.behind) + 0.01 * static_cast<double>(after.predicted))
+        static_cast<double>(after.behind) > static_cast<double>(unturned->behind) + 0.01 * static_cast<double>(after.predicted))
       continue;
     return turned;
   }

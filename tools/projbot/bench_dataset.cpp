@@ -31,13 +31,7 @@ struct Perturbation {
   double mm = 20.0, deg = 5.0;
 };
 
-// One object's model: points for estimation, vertices for scoring.
-struct ObjectModel {
-  const alignment::BopObject* info = nullptr;
-  alignment::ModelCloud cloud;
-  std::vector<Eigen::Vector3f> vertices;
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< bounding-box centre, model frame (the turn's pivot)
-};
+using ObjectModel = alignment::BopModel;  // points for estimation, vertices for scoring
 
 // One estimate, as the report's row holds it.
 struct Row {
@@ -65,18 +59,6 @@ std::vector<Perturbation> parse_perturbations(const std::vector<std::string>& te
   }
   if (out.empty()) out.push_back(Perturbation{});
   return out;
-}
-
-ObjectModel load_object(const alignment::BopObject& o, double scale) {
-  assets::Model mesh = assets::load_model(o.model);
-  assets::scale_and_recenter(mesh, scale, false);
-  ObjectModel m;
-  m.info = &o;
-  m.cloud = alignment::model_cloud_from(mesh);
-  for (const auto& p : mesh.primitives)
-    for (const auto& v : p.vertices) m.vertices.emplace_back(v.position[0], v.position[1], v.position[2]);
-  m.centre = mesh.bounds().center();
-  return m;
 }
 
 // The truth moved `mm` in a random direction and turned `deg` about a random axis through the model's
@@ -240,7 +222,7 @@ class Bench {
 
   const ObjectModel& model(int id) {
     auto it = models_.find(id);
-    if (it == models_.end()) it = models_.emplace(id, load_object(*data_.object(id), scale_)).first;
+    if (it == models_.end()) it = models_.emplace(id, alignment::load_bop_model(*data_.object(id), scale_)).first;
     return it->second;
   }
 

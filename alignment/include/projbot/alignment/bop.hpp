@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/registration.hpp"
 
 namespace projbot::alignment {
 
@@ -64,6 +65,18 @@ inline const std::vector<int> kYcbvSymmetricIds{1, 4, 6, 13, 16, 18, 19, 20, 21}
 /// Images are not decoded here: read_bop_depth does that.
 BopDataset read_bop_dataset(const std::filesystem::path& root, const std::vector<std::string>& scenes = {},
                             const std::string& split = "test");
+
+/// One object's model as the benchmark estimates and scores it, in metres (`scale`: model units to
+/// metres) and not recentred (BOP's poses are of the model's own frame).
+struct BopModel {
+  const BopObject* info = nullptr;
+  ModelCloud cloud;                                  ///< surface samples, for estimation
+  std::vector<Eigen::Vector3f> vertices;             ///< the mesh's vertices, for ADD / ADD-S
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< bounding-box centre, model frame
+};
+
+/// Loads `object`'s model file; throws assets::AssetError naming it when it cannot be read.
+BopModel load_bop_model(const BopObject& object, double scale);
 
 /// The image's depth in metres; an image whose size disagrees with the first image's camera is an error.
 DepthImage read_bop_depth(const BopImage& image);

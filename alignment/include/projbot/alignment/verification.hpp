@@ -139,10 +139,19 @@ Eigen::Matrix4d nearest_look_alike(const ModelCloud& model, const Eigen::Matrix4
 std::vector<std::size_t> visible_samples(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
                                          const CameraIntrinsics& k, std::size_t max = 300);
 
-/// The turn about the axis of a weak rotation (`weak` from view_constraints at T_camera_model, a
-/// rotation rather than a slide) that brings T_camera_model's orientation nearest `prior`'s about that
-/// axis, as a T_camera_camera to apply on the left; identity for a slide. The axis passes through the
-/// point about which the weak motion is a pure turn (the axis of a mug seen with its handle hidden).
+/// The axis of a weak rotation (`weak` from view_constraints, a rotation rather than a slide): through
+/// the point about which the weak motion is a pure turn (the axis of a mug seen with its handle hidden),
+/// camera frame.
+struct TurnAxis {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  ///< unit
+  /// The turn by angle_rad about it, as a T_camera_camera to apply on the left.
+  Eigen::Matrix4d turn(double angle_rad) const;
+};
+TurnAxis turn_axis(const ViewConstraints& view, const WeakDirection& weak);
+
+/// The turn about turn_axis(view, weak) that brings T_camera_model's orientation nearest `prior`'s about
+/// that axis, as a T_camera_camera to apply on the left; identity for a slide.
 Eigen::Matrix4d turn_towards(const ViewConstraints& view, const WeakDirection& weak, const Eigen::Matrix4d& T_camera_model,
                              const Eigen::Matrix4d& prior);
 
