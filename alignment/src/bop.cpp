@@ -13,7 +13,6 @@
 #include <sstream>
 
 #include "projbot/assets/image.hpp"
-#include "projbot/assets/model.hpp"
 #include "projbot/config/rigid.hpp"
 
 namespace projbot::alignment {
@@ -249,18 +248,6 @@ std::vector<std::uint8_t> read_bop_mask(const BopScene& scene, const BopImage& i
   std::vector<std::uint8_t> out(static_cast<std::size_t>(mask.width) * mask.height);
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = mask.rgba[4 * i] > 127 ? 1 : 0;
   return out;
-}
-
-BopModel load_bop_model(const BopObject& object, double scale) {
-  assets::Model mesh = assets::load_model(object.model);
-  assets::scale_and_recenter(mesh, scale, false);
-  BopModel m;
-  m.info = &object;
-  m.cloud = model_cloud_from(mesh);
-  for (const auto& p : mesh.primitives)
-    for (const auto& v : p.vertices) m.vertices.emplace_back(v.position[0], v.position[1], v.position[2]);
-  m.centre = mesh.bounds().center();
-  return m;
 }
 
 }  // namespace projbot::alignment
