@@ -58,6 +58,21 @@ TEST(SceneTest, ParsesEveryField) {
   EXPECT_FALSE(s.targets[1].recenter);
   EXPECT_NEAR(s.targets[1].T_projector_target(0, 3), 0.5, 1e-12);
   EXPECT_NEAR(s.targets[1].T_projector_target(2, 3), 2.0, 1e-12);
+  // Issue 43's defaults: a 3000-lumen DLP, light grey targets, a dimmed room.
+  EXPECT_DOUBLE_EQ(s.projector.photometry.brightness_lm, 3000.0);
+  EXPECT_DOUBLE_EQ(s.projector.photometry.gamma, 2.2);
+  EXPECT_DOUBLE_EQ(s.targets[0].surface.albedo.x(), 0.75);
+  EXPECT_DOUBLE_EQ(s.room.ambient_lux, 20.0);
+  const auto lit = parse_scene(
+      "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, brightness_lm: 5000, gamma: 2.4, black_level: 0.001}\n"
+      "room: {width: 4, depth: 4, ambient_lux: 150}\n"
+      "targets:\n  - name: a\n    model: a.glb\n    pose: {translation: [0, 0, 1]}\n    surface: {albedo: [0.8, 0.6, 0.4]}\n",
+      "/scenes/s.yaml");
+  EXPECT_DOUBLE_EQ(lit.projector.photometry.brightness_lm, 5000.0);
+  EXPECT_DOUBLE_EQ(lit.projector.photometry.gamma, 2.4);
+  EXPECT_DOUBLE_EQ(lit.projector.photometry.black_level, 0.001);
+  EXPECT_DOUBLE_EQ(lit.room.ambient_lux, 150.0);
+  EXPECT_DOUBLE_EQ(lit.targets[0].surface.albedo.z(), 0.4);
 }
 
 TEST(SceneTest, RpyIsRzRyRx) {
@@ -128,6 +143,28 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"far_over_near_too_large",
                 "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, near: 0.0001, far: 5000}\ntargets: []\n",
                 {"far / near <= 1e7"}},
+        // Issue 43: the projector's photometry, a target's surface and the room's light.
+        BadCase{"gamma_absurd",
+                "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, gamma: 0.2}\ntargets: []\n",
+                {"s.yaml:1:", "projector.gamma", "must be 1..4"}},
+        BadCase{"brightness_zero",
+                "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, brightness_lm: 0}\ntargets: []\n",
+                {"projector.brightness_lm", "1..100000 lumens"}},
+        BadCase{"black_level_negative",
+                "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, black_level: -0.1}\ntargets: []\n",
+                {"projector.black_level", "0..0.2"}},
+        BadCase{"albedo_over_one",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    surface: {albedo: [0.5, 1.5, 0.2]}\n",
+                {"s.yaml:5:", "targets[0].surface.albedo", "0..1"}},
+        BadCase{"albedo_missing",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    surface: {}\n",
+                {"targets[0].surface.albedo", "missing"}},
+        BadCase{"surface_texture_not_yet",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    surface: {texture: a.png}\n",
+                {"targets[0].surface.texture", "not supported yet"}},
+        BadCase{"ambient_negative",
+                kProj + "targets: []\nroom: {width: 4, depth: 4, ambient_lux: -3}\n",
+                {"room.ambient_lux", "0..100000 lux"}},
         BadCase{"drift_absurd", kProj + "targets: []\nrobot: {drift: {slip_scale: 1e308}}\n", {"slip_scale", "must be 0..0.5"}},
         BadCase{"duplicate_top_key", kProj + "targets: []\ntargets: []\n", {"s.yaml:3: 'targets' is given twice"}},
         BadCase{"duplicate_nested_key",

@@ -36,6 +36,34 @@ Distortion read_distortion(const MapReader& r, const YAML::Node& d, const std::s
   return k;
 }
 
+// The projector's brightness and response (`brightness_lm`, `gamma`, `black_level`), each optional.
+void read_photometry(MapReader& r, const YAML::Node& node, Photometry& p) {
+  p.brightness_lm = r.get<double>("brightness_lm", p.brightness_lm);
+  p.gamma = r.get<double>("gamma", p.gamma);
+  p.black_level = r.get<double>("black_level", p.black_level);
+  if (!(p.brightness_lm >= 1.0 && p.brightness_lm <= 1e5))
+    r.fail(node["brightness_lm"], r.key_path("brightness_lm"), "must be 1..100000 lumens");
+  if (!(p.gamma >= 1.0 && p.gamma <= 4.0)) r.fail(node["gamma"], r.key_path("gamma"), "must be 1..4");
+  if (!(p.black_level >= 0.0 && p.black_level <= 0.2))
+    r.fail(node["black_level"], r.key_path("black_level"), "must be 0..0.2 (black's light, of full white's)");
+}
+
+// A target's `surface: {albedo: [r, g, b]}`: linear reflectance, each 0..1.
+TargetSurface read_surface(MapReader& t, const std::string& path) {
+  TargetSurface surface;
+  YAML::Node node = t.child("surface", false);
+  if (!node) return surface;
+  MapReader m(node, path, t.file());
+  if (m.has("texture"))
+    m.fail(node["texture"], m.key_path("texture"), "a reflectance texture is not supported yet: give surface.albedo: [r, g, b]");
+  const YAML::Node albedo = m.child("albedo", true);
+  surface.albedo = m.vector3(albedo, m.key_path("albedo"));
+  if (!((surface.albedo.array() >= 0.0).all() && (surface.albedo.array() <= 1.0).all()))
+    m.fail(albedo, m.key_path("albedo"), "each of r, g, b must be 0..1 (linear reflectance)");
+  m.reject_unknown();
+  return surface;
+}
+
 // A pinhole section (`projector:`, `camera:`): every intrinsic required unless defaults are given.
 ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std::optional<ProjectorConfig>& defaults) {
   YAML::Node node = root.child(key, !defaults);
@@ -59,6 +87,7 @@ ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std:
     if (!(p.input_lag_ms >= 0.0 && p.input_lag_ms <= 1000.0))
       r.fail(node["input_lag_ms"], r.key_path("input_lag_ms"), "must be 0..1000 ms");
     if (YAML::Node d = r.child("distortion", false)) p.distortion = read_distortion(r, d, r.key_path("distortion"));
+    read_photometry(r, node, p.photometry);
   }
   r.reject_unknown();
   try {
@@ -392,6 +421,9 @@ void read_room(MapReader& r, const std::string& file, Scene& scene) {
   scene.room.wall_height_m = m.get<double>("wall_height", scene.room.wall_height_m);
   if (!(scene.room.wall_height_m >= 0.1 && scene.room.wall_height_m <= 50.0))
     m.fail(room["wall_height"], "room.wall_height", "must be 0.1..50 m");
+  scene.room.ambient_lux = m.get<double>("ambient_lux", scene.room.ambient_lux);
+  if (!(scene.room.ambient_lux >= 0.0 && scene.room.ambient_lux <= 1e5))
+    m.fail(room["ambient_lux"], "room.ambient_lux", "must be 0..100000 lux");
   if (YAML::Node obs = m.child("obstacles", false)) {
     if (!obs.IsSequence()) m.fail(obs, "room.obstacles", "expected a list of [x0, y0, x1, y1]");
     for (std::size_t i = 0; i < obs.size(); ++i) {
@@ -434,6 +466,7 @@ TargetConfig read_target(const YAML::Node& node, const std::string& path, const 
   read_model_ref(t, node, path, base, target.model, target.scale, target.recenter);
   target.present = t.get<bool>("present", true);
   target.support = read_support(t, path + ".support");
+  target.surface = read_surface(t, path + ".surface");
   target.T_projector_target = read_pose(t, path + ".pose");
   if (t.has("world_pose")) target.T_world_target = read_pose(t, path + ".world_pose", "world_pose");
   if (t.has("map_pose")) {

@@ -18,6 +18,9 @@ struct Room {
   std::vector<Box2D> obstacles;
   /// The outline and the obstacles stand this high in the twin's depth and projector light.
   double wall_height_m = 2.5;
+  /// The room's own light on every surface while projecting, lux (`room.ambient_lux`, 0..100000): a
+  /// dimmed shop or museum room.
+  double ambient_lux = 20.0;
   /// The laser's occupancy grid: the walls' thickness and the cell size. MRPT's ray tracer reads walls
   /// about one cell too far (1.2-1.6 cm at 1 cm cells, measured), the same for the map and live scans.
   double wall_thickness_m = 0.1;

@@ -25,6 +25,15 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// How much light the projector gives and how its input becomes light (issue 43): per channel, an input
+/// c in 0..1 gives black + (1 - black) c^gamma of full white, and full white is `brightness_lm` lumens
+/// spread evenly over the panel's pixels. Defaults: a typical 3000-lumen DLP.
+struct Photometry {
+  double brightness_lm = 3000.0;  ///< `projector.brightness_lm`: full white's flux (1..100000 lm)
+  double gamma = 2.2;             ///< `projector.gamma`: the response's exponent (1..4)
+  double black_level = 0.0005;    ///< `projector.black_level`: black's light, of full white's (0..0.2)
+};
+
 /// The projector as a scene gives it (`projector:`), and a depth camera's pinhole with its clip range
 /// (`camera:`): the pinhole (A_p, Eq. 3) plus what drawing needs.
 struct ProjectorConfig : Pinhole {
@@ -38,6 +47,7 @@ struct ProjectorConfig : Pinhole {
   /// Its lens (`projector.distortion`, or a calibration's): k1, k2, p1, p2, k3. Zero for a pinhole and
   /// for every depth camera. The renderer pre-distorts the projector's image by it.
   Distortion distortion{};
+  Photometry photometry;  ///< the projector only: its brightness and response
 
   /// The panel pixel whose light reaches projector-frame point p (z > 0): A_p after the lens. Equals
   /// project(p) without distortion.
@@ -81,6 +91,12 @@ struct TargetSupport {
   double depth_m = 0.24;
 };
 
+/// What a target's physical surface reflects (`surface:`, issue 43): the twin's visitor sees it lit, and
+/// the renderer divides it out when it compensates. Linear reflectance per channel, 0..1.
+struct TargetSurface {
+  Eigen::Vector3d albedo{0.75, 0.75, 0.75};  ///< `surface: {albedo: [r, g, b]}`; default a light grey
+};
+
 /// A static thing in the twin's room that is not a target (`props:`): a neighbour, a distractor, a
 /// pillar that hides part of a target. A glTF model placed like a target, or a plain coloured box.
 struct PropConfig {
@@ -121,6 +137,7 @@ struct TargetConfig {
   /// projection error is measured.
   std::vector<Eigen::Vector3d> markers_m;
   TargetSupport support;  ///< the twin only
+  TargetSurface surface;  ///< its own colour under white light
   /// Scripted moves in the twin (`motion:`, one or a list), at most one per visit of this target.
   std::vector<TargetMotion> motions;
   /// The move scripted for this target's `visit`-th visit, or nullptr.
