@@ -1,9 +1,12 @@
 #version 450
 // Unlit: the model's colouring is the projection content. Texture texels are sampled from a UNORM
-// image and written to a UNORM target, so stored values reach the projector unchanged.
+// image and written to a UNORM target, so stored values reach the projector unchanged; with compensation
+// (issue 43) the output is what makes the target's surface show them (engine/photometry.hpp, whose
+// compensated_input is this pass on the CPU).
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 1) in vec4 in_color;
+layout(location = 2) in vec3 in_q;
 
 layout(set = 0, binding = 0) uniform sampler2D base_color_texture;
 
@@ -14,18 +17,45 @@ layout(constant_id = 0) const int kAlphaMode = 0;
 layout(push_constant) uniform Draw {
   mat4 clip_from_model;
   vec4 base_color_factor;
-  float alpha_cutoff;  // kAlphaMode 1 only
+  vec4 compensate;  // rgb: the lux content 1 needs (k kReferenceLux / albedo; 0: off); a: the room's lux
+  vec4 projector;   // x: full white's lux at 1 m facing the lens, y: gamma, z: black level, w: MASK alpha cutoff
+  vec4 ray;         // see mesh.vert
 } draw;
 
 layout(location = 0) out vec4 out_color;
 
+vec3 srgb_to_linear(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+}
+
+// Full white's lux here, from the triangle's own normal (its incidence) and the distance. Taken before
+// MASK's discard, under a branch on a push constant: derivatives stay in uniform control flow.
+float white_lux() {
+  vec3 n = cross(dFdx(in_q), dFdy(in_q));
+  float nn = length(n);
+  float z = in_q.z;
+  return (nn > 0.0 && z > 0.0) ? draw.projector.x * abs(dot(in_q, n)) / (nn * z * z * z) : 0.0;
+}
+
+// The input that adds what the surface lacks: the lux needed less the room's, as a share of full white
+// here, through the inverse response.
+vec3 compensated(vec3 c, float white) {
+  vec3 needed = draw.compensate.rgb * srgb_to_linear(c) - draw.compensate.a;
+  vec3 d = white > 0.0 ? needed / white : mix(vec3(0.0), vec3(2.0), greaterThan(needed, vec3(0.0)));
+  vec3 x = (d - draw.projector.z) / (1.0 - draw.projector.z);
+  return pow(clamp(x, 0.0, 1.0), vec3(1.0 / draw.projector.y));
+}
+
 void main() {
+  float white = draw.compensate.r > 0.0 ? white_lux() : 0.0;
   vec4 c = texture(base_color_texture, in_uv) * draw.base_color_factor * in_color;
   if (kAlphaMode == 1) {
-    if (c.a < draw.alpha_cutoff) discard;
+    if (c.a < draw.projector.w) discard;
     c.a = 1.0;
   } else if (kAlphaMode == 0) {
     c.a = 1.0;
   }
+  if (draw.compensate.r > 0.0) c.rgb = compensated(c.rgb, white);
   out_color = c;
 }

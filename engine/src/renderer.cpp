@@ -25,13 +25,28 @@ using detail::Gpu;
 
 constexpr std::size_t kFramesInFlight = 2;
 
-/// Push constants of mesh.vert / mesh.frag (std430 layout: 84 bytes).
+/// Push constants of mesh.vert / mesh.frag (std430 layout: 128 bytes, the size Vulkan guarantees).
 struct DrawConstants {
   std::array<float, 16> clip_from_model;
   std::array<float, 4> base_color_factor;
-  float alpha_cutoff;
+  std::array<float, 4> compensate;  // Compensation::scale_lux (0: off), ambient_lux
+  std::array<float, 4> projector;   // white_gain, gamma, black level, alpha cutoff
+  std::array<float, 4> ray;         // the projector-frame position from clip coordinates (mesh.vert)
 };
-static_assert(sizeof(DrawConstants) == 84);
+static_assert(sizeof(DrawConstants) == 128);
+
+/// What every draw of a frame shares: the projector's photometry, and how mesh.vert recovers the
+/// projector-frame position from clip coordinates (x = (clip.x - m02 clip.w) / m00, likewise y).
+DrawConstants frame_constants(const config::ProjectorConfig& projector, const Eigen::Matrix4d& clip_from_projector_m) {
+  DrawConstants c{};
+  c.projector = {static_cast<float>(white_gain(projector)), static_cast<float>(projector.photometry.gamma),
+                 static_cast<float>(projector.photometry.black_level), 0.0F};
+  c.ray = {static_cast<float>(1.0 / clip_from_projector_m(0, 0)),
+           static_cast<float>(-clip_from_projector_m(0, 2) / clip_from_projector_m(0, 0)),
+           static_cast<float>(1.0 / clip_from_projector_m(1, 1)),
+           static_cast<float>(-clip_from_projector_m(1, 2) / clip_from_projector_m(1, 1))};
+  return c;
+}
 
 /// Whether two projectors draw the same lens canvas.
 bool same_lens(const config::ProjectorConfig& a, const config::ProjectorConfig& b) {
@@ -362,9 +377,12 @@ struct Renderer::Impl {
     slot.profiler->add(slot.record);
   }
 
+  // `projector`: the pinhole drawn through (a lens canvas's, or the projector's); `panel`: the projector
+  // whose light compensation divides out.
   void record_draws(const vk::raii::CommandBuffer& cmd, vk::Format format, const config::ProjectorConfig& projector,
-                    bool depth_camera) {
+                    bool depth_camera, const config::ProjectorConfig& panel) {
     const Eigen::Matrix4d clip_from_projector_m = clip_from_projector(projector);
+    const DrawConstants shared = frame_constants(panel, clip_from_projector_m);
     // Opaque and masked first, blended after them so they blend over what is behind.
     // A depth camera sees every surface, whatever its material: one opaque pass.
     static constexpr bool kPasses[] = {false, true};
@@ -374,8 +392,10 @@ struct Renderer::Impl {
         const vk::Buffer vb = *m.vertices.buffer;
         cmd.bindVertexBuffers(0, vb, vk::DeviceSize(0));
         cmd.bindIndexBuffer(*m.indices.buffer, 0, vk::IndexType::eUint32);
-        DrawConstants c{};
+        DrawConstants c = shared;
         c.clip_from_model = to_gpu_matrix(clip_from_projector_m * item.T_projector_target);  // Eq. 3
+        const Compensation& comp = item.compensation;
+        if (comp.on && !depth_camera) c.compensate = {comp.scale_lux[0], comp.scale_lux[1], comp.scale_lux[2], comp.ambient_lux};
         for (const auto& part : m.parts) {
           const assets::Material& mat = m.materials[part.material];
           if (!depth_camera && (mat.alpha_mode == assets::AlphaMode::kBlend) != blend_pass) continue;
@@ -383,7 +403,7 @@ struct Renderer::Impl {
                            *pipeline(format, !mat.double_sided, depth_camera ? 0 : alpha_mode_id(mat.alpha_mode), depth_camera));
           cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout, 0, *m.sets[part.material], {});
           c.base_color_factor = mat.base_color_factor;
-          c.alpha_cutoff = mat.alpha_cutoff;
+          c.projector[3] = mat.alpha_cutoff;
           cmd.pushConstants<DrawConstants>(*pipeline_layout,
                                            vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, c);
           cmd.drawIndexed(part.index_count, 1, part.first_index, part.vertex_offset, 0);
@@ -422,7 +442,7 @@ struct Renderer::Impl {
                        vk::AccessFlagBits2::eColorAttachmentWrite);
     transition_depth(cmd, *c.depth.image);
     begin_pass(cmd, *c.color.view, *c.depth.view, c.color.extent, 1.0F);
-    record_draws(cmd, t.color_format(), c.lens.pinhole, false);
+    record_draws(cmd, t.color_format(), c.lens.pinhole, false, c.projector);
     cmd.endRendering();
     detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eColorAttachmentOptimal,
                        vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
@@ -484,7 +504,7 @@ struct Renderer::Impl {
       transition_depth(cmd, *t.depth().image);
       begin_pass(cmd, frame->color_view, *t.depth().view, t.extent(), t.depth_output() ? 0.0F : 1.0F);
       // The projector image (width x height of the intrinsics) is stretched onto the target.
-      record_draws(cmd, t.color_format(), projector, t.depth_output());
+      record_draws(cmd, t.color_format(), projector, t.depth_output(), projector);
       cmd.endRendering();
     }
     const bool to_present = frame->color_final_layout == vk::ImageLayout::ePresentSrcKHR;

@@ -16,6 +16,7 @@
 #include "projbot/assets/model.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/frame_profiler.hpp"
+#include "projbot/engine/photometry.hpp"
 
 namespace projbot::engine {
 
@@ -74,8 +75,12 @@ struct DepthMap {
 
 /// One target to draw: which uploaded model, and T_projector_target (model frame -> projector frame).
 struct DrawItem {
+  DrawItem() = default;
+  DrawItem(std::size_t model_id, const Eigen::Matrix4d& T, const Compensation& comp = {})
+      : model(model_id), T_projector_target(T), compensation(comp) {}
   std::size_t model = 0;
   Eigen::Matrix4d T_projector_target = Eigen::Matrix4d::Identity();
+  Compensation compensation;  ///< off: the content as stored; on: what makes its surface show it (issue 43)
 };
 
 /// Called once per frame, as late as possible, to fill the poses to draw (the newest ones).

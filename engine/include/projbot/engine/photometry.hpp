@@ -1,0 +1,70 @@
+#pragma once
+// What a visitor sees (issue 43): the projector's light on a surface of known reflectance, pose and room
+// light, and the input that makes that surface show the content. One model serves the twin's visitor
+// (forward) and the renderer's compensation (inverse, here as the CPU reference of mesh.frag).
+//
+// Light, per channel: a surface of reflectance rho lit by E lux is seen as rho E / kReferenceLux (linear,
+// 1 = a white surface under the reference light). The projector adds E_p = white_lux(q, n) drive(c), where
+// drive(c) = black + (1 - black) c^gamma and white_lux spreads the projector's lumens evenly over its
+// pixels: a pixel's footprint on a plane facing the lens at depth z is (z / fx)(z / fy), tilted by the
+// surface's incidence. Content c (sRGB) should be seen as k linear(c): the content under the reference
+// light, scaled by the target's gain k (< 1 where the projector cannot make it brighter).
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+#include "projbot/assets/model.hpp"
+#include "projbot/config/scene.hpp"
+
+namespace projbot::engine {
+
+/// The light that a white surface is seen by at 1.0: what "the content under the reference light" means.
+constexpr double kReferenceLux = 1000.0;
+
+/// sRGB's transfer (IEC 61966-2-1), 0..1 both ways.
+double srgb_to_linear(double c);
+double linear_to_srgb(double l);
+
+/// brightness_lm fx fy / (W H): full white's lux at depth z = 1 m on a surface facing the lens, lux m^2.
+double white_gain(const config::ProjectorConfig& projector);
+/// Full white's lux on a surface at projector-frame point q (metres, z > 0) with normal n (either sign);
+/// 0 behind the projector or edge-on.
+double white_lux(const config::ProjectorConfig& projector, const Eigen::Vector3d& q, const Eigen::Vector3d& n);
+/// The projector's light for input c (0..1 per channel), of full white's: black + (1 - black) c^gamma.
+Eigen::Vector3d drive(const config::Photometry& photometry, const Eigen::Vector3d& c);
+
+/// A drawn target's compensation: its surface shows content c as k linear(c). Off: the content is sent as
+/// stored.
+struct Compensation {
+  bool on = false;
+  std::array<float, 3> scale_lux{};  ///< k kReferenceLux / albedo per channel: the lux that content 1 needs
+  float ambient_lux = 0.0F;          ///< the room's light, which the projector need not add
+};
+/// The compensation for a target of reflectance `albedo` seen with gain k in `ambient_lux`.
+Compensation compensation(const Eigen::Vector3d& albedo, double ambient_lux, double k);
+
+/// The input (0..1 per channel, clamped) that makes point q (normal n, projector frame) show content c
+/// (sRGB, 0..1) under `comp`: mesh.frag's compensation, on the CPU. `clipped` (when given): whether a
+/// channel needed more than full white or less than black.
+Eigen::Vector3d compensated_input(const config::ProjectorConfig& projector, const Compensation& comp, const Eigen::Vector3d& c,
+                                  const Eigen::Vector3d& q, const Eigen::Vector3d& n, bool* clipped = nullptr);
+
+/// A point of a target's surface as the projector sees it now: its content (sRGB) and full white's lux there.
+struct SurfaceSample {
+  Eigen::Vector3d content = Eigen::Vector3d::Ones();
+  double white_lux = 0.0;
+  double weight = 1.0;  ///< its share of the projector's pixels: the solid angle it fills, sr
+};
+/// The target's triangles that face the projector at T_projector_target, their middle inside its image:
+/// each one's content (material, texture at its corners' UVs, vertex colours; averaged) and full white's
+/// lux at its middle, weighted by the projector pixels it covers (so that grazing slivers count little).
+std::vector<SurfaceSample> surface_samples(const assets::Model& model, const config::ProjectorConfig& projector,
+                                           const Eigen::Matrix4d& T_projector_target);
+/// The target's gain k: the largest that leaves at most `clip_share` of `samples`' weight asking a channel
+/// for more than full white (albedo, ambient as above), at most 1 (the content under the reference light); 1 when
+/// nothing asks. Chosen once per visit, so frames do not flicker.
+double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vector3d& albedo, double ambient_lux,
+                   double clip_share = 0.02);
+
+}  // namespace projbot::engine

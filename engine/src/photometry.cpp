@@ -1,0 +1,141 @@
+#include "projbot/engine/photometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace projbot::engine {
+
+double srgb_to_linear(double c) {
+  c = std::clamp(c, 0.0, 1.0);
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+double linear_to_srgb(double l) {
+  l = std::clamp(l, 0.0, 1.0);
+  return l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
+}
+
+double white_gain(const config::ProjectorConfig& p) {
+  return p.photometry.brightness_lm * p.fx_px * p.fy_px / (static_cast<double>(p.width_px) * p.height_px);
+}
+
+double white_lux(const config::ProjectorConfig& p, const Eigen::Vector3d& q, const Eigen::Vector3d& n) {
+  const double r = q.norm(), nn = n.norm();
+  if (!(q.z() > 0.0) || !(r > 0.0) || !(nn > 0.0)) return 0.0;
+  // A pixel's footprint on the plane z = const is (z/fx)(z/fy); a surface tilted to the ray gets the
+  // pixel's flux over that footprint times cos(incidence) / cos(ray to the axis).
+  const double cos_incidence = std::abs(q.dot(n)) / (r * nn), cos_axis = q.z() / r;
+  return white_gain(p) * cos_incidence / (q.z() * q.z() * cos_axis);
+}
+
+Eigen::Vector3d drive(const config::Photometry& ph, const Eigen::Vector3d& c) {
+  Eigen::Vector3d d;
+  for (int i = 0; i < 3; ++i) d[i] = ph.black_level + (1.0 - ph.black_level) * std::pow(std::clamp(c[i], 0.0, 1.0), ph.gamma);
+  return d;
+}
+
+Compensation compensation(const Eigen::Vector3d& albedo, double ambient_lux, double k) {
+  Compensation comp;
+  comp.on = true;
+  for (int i = 0; i < 3; ++i)
+    comp.scale_lux[static_cast<std::size_t>(i)] = static_cast<float>(k * kReferenceLux / std::max(albedo[i], 1e-3));
+  comp.ambient_lux = static_cast<float>(ambient_lux);
+  return comp;
+}
+
+Eigen::Vector3d compensated_input(const config::ProjectorConfig& p, const Compensation& comp, const Eigen::Vector3d& c,
+                                  const Eigen::Vector3d& q, const Eigen::Vector3d& n, bool* clipped) {
+  const double white = white_lux(p, q, n);
+  const config::Photometry& ph = p.photometry;
+  Eigen::Vector3d out;
+  bool clip = false;
+  for (int i = 0; i < 3; ++i) {
+    // The lux the projector must add, as a share of full white, then through the inverse response.
+    const double needed = comp.scale_lux[static_cast<std::size_t>(i)] * srgb_to_linear(c[i]) - comp.ambient_lux;
+    const double d = white > 0.0 ? needed / white : (needed > 0.0 ? 2.0 : 0.0);
+    const double x = (d - ph.black_level) / (1.0 - ph.black_level);
+    clip = clip || x > 1.0 + 1e-6 || x < -1e-6;
+    out[i] = std::pow(std::clamp(x, 0.0, 1.0), 1.0 / ph.gamma);
+  }
+  if (clipped) *clipped = clip;
+  return out;
+}
+
+namespace {
+
+// A material's colour at a vertex: base colour factor x texture (nearest texel, repeated) x vertex colour.
+Eigen::Vector3d vertex_content(const assets::Model& model, const assets::Material& m, const assets::Vertex& v) {
+  Eigen::Vector3d c(m.base_color_factor[0], m.base_color_factor[1], m.base_color_factor[2]);
+  for (int i = 0; i < 3; ++i) c[i] *= v.color[static_cast<std::size_t>(i)];
+  if (m.base_color_image >= 0 && static_cast<std::size_t>(m.base_color_image) < model.images.size()) {
+    const assets::Image& img = model.images[static_cast<std::size_t>(m.base_color_image)];
+    if (img.width > 0 && img.height > 0 && !img.rgba.empty()) {
+      const double u = v.uv[0] - std::floor(v.uv[0]), t = v.uv[1] - std::floor(v.uv[1]);
+      const int x = std::clamp(static_cast<int>(u * img.width), 0, img.width - 1);
+      const int y = std::clamp(static_cast<int>(t * img.height), 0, img.height - 1);
+      const std::uint8_t* px = img.rgba.data() + 4 * (static_cast<std::size_t>(y) * img.width + x);
+      for (int i = 0; i < 3; ++i) c[i] *= px[i] / 255.0;
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
+std::vector<SurfaceSample> surface_samples(const assets::Model& model, const config::ProjectorConfig& p,
+                                           const Eigen::Matrix4d& T_projector_target) {
+  std::vector<SurfaceSample> out;
+  const Eigen::Matrix3d R = T_projector_target.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T_projector_target.topRightCorner<3, 1>();
+  for (const assets::Primitive& prim : model.primitives) {
+    const assets::Material& m = model.materials.at(static_cast<std::size_t>(prim.material));
+    const auto at = [&](std::uint32_t k) {
+      const auto& x = prim.vertices.at(k).position;
+      return Eigen::Vector3d(R * Eigen::Vector3d(x[0], x[1], x[2]) + t);
+    };
+    for (std::size_t f = 0; f + 2 < prim.indices.size(); f += 3) {
+      const std::uint32_t a = prim.indices[f], b = prim.indices[f + 1], c = prim.indices[f + 2];
+      const Eigen::Vector3d qa = at(a), qb = at(b), qc = at(c), q = (qa + qb + qc) / 3.0;
+      const Eigen::Vector3d n = (qb - qa).cross(qc - qa);  // twice the area, facing out (counter-clockwise)
+      if (!(q.z() > p.near_m) || (!m.double_sided && n.dot(q) >= 0.0)) continue;  // behind, or facing away
+      const Eigen::Vector2d x = p.project(q);
+      if (x.x() < -0.5 || x.y() < -0.5 || x.x() > p.width_px - 0.5 || x.y() > p.height_px - 0.5) continue;
+      SurfaceSample s;
+      s.content = (vertex_content(model, m, prim.vertices[a]) + vertex_content(model, m, prim.vertices[b]) +
+                   vertex_content(model, m, prim.vertices[c])) /
+                  3.0;
+      s.white_lux = white_lux(p, q, n);
+      s.weight = std::abs(n.dot(q)) / (2.0 * q.norm() * q.squaredNorm());  // its solid angle: the projector's pixels on it
+      if (s.weight > 0.0) out.push_back(s);
+    }
+  }
+  return out;
+}
+
+double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vector3d& albedo, double ambient_lux,
+                   double clip_share) {
+  // Per sample, the largest k it can show: rho (ambient + white) / (kReferenceLux linear(c)) per channel.
+  std::vector<std::pair<double, double>> k_max;  // (k, weight)
+  double total = 0.0;
+  for (const SurfaceSample& s : samples) {
+    double k = 1e9;
+    for (int i = 0; i < 3; ++i) {
+      const double c = srgb_to_linear(s.content[i]);
+      if (c > 1e-4) k = std::min(k, albedo[i] * (ambient_lux + s.white_lux) / (kReferenceLux * c));
+    }
+    if (k < 1e9 && s.weight > 0.0) {
+      k_max.emplace_back(k, s.weight);
+      total += s.weight;
+    }
+  }
+  // The largest k that leaves at most clip_share of the weight (the projector's pixels) below it.
+  std::sort(k_max.begin(), k_max.end());
+  double below = 0.0, k = 1.0;
+  for (const auto& [k_s, w] : k_max) {
+    k = k_s;
+    if ((below += w) > clip_share * total) break;
+  }
+  return std::min(k, 1.0);  // never brighter than the content under the reference light
+}
+
+}  // namespace projbot::engine

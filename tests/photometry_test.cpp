@@ -1,0 +1,153 @@
+// The twin's radiometry and the renderer's compensation (issue 43): light on a surface computed by hand,
+// the compensation's round trip through the forward model, and mesh.frag against its CPU reference.
+
+#include "projbot/engine/photometry.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "projbot/engine/renderer.hpp"
+
+namespace {
+
+using projbot::config::ProjectorConfig;
+namespace engine = projbot::engine;
+
+// The default projector: 1280 x 800, fx = fy = 1400 px, 3000 lm, gamma 2.2, black 0.0005.
+const ProjectorConfig kProjector;
+
+TEST(Photometry, FullWhiteOnAPatchByHand) {
+  // 3000 lm over 1280 x 800 pixels, each (z / 1400)^2 m^2 at depth z: at 2 m facing the lens,
+  // 3000 * 1400^2 / (1280 * 800) / 4 = 1435.5 lux.
+  const double on_axis = engine::white_lux(kProjector, {0.0, 0.0, 2.0}, {0.0, 0.0, -1.0});
+  EXPECT_NEAR(on_axis, 1435.5469, 1e-3);
+  // The same plane z = 2 off the axis: the footprints of a plane facing the lens are all equal.
+  EXPECT_NEAR(engine::white_lux(kProjector, {0.5, -0.3, 2.0}, {0.0, 0.0, 1.0}), on_axis, 1e-9);
+  // Tilted 60 degrees to the ray on the axis: half the light. Twice as far: a quarter.
+  const Eigen::Vector3d tilted(std::sin(M_PI / 3), 0.0, -std::cos(M_PI / 3));
+  EXPECT_NEAR(engine::white_lux(kProjector, {0.0, 0.0, 2.0}, tilted), on_axis / 2, 1e-9);
+  EXPECT_NEAR(engine::white_lux(kProjector, {0.0, 0.0, 4.0}, {0.0, 0.0, -1.0}), on_axis / 4, 1e-9);
+  // A surface facing the lens off the axis, at distance r along its ray: a point source's 1 / r^2, the
+  // pixel's flux over its solid angle, which shrinks by cos^3 of the ray to the axis.
+  const Eigen::Vector3d q(1.0, 0.0, 2.0);
+  const double cos_axis = 2.0 / q.norm();
+  EXPECT_NEAR(engine::white_lux(kProjector, q, -q), engine::white_gain(kProjector) / (q.squaredNorm() * std::pow(cos_axis, 3)),
+              1e-9);
+  EXPECT_EQ(engine::white_lux(kProjector, {0.0, 0.0, -1.0}, {0.0, 0.0, 1.0}), 0.0);  // behind the lens
+  // The response: black + (1 - black) c^2.2.
+  const Eigen::Vector3d d = engine::drive(kProjector.photometry, {0.0, 0.5, 1.0});
+  EXPECT_NEAR(d[0], 0.0005, 1e-12);
+  EXPECT_NEAR(d[1], 0.0005 + 0.9995 * std::pow(0.5, 2.2), 1e-12);
+  EXPECT_NEAR(d[2], 1.0, 1e-12);
+  EXPECT_NEAR(engine::srgb_to_linear(engine::linear_to_srgb(0.2)), 0.2, 1e-12);
+  EXPECT_NEAR(engine::srgb_to_linear(0.5), 0.21404, 1e-5);  // sRGB 128 is about 21 % linear
+}
+
+// What the visitor sees of a compensated surface: rho (ambient + white drive(input)) / kReferenceLux
+// equals k linear(content) wherever the input is not clipped, and a clipped input is reported.
+TEST(Photometry, CompensationShowsTheContentScaledByItsGain) {
+  const Eigen::Vector3d albedo(0.8, 0.55, 0.3);  // a beige surface
+  const double ambient = 30.0, k = 0.5;
+  const engine::Compensation comp = engine::compensation(albedo, ambient, k);
+  const Eigen::Vector3d q(0.2, -0.1, 1.8), n = Eigen::Vector3d(0.3, 0.1, -1.0).normalized();
+  const double white = engine::white_lux(kProjector, q, n);
+  for (const Eigen::Vector3d& content :
+       {Eigen::Vector3d(0.9, 0.6, 0.3), Eigen::Vector3d(0.4, 0.4, 0.4), Eigen::Vector3d(0.45, 0.7, 0.5)}) {
+    bool clipped = true;
+    const Eigen::Vector3d input = engine::compensated_input(kProjector, comp, content, q, n, &clipped);
+    EXPECT_FALSE(clipped) << content.transpose();
+    const Eigen::Vector3d light = engine::drive(kProjector.photometry, input);
+    for (int i = 0; i < 3; ++i) {
+      const double seen = albedo[i] * (ambient + white * light[i]) / engine::kReferenceLux;
+      EXPECT_NEAR(seen, k * engine::srgb_to_linear(content[i]), 1e-6) << "channel " << i;  // scale_lux is a float
+    }
+  }
+  bool clipped = false;
+  const Eigen::Vector3d dark = engine::compensated_input(kProjector, comp, {0.02, 0.02, 0.02}, q, n, &clipped);
+  EXPECT_TRUE(clipped);  // the room alone is brighter than this content at k = 0.5
+  EXPECT_EQ(dark, Eigen::Vector3d::Zero());
+  const auto bright =
+      engine::compensated_input(kProjector, engine::compensation(albedo, ambient, 5.0), {1, 1, 1}, q, n, &clipped);
+  EXPECT_TRUE(clipped);  // more than full white
+  EXPECT_EQ(bright, Eigen::Vector3d::Ones());
+}
+
+// The gain: the largest k that leaves 2 % of the samples clipped.
+TEST(Photometry, TheGainClipsTheShareAskedFor) {
+  std::vector<engine::SurfaceSample> samples;
+  for (int i = 0; i < 100; ++i) samples.push_back({Eigen::Vector3d::Ones(), 500.0 + 10.0 * i});  // white content
+  const Eigen::Vector3d albedo(0.5, 0.5, 0.5);
+  const double k = engine::choose_gain(samples, albedo, 0.0, 0.02);
+  EXPECT_NEAR(k, 0.5 * 520.0 / engine::kReferenceLux, 1e-12);  // the third-weakest light sets it
+  int clipped = 0;
+  const engine::Compensation comp = engine::compensation(albedo, 0.0, k);
+  for (const auto& s : samples) clipped += comp.scale_lux[0] > s.white_lux * (1.0 + 1e-6) ? 1 : 0;
+  EXPECT_EQ(clipped, 2);
+  EXPECT_EQ(engine::choose_gain({}, albedo, 0.0), 1.0);
+  // Weighted by the projector's pixels: a dim patch that fills half the view sets k by itself.
+  samples[0].weight = 99.0;
+  EXPECT_NEAR(engine::choose_gain(samples, albedo, 0.0, 0.02), 0.5 * 500.0 / engine::kReferenceLux, 1e-12);
+  // Never above 1: brighter than the content under the reference light is not asked for.
+  EXPECT_EQ(engine::choose_gain({{Eigen::Vector3d::Ones(), 1e5, 1.0}}, albedo, 0.0), 1.0);
+}
+
+// mesh.frag's compensation against compensated_input: a flat patch of one colour, tilted 40 degrees
+// and off the axis, each pixel's input from the ray's point on the plane.
+TEST(Photometry, TheShaderMatchesItsCpuReference) {
+  engine::Renderer renderer{engine::RendererOptions{}};
+  projbot::assets::Model quad;
+  quad.source = "quad";
+  projbot::assets::Primitive prim;
+  for (const auto& [x, y] : {std::pair{-0.3F, -0.3F}, {0.3F, -0.3F}, {0.3F, 0.3F}, {-0.3F, 0.3F}}) {
+    projbot::assets::Vertex v;
+    v.position = {x, y, 0.0F};
+    v.normal = {0.0F, 0.0F, -1.0F};
+    prim.vertices.push_back(v);
+  }
+  prim.indices = {0, 1, 2, 0, 2, 3};
+  quad.primitives.push_back(prim);
+  projbot::assets::Material material;
+  const Eigen::Vector3d content(0.85, 0.55, 0.35);  // sRGB
+  material.base_color_factor = {0.85F, 0.55F, 0.35F, 1.0F};
+  material.double_sided = true;
+  quad.materials.push_back(material);
+  const std::size_t id = renderer.add_model(quad);
+  ProjectorConfig projector;
+  projector.width_px = 320, projector.height_px = 200, projector.fx_px = projector.fy_px = 350.0;
+  projector.cx_px = 150.3, projector.cy_px = 104.1;
+  auto target = renderer.make_offscreen(projector.width_px, projector.height_px);
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T.topRightCorner<3, 1>() = Eigen::Vector3d(0.15, -0.05, 2.0);
+  const engine::Compensation comp = engine::compensation({0.7, 0.6, 0.5}, 20.0, 0.35);
+  const std::vector<engine::DrawItem> items{{id, T, comp}};
+  renderer.draw_frame(*target, projector, items);
+  const auto image = target->read_back();
+  const Eigen::Vector3d n = T.topLeftCorner<3, 3>() * Eigen::Vector3d::UnitZ(), p0 = T.topRightCorner<3, 1>();
+  std::size_t compared = 0;
+  double worst = 0.0;
+  for (int v = 0; v < projector.height_px; ++v)
+    for (int u = 0; u < projector.width_px; ++u) {
+      const Eigen::Vector3d ray((u - projector.cx_px) / projector.fx_px, (v - projector.cy_px) / projector.fy_px, 1.0);
+      const Eigen::Vector3d q = ray * (n.dot(p0) / n.dot(ray));
+      const Eigen::Vector3d local = T.topLeftCorner<3, 3>().transpose() * (q - p0);
+      if (std::abs(local.x()) > 0.29 || std::abs(local.y()) > 0.29) continue;  // off the patch or on its edge
+      const Eigen::Vector3d want = engine::compensated_input(projector, comp, content, q, n);
+      const std::uint8_t* px = image.pixel(u, v);
+      for (int i = 0; i < 3; ++i) worst = std::max(worst, std::abs(px[i] - 255.0 * want[i]));
+      ++compared;
+    }
+  EXPECT_GT(compared, 8000U);
+  EXPECT_LT(worst, 1.5) << "levels of 255";  // float in the shader, rounding to 8 bits
+  // Without compensation the content is sent as stored.
+  renderer.draw_frame(*target, projector, std::vector<engine::DrawItem>{{id, T}});
+  const auto plain = target->read_back();
+  const std::uint8_t* mid = plain.pixel(160, 100);
+  EXPECT_EQ(mid[0], 217);
+  EXPECT_EQ(mid[1], 140);
+  EXPECT_EQ(mid[2], 89);
+}
+
+}  // namespace
