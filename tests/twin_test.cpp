@@ -12,7 +12,9 @@
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/config/scene.hpp"
+#include "projbot/engine/photometry.hpp"
 #include "projbot/session/session.hpp"
+#include "projbot/twin/appearance.hpp"
 #include "projbot/twin/camera.hpp"
 #include "projbot/twin/raycast.hpp"
 #include "projbot/twin/spectator.hpp"
@@ -1161,4 +1163,87 @@ TEST(SessionTest, TheYoubotSiteNamesThePapersDevicesAndRunsInTheTwin) {
   ASSERT_EQ(report.visits.size(), 1U);
   EXPECT_TRUE(report.visits[0].projected);
   EXPECT_LT(report.visits[0].mean_mm, 3.0);
+}
+
+// CIEDE2000 against Sharma, Wu and Dalal's test data (Color Res. Appl. 30(1), 2005, Table 1: pairs 1, 2, 7,
+// 17, 25 and 34), and L*a*b* of sRGB's white and red.
+TEST(Appearance, Ciede2000MatchesSharmasTestData) {
+  struct Pair {
+    Eigen::Vector3d a, b;
+    double de;
+  };
+  const Pair pairs[] = {{{50.0, 2.6772, -79.7751}, {50.0, 0.0, -82.7485}, 2.0425},
+                        {{50.0, 3.1571, -77.2803}, {50.0, 0.0, -82.7485}, 2.8615},
+                        {{50.0, 0.0, 0.0}, {50.0, -1.0, 2.0}, 2.3669},
+                        {{50.0, 2.5, 0.0}, {73.0, 25.0, -18.0}, 27.1492},
+                        {{60.2574, -34.0099, 36.2677}, {60.4626, -34.1751, 39.4387}, 1.2644},
+                        {{2.0776, 0.0795, -1.1350}, {0.9033, -0.0636, -0.5514}, 0.9082}};
+  for (const Pair& p : pairs) {
+    EXPECT_NEAR(projbot::twin::ciede2000(p.a, p.b), p.de, 1e-4) << p.a.transpose() << " / " << p.b.transpose();
+    EXPECT_NEAR(projbot::twin::ciede2000(p.b, p.a), p.de, 1e-4);  // symmetric
+  }
+  const Eigen::Vector3d white = projbot::twin::srgb_to_lab({1.0, 1.0, 1.0}), red = projbot::twin::srgb_to_lab({1.0, 0.0, 0.0});
+  EXPECT_NEAR(white[0], 100.0, 0.01);
+  EXPECT_NEAR(white[1], 0.0, 0.01);
+  EXPECT_NEAR(red[0], 53.24, 0.01);
+  EXPECT_NEAR(red[1], 80.09, 0.02);
+  EXPECT_NEAR(red[2], 67.20, 0.02);
+}
+
+// The visitor's light (issue 43) at the shop's Duck: a wall patch lit by full white shows its reflectance
+// times (room + the projector's lux there) over the reference light, as photometry.hpp computes it by
+// hand; unlit, the room's light alone. And the Duck's own content, compensated at its true pose, is seen
+// as its content scaled by k where it can be reached, uncompensated far off it.
+TEST_F(ShopDuckStop, TheVisitorSeesReflectanceTimesLight) {
+  const Eigen::Matrix4d T_world_projector = arrival.truth.T_world_projector.matrix();
+  const Eigen::Matrix4d T_world_duck = twin.targets()[duck].T_world_target_true;
+  projbot::twin::SpectatorView view(renderer, scene.projector);
+  const Eigen::Matrix4d T_world_spectator =
+      projbot::twin::spectator_pose(arrival.truth.T_world_camera.translation(), T_world_duck.topRightCorner<3, 1>());
+  projbot::assets::Image white;
+  white.width = scene.projector.width_px, white.height = scene.projector.height_px;
+  white.rgba.assign(static_cast<std::size_t>(white.width) * white.height * 4, 255);
+  const auto seen = view.see(twin, T_world_spectator, T_world_projector, white);
+  auto black = white;
+  std::fill(black.rgba.begin(), black.rgba.end(), 0);
+  const auto dark = view.see(twin, T_world_spectator, T_world_projector, black);
+  const double ambient = scene.room.ambient_lux, black_level = scene.projector.photometry.black_level;
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < seen.white_lux.size(); i += 97) {
+    const double rho = projbot::engine::srgb_to_linear(seen.albedo.rgba[4 * i] / 255.0);
+    const double lit = projbot::engine::srgb_to_linear(seen.image.rgba[4 * i] / 255.0);
+    const double unlit = projbot::engine::srgb_to_linear(dark.image.rgba[4 * i] / 255.0);
+    const double E = seen.white_lux[i];
+    if (rho * (ambient + E) / projbot::engine::kReferenceLux > 0.95 || rho < 0.05) continue;  // saturated or black
+    // 8-bit sRGB both ways: half a level of the brighter value.
+    EXPECT_NEAR(lit, rho * (ambient + E) / projbot::engine::kReferenceLux, 0.004 + 0.01 * lit) << i;
+    EXPECT_NEAR(unlit, rho * (ambient + black_level * E) / projbot::engine::kReferenceLux, 0.002) << i;
+    checked += E > 0.0 ? 1 : 0;
+  }
+  EXPECT_GT(checked, 300U);
+  // The Duck's frame with and without compensation, scored as bench appearance scores it.
+  auto frame = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+  const Eigen::Matrix4d T_projector_duck = projbot::alignment::rigid_inverse(T_world_projector) * T_world_duck;
+  const auto& albedo = twin.targets()[duck].config.surface.albedo;
+  const double k = projbot::engine::choose_gain(
+      projbot::engine::surface_samples(twin.targets()[duck].model, scene.projector, T_projector_duck), albedo, ambient);
+  EXPECT_GT(k, 0.2);
+  EXPECT_LE(k, 1.0);
+  std::array<projbot::twin::AppearanceScore, 2> scores;
+  for (const bool on : {false, true}) {
+    const projbot::engine::Compensation comp =
+        on ? projbot::engine::compensation(albedo, ambient, k) : projbot::engine::Compensation{};
+    renderer.draw_frame(*frame, scene.projector,
+                        std::vector<projbot::engine::DrawItem>{{twin.target_model_ids()[duck], T_projector_duck, comp}});
+    const auto picture = view.see(twin, T_world_spectator, T_world_projector, frame->read_back());
+    const auto content = view.content(twin, duck, T_world_spectator, picture);
+    scores[on ? 1 : 0] = projbot::twin::score_appearance(picture, content, k, ambient, scene.projector.photometry);
+  }
+  EXPECT_GT(scores[1].pixels, 5000U);
+  EXPECT_LT(scores[1].de2000_median, 5.0);  // issue 43's goals
+  EXPECT_LT(scores[1].de2000_p95, 12.0);
+  EXPECT_GT(scores[1].ssim, 0.85);
+  EXPECT_GT(scores[1].psnr_db, scores[0].psnr_db + 8.0);
+  EXPECT_GT(scores[0].de2000_median, 10.0);                             // the content as stored: far off
+  EXPECT_EQ(scores[0].unreachable_share, scores[1].unreachable_share);  // the same k, the same reach
 }

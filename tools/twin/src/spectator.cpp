@@ -3,9 +3,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "projbot/alignment/equations.hpp"
+#include "projbot/engine/photometry.hpp"
 #include "projbot/engine/projection.hpp"
 
 namespace projbot::twin {
@@ -47,30 +49,86 @@ SpectatorView::SpectatorView(engine::Renderer& renderer, const config::Projector
   projector_depth_ = renderer_.make_depth_camera(projector_.width_px, projector_.height_px);
 }
 
-assets::Image SpectatorView::draw(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const Eigen::Matrix4d& T_world_projector,
-                                  const assets::Image& projector_frame) {
+namespace {
+
+// The surface normal at a depth pixel (camera frame), from its nearer neighbour on each axis so that a
+// silhouette's far side does not bend it; zero where a neighbour is missing.
+Eigen::Vector3d normal_at(const engine::DepthMap& depth, const config::ProjectorConfig& k, int u, int v) {
+  const auto point = [&](int x, int y) -> std::optional<Eigen::Vector3d> {
+    if (x < 0 || y < 0 || x >= depth.width || y >= depth.height) return std::nullopt;
+    const float z = depth.z_m[static_cast<std::size_t>(y) * depth.width + x];
+    if (!(z > 0.0F)) return std::nullopt;
+    return k.back_project(x, y, z);
+  };
+  const auto p = point(u, v);
+  if (!p) return Eigen::Vector3d::Zero();
+  const auto step = [&](int dx, int dy) -> Eigen::Vector3d {
+    const auto a = point(u + dx, v + dy), b = point(u - dx, v - dy);
+    if (a && (!b || std::abs(a->z() - p->z()) <= std::abs(b->z() - p->z()))) return *a - *p;
+    if (b) return *p - *b;
+    return Eigen::Vector3d::Zero();
+  };
+  const Eigen::Vector3d n = step(1, 0).cross(step(0, 1));
+  return n.norm() > 0.0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+}
+
+}  // namespace
+
+// Each pixel's true normal where a target is the nearest surface (its facet, from facet_model_ids), in the
+// spectator's frame; zero elsewhere.
+std::vector<Eigen::Vector3f> SpectatorView::facet_normals(Twin& twin, const Eigen::Matrix4d& T_world_spectator,
+                                                          const engine::DepthMap& depth) {
+  std::vector<Eigen::Vector3f> out(depth.z_m.size(), Eigen::Vector3f::Zero());
+  const Eigen::Matrix4d T_spectator_world = alignment::rigid_inverse(T_world_spectator);
+  for (std::size_t t = 0; t < twin.targets().size(); ++t) {
+    if (!twin.targets()[t].in_world) continue;
+    const Eigen::Matrix4d T = T_spectator_world * twin.targets()[t].T_world_target_true;
+    const std::vector<engine::DrawItem> item{{twin.facet_model_ids()[t], T}};
+    renderer_.draw_frame(*depth_, pinhole_, item);
+    const engine::DepthMap alone = depth_->read_back_depth();
+    renderer_.draw_frame(*colour_, pinhole_, item);
+    const assets::Image colours = colour_->read_back();
+    const Eigen::Matrix3f R = T.topLeftCorner<3, 3>().cast<float>();
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      if (!(alone.z_m[i] > 0.0F) || std::abs(alone.z_m[i] - depth.z_m[i]) > 0.002F) continue;
+      const std::uint8_t* c = colours.rgba.data() + 4 * i;
+      const Eigen::Vector3f n(c[0] / 127.5F - 1.0F, c[1] / 127.5F - 1.0F, c[2] / 127.5F - 1.0F);
+      if (n.norm() > 0.5F) out[i] = R * n.normalized();
+    }
+  }
+  return out;
+}
+
+SpectatorPicture SpectatorView::see(Twin& twin, const Eigen::Matrix4d& T_world_spectator,
+                                    const Eigen::Matrix4d& T_world_projector, const assets::Image& projector_frame) {
   if (projector_frame.width != projector_.width_px || projector_frame.height != projector_.height_px ||
       projector_frame.rgba.size() != static_cast<std::size_t>(projector_frame.width) * projector_frame.height * 4)
     throw TwinError("spectator view: the projector frame is " + std::to_string(projector_frame.width) + "x" +
                     std::to_string(projector_frame.height) + ", the projector " + std::to_string(projector_.width_px) + "x" +
                     std::to_string(projector_.height_px));
-  const std::vector<engine::DrawItem> room = twin.draw_items(T_world_spectator);
+  const std::vector<engine::DrawItem> room = twin.surface_items(T_world_spectator);
   renderer_.draw_frame(*colour_, pinhole_, room);
-  assets::Image out = colour_->read_back();  // the albedo: the twin's colours as they are
+  SpectatorPicture out;
+  out.albedo = colour_->read_back();
+  out.image = out.albedo;
+  out.white_lux.assign(static_cast<std::size_t>(kWidth) * kHeight, 0.0F);
   renderer_.draw_frame(*depth_, pinhole_, room);
   const engine::DepthMap depth = depth_->read_back_depth();
-  renderer_.draw_frame(*projector_depth_, projector_, twin.draw_items(T_world_projector));
+  out.z_m = depth.z_m;
+  const std::vector<Eigen::Vector3f> facets = facet_normals(twin, T_world_spectator, depth);
+  renderer_.draw_frame(*projector_depth_, projector_, twin.surface_items(T_world_projector));
   const engine::DepthMap lit_depth = projector_depth_->read_back_depth();
   const Eigen::Matrix4d T_projector_spectator = alignment::rigid_inverse(T_world_projector) * T_world_spectator;
+  const Eigen::Matrix3d R = T_projector_spectator.topLeftCorner<3, 3>();
   const config::ProjectorConfig& k = projector_;
+  const double ambient = twin.scene().room.ambient_lux;
   for (int v = 0; v < kHeight; ++v)
     for (int u = 0; u < kWidth; ++u) {
-      std::uint8_t* px = out.pixel(u, v);
-      const float z = depth.z_m[static_cast<std::size_t>(v) * kWidth + u];
-      double light[3] = {kRoomLight, kRoomLight, kRoomLight};
+      const std::size_t i = static_cast<std::size_t>(v) * kWidth + u;
+      const float z = depth.z_m[i];
+      Eigen::Vector3d lux = Eigen::Vector3d::Constant(ambient);
       if (z > 0.0F) {
-        const Eigen::Vector4d p(z * (u - pinhole_.cx_px) / pinhole_.fx_px, z * (v - pinhole_.cy_px) / pinhole_.fy_px, z, 1.0);
-        const Eigen::Vector3d q = (T_projector_spectator * p).head<3>();
+        const Eigen::Vector3d q = (T_projector_spectator * pinhole_.back_project(u, v, z).homogeneous()).head<3>();
         // Eq. 3: the projector pixel that reaches this point through its lens, if nothing nearer the
         // projector blocks it (the projector's depth image is a pinhole's: looked up along the ray).
         const bool ahead = q.z() > k.near_m;
@@ -81,15 +139,40 @@ assets::Image SpectatorView::draw(Twin& twin, const Eigen::Matrix4d& T_world_spe
             rv < k.height_px) {
           const float seen = lit_depth.z_m[static_cast<std::size_t>(rv) * k.width_px + ru];
           if (seen > 0.0F && std::abs(seen - q.z()) < 0.01 + 0.01 * q.z()) {
+            // The targets' true facets; the room's flat faces from the depth.
+            const Eigen::Vector3d n = facets[i].isZero() ? normal_at(depth, pinhole_, u, v) : facets[i].cast<double>();
+            const double white = engine::white_lux(k, q, R * n);
             const std::uint8_t* c = projector_frame.pixel(static_cast<int>(pu), static_cast<int>(pv));
-            for (int ch = 0; ch < 3; ++ch) light[ch] += c[ch] / 255.0;
+            lux += white * engine::drive(k.photometry, Eigen::Vector3d(c[0], c[1], c[2]) / 255.0);
+            out.white_lux[i] = static_cast<float>(white);
           }
         }
       }
-      for (int ch = 0; ch < 3; ++ch) px[ch] = static_cast<std::uint8_t>(std::clamp(std::lround(px[ch] * light[ch]), 0L, 255L));
+      std::uint8_t* px = out.image.pixel(u, v);
+      for (int ch = 0; ch < 3; ++ch) {
+        const double seen = engine::srgb_to_linear(px[ch] / 255.0) * lux[ch] / engine::kReferenceLux;
+        px[ch] = static_cast<std::uint8_t>(std::lround(255.0 * engine::linear_to_srgb(seen)));
+      }
       px[3] = 255;
     }
   return out;
+}
+
+ContentView SpectatorView::content(Twin& twin, std::size_t target, const Eigen::Matrix4d& T_world_spectator,
+                                   const SpectatorPicture& picture) {
+  const TwinTarget& t = twin.targets().at(target);
+  const Eigen::Matrix4d T_spectator_target = alignment::rigid_inverse(T_world_spectator) * t.T_world_target_true;
+  ContentView view;
+  renderer_.draw_frame(*colour_, pinhole_,
+                       std::vector<engine::DrawItem>{{twin.target_model_ids().at(target), T_spectator_target}});
+  view.content = colour_->read_back();
+  renderer_.draw_frame(*depth_, pinhole_,
+                       std::vector<engine::DrawItem>{{twin.target_model_ids().at(target), T_spectator_target}});
+  const engine::DepthMap alone = depth_->read_back_depth();
+  view.mask.assign(alone.z_m.size(), 0);
+  for (std::size_t i = 0; i < alone.z_m.size() && i < picture.z_m.size(); ++i)
+    view.mask[i] = t.in_world && alone.z_m[i] > 0.0F && std::abs(alone.z_m[i] - picture.z_m[i]) < 0.002F ? 1 : 0;
+  return view;
 }
 
 }  // namespace projbot::twin

@@ -15,6 +15,7 @@
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/image.hpp"
 #include "projbot/engine/frame_profiler.hpp"
+#include "projbot/engine/photometry.hpp"
 #include "projbot/engine/projection.hpp"
 #include "projbot/twin/spectator.hpp"
 #include "projbot/twin/world.hpp"
@@ -482,7 +483,7 @@ struct Tour {
   std::vector<alignment::TargetFollower> followers;       // by index into Twin::targets()
   std::vector<SimClockTracker> trackers;                  // likewise
   std::vector<alignment::PoseTracker*> by_scene;          // the trackers by scene index, for Session::visit
-  std::unique_ptr<engine::RenderTarget> projector_frame;  // with --frames
+  std::unique_ptr<engine::RenderTarget> projector_frame;  // with --frames or appearance
   std::unique_ptr<SpectatorView> spectator;
 };
 
@@ -498,8 +499,8 @@ Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Tw
   for (const session::Target& target : twin.session_targets())
     by_scene[static_cast<std::size_t>(target.scene_index)] =
         &trackers[twin.target_index(scene.targets[static_cast<std::size_t>(target.scene_index)].name)];
-  if (!options.frames_dir.empty()) {
-    std::filesystem::create_directories(options.frames_dir);
+  if (!options.frames_dir.empty()) std::filesystem::create_directories(options.frames_dir);
+  if (!options.frames_dir.empty() || options.appearance) {
     projector_frame = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
     spectator = std::make_unique<SpectatorView>(renderer, scene.projector);
   }
@@ -528,7 +529,8 @@ class TourStop final : public session::StopObserver {
 
  private:
   void at_arrival(const session::Stop& at, const alignment::RgbdFrame& f);
-  assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target);
+  assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, const engine::Compensation& comp = {});
+  void measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target);
   assets::Image spectator_picture(const assets::Image& projector);
   void write_pictures(const assets::Image& colour);
   void project(double start_s);
@@ -552,6 +554,11 @@ class TourStop final : public session::StopObserver {
   double motion_end_s_ = 0.0;
   double back_under_ = -1.0;  // when the error went back under the goal for good, -1 while it is not
   bool ever_over_ = false;
+  // TourOptions::appearance: the visited target's compensation for this visit, and whether the middle of
+  // its motion was measured.
+  double gain_ = 1.0;
+  engine::Compensation compensation_;
+  bool moving_measured_ = false;
 };
 
 alignment::RgbdCamera& TourStop::arrived(const session::Stop& at) {
@@ -623,7 +630,16 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
   report.max_mm = e.max_mm;
   for (std::size_t k = 1; k < at.lit.size(); ++k)
     lights_.push_back(neighbour_light(tour_.twin, tour_.trackers[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, tour_.models));
-  if (tour_.projector_frame) write_pictures(f.colour);
+  if (!tour_.options.frames_dir.empty()) write_pictures(f.colour);
+  if (tour_.options.appearance) {
+    // The estimator's side: the scene's surface and room light, the believed projector, the estimated pose.
+    const config::Scene& scene = tour_.scene;
+    const Eigen::Vector3d& albedo = target.config.surface.albedo;
+    gain_ = engine::choose_gain(engine::surface_samples(target.model, tour_.models.believed, report.T_projector_target_estimated),
+                                albedo, scene.room.ambient_lux);
+    compensation_ = engine::compensation(albedo, scene.room.ambient_lux, gain_);
+    measure_appearance(false, report.projected, report.T_projector_target_estimated);
+  }
 
   dwell_.emplace(DwellContext{tour_.twin, target_index_, tour_.models, truth_, tour_.options, lights_});
   period_s_ = 1.0 / tour_.models.truth.refresh_hz;
@@ -638,9 +654,9 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
 
 // The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else
 // all black.
-assets::Image TourStop::projector_image(bool lit, const Eigen::Matrix4d& T_projector_target) {
+assets::Image TourStop::projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, const engine::Compensation& comp) {
   std::vector<engine::DrawItem> items;
-  if (lit) items.push_back({tour_.twin.target_model_ids()[target_index_], T_projector_target});
+  if (lit) items.push_back({tour_.twin.target_model_ids()[target_index_], T_projector_target, comp});
   for (const NeighbourLight& n : lights_)
     if (n.shown)
       items.push_back({tour_.twin.target_model_ids()[n.target], tour_.models.projector_from_target(n.drawn.T_camera_target)});
@@ -655,6 +671,27 @@ assets::Image TourStop::spectator_picture(const assets::Image& projector) {
   const Eigen::Matrix4d T_world_spectator =
       spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
   return tour_.spectator->draw(tour_.twin, T_world_spectator, truth_.T_world_projector.matrix(), projector);
+}
+
+// What a visitor sees of the visited target drawn at T_projector_target, compensation off and on, against
+// its content under the reference light scaled by the visit's gain; with --frames the compensated
+// picture too.
+void TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target) {
+  const TwinTarget& target = tour_.twin.targets()[target_index_];
+  const Eigen::Matrix4d T_world_spectator =
+      spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
+  for (const bool on : {false, true}) {
+    const auto t0 = Clock::now();
+    const auto image = projector_image(lit, T_projector_target, on ? compensation_ : engine::Compensation{});
+    const double ms = ms_since(t0);
+    const SpectatorPicture seen = tour_.spectator->see(tour_.twin, T_world_spectator, truth_.T_world_projector.matrix(), image);
+    const ContentView view = tour_.spectator->content(tour_.twin, target_index_, T_world_spectator, seen);
+    const AppearanceScore score =
+        score_appearance(seen, view, gain_, tour_.scene.room.ambient_lux, tour_.models.truth.photometry);
+    report.appearance.push_back({on, moving, gain_, ms, score});
+    if (on && !moving && !tour_.options.frames_dir.empty())
+      assets::write_png(frame_path(tour_.options, report, "_spectator_compensated"), seen.image);
+  }
 }
 
 // --frames at arrival: the projector's frame, the RGB-D camera's colour (registered to the depth that
@@ -685,6 +722,13 @@ void TourStop::project(double start_s) {
     seen_track_ms_ = track_ms;
   }
   const TimelineSample s = measure_frame(c, report, start_s + display_delay_s_, shown_, drawn_, tour_.options.predict);
+  const config::TargetMotion* motion = tour_.twin.targets()[target_index_].config.motion_on(report.target_visit);
+  if (tour_.options.appearance && s.moving && !moving_measured_ && s.t_s >= motion->start_s + motion->duration_s / 2) {
+    moving_measured_ = true;
+    const Eigen::Matrix4d T_camera_target =
+        tour_.options.predict ? alignment::predict_pose(drawn_.motion, s.t_s) : drawn_.T_camera_target;
+    measure_appearance(true, shown_, tour_.models.projector_from_target(T_camera_target));
+  }
   for (NeighbourLight& n : lights_) measure_neighbour(c, n, start_s + display_delay_s_);
   report.timeline.push_back(s);
   report.lit_frames += shown_ ? 1 : 0;
@@ -724,7 +768,7 @@ void TourStop::end_dwell() {
 
 void TourStop::finish() {
   for (const NeighbourLight& l : lights_) report.neighbours.push_back(finished(l));
-  if (tour_.spectator && report.moved && !interrupted) {
+  if (!tour_.options.frames_dir.empty() && report.moved && !interrupted) {
     // A moved target: what the visitor sees at the end of the dwell, where the target went and where
     // the light went (followed, or left where the target was).
     const auto image = projector_image(report.shown_at_end, tour_.models.projector_from_target(report.T_camera_target_at_end));

@@ -9,6 +9,7 @@
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
+#include "projbot/engine/photometry.hpp"
 #include "projbot/engine/projection.hpp"
 
 namespace projbot::twin {
@@ -51,6 +52,51 @@ assets::Model room_model(const config::Scene& scene) {
     if (p.is_box()) append(room, assets::make_box(p.box_min_m, p.box_max_m, {p.colour[0], p.colour[1], p.colour[2], 1.0F}));
   room.source = "room";
   return room;
+}
+
+// The target's physical surface: its mesh, every material a flat colour, its albedo as sRGB (the twin's
+// colours are sRGB, as the room's are; SpectatorView decodes them to reflectance).
+assets::Model surface_model(const assets::Model& model, const Eigen::Vector3d& albedo) {
+  assets::Model surface = model;
+  surface.images.clear();
+  for (assets::Material& m : surface.materials) {
+    m.base_color_image = -1;
+    for (int i = 0; i < 3; ++i)
+      m.base_color_factor[static_cast<std::size_t>(i)] = static_cast<float>(engine::linear_to_srgb(albedo[i]));
+  }
+  for (assets::Primitive& p : surface.primitives)
+    for (assets::Vertex& v : p.vertices) v.color = {1.0F, 1.0F, 1.0F, v.color[3]};
+  return surface;
+}
+
+// The target's facets as colours: each triangle on its own, its three corners coloured (n + 1) / 2 by its
+// model-frame normal, so that a rendering of it tells each pixel's true facet (SpectatorView's light).
+assets::Model facet_normal_model(const assets::Model& model) {
+  assets::Model out;
+  out.source = model.source;
+  assets::Material m;
+  m.double_sided = true;
+  out.materials.push_back(m);
+  assets::Primitive all;
+  for (const assets::Primitive& p : model.primitives)
+    for (std::size_t f = 0; f + 2 < p.indices.size(); f += 3) {
+      std::array<Eigen::Vector3f, 3> x;
+      for (int k = 0; k < 3; ++k)
+        x[static_cast<std::size_t>(k)] =
+            Eigen::Vector3f(p.vertices.at(p.indices[f + static_cast<std::size_t>(k)]).position.data());
+      const Eigen::Vector3f n = (x[1] - x[0]).cross(x[2] - x[0]).normalized();
+      if (!n.allFinite()) continue;  // a degenerate triangle covers no pixel
+      for (int k = 0; k < 3; ++k) {
+        assets::Vertex v;
+        v.position = {x[static_cast<std::size_t>(k)].x(), x[static_cast<std::size_t>(k)].y(), x[static_cast<std::size_t>(k)].z()};
+        v.normal = {n.x(), n.y(), n.z()};
+        v.color = {0.5F * (n.x() + 1.0F), 0.5F * (n.y() + 1.0F), 0.5F * (n.z() + 1.0F), 1.0F};
+        all.indices.push_back(static_cast<std::uint32_t>(all.vertices.size()));
+        all.vertices.push_back(v);
+      }
+    }
+  out.primitives.push_back(std::move(all));
+  return out;
 }
 
 }  // namespace
@@ -110,6 +156,8 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     tt.T_world_target_true = *t.T_world_target;
     place_support(tt, where, footprints);
     target_ids_.push_back(renderer_.add_model(tt.model));
+    surface_ids_.push_back(renderer_.add_model(surface_model(tt.model, t.surface.albedo)));
+    facet_ids_.push_back(renderer_.add_model(facet_normal_model(tt.model)));
     tt.in_world = t.present;
     home_.push_back(tt.T_world_target_true);
     targets_.push_back(std::move(tt));
@@ -229,11 +277,20 @@ void Twin::end_visit(std::size_t target, int target_visit) {
 }
 
 std::vector<engine::DrawItem> Twin::draw_items(const Eigen::Matrix4d& T_world_camera) const {
+  return placed_items(T_world_camera, target_ids_);
+}
+
+std::vector<engine::DrawItem> Twin::surface_items(const Eigen::Matrix4d& T_world_camera) const {
+  return placed_items(T_world_camera, surface_ids_);
+}
+
+std::vector<engine::DrawItem> Twin::placed_items(const Eigen::Matrix4d& T_world_camera,
+                                                 const std::vector<std::size_t>& ids) const {
   const Eigen::Matrix4d T_camera_world = alignment::rigid_inverse(T_world_camera);
   std::vector<engine::DrawItem> items{{room_id_, T_camera_world}};
   for (const auto& p : props_) items.push_back({p.id, T_camera_world * p.T_world});
   for (std::size_t i = 0; i < targets_.size(); ++i) {
-    if (targets_[i].in_world) items.push_back({target_ids_[i], T_camera_world * targets_[i].T_world_target_true});
+    if (targets_[i].in_world) items.push_back({ids[i], T_camera_world * targets_[i].T_world_target_true});
     if (targets_[i].pedestal_raycaster) items.push_back({targets_[i].pedestal_id, T_camera_world * targets_[i].T_world_pedestal});
   }
   return items;

@@ -1,10 +1,12 @@
 #pragma once
-// A spectator's view of a visit: the room as a visitor standing beside the robot sees it, dimmed for
-// projection, with the projector's light falling on the true surfaces (on the target, and wherever it
-// spills past it), so a person sees at a glance whether the content sits on the object.
+// A spectator's view of a visit: the room as a visitor standing beside the robot sees it, in its own dim
+// light, with the projector's light falling on the true surfaces (on the target, and wherever it spills
+// past it), so a person sees at a glance whether the content sits on the object, and in what colour
+// (issue 43: engine/photometry.hpp's light, each surface's own reflectance).
 
 #include <Eigen/Core>
 #include <memory>
+#include <vector>
 
 #include "projbot/assets/image.hpp"
 #include "projbot/config/scene.hpp"
@@ -20,20 +22,42 @@ Eigen::Matrix4d look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& at);
 /// it, eyes at 1.6 m, looking at the middle of the target (world frame).
 Eigen::Matrix4d spectator_pose(const Eigen::Vector3d& head, const Eigen::Vector3d& target_middle);
 
+/// What the spectator sees, and per pixel what the appearance bench scores it by (row-major, top first).
+struct SpectatorPicture {
+  assets::Image image;           ///< sRGB: reflectance x (room + projector light) / engine::kReferenceLux
+  assets::Image albedo;          ///< the surfaces' own colours, sRGB (the twin's; targets' from `surface:`)
+  std::vector<float> white_lux;  ///< full white's lux on the surface seen; 0 where the projector cannot reach it
+  std::vector<float> z_m;        ///< the spectator's depth of the surface seen, 0 for none
+};
+
+/// A target as the spectator would see it: its content (sRGB, the content model drawn from the spectator)
+/// and where the target itself is the nearest surface.
+struct ContentView {
+  assets::Image content;
+  std::vector<std::uint8_t> mask;  ///< 1 where the spectator sees the target
+};
+
 class SpectatorView {
  public:
   static constexpr int kWidth = 960;
   static constexpr int kHeight = 720;
-  static constexpr double kRoomLight = 0.3;  ///< the room's light while projecting, of full white
 
   SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector);
 
-  /// The spectator's picture at T_world_spectator: each visible surface point's albedo (the twin's
-  /// colour) lit by the room light plus the projector's pixel that reaches it (Eq. 3 from
-  /// T_world_projector, blocked by whatever stands nearer the projector). Throws TwinError when the
-  /// frame is not the projector's size.
+  /// The spectator's picture at T_world_spectator: each visible surface point's reflectance lit by the
+  /// room's light (`room.ambient_lux`) plus the light of the projector's pixel that reaches it (Eq. 3 from
+  /// T_world_projector, blocked by whatever stands nearer the projector; its brightness, response, distance
+  /// and incidence). Throws TwinError when the frame is not the projector's size.
+  SpectatorPicture see(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const Eigen::Matrix4d& T_world_projector,
+                       const assets::Image& projector_frame);
+  /// Target `target` (index into Twin::targets()) where it stands now, as seen from T_world_spectator: its
+  /// content, and where it is what `picture` (see() from the same place) shows.
+  ContentView content(Twin& twin, std::size_t target, const Eigen::Matrix4d& T_world_spectator, const SpectatorPicture& picture);
+  /// see()'s picture alone.
   assets::Image draw(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const Eigen::Matrix4d& T_world_projector,
-                     const assets::Image& projector_frame);
+                     const assets::Image& projector_frame) {
+    return see(twin, T_world_spectator, T_world_projector, projector_frame).image;
+  }
 
   const config::ProjectorConfig& pinhole() const { return pinhole_; }
 
@@ -42,6 +66,7 @@ class SpectatorView {
   config::ProjectorConfig projector_;
   config::ProjectorConfig pinhole_;  // the spectator's eye: 960 x 720, about 69 degrees across
   std::unique_ptr<engine::RenderTarget> colour_, depth_, projector_depth_;
+  std::vector<Eigen::Vector3f> facet_normals(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const engine::DepthMap& depth);
 };
 
 }  // namespace projbot::twin

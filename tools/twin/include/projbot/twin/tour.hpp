@@ -17,6 +17,7 @@
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/config/scene.hpp"
+#include "projbot/twin/appearance.hpp"
 #include "projbot/twin/raycast.hpp"
 
 namespace projbot::twin {
@@ -53,6 +54,18 @@ struct TourOptions {
   /// T_cp while the twin's light keeps the scene's, the truth, so the markers show what the calibration's
   /// error costs. Unset: the session knows the truth.
   std::optional<config::ProjectorCalibration> calibration;
+  /// Issue 43: at each arrival (and once in the middle of a scripted motion) the visited target's frame is
+  /// drawn with compensation off and on, and what a visitor sees of it scored (VisitReport::appearance).
+  bool appearance = false;
+};
+
+/// What a visitor saw of the visited target in one projector frame (TourOptions::appearance).
+struct AppearanceSample {
+  bool compensation = false;
+  bool moving = false;        ///< in the middle of a scripted motion, the pose predicted for its display time
+  double gain = 1.0;          ///< the target's k for this visit (the same off and on)
+  double ms_per_frame = 0.0;  ///< wall time to draw the projector's frame and read it back
+  AppearanceScore score;
 };
 
 /// The projection error of one projector frame while projecting, at its display time.
@@ -129,7 +142,8 @@ struct VisitReport {
   /// motion.removed: seconds from the first depth frame without the target to the first blank
   /// projector frame; -1 when it was never blanked (or nothing was removed).
   double blank_after_removal_s = -1.0;
-  std::vector<NeighbourReport> neighbours;  ///< other targets in view at this stop, nearest first
+  std::vector<NeighbourReport> neighbours;   ///< other targets in view at this stop, nearest first
+  std::vector<AppearanceSample> appearance;  ///< TourOptions::appearance: off and on at arrival, and while moving
 };
 
 struct TourReport {

@@ -123,11 +123,16 @@ class Twin {
   /// What a camera at T_world_camera sees: the room, props, supports and the targets in the world, each
   /// placed in the camera frame (for the renderer's draw_frame).
   std::vector<engine::DrawItem> draw_items(const Eigen::Matrix4d& T_world_camera) const;
+  /// draw_items with each target's physical surface (`surface:`, its albedo as sRGB colour) instead of
+  /// its content: what the projector's light and the room's fall on (issue 43).
+  std::vector<engine::DrawItem> surface_items(const Eigen::Matrix4d& T_world_camera) const;
   /// The middle of a target's model (its bounding box's centre) where the map says it stands.
   Eigen::Vector3d surveyed_middle(std::size_t target) const;
 
   /// Renderer model ids of the targets (same order as targets()).
   const std::vector<std::size_t>& target_model_ids() const { return target_ids_; }
+  /// Renderer model ids of the targets' facets, each coloured (n + 1) / 2 by its model-frame normal.
+  const std::vector<std::size_t>& facet_model_ids() const { return facet_ids_; }
 
  private:
   config::Scene scene_;
@@ -145,6 +150,9 @@ class Twin {
   };
   std::vector<PlacedProp> props_;  // the glTF props
   std::vector<std::size_t> target_ids_;
+  std::vector<std::size_t> surface_ids_;  // each target's model coloured by its surface's albedo
+  std::vector<std::size_t> facet_ids_;    // facet_model_ids()
+  std::vector<engine::DrawItem> placed_items(const Eigen::Matrix4d& T_world_camera, const std::vector<std::size_t>& ids) const;
   // Checks and builds a target's support; adds what stands on the floor to `footprints` (the laser's).
   void place_support(TwinTarget& t, const std::string& where, std::vector<config::Box2D>& footprints);
   std::unique_ptr<robot::SimRobot> robot_;

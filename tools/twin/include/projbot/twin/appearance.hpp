@@ -1,0 +1,36 @@
+#pragma once
+// What the visitor sees of a target against what it should show (issue 43): the content under the
+// reference light scaled by the target's gain k, over the target's lit pixels of a spectator's picture.
+// PSNR over 8-bit sRGB, SSIM (Wang et al. 2004: 11 x 11 Gaussian window, sigma 1.5, on luma), and CIEDE2000
+// (Sharma, Wu and Dalal 2005) over the pixels whose reflectance lets the projector reach the content.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "projbot/assets/image.hpp"
+#include "projbot/config/scene.hpp"
+#include "projbot/twin/spectator.hpp"
+
+namespace projbot::twin {
+
+/// CIE L*a*b* (D65) of an sRGB colour (0..1 per channel).
+Eigen::Vector3d srgb_to_lab(const Eigen::Vector3d& srgb);
+/// CIEDE2000 colour difference of two L*a*b* colours (kL = kC = kH = 1).
+double ciede2000(const Eigen::Vector3d& lab1, const Eigen::Vector3d& lab2);
+
+struct AppearanceScore {
+  std::size_t pixels = 0;  ///< the target's lit pixels scored
+  double psnr_db = 0.0, ssim = 0.0;
+  double de2000_median = 0.0, de2000_p95 = 0.0;  ///< over the reachable pixels
+  double clipped_share = 0.0;                    ///< pixels whose content needs more than full white there
+  double unreachable_share = 0.0;                ///< clipped, or darker than the room's light and the projector's black allow
+};
+
+/// Scores `seen` (SpectatorView::see) against k x the content of `view` (SpectatorView::content), over the pixels of the target
+/// that the projector reaches. `ambient_lux` and `photometry`: the room's and the projector's light, to
+/// tell which pixels any projector input could make right.
+AppearanceScore score_appearance(const SpectatorPicture& seen, const ContentView& view, double k, double ambient_lux,
+                                 const config::Photometry& photometry);
+
+}  // namespace projbot::twin
