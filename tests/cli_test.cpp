@@ -703,6 +703,32 @@ TEST_F(CliTest, TourRunsWithTheDepthModelFittedToRealFrames) {
   EXPECT_TRUE(std::isfinite(report.at("visits")[0].at("mean_mm").get<double>()));
 }
 
+// bench appearance (issue 43): the shop's figure, compensation off and on, scored and reported; the
+// compensated picture within the issue's colour goals, the one as stored far off them.
+TEST_F(CliTest, BenchAppearanceScoresCompensationOffAndOn) {
+  const fs::path report = dir_ / "appearance.json";
+  const CliRun r =
+      run_projbot("bench appearance --visits 1 --frames " + (dir_ / "frames").string() + " --report " + report.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("| 1 | figure | no |"), std::string::npos) << r.output;
+  std::ifstream in(report);
+  const auto json = nlohmann::json::parse(in);
+  ASSERT_EQ(json.at("visits").size(), 2U) << json.dump(1);
+  const auto& off = json.at("visits")[0];
+  const auto& on = json.at("visits")[1];
+  EXPECT_EQ(off.at("compensation"), "off");
+  EXPECT_EQ(on.at("compensation"), "on");
+  EXPECT_EQ(on.at("target"), "figure");
+  EXPECT_FALSE(on.at("moving").get<bool>());
+  EXPECT_LE(on.at("de2000_median").get<double>(), 5.0) << on.dump();
+  EXPECT_LE(on.at("de2000_p95").get<double>(), 12.0) << on.dump();
+  EXPECT_GE(on.at("ssim").get<double>(), 0.85) << on.dump();
+  EXPECT_GE(on.at("psnr_db").get<double>(), off.at("psnr_db").get<double>() + 10.0) << off.dump() << on.dump();
+  EXPECT_GT(off.at("de2000_median").get<double>(), 10.0) << off.dump();
+  EXPECT_GT(on.at("ms_per_frame").get<double>(), 0.0);
+  EXPECT_TRUE(fs::exists(dir_ / "frames" / "visit01_figure_spectator_compensated.png"));
+}
+
 // Two targets side by side: at the duck's stop the box is lit in the same projector frames, on the
 // right of the duck (the box stands 0.6 m east of it).
 TEST_F(CliTest, TourLightsANeighbourInTheSameFrame) {

@@ -103,15 +103,19 @@ engine::FrameSummary measure(engine::Renderer& renderer, const config::Projector
 const Command kBenchRender{
     "bench render",
     "benchmark the projector pass (frame rate, frame-time percentiles)",
-    "projbot bench render [--frames N] [--sizes WxH,...] [--lens K1,K2] [--offscreen-only | --windowed-only]\n\n"
+    "projbot bench render [--frames N] [--sizes WxH,...] [--lens K1,K2] [--compensation]\n"
+    "                     [--offscreen-only | --windowed-only]\n\n"
     "Draws the Duck (4212 triangles) and a 100k-triangle textured sphere at each size, offscreen and\n"
     "(when a display is there, e.g. under xvfb-run) in a window, and prints one row per run. Frame time\n"
     "is start-to-start of consecutive frames; windowed runs use the IMMEDIATE present mode where offered.\n"
     "With --lens every run is made twice, through a pinhole and through a projector lens with those\n"
-    "radial terms (the lens pass: the models drawn onto an undistorted canvas, then warped per pixel).\n",
+    "radial terms (the lens pass: the models drawn onto an undistorted canvas, then warped per pixel).\n"
+    "With --compensation every run is made twice, the content as stored and radiometrically compensated\n"
+    "(issue 43: a beige surface in 50 lux, the default 3000-lumen projector; its cost is the difference).\n",
     {{"frames", "N", "measured frames per run, after 20 warm-up frames (default 300)"},
      {"sizes", "WxH,...", "target sizes (default 1280x800,1920x1080)"},
      {"lens", "K1,K2", "also measure each run through a projector lens with these radial terms"},
+     {"compensation", "", "also measure each run with radiometric compensation on"},
      {"offscreen-only", "", "skip the windowed runs"},
      {"windowed-only", "", "skip the offscreen runs"},
      {"device", "N", "Vulkan physical device index"}},
@@ -139,30 +143,33 @@ const Command kBenchRender{
       engine::Renderer renderer(ro);
       catch_interrupts();  // Ctrl-C: the rows printed are whole; the run under way is dropped; exit 130
       std::cout << "device: " << renderer.device_info().name << " (" << renderer.device_info().driver << ")\n";
-      std::printf("%-11s %8s %10s %-9s %8s %8s %8s %8s %8s %8s  %s\n", "model", "tris", "size", "target", "fps", "p50_ms",
-                  "p95_ms", "p99_ms", "max_ms", "gpu_p50", "lens");
+      std::vector<engine::Compensation> compensations{engine::Compensation{}};
+      if (args.flag("compensation")) compensations.push_back(engine::compensation({0.72, 0.58, 0.44}, 50.0, 0.5));
+      std::printf("%-11s %8s %10s %-9s %8s %8s %8s %8s %8s %8s  %-16s %s\n", "model", "tris", "size", "target", "fps", "p50_ms",
+                  "p95_ms", "p99_ms", "max_ms", "gpu_p50", "lens", "compensation");
       for (const auto& m : models) {
         const std::size_t id = renderer.add_model(m.model);
         const double radius = 0.5 * m.model.bounds().diagonal().norm();
         for (const auto& [w, h] : sizes)
           for (const auto& lens : lenses)
-            for (const bool windowed : {false, true}) {
-              auto projector = projector_for(w, h);
-              if (lens) projector.distortion = *lens;
-              const std::vector<engine::DrawItem> items{{id, framing_pose(projector, radius)}};
-              if ((windowed && !want_window) || (!windowed && !want_offscreen)) continue;
-              const engine::FrameSummary s = measure(renderer, projector, items, windowed, frames);
-              if (interrupted())
-                return benchmark_interrupted("after " + std::to_string(s.frames) + " of " + std::to_string(frames) +
-                                             " frames of this run (not reported)");
-              char size[32], lens_text[48] = "pinhole";
-              std::snprintf(size, sizeof size, "%dx%d", w, h);
-              if (lens) std::snprintf(lens_text, sizeof lens_text, "k1=%g,k2=%g", (*lens)[0], (*lens)[1]);
-              std::printf("%-11s %8zu %10s %-9s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f  %s\n", m.name.c_str(),
-                          m.model.triangle_count(), size, windowed ? "window" : "offscreen", s.fps, s.p50_ms, s.p95_ms, s.p99_ms,
-                          s.max_ms, s.gpu_p50_ms, lens_text);
-              std::fflush(stdout);
-            }
+            for (const engine::Compensation& comp : compensations)
+              for (const bool windowed : {false, true}) {
+                auto projector = projector_for(w, h);
+                if (lens) projector.distortion = *lens;
+                const std::vector<engine::DrawItem> items{{id, framing_pose(projector, radius), comp}};
+                if ((windowed && !want_window) || (!windowed && !want_offscreen)) continue;
+                const engine::FrameSummary s = measure(renderer, projector, items, windowed, frames);
+                if (interrupted())
+                  return benchmark_interrupted("after " + std::to_string(s.frames) + " of " + std::to_string(frames) +
+                                               " frames of this run (not reported)");
+                char size[32], lens_text[48] = "pinhole";
+                std::snprintf(size, sizeof size, "%dx%d", w, h);
+                if (lens) std::snprintf(lens_text, sizeof lens_text, "k1=%g,k2=%g", (*lens)[0], (*lens)[1]);
+                std::printf("%-11s %8zu %10s %-9s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f  %-16s %s\n", m.name.c_str(),
+                            m.model.triangle_count(), size, windowed ? "window" : "offscreen", s.fps, s.p50_ms, s.p95_ms,
+                            s.p99_ms, s.max_ms, s.gpu_p50_ms, lens_text, comp.on ? "on" : "off");
+                std::fflush(stdout);
+              }
       }
       return 0;
     }};

@@ -20,16 +20,27 @@ namespace {
 using projbot::tools::Command;
 
 const std::vector<const Command*>& commands() {
-  static const std::vector<const Command*> all{&projbot::tools::kRender,         &projbot::tools::kShow,
-                                               &projbot::tools::kBenchRender,    &projbot::tools::kAlign,
-                                               &projbot::tools::kBenchTrack,     &projbot::tools::kBenchMotion,
-                                               &projbot::tools::kBenchAcquire,   &projbot::tools::kBenchDataset,
-                                               &projbot::tools::kBenchSensor,    &projbot::tools::kSlam,
-                                               &projbot::tools::kLocalize,       &projbot::tools::kBenchLocalize,
-                                               &projbot::tools::kTour,           &projbot::tools::kRun,
-                                               &projbot::tools::kDevices,        &projbot::tools::kSimBase,
-                                               &projbot::tools::kRecord,         &projbot::tools::kCalibrateSimulate,
-                                               &projbot::tools::kCalibrateSolve, &projbot::tools::kCalibrateCapture};
+  static const std::vector<const Command*> all{&projbot::tools::kRender,
+                                               &projbot::tools::kShow,
+                                               &projbot::tools::kBenchRender,
+                                               &projbot::tools::kAlign,
+                                               &projbot::tools::kBenchTrack,
+                                               &projbot::tools::kBenchMotion,
+                                               &projbot::tools::kBenchAppearance,
+                                               &projbot::tools::kBenchAcquire,
+                                               &projbot::tools::kBenchDataset,
+                                               &projbot::tools::kBenchSensor,
+                                               &projbot::tools::kSlam,
+                                               &projbot::tools::kLocalize,
+                                               &projbot::tools::kBenchLocalize,
+                                               &projbot::tools::kTour,
+                                               &projbot::tools::kRun,
+                                               &projbot::tools::kDevices,
+                                               &projbot::tools::kSimBase,
+                                               &projbot::tools::kRecord,
+                                               &projbot::tools::kCalibrateSimulate,
+                                               &projbot::tools::kCalibrateSolve,
+                                               &projbot::tools::kCalibrateCapture};
   return all;
 }
 
@@ -94,10 +105,10 @@ static int dispatch(int argc, char** argv, std::string& name) {
   if (name == "bench") {  // "bench render", "bench track", ...: the benchmark of a subsystem
     const std::string what = argc < 3 ? std::string() : argv[2];
     if (what != "render" && what != "track" && what != "motion" && what != "acquire" && what != "localize" && what != "dataset" &&
-        what != "sensor") {
+        what != "sensor" && what != "appearance") {
       std::cerr << "projbot bench: "
                 << (argc < 3 ? std::string("say what to benchmark") : "no benchmark '" + std::string(argv[2]) + "'")
-                << ": projbot bench render | track | motion | acquire | localize | dataset | sensor\n";
+                << ": projbot bench render | track | motion | appearance | acquire | localize | dataset | sensor\n";
       return 2;
     }
     name = std::string("bench ") + argv[2];

@@ -1,0 +1,114 @@
+// projbot bench appearance: what a visitor sees of each target, compensation off and on (issue 43). The
+// scene's tour in the twin, tracking; at each arrival, and once in the middle of a scripted motion, the
+// visited target's frame is drawn both ways and the spectator's picture scored against the content under
+// the reference light, scaled by the target's gain.
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "interrupt.hpp"
+#include "progress.hpp"
+#include "projbot/config/output_file.hpp"
+#include "projbot/twin/tour.hpp"
+#include "scene_setup.hpp"
+
+namespace projbot::tools {
+namespace {
+
+void print_table(const twin::TourReport& report) {
+  std::printf(
+      "\n| # | target | moving | k | compensation | PSNR dB | SSIM | dE2000 median / p95 | clipped %% | unreachable %% | "
+      "ms per frame |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const auto& v : report.visits)
+    for (const auto& a : v.appearance) {
+      const auto& s = a.score;
+      if (s.pixels == 0) {
+        std::printf("| %d | %s | %s | %.2f | %s | no lit pixel of the target in view | | | | | %.1f |\n", v.visit,
+                    v.target.c_str(), a.moving ? "yes" : "no", a.gain, a.compensation ? "on" : "off", a.ms_per_frame);
+        continue;
+      }
+      std::printf("| %d | %s | %s | %.2f | %s | %.1f | %.3f | %.1f / %.1f | %.1f | %.1f | %.1f |\n", v.visit, v.target.c_str(),
+                  a.moving ? "yes" : "no", a.gain, a.compensation ? "on" : "off", s.psnr_db, s.ssim, s.de2000_median,
+                  s.de2000_p95, 100.0 * s.clipped_share, 100.0 * s.unreachable_share, a.ms_per_frame);
+    }
+}
+
+void write_report(const std::filesystem::path& file, const twin::TourReport& report) {
+  nlohmann::json out = {{"visits", nlohmann::json::array()}, {"interrupted", report.interrupted}};
+  for (const auto& v : report.visits)
+    for (const auto& a : v.appearance) {
+      const auto& s = a.score;
+      const auto number = [&](double x) {
+        return s.pixels > 0 && std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+      };
+      out["visits"].push_back({{"visit", v.visit},
+                               {"target", v.target},
+                               {"compensation", a.compensation ? "on" : "off"},
+                               {"moving", a.moving},
+                               {"gain", a.gain},
+                               {"pixels", s.pixels},
+                               {"psnr_db", number(s.psnr_db)},
+                               {"ssim", number(s.ssim)},
+                               {"de2000_median", number(s.de2000_median)},
+                               {"de2000_p95", number(s.de2000_p95)},
+                               {"clipped_share", number(s.clipped_share)},
+                               {"unreachable_share", number(s.unreachable_share)},
+                               {"ms_per_frame", a.ms_per_frame}});
+    }
+  config::write_file_atomically(file, out.dump(1) + "\n");
+}
+
+}  // namespace
+
+const Command kBenchAppearance{
+    "bench appearance",
+    "benchmark what a visitor sees of each target, radiometric compensation off and on (the twin)",
+    "projbot bench appearance [--scene S.yaml] [--visits N] [--seed K] [--dwell S] [--frames DIR] [--report FILE.json]\n\n"
+    "Runs the scene's tour in the digital twin, tracking. At each arrival, and once in the middle of a\n"
+    "scripted motion, the visited target's projector frame is drawn with compensation off (the content as\n"
+    "stored) and on (what makes the target's surface show it: the content x k / the surface's reflectance,\n"
+    "less the room's light, through the projector's inverse response, for this frame's distance and\n"
+    "incidence), and a visitor's picture of it (the twin's light: the surfaces' `surface:` reflectance,\n"
+    "room.ambient_lux, the projector's brightness_lm, gamma and black_level) is scored over the target's\n"
+    "lit pixels against the content under the reference light (1000 lux), scaled by the target's gain k\n"
+    "(chosen per visit so that about 2 % of its surface would need more than full white; at most 1):\n"
+    "PSNR and SSIM over all of them, CIEDE2000 over those the projector can reach (the rest are counted as\n"
+    "unreachable: darker than the room's light allows, or brighter than full white). ms per frame: drawing\n"
+    "the projector's frame and reading it back on this machine. Without --scene, assets/scenes/shop.yaml\n"
+    "runs. With --frames, DIR/visitNN_TARGET_spectator.png (off) and _spectator_compensated.png (on).\n"
+    "Ctrl-C prints and reports the visits finished so far.\n",
+    {{"scene", "FILE", "scene with a tour (default: assets/scenes/shop.yaml)", cli::PathRole::input_file},
+     {"visits", "N", "visits, cycling through the scene's list (default: the list once)"},
+     {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
+     {"dwell", "S", "simulated seconds of projection per visit (default 3)"},
+     {"frames", "DIR", "write each visit's pictures here", cli::PathRole::output_folder},
+     {"report", "FILE", "JSON report, one row per visit and compensation", cli::PathRole::output_file}},
+    [](const cli::Args& args) {
+      twin::TourOptions o;
+      o.mode = twin::TourMode::tracking;
+      o.appearance = true;
+      o.visits = args.get_int("visits", 0, 1, 1000);
+      o.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
+      o.dwell_s = args.get_double("dwell", 3.0);
+      if (!(o.dwell_s >= 0.1 && o.dwell_s <= 600.0)) throw cli::UsageError("--dwell must be 0.1..600 seconds");
+      if (const auto frames = args.get("frames")) o.frames_dir = *frames;
+      const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
+      catch_interrupts();
+      o.stop_requested = [] { return interrupted(); };
+      const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
+      Progress progress("visit", visits);
+      o.on_visit = [&](const twin::VisitReport& v) { progress.step(v.visit); };
+      const twin::TourReport report = twin::run_tour(scene, o);
+      print_table(report);
+      std::printf("\nroom %.0f lux; projector %.0f lm, gamma %.2f, black %.4f; tour in %.1f s\n", scene.room.ambient_lux,
+                  scene.projector.photometry.brightness_lm, scene.projector.photometry.gamma,
+                  scene.projector.photometry.black_level, report.wall_s);
+      if (const auto file = args.get("report")) write_report(*file, report);
+      if (interrupted()) return benchmark_interrupted("during the tour (the visits above are those finished)");
+      return 0;
+    }};
+
+}  // namespace projbot::tools
