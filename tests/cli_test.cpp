@@ -945,6 +945,20 @@ TEST_F(CliTest, CalibrateSimulateThenSolveFeedsAScene) {
   r = run_projbot("calibrate solve " + cap.string() + " --out " + calib.string() +
                   " --projector 1280x800 --board charuco:10x7:0.06:0.045");
   EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("T_cp (mm, in the board's unit: its square taken as 60.0 mm)"), std::string::npos) << r.output;
+  // Issue 43: the projected patterns kept beside the captures (procam-calibration's graycode_pattern/,
+  // images at the projector's size) are skipped with a note, not refused as a pose.
+  projbot::assets::Image pattern;
+  pattern.width = 1280, pattern.height = 800;
+  pattern.rgba.assign(1280 * 800 * 4, 255);
+  fs::create_directories(cap / "graycode_pattern");
+  projbot::assets::write_png(cap / "graycode_pattern" / "pattern_00.png", pattern);
+  r = run_projbot("calibrate solve " + cap.string() + " --out " + calib.string() +
+                  " --projector 1280x800 --board charuco:10x7:0.06:0.045");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: skipped 'graycode_pattern': its images are at the projector's size (1280x800)"),
+            std::string::npos)
+      << r.output;
   EXPECT_EQ(run_projbot("calibrate solve --out " + calib.string()).code, 2);
   EXPECT_EQ(run_projbot("calibrate solve " + cap.string() + " --out " + calib.string() + " --projector 1280by800").code, 2);
   EXPECT_EQ(run_projbot("calibrate capture").code, 2);

@@ -111,10 +111,12 @@ void print_result(const calibrate::Calibration& c) {
     std::cout << ", k1 " << c.projector.distortion[0] << " k2 " << c.projector.distortion[1];
   std::cout << "\ncamera " << k.width_px << "x" << k.height_px << ": fx " << k.fx_px << " fy " << k.fy_px << " cx " << k.cx_px
             << " cy " << k.cy_px << ", k1 " << c.camera.distortion[0] << " k2 " << c.camera.distortion[1]
-            << "\nT_cp (mm): " << std::setprecision(2) << 1000 * c.T_projector_camera(0, 3) << ", "
-            << 1000 * c.T_projector_camera(1, 3) << ", " << 1000 * c.T_projector_camera(2, 3) << std::setprecision(3)
-            << "\nreprojection RMS: camera " << c.camera_rms_px << " px, projector " << c.projector_rms_px
-            << " px; corners cover " << std::setprecision(0) << 100 * c.projector_coverage << " % of the projector's image\n";
+            << "\nT_cp (mm, in the board's unit: its square taken as " << std::setprecision(1) << 1000 * c.board_square_m
+            << " mm): " << std::setprecision(2) << 1000 * c.T_projector_camera(0, 3) << ", " << 1000 * c.T_projector_camera(1, 3)
+            << ", " << 1000 * c.T_projector_camera(2, 3) << std::setprecision(3) << "\nreprojection RMS: camera "
+            << c.camera_rms_px << " px, projector " << c.projector_rms_px << " px; corners cover " << std::setprecision(0)
+            << 100 * c.projector_coverage << " % of the projector's image\n";
+  for (const auto& n : c.notes) std::cout << "note: " << n << '\n';
   for (const auto& w : c.warnings) std::cout << "warning: " << w << '\n';
 }
 

@@ -27,7 +27,7 @@ CaptureSummary capture(CaptureRig& rig, const CaptureOptions& o, const std::file
   if (o.poses < 1 || o.poses > 100) throw CalibrationError("capture: poses must be 1..100");
   const std::vector<cv::Mat> patterns = gray_code_images(o.projector_width, o.projector_height);
   CaptureWriter writer(out);  // checks `out` before any image is shown
-  CaptureManifest manifest{o.projector_width, o.projector_height, o.board, {}};
+  CaptureManifest manifest{o.projector_width, o.projector_height, o.board, {}, {}};
   CaptureSummary s;
   const auto stopped = [&] { return stop && stop(); };
   while (s.kept < o.poses && !stopped()) {

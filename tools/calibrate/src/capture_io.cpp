@@ -9,6 +9,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 
 #include "projbot/assets/image.hpp"
@@ -117,6 +118,40 @@ void CaptureWriter::finish(const CaptureManifest& m, const std::optional<Calibra
   done_ = true;
 }
 
+namespace {
+
+// The size of a folder's first image, or nothing when it cannot be read (read_pose says why later).
+std::optional<cv::Size> first_image_size(const fs::path& folder) {
+  const std::vector<fs::path> files = images_in(folder);
+  if (files.empty()) return std::nullopt;
+  try {
+    assets::check_png_structure(files.front());
+  } catch (const assets::AssetError&) {
+    return std::nullopt;
+  }
+  const cv::Mat img = cv::imread(files.front().string(), cv::IMREAD_GRAYSCALE);
+  if (img.empty()) return std::nullopt;
+  return img.size();
+}
+
+// Another tool's capture may keep the projected patterns beside the captures (procam-calibration's
+// graycode_pattern/): folders of images at the projector's size are skipped with a note, unless every
+// folder is (a camera as large as the projector: then none can be told apart).
+void skip_pattern_folders(const fs::path& dir, CaptureManifest& m) {
+  std::vector<std::string> kept, skipped;
+  for (const std::string& name : m.folders) {
+    const auto size = first_image_size(dir / name);
+    (size && *size == cv::Size(m.projector_width, m.projector_height) ? skipped : kept).push_back(name);
+  }
+  if (skipped.empty() || kept.empty()) return;
+  for (const std::string& name : skipped)
+    m.notes.push_back("skipped '" + name + "': its images are at the projector's size (" + std::to_string(m.projector_width) +
+                      "x" + std::to_string(m.projector_height) + "), the projected patterns rather than a capture");
+  m.folders = kept;
+}
+
+}  // namespace
+
 CaptureManifest read_manifest(const fs::path& dir, const SolveOptions& options) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw CalibrationError("'" + dir.string() + "' is not a folder");
@@ -148,6 +183,7 @@ CaptureManifest read_manifest(const fs::path& dir, const SolveOptions& options) 
       if (e.is_directory(ec) && !images_in(e.path()).empty()) names.push_back(e.path().filename().string());
     std::sort(names.begin(), names.end(), natural_less);
     m.folders = names;
+    skip_pattern_folders(dir, m);
   }
   if (options.board) m.board = *options.board;
   if (m.projector_width < 8 || m.projector_height < 8 || m.projector_width > 16384 || m.projector_height > 16384)

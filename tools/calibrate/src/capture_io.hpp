@@ -15,6 +15,7 @@ struct CaptureManifest {
   int projector_width = 0, projector_height = 0;
   Board board;
   std::vector<std::string> folders;  ///< one per board pose, relative to the capture folder
+  std::vector<std::string> notes;    ///< what reading it skipped, and why
 };
 
 class CaptureWriter {
@@ -35,7 +36,8 @@ class CaptureWriter {
 };
 
 /// The manifest of capture folder `dir`: capture.yaml's, or for a folder without one the sub-folders
-/// that hold images, with the projector size and board from `options`. Throws CalibrationError.
+/// that hold images, with the projector size and board from `options` (those holding images at the
+/// projector's size, the patterns themselves, skipped with a note). Throws CalibrationError.
 CaptureManifest read_manifest(const std::filesystem::path& dir, const SolveOptions& options);
 /// A pose's images, 8-bit grey, in order (file names sorted with numbers compared as numbers).
 std::vector<cv::Mat> read_pose(const std::filesystem::path& folder, std::size_t expected);

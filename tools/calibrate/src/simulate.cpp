@@ -261,7 +261,7 @@ int simulate(const SimulationConfig& c, const std::filesystem::path& out, const 
   const std::vector<cv::Mat> patterns = gray_code_images(c.projector.width_px, c.projector.height_px);
   const std::vector<cv::Point2d> rays = sample_rays(c.camera);
   CaptureWriter writer(out);
-  CaptureManifest manifest{c.projector.width_px, c.projector.height_px, c.board, {}};
+  CaptureManifest manifest{c.projector.width_px, c.projector.height_px, c.board, {}, {}};
   for (int i = 0; i < count && !(stop && stop()); ++i) {
     const std::vector<Sample> samples = trace(c, g, rays, poses[static_cast<std::size_t>(i)]);
     std::mt19937_64 rng(c.seed * 1000003u + static_cast<std::uint64_t>(i));

@@ -138,6 +138,8 @@ Calibration solve(const std::filesystem::path& dir, const SolveOptions& o,
   const auto expected = static_cast<std::size_t>(images_per_pose(m.projector_width, m.projector_height));
   const cv::Size projector_size(m.projector_width, m.projector_height);
   Calibration c;
+  c.notes = m.notes;
+  c.board_square_m = m.board.square_m;
   cv::Size camera_size;
   Correspondences used;
   for (std::size_t i = 0; i < m.folders.size(); ++i) {

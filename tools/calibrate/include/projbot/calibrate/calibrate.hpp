@@ -114,6 +114,8 @@ struct Calibration {
   double projector_coverage = 0.0;                                   ///< area of the corners' convex hull / the projector's image
   std::vector<ViewResult> views;
   std::vector<std::string> warnings;
+  std::vector<std::string> notes;  ///< what solve skipped in the capture folder, and why (not written)
+  double board_square_m = 0.0;     ///< the board's square as given: T_cp is in its unit
   /// A simulated capture's truth only: each pose's board in the camera frame (OpenCV's board frame).
   std::vector<Eigen::Matrix4d> T_camera_board;
 };
