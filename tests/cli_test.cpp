@@ -726,7 +726,24 @@ TEST_F(CliTest, BenchAppearanceScoresCompensationOffAndOn) {
   EXPECT_GE(on.at("psnr_db").get<double>(), off.at("psnr_db").get<double>() + 10.0) << off.dump() << on.dump();
   EXPECT_GT(off.at("de2000_median").get<double>(), 10.0) << off.dump();
   EXPECT_GT(on.at("ms_per_frame").get<double>(), 0.0);
-  EXPECT_TRUE(fs::exists(dir_ / "frames" / "visit01_figure_spectator_compensated.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "frames" / "visit01_figure_spectator_off.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "frames" / "visit01_figure_spectator_on.png"));
+}
+
+// tour --compensation (issue 43, default on): the shop's figure is beige, so the compensated frame sends
+// it more blue than red to show its grey content grey; off, the content goes out as stored.
+TEST_F(CliTest, TourCompensatesTheFiguresBeigeUnlessTurnedOff) {
+  const auto blue_over_red = [&](const std::string& extra, const fs::path& frames) {
+    const CliRun r = run_projbot("tour --visits 1 --mode localized --frames " + frames.string() + extra);
+    EXPECT_EQ(r.code, 0) << r.output;
+    const auto image = projbot::assets::read_image(frames / "visit01_figure.png");
+    double red = 0.0, blue = 0.0;
+    for (std::size_t i = 0; i < image.rgba.size(); i += 4)
+      if (image.rgba[i] + image.rgba[i + 1] + image.rgba[i + 2] > 60) red += image.rgba[i], blue += image.rgba[i + 2];
+    return red > 0.0 ? blue / red : 0.0;
+  };
+  EXPECT_GT(blue_over_red("", dir_ / "on"), 1.15);  // beige reflects red 0.72, blue 0.44
+  EXPECT_NEAR(blue_over_red(" --compensation off", dir_ / "off"), 1.0, 0.1);
 }
 
 // Two targets side by side: at the duck's stop the box is lit in the same projector frames, on the

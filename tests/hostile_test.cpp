@@ -259,6 +259,8 @@ std::vector<Hostile> clash_cases() {
               "a: 1\n",
               2,
               {"--report {dir}/bad.yaml is also the input --scene {dir}/bad.yaml"}},
+      Hostile{"tour_compensation_maybe", "tour --compensation maybe", "", 2, {"--compensation must be on or off, not 'maybe'"}},
+      Hostile{"run_compensation_empty", "run --sim --headless --compensation ''", "", 2, {"--compensation must be on or off"}},
       Hostile{"bench_appearance_dwell_zero", "bench appearance --dwell 0", "", 2, {"--dwell must be 0.1..600 seconds"}},
       Hostile{"bench_appearance_gamma_nan",
               "bench appearance --scene {dir}/bad.yaml",

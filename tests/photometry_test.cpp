@@ -151,3 +151,24 @@ TEST(Photometry, TheShaderMatchesItsCpuReference) {
 }
 
 }  // namespace
+
+namespace {
+
+// The plan keeps a target's gain through a visit, whatever the pose does, and chooses it again in the next.
+TEST(Photometry, ThePlanKeepsTheGainThroughAVisit) {
+  projbot::assets::Model quad = projbot::assets::make_box({-0.2, -0.2, -0.01}, {0.2, 0.2, 0.01}, {1.0F, 1.0F, 1.0F, 1.0F});
+  engine::CompensationPlan plan({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5)}}, 20.0, true);
+  Eigen::Matrix4d near = Eigen::Matrix4d::Identity(), far = Eigen::Matrix4d::Identity();
+  near(2, 3) = 1.0;
+  far(2, 3) = 3.0;  // nine times less light: a smaller gain
+  const engine::Compensation first = plan.at(0, 1, kProjector, near);
+  EXPECT_TRUE(first.on);
+  const double k_near = plan.gain(0);
+  EXPECT_EQ(plan.at(0, 1, kProjector, far).scale_lux, first.scale_lux);  // the same visit: kept
+  plan.at(0, 2, kProjector, far);
+  EXPECT_LT(plan.gain(0), 0.5 * k_near);  // the next visit: chosen again, far away
+  engine::CompensationPlan off({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5)}}, 20.0, false);
+  EXPECT_FALSE(off.at(0, 1, kProjector, near).on);
+}
+
+}  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace projbot::engine {
 
@@ -136,6 +137,22 @@ double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vecto
     if ((below += w) > clip_share * total) break;
   }
   return std::min(k, 1.0);  // never brighter than the content under the reference light
+}
+
+CompensationPlan::CompensationPlan(std::vector<Target> targets, double ambient_lux, bool on)
+    : targets_(std::move(targets)), chosen_(targets_.size()), ambient_lux_(ambient_lux), on_(on) {}
+
+Compensation CompensationPlan::at(std::size_t target, long visit, const config::ProjectorConfig& projector,
+                                  const Eigen::Matrix4d& T_projector_target) {
+  if (!on_) return {};
+  const Target& t = targets_.at(target);
+  Chosen& c = chosen_.at(target);
+  if (!c.made || c.visit != visit) {
+    c.gain = t.model ? choose_gain(surface_samples(*t.model, projector, T_projector_target), t.albedo, ambient_lux_) : 1.0;
+    c.visit = visit;
+    c.made = true;
+  }
+  return compensation(t.albedo, ambient_lux_, c.gain);
 }
 
 }  // namespace projbot::engine

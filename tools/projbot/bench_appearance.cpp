@@ -78,7 +78,7 @@ const Command kBenchAppearance{
     "PSNR and SSIM over all of them, CIEDE2000 over those the projector can reach (the rest are counted as\n"
     "unreachable: darker than the room's light allows, or brighter than full white). ms per frame: drawing\n"
     "the projector's frame and reading it back on this machine. Without --scene, assets/scenes/shop.yaml\n"
-    "runs. With --frames, DIR/visitNN_TARGET_spectator.png (off) and _spectator_compensated.png (on).\n"
+    "runs. With --frames, DIR/visitNN_TARGET_spectator_off.png and _spectator_on.png at each arrival.\n"
     "Ctrl-C prints and reports the visits finished so far.\n",
     {{"scene", "FILE", "scene with a tour (default: assets/scenes/shop.yaml)", cli::PathRole::input_file},
      {"visits", "N", "visits, cycling through the scene's list (default: the list once)"},

@@ -276,7 +276,9 @@ const Command kRun{
      {"visits", "N", "visits, cycling through the tour (default: the list once)"},
      {"dwell", "S", "seconds the robot projects at each stop (default 4)"},
      {"seed", "K", "seed of the twin's noise (default 1)"},
-     {"no-predict", "", "draw the newest measured pose, not the one predicted for display time"}},
+     {"no-predict", "", "draw the newest measured pose, not the one predicted for display time"},
+     {"compensation", "on|off",
+      "radiometric compensation of each target's surface and the room's light (default on; off: the content as stored)"}},
     [](const cli::Args& args) {
       catch_interrupts();  // Ctrl-C / SIGTERM: leave the frame loop at the next frame, then write what was measured
       const std::optional<config::Recording> recording = replay_of(args);
@@ -300,12 +302,17 @@ const Command kRun{
       const bool headless = args.flag("headless");
       present_mode(args.get_or("present-mode", "fifo"));  // a bad mode is an error with --headless too
       args.get_int("monitor", 0, 0, 64);                  // so is a bad monitor
+      const bool compensate = on_off(args, "compensation", true);
 
       engine::RendererOptions ro;
       ro.windowing = !headless;
       engine::Renderer renderer(ro);
       std::cout << "device: " << renderer.device_info().name << std::endl;  // flushed: a log shows it has started
-      const auto items = upload_scene(renderer, scene);
+      std::vector<assets::Model> models;
+      const auto items = upload_scene(renderer, scene, &models);
+      std::vector<engine::CompensationPlan::Target> surfaces;
+      for (std::size_t i = 0; i < models.size(); ++i) surfaces.push_back({&models[i], scene.targets[i].surface.albedo});
+      engine::CompensationPlan plan(std::move(surfaces), scene.room.ambient_lux, compensate);
       std::unique_ptr<engine::RenderTarget> target;
       if (headless) {
         target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
@@ -375,7 +382,8 @@ const Command kRun{
           session::LitNow now{{}, robot.since_s, handoffs.last_s};
           for (const DrawnTarget& lit : robot.lit) now.targets.push_back(lit.target);
           for (const session::DrawnPose& d : frames.compose(config::steady_now_s(), now, pose_of)) {
-            out.push_back({items[static_cast<std::size_t>(d.target)].model, d.T_projector_target});
+            const auto t = static_cast<std::size_t>(d.target);
+            out.push_back({items[t].model, d.T_projector_target, plan.at(t, robot.visit, scene.projector, d.T_projector_target)});
             const auto lit =
                 std::find_if(robot.lit.begin(), robot.lit.end(), [&](const DrawnTarget& l) { return l.target == d.target; });
             drawn.push_back({&*lit, d.capture_s, d.display_s, d.T_camera_target});

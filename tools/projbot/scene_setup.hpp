@@ -30,8 +30,13 @@ config::Scene scene_from_args(const cli::Args& args);
 /// model front (+z) towards the projector.
 Eigen::Matrix4d framing_pose(const config::ProjectorConfig& projector, double radius_m);
 
-/// Loads, scales and recentres each target's model and uploads it; returns one DrawItem per target.
-std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene);
+/// An `--NAME on|off` option: `fallback` when not given; anything else is a usage error naming it.
+bool on_off(const cli::Args& args, const std::string& name, bool fallback);
+
+/// Loads, scales and recentres each target's model and uploads it; returns one DrawItem per target (and
+/// the models into `models` when given, in the same order).
+std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene,
+                                           std::vector<assets::Model>* models = nullptr);
 /// fifo, mailbox or immediate. Throws cli::UsageError listing them for anything else.
 engine::PresentMode present_mode(const std::string& name);
 /// The projector window from --fullscreen, --monitor and --present-mode (fifo, mailbox or immediate), the

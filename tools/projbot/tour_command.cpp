@@ -72,6 +72,8 @@ const Command kTour{
      {"no-noise", "", "depth without the Kinect v1 noise model"},
      {"depth-model", "M", "the twin's depth camera: kinect (the published model, default) or fitted (to real frames)"},
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"},
+     {"compensation", "on|off",
+      "radiometric compensation of each target's surface and the room's light (default on; off: the content as stored)"},
      {"calibration", "FILE",
       "project with a calibration's A_p and R_cp, T_cp (projbot calibrate solve) while the twin's projector keeps the "
       "scene's: what the calibration's error costs at the markers",
@@ -98,6 +100,7 @@ const Command kTour{
       if (depth_model != "fitted" && depth_model != "kinect")
         throw cli::UsageError("--depth-model must be kinect or fitted, not '" + depth_model + "'");
       o.predict = !args.flag("no-predict");
+      o.compensation = on_off(args, "compensation", true);
       const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
       args.check_clashes({{"the default scene", scene_path, false}});
       const auto scene = config::load_scene(scene_path);

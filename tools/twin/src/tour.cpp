@@ -468,6 +468,13 @@ alignment::WorkerConfig follower_config(const TourOptions& options) {
   return follow;
 }
 
+// Each target's content and the surface the scene gives it, as the session knows them.
+std::vector<engine::CompensationPlan::Target> compensation_targets(const Twin& twin) {
+  std::vector<engine::CompensationPlan::Target> out;
+  for (const TwinTarget& t : twin.targets()) out.push_back({&t.model, t.config.surface.albedo});
+  return out;
+}
+
 // What every stop of a tour shares: the twin, its camera on the simulated clock, and a follower and its
 // tracker per target (the follower's aligner acquires at each stop, its policy tracks while projecting: the
 // same one the live engine's TrackerWorker runs).
@@ -485,10 +492,16 @@ struct Tour {
   std::vector<alignment::PoseTracker*> by_scene;          // the trackers by scene index, for Session::visit
   std::unique_ptr<engine::RenderTarget> projector_frame;  // with --frames or appearance
   std::unique_ptr<SpectatorView> spectator;
+  engine::CompensationPlan plan;  // by index into Twin::targets()
 };
 
 Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Twin& t)
-    : scene(s), options(o), renderer(r), twin(t), models(projector_models(s, o)) {
+    : scene(s),
+      options(o),
+      renderer(r),
+      twin(t),
+      models(projector_models(s, o)),
+      plan(compensation_targets(t), s.room.ambient_lux, true) {
   clock.processing_ms = options.processing_ms;
   const alignment::WorkerConfig follow = follower_config(options);
   followers.reserve(twin.targets().size());
@@ -529,7 +542,8 @@ class TourStop final : public session::StopObserver {
 
  private:
   void at_arrival(const session::Stop& at, const alignment::RgbdFrame& f);
-  assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, const engine::Compensation& comp = {});
+  // compensate: the plan's compensation (TourOptions::compensation unless said otherwise).
+  assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate = {});
   void measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target);
   assets::Image spectator_picture(const assets::Image& projector);
   void write_pictures(const assets::Image& colour);
@@ -554,11 +568,7 @@ class TourStop final : public session::StopObserver {
   double motion_end_s_ = 0.0;
   double back_under_ = -1.0;  // when the error went back under the goal for good, -1 while it is not
   bool ever_over_ = false;
-  // TourOptions::appearance: the visited target's compensation for this visit, and whether the middle of
-  // its motion was measured.
-  double gain_ = 1.0;
-  engine::Compensation compensation_;
-  bool moving_measured_ = false;
+  bool moving_measured_ = false;  // TourOptions::appearance: the middle of the motion was measured
 };
 
 alignment::RgbdCamera& TourStop::arrived(const session::Stop& at) {
@@ -631,15 +641,7 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
   for (std::size_t k = 1; k < at.lit.size(); ++k)
     lights_.push_back(neighbour_light(tour_.twin, tour_.trackers[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, tour_.models));
   if (!tour_.options.frames_dir.empty()) write_pictures(f.colour);
-  if (tour_.options.appearance) {
-    // The estimator's side: the scene's surface and room light, the believed projector, the estimated pose.
-    const config::Scene& scene = tour_.scene;
-    const Eigen::Vector3d& albedo = target.config.surface.albedo;
-    gain_ = engine::choose_gain(engine::surface_samples(target.model, tour_.models.believed, report.T_projector_target_estimated),
-                                albedo, scene.room.ambient_lux);
-    compensation_ = engine::compensation(albedo, scene.room.ambient_lux, gain_);
-    measure_appearance(false, report.projected, report.T_projector_target_estimated);
-  }
+  if (tour_.options.appearance) measure_appearance(false, report.projected, report.T_projector_target_estimated);
 
   dwell_.emplace(DwellContext{tour_.twin, target_index_, tour_.models, truth_, tour_.options, lights_});
   period_s_ = 1.0 / tour_.models.truth.refresh_hz;
@@ -654,12 +656,17 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
 
 // The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else
 // all black.
-assets::Image TourStop::projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, const engine::Compensation& comp) {
+assets::Image TourStop::projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate) {
   std::vector<engine::DrawItem> items;
-  if (lit) items.push_back({tour_.twin.target_model_ids()[target_index_], T_projector_target, comp});
+  const bool on = compensate.value_or(tour_.options.compensation);
+  // The estimator's side: the scene's surfaces and room light, the believed projector, the drawn poses.
+  const auto item = [&](std::size_t target, const Eigen::Matrix4d& T) {
+    const engine::Compensation comp = on ? tour_.plan.at(target, visit_, tour_.models.believed, T) : engine::Compensation{};
+    items.push_back({tour_.twin.target_model_ids()[target], T, comp});
+  };
+  if (lit) item(target_index_, T_projector_target);
   for (const NeighbourLight& n : lights_)
-    if (n.shown)
-      items.push_back({tour_.twin.target_model_ids()[n.target], tour_.models.projector_from_target(n.drawn.T_camera_target)});
+    if (n.shown) item(n.target, tour_.models.projector_from_target(n.drawn.T_camera_target));
   tour_.renderer.draw_frame(*tour_.projector_frame, tour_.models.believed, items);
   return tour_.projector_frame->read_back();
 }
@@ -674,23 +681,23 @@ assets::Image TourStop::spectator_picture(const assets::Image& projector) {
 }
 
 // What a visitor sees of the visited target drawn at T_projector_target, compensation off and on, against
-// its content under the reference light scaled by the visit's gain; with --frames the compensated
-// picture too.
+// its content under the reference light scaled by the visit's gain; with --frames both pictures.
 void TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target) {
   const TwinTarget& target = tour_.twin.targets()[target_index_];
   const Eigen::Matrix4d T_world_spectator =
       spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
+  tour_.plan.at(target_index_, visit_, tour_.models.believed, T_projector_target);  // the visit's gain, if not yet chosen
+  const double gain = tour_.plan.gain(target_index_);
   for (const bool on : {false, true}) {
     const auto t0 = Clock::now();
-    const auto image = projector_image(lit, T_projector_target, on ? compensation_ : engine::Compensation{});
+    const auto image = projector_image(lit, T_projector_target, on);
     const double ms = ms_since(t0);
     const SpectatorPicture seen = tour_.spectator->see(tour_.twin, T_world_spectator, truth_.T_world_projector.matrix(), image);
     const ContentView view = tour_.spectator->content(tour_.twin, target_index_, T_world_spectator, seen);
-    const AppearanceScore score =
-        score_appearance(seen, view, gain_, tour_.scene.room.ambient_lux, tour_.models.truth.photometry);
-    report.appearance.push_back({on, moving, gain_, ms, score});
-    if (on && !moving && !tour_.options.frames_dir.empty())
-      assets::write_png(frame_path(tour_.options, report, "_spectator_compensated"), seen.image);
+    const AppearanceScore score = score_appearance(seen, view, gain, tour_.scene.room.ambient_lux, tour_.models.truth.photometry);
+    report.appearance.push_back({on, moving, gain, ms, score});
+    if (!moving && !tour_.options.frames_dir.empty())
+      assets::write_png(frame_path(tour_.options, report, on ? "_spectator_on" : "_spectator_off"), seen.image);
   }
 }
 

@@ -67,4 +67,35 @@ std::vector<SurfaceSample> surface_samples(const assets::Model& model, const con
 double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vector3d& albedo, double ambient_lux,
                    double clip_share = 0.02);
 
+/// The compensation of each target a session draws (issue 43): a target's gain is chosen the first time it
+/// is drawn in a visit, from its surface at that pose, and kept until the visit changes, so a target that
+/// moves or is tracked does not flicker. Off: every target's content as stored. One thread (the render
+/// thread, or the tour's).
+class CompensationPlan {
+ public:
+  struct Target {
+    const assets::Model* model = nullptr;  ///< its content; must outlive the plan
+    Eigen::Vector3d albedo = Eigen::Vector3d::Constant(0.75);
+  };
+  CompensationPlan(std::vector<Target> targets, double ambient_lux, bool on);
+  /// Target `target`'s compensation in visit `visit` (any number that changes between visits), drawn at
+  /// T_projector_target through `projector`.
+  Compensation at(std::size_t target, long visit, const config::ProjectorConfig& projector,
+                  const Eigen::Matrix4d& T_projector_target);
+  /// The gain chosen for `target` in its latest visit; 1 before any.
+  double gain(std::size_t target) const { return chosen_.at(target).gain; }
+  bool on() const { return on_; }
+
+ private:
+  struct Chosen {
+    long visit = -1;
+    double gain = 1.0;
+    bool made = false;
+  };
+  std::vector<Target> targets_;
+  std::vector<Chosen> chosen_;
+  double ambient_lux_;
+  bool on_;
+};
+
 }  // namespace projbot::engine

@@ -54,6 +54,9 @@ struct TourOptions {
   /// T_cp while the twin's light keeps the scene's, the truth, so the markers show what the calibration's
   /// error costs. Unset: the session knows the truth.
   std::optional<config::ProjectorCalibration> calibration;
+  /// Issue 43: the projector's frames compensate each target's surface (`surface:`) and the room's light;
+  /// false sends the content as stored.
+  bool compensation = true;
   /// Issue 43: at each arrival (and once in the middle of a scripted motion) the visited target's frame is
   /// drawn with compensation off and on, and what a visitor sees of it scored (VisitReport::appearance).
   bool appearance = false;
