@@ -15,6 +15,7 @@
 #include <random>
 
 #include "projbot/calibrate/capture.hpp"
+#include "projbot/calibrate/photometric.hpp"
 #include "projbot/calibrate/procam.hpp"
 #include "projbot/config/scene.hpp"
 
@@ -368,4 +369,31 @@ TEST(Capture, RefusesABadPoseOnTheSpotAndKeepsTheRest) {
             std::string::npos);
   EXPECT_FALSE(fs::exists(root / "cap2"));
   fs::remove_all(root);
+}
+
+// Photometric calibration (issue 43) on the twin's patch: three different channel gammas, a DLP's
+// crosstalk and a camera of its own response, recovered within the issue's goals; a rig whose camera
+// does not follow its exposure is refused by name.
+TEST(Photometric, RecoversEachChannelsGammaAndTheMixing) {
+  projbot::calibrate::PhotometricSim sim;
+  sim.colour.gamma = {2.0, 2.3, 2.5};
+  sim.colour.mixing = projbot::calibrate::typical_mixing();
+  sim.camera_gamma = 1.8;
+  sim.ambient_lux = 50.0;
+  sim.seed = 7;
+  const auto rig = projbot::calibrate::make_twin_photometric_rig(sim);
+  const auto r = projbot::calibrate::calibrate_photometric(*rig, sim.colour.black_level);
+  for (std::size_t j = 0; j < 3; ++j) EXPECT_NEAR(r.projector.gamma[j], sim.colour.gamma[j], 0.02 * sim.colour.gamma[j]) << j;
+  EXPECT_LT((r.projector.mixing - sim.colour.mixing).cwiseAbs().maxCoeff(), 0.02) << r.projector.mixing;
+  EXPECT_NEAR(r.camera_gamma, 1.8, 0.02);
+  EXPECT_EQ(r.captures, 6 + 2 + 3 * 8);
+  struct Stuck final : projbot::calibrate::PhotometricRig {
+    Eigen::Vector3d show_and_measure(const Eigen::Vector3d&, double) override { return Eigen::Vector3d::Constant(128.0); }
+  } stuck;
+  try {
+    projbot::calibrate::calibrate_photometric(stuck, 0.0);
+    ADD_FAILURE() << "a camera that ignores its exposure was fitted";
+  } catch (const projbot::calibrate::CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("do not follow its exposure"), std::string::npos) << e.what();
+  }
 }

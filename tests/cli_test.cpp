@@ -982,6 +982,33 @@ TEST_F(CliTest, CalibrateSimulateThenSolveFeedsAScene) {
   EXPECT_EQ(run_projbot("calibrate simulate --out " + cap.string()).code, 1);  // not empty
 }
 
+// calibrate photometric --sim (issue 43): the twin's projector response and mixing recovered within the
+// issue's goals (gamma 2 %, mixing 0.02 per entry), written as a calibration carries it; without --sim
+// it says the real session is not there yet.
+TEST_F(CliTest, CalibratePhotometricRecoversTheTwinsResponse) {
+  const fs::path out = dir_ / "photo.yaml";
+  CliRun r = run_projbot("calibrate photometric --sim --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  double gamma_pct = 99.0, mixing = 99.0;
+  const std::size_t at = r.output.find("against the twin's truth: gamma within ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + at, "against the twin's truth: gamma within %lf %% (worst channel), mixing within %lf",
+                        &gamma_pct, &mixing),
+            2)
+      << r.output;
+  EXPECT_LT(gamma_pct, 2.0) << r.output;
+  EXPECT_LT(mixing, 0.02) << r.output;
+  std::ifstream in(out);
+  std::ostringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("photometry:\n  gamma: 2."), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("  mixing: [0.9"), std::string::npos) << text.str();
+  r = run_projbot("calibrate photometric --out " + (dir_ / "real.yaml").string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("not available yet: give --sim"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "real.yaml"));
+}
+
 // tour --calibration: the session projects with the calibration's A_p while the twin's light keeps the
 // scene's. The truth as a calibration changes nothing; a principal point 5 px off (at fx 1400 and about
 // 1.5 m, some 5 mm) shows at the markers.

@@ -428,6 +428,25 @@ TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
     return "";
   };
   const std::string good_pose = "projector_from_camera: {translation: [0, 0, 0]}\n";
+  // Issue 43: a calibration may carry `photometry:` (calibrate photometric's file, pasted in): its gamma and
+  // black level replace the scene's, which may then not give them too; its mixing is checked.
+  const std::string intrinsics = "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512, cy: 384}\n";
+  const std::string photometry =
+      "photometry: {gamma: 2.31, gamma_rgb: [2.3, 2.31, 2.32], black_level: 0.001, mixing: [0.94, 0.05, 0.01, 0.04, 0.92, "
+      "0.04, 0.01, 0.06, 0.93], camera_gamma: 2.2}\n";
+  EXPECT_EQ(error("calibration: calib2.yaml\n", intrinsics + good_pose + photometry), "");
+  const auto measured = projbot::config::load_scene(dir / "scene2.yaml");
+  EXPECT_DOUBLE_EQ(measured.projector.photometry.gamma, 2.31);
+  EXPECT_DOUBLE_EQ(measured.projector.photometry.black_level, 0.001);
+  EXPECT_DOUBLE_EQ(measured.projector.photometry.brightness_lm, 3000.0);  // not measured: the default
+  EXPECT_NE(error("calibration: calib2.yaml\nprojector: {gamma: 2.2}\n", intrinsics + good_pose + photometry)
+                .find("projector.gamma is the calibration's photometry; leave it out of the scene"),
+            std::string::npos);
+  EXPECT_NE(error("calibration: calib2.yaml\n", intrinsics + good_pose + "photometry: {mixing: [1, 0, 0]}\n")
+                .find("photometry.mixing: expected a list of 9 numbers"),
+            std::string::npos);
+  EXPECT_NE(error("calibration: calib2.yaml\n", intrinsics + good_pose + "photometry: {gamma: 9}\n").find("photometry.gamma"),
+            std::string::npos);
   // The projector's lens comes with the calibration (the renderer pre-distorts by it); OpenCV's rational
   // terms k4..k6 are accepted only as zeros, and a lens that folds the image over is refused.
   EXPECT_EQ(error("calibration: calib2.yaml\n",

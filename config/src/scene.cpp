@@ -279,6 +279,24 @@ PanTiltConfig read_robot(MapReader& root, Scene& scene) {
   return c;
 }
 
+// A calibration's `photometry:` (projbot calibrate photometric): gamma, black_level and brightness_lm as a
+// scene's projector gives them, and what the renderer does not use yet, checked.
+Photometry read_calibrated_photometry(const MapReader& r, const YAML::Node& node) {
+  MapReader m(node, "photometry", r.file());
+  Photometry p;
+  read_photometry(m, node, p);
+  if (YAML::Node g = m.child("gamma_rgb", false))
+    for (const double v : m.numbers(g, "photometry.gamma_rgb", 3))
+      if (!(v >= 1.0 && v <= 4.0)) m.fail(g, "photometry.gamma_rgb", "each must be 1..4");
+  if (YAML::Node x = m.child("mixing", false))
+    for (const double v : m.numbers(x, "photometry.mixing", 9))
+      if (!(v >= -0.5 && v <= 1.5)) m.fail(x, "photometry.mixing", "entries must be -0.5..1.5 (shares of each channel's light)");
+  const double camera_gamma = m.get<double>("camera_gamma", 2.2);
+  if (!(camera_gamma >= 0.5 && camera_gamma <= 5.0)) m.fail(node["camera_gamma"], "photometry.camera_gamma", "must be 0.5..5");
+  m.reject_unknown();
+  return p;
+}
+
 // `calibration: calib.yaml` (issue 13's output): the projector's intrinsics A_p and the camera-to-projector
 // extrinsics R_cp, T_cp as a calibration measured them; they replace the scene's own.
 void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::path& base) {
@@ -301,8 +319,14 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
   std::ifstream probe(path, std::ios::binary);
   if (!probe) root.fail(node, "calibration", "cannot open '" + path.string() + "'");
   const ProjectorCalibration c = load_calibration(path);
+  if (c.photometry)
+    for (const char* key : {"gamma", "black_level", "brightness_lm"})
+      if (root.has("projector") && root.child("projector", false)[key])
+        root.fail(node, "calibration",
+                  std::string("projector.") + key + " is the calibration's photometry; leave it out of the scene");
   static_cast<Pinhole&>(scene.projector) = c.projector;
   scene.projector.distortion = c.distortion;
+  if (c.photometry) scene.projector.photometry = *c.photometry;
   scene.pan_tilt.T_projector_camera = c.T_projector_camera;
 }
 
@@ -353,6 +377,7 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
     m.get<double>("projector", 0.0);
     m.reject_unknown();
   }
+  if (YAML::Node ph = r.child("photometry", false)) out.photometry = read_calibrated_photometry(r, ph);
   // What `projbot calibrate solve` also reports: the colour camera's own lens (the depth camera is the
   // scene's `camera:`), the projector area covered, the views and warnings. Informational here.
   for (const char* key : {"camera", "projector_coverage", "views", "warnings", "board_poses"}) r.child(key, false);

@@ -39,6 +39,7 @@ extern const Command kRecord;
 extern const Command kCalibrateSimulate;
 extern const Command kCalibrateSolve;
 extern const Command kCalibrateCapture;
+extern const Command kCalibratePhotometric;
 
 /// A planar pose from "x y phi" (metres, metres, radians; commas also separate). Throws a UsageError-like
 /// config error naming `what` (the option) when it is not three finite numbers.

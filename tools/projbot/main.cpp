@@ -40,7 +40,8 @@ const std::vector<const Command*>& commands() {
                                                &projbot::tools::kRecord,
                                                &projbot::tools::kCalibrateSimulate,
                                                &projbot::tools::kCalibrateSolve,
-                                               &projbot::tools::kCalibrateCapture};
+                                               &projbot::tools::kCalibrateCapture,
+                                               &projbot::tools::kCalibratePhotometric};
   return all;
 }
 
@@ -116,9 +117,9 @@ static int dispatch(int argc, char** argv, std::string& name) {
   }
   if (name == "calibrate") {  // "calibrate capture", "simulate", "solve": the projector-camera calibration's steps
     const std::string what = argc < 3 ? std::string() : argv[2];
-    if (what != "capture" && what != "simulate" && what != "solve") {
+    if (what != "capture" && what != "simulate" && what != "solve" && what != "photometric") {
       std::cerr << "projbot calibrate: " << (argc < 3 ? std::string("say which step") : "no step '" + what + "'")
-                << ": projbot calibrate capture | simulate | solve\n";
+                << ": projbot calibrate capture | simulate | solve | photometric\n";
       return 2;
     }
     name = "calibrate " + what;

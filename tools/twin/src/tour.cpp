@@ -441,6 +441,7 @@ ProjectorModels projector_models(const config::Scene& scene, const TourOptions& 
   if (options.calibration) {
     static_cast<config::Pinhole&>(models.believed) = options.calibration->projector;
     models.believed.distortion = options.calibration->distortion;
+    if (options.calibration->photometry) models.believed.photometry = *options.calibration->photometry;
     models.T_projector_camera = options.calibration->T_projector_camera;
   }
   return models;

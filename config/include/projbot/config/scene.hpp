@@ -180,6 +180,9 @@ struct ProjectorCalibration {
   Pinhole projector;
   Distortion distortion{};  ///< the projector's lens, k1 k2 p1 p2 k3
   Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();
+  /// `photometry:` (projbot calibrate photometric): gamma and black_level (brightness_lm when given) replace
+  /// the scene's; the per-channel gammas, mixing and camera gamma are read and checked, not yet drawn by.
+  std::optional<Photometry> photometry;
 };
 /// Reads and validates one (a scene's `calibration:` reads it so). Throws ConfigError naming file:line.
 ProjectorCalibration load_calibration(const std::filesystem::path& path);

@@ -1,0 +1,69 @@
+#pragma once
+// Photometric calibration (issue 43): the projector's response per channel and its colour mixing, from
+// uniform colours it shows on a light surface and the colour camera's images of them. The camera's own
+// response comes first, from exposure brackets of the projector's white, so that its values can be
+// linearised. Black level and the room's light cannot be told apart with the projector on: the scene's
+// black_level stays.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "projbot/config/scene.hpp"
+
+namespace projbot::calibrate {
+
+/// A projector's colour as the camera sees it: per channel c in 0..1 gives black + (1 - black) c^gamma of
+/// that channel's full light, and `mixing` spreads channel j's light over the camera's R, G, B (column j;
+/// rows sum to 1, so white is white). The twin's default has a DLP's few percent of crosstalk.
+struct ProjectorColour {
+  std::array<double, 3> gamma{2.2, 2.2, 2.2};
+  double black_level = 0.0005;
+  Eigen::Matrix3d mixing = Eigen::Matrix3d::Identity();
+};
+
+/// What a photometric session drives: the projector showing one colour over its whole image, and the
+/// colour camera's mean R, G, B (8-bit levels, 0..255) over the patch of surface it lights, at an exposure
+/// relative to the session's first.
+class PhotometricRig {
+ public:
+  virtual ~PhotometricRig() = default;
+  virtual Eigen::Vector3d show_and_measure(const Eigen::Vector3d& input, double exposure) = 0;
+};
+
+struct PhotometricResult {
+  ProjectorColour projector;  ///< gamma per channel and mixing measured; black_level as given
+  double camera_gamma = 0.0;  ///< the camera's response: value = 255 (exposure x light)^(1 / camera_gamma)
+  int captures = 0;
+};
+
+/// The session: white at six exposures (the camera's response), black, white and each primary, and an
+/// eight-step ramp per channel. `black_level`: the projector's, from its scene (not measurable here).
+/// Throws CalibrationError when the captures cannot be fitted (saturated, too dark, not monotonic).
+PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level);
+
+/// The twin's rig: a light grey patch (reflectance 0.8) facing the projector 1.5 m away, lit by the
+/// room's `ambient_lux` and the projector (its lumens, `colour`), seen by an 8-bit camera whose response
+/// is x^(1 / camera_gamma), exposed so that white fills 90 % of its range, with Gaussian noise of
+/// `noise_levels` per pixel over a 32 x 32 patch.
+struct PhotometricSim {
+  config::ProjectorConfig projector;
+  ProjectorColour colour;
+  double ambient_lux = 20.0;
+  double camera_gamma = 2.2;
+  double noise_levels = 2.0;
+  std::uint64_t seed = 1;
+};
+std::unique_ptr<PhotometricRig> make_twin_photometric_rig(const PhotometricSim& sim);
+/// The crosstalk of a typical DLP's colour wheel, the twin's truth: a few percent of each channel's light
+/// in its neighbours.
+Eigen::Matrix3d typical_mixing();
+
+/// Writes `photometry:` (gamma, the per-channel gammas, black_level, mixing, the camera's gamma) as a
+/// calibration file carries it, atomically.
+void write_photometric(const PhotometricResult& r, const std::filesystem::path& path, const std::string& comment);
+
+}  // namespace projbot::calibrate
