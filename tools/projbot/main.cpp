@@ -53,7 +53,7 @@ void print_help() {
                "       projbot --version\n\nCommands:\n";
   for (const auto* c : commands()) {
     std::string name = "  " + c->name;
-    name.resize(std::max<std::size_t>(22, name.size() + 2), ' ');
+    name.resize(std::max<std::size_t>(25, name.size() + 2), ' ');  // the longest, "calibrate photometric", and two
     std::cout << name << c->summary << '\n';
   }
   std::cout
