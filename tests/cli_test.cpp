@@ -730,6 +730,22 @@ TEST_F(CliTest, BenchAppearanceScoresCompensationOffAndOn) {
   EXPECT_TRUE(fs::exists(dir_ / "frames" / "visit01_figure_spectator_on.png"));
 }
 
+// bench appearance --reflectance measured (issue 43): the figure's beige measured at its stop from the
+// colour camera under the projector's black and grey, within 3 % of the scene's (the twin's truth).
+TEST_F(CliTest, BenchAppearanceMeasuresTheFiguresReflectance) {
+  const CliRun r = run_projbot("bench appearance --visits 1 --dwell 0.2 --reflectance measured");
+  ASSERT_EQ(r.code, 0) << r.output;
+  double m[3] = {0, 0, 0}, t[3] = {0, 0, 0};
+  const std::size_t at = r.output.find("visit 1 figure: reflectance measured ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + at, "visit 1 figure: reflectance measured %lf %lf %lf, the scene's %lf %lf %lf", &m[0],
+                        &m[1], &m[2], &t[0], &t[1], &t[2]),
+            6)
+      << r.output;
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(m[ch], t[ch], 0.03 * t[ch]) << "channel " << ch << "\n" << r.output;
+  EXPECT_DOUBLE_EQ(t[0], 0.72);  // the shop's beige
+}
+
 // tour --compensation (issue 43, default on): the shop's figure is beige, so the compensated frame sends
 // it more blue than red to show its grey content grey; off, the content goes out as stored.
 TEST_F(CliTest, TourCompensatesTheFiguresBeigeUnlessTurnedOff) {

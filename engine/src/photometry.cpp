@@ -139,6 +139,83 @@ double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vecto
   return std::min(k, 1.0);  // never brighter than the content under the reference light
 }
 
+namespace {
+
+// Points spread over a triangle (the middles of an m x m subdivision), m from its size in the camera's
+// image: about one point per 4 x 4 pixels, at most 256.
+std::vector<Eigen::Vector3d> spread_over(const Eigen::Vector3d (&x)[3], const config::ProjectorConfig& camera,
+                                         const Eigen::Matrix4d& T_camera_target) {
+  Eigen::Vector2d px[3];
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d q = T_camera_target.topLeftCorner<3, 3>() * x[k] + T_camera_target.topRightCorner<3, 1>();
+    px[k] = q.z() > 0.1 ? camera.project(q) : Eigen::Vector2d::Zero();
+  }
+  const Eigen::Vector2d a = px[1] - px[0], b = px[2] - px[0];
+  const double area_px = 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
+  const int m = std::clamp(static_cast<int>(std::ceil(std::sqrt(area_px / 8.0))), 1, 16);
+  std::vector<Eigen::Vector3d> out;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; i + j < m; ++j) {
+      const double u = (i + 1.0 / 3.0) / m, v = (j + 1.0 / 3.0) / m;
+      out.push_back(x[0] + u * (x[1] - x[0]) + v * (x[2] - x[0]));
+    }
+  return out;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::ProjectorConfig& camera,
+                                              const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
+                                              const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
+                                              const assets::Image& under_grey, double grey) {
+  if (under_black.width != camera.width_px || under_black.height != camera.height_px || under_grey.width != camera.width_px ||
+      under_grey.height != camera.height_px || !(grey > 0.0 && grey <= 1.0))
+    return std::nullopt;
+  const double added =
+      (drive(projector.photometry, Eigen::Vector3d::Constant(grey)) - drive(projector.photometry, Eigen::Vector3d::Zero()))[0];
+  std::array<std::vector<double>, 3> ratios;
+  const Eigen::Matrix3d Rc = T_camera_target.topLeftCorner<3, 3>(), Rp = T_projector_target.topLeftCorner<3, 3>();
+  for (const assets::Primitive& prim : model.primitives)
+    for (std::size_t f = 0; f + 2 < prim.indices.size(); f += 3) {
+      Eigen::Vector3d x[3];
+      for (int k = 0; k < 3; ++k) {
+        const auto& p = prim.vertices.at(prim.indices[f + static_cast<std::size_t>(k)]).position;
+        x[k] = Eigen::Vector3d(p[0], p[1], p[2]);
+      }
+      const Eigen::Vector3d n = (x[1] - x[0]).cross(x[2] - x[0]).normalized();
+      const Eigen::Vector3d nc = Rc * n, np = Rp * n;
+      for (const Eigen::Vector3d& point : spread_over(x, camera, T_camera_target)) {
+        const Eigen::Vector3d qc = Rc * point + T_camera_target.topRightCorner<3, 1>();
+        const Eigen::Vector3d qp = Rp * point + T_projector_target.topRightCorner<3, 1>();
+        if (!n.allFinite() || !(qc.z() > 0.1) || !(qp.z() > 0.1) || nc.dot(qc) >= 0.0) break;  // hidden from the camera
+        if (np.dot(qp) >= 0.0 || -np.dot(qp.normalized()) < 0.5) break;                        // away from the light, or grazing
+        const Eigen::Vector2d px = camera.project(qc);
+        const long u = std::lround(px.x()), v = std::lround(px.y());
+        if (u < 1 || v < 1 || u >= camera.width_px - 1 || v >= camera.height_px - 1) continue;
+        const double lux = white_lux(projector, qp, np) * added;
+        const std::uint8_t* b = under_black.pixel(static_cast<int>(u), static_cast<int>(v));
+        const std::uint8_t* g = under_grey.pixel(static_cast<int>(u), static_cast<int>(v));
+        for (int ch = 0; ch < 3; ++ch) {
+          const double lifted = srgb_to_linear(g[ch] / 255.0) - srgb_to_linear(b[ch] / 255.0);
+          if (g[ch] < 250) ratios[static_cast<std::size_t>(ch)].push_back(lifted * kReferenceLux / lux);  // not saturated
+        }
+      }
+    }
+  Eigen::Vector3d albedo;
+  for (int ch = 0; ch < 3; ++ch) {
+    std::vector<double>& r = ratios[static_cast<std::size_t>(ch)];
+    if (r.size() < 20) return std::nullopt;
+    std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+    albedo[ch] = std::clamp(r[r.size() / 2], 0.0, 1.0);
+  }
+  return albedo;
+}
+
+void CompensationPlan::set_albedo(std::size_t target, const Eigen::Vector3d& albedo) {
+  targets_.at(target).albedo = albedo;
+  chosen_.at(target).made = false;
+}
+
 CompensationPlan::CompensationPlan(std::vector<Target> targets, double ambient_lux, bool on)
     : targets_(std::move(targets)), chosen_(targets_.size()), ambient_lux_(ambient_lux), on_(on) {}
 

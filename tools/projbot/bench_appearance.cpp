@@ -36,6 +36,18 @@ void print_table(const twin::TourReport& report) {
     }
 }
 
+// --reflectance measured: each visit's measurement beside the scene's surface (the twin's truth).
+void print_albedo(const twin::TourReport& report, const config::Scene& scene) {
+  for (const auto& v : report.visits) {
+    if (!v.measured_albedo) continue;
+    const Eigen::Vector3d& truth = scene.targets[static_cast<std::size_t>(scene.target_index(v.target))].surface.albedo;
+    const Eigen::Vector3d& m = *v.measured_albedo;
+    std::printf("visit %d %s: reflectance measured %.3f %.3f %.3f, the scene's %.3f %.3f %.3f (worst channel %+.1f %%)\n",
+                v.visit, v.target.c_str(), m.x(), m.y(), m.z(), truth.x(), truth.y(), truth.z(),
+                100.0 * (m.cwiseQuotient(truth) - Eigen::Vector3d::Ones()).cwiseAbs().maxCoeff());
+  }
+}
+
 void write_report(const std::filesystem::path& file, const twin::TourReport& report) {
   nlohmann::json out = {{"visits", nlohmann::json::array()}, {"interrupted", report.interrupted}};
   for (const auto& v : report.visits)
@@ -44,19 +56,23 @@ void write_report(const std::filesystem::path& file, const twin::TourReport& rep
       const auto number = [&](double x) {
         return s.pixels > 0 && std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
       };
-      out["visits"].push_back({{"visit", v.visit},
-                               {"target", v.target},
-                               {"compensation", a.compensation ? "on" : "off"},
-                               {"moving", a.moving},
-                               {"gain", a.gain},
-                               {"pixels", s.pixels},
-                               {"psnr_db", number(s.psnr_db)},
-                               {"ssim", number(s.ssim)},
-                               {"de2000_median", number(s.de2000_median)},
-                               {"de2000_p95", number(s.de2000_p95)},
-                               {"clipped_share", number(s.clipped_share)},
-                               {"unreachable_share", number(s.unreachable_share)},
-                               {"ms_per_frame", a.ms_per_frame}});
+      out["visits"].push_back(
+          {{"visit", v.visit},
+           {"target", v.target},
+           {"compensation", a.compensation ? "on" : "off"},
+           {"moving", a.moving},
+           {"gain", a.gain},
+           {"pixels", s.pixels},
+           {"psnr_db", number(s.psnr_db)},
+           {"ssim", number(s.ssim)},
+           {"de2000_median", number(s.de2000_median)},
+           {"de2000_p95", number(s.de2000_p95)},
+           {"clipped_share", number(s.clipped_share)},
+           {"unreachable_share", number(s.unreachable_share)},
+           {"ms_per_frame", a.ms_per_frame},
+           {"albedo_measured", v.measured_albedo
+                                   ? nlohmann::json({v.measured_albedo->x(), v.measured_albedo->y(), v.measured_albedo->z()})
+                                   : nlohmann::json(nullptr)}});
     }
   config::write_file_atomically(file, out.dump(1) + "\n");
 }
@@ -79,12 +95,16 @@ const Command kBenchAppearance{
     "unreachable: darker than the room's light allows, or brighter than full white). ms per frame: drawing\n"
     "the projector's frame and reading it back on this machine. Without --scene, assets/scenes/shop.yaml\n"
     "runs. With --frames, DIR/visitNN_TARGET_spectator_off.png and _spectator_on.png at each arrival.\n"
+    "With --reflectance measured, each target's reflectance is measured at its stop (the colour camera under\n"
+    "the projector's black and mid grey, read at the estimated pose) instead of taken from the scene, and\n"
+    "printed beside the scene's (the twin's truth).\n"
     "Ctrl-C prints and reports the visits finished so far.\n",
     {{"scene", "FILE", "scene with a tour (default: assets/scenes/shop.yaml)", cli::PathRole::input_file},
      {"visits", "N", "visits, cycling through the scene's list (default: the list once)"},
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
      {"dwell", "S", "simulated seconds of projection per visit (default 3)"},
      {"frames", "DIR", "write each visit's pictures here", cli::PathRole::output_folder},
+     {"reflectance", "scene|measured", "each target's reflectance: the scene's surface (default) or measured at its stop"},
      {"report", "FILE", "JSON report, one row per visit and compensation", cli::PathRole::output_file}},
     [](const cli::Args& args) {
       twin::TourOptions o;
@@ -95,6 +115,10 @@ const Command kBenchAppearance{
       o.dwell_s = args.get_double("dwell", 3.0);
       if (!(o.dwell_s >= 0.1 && o.dwell_s <= 600.0)) throw cli::UsageError("--dwell must be 0.1..600 seconds");
       if (const auto frames = args.get("frames")) o.frames_dir = *frames;
+      const std::string reflectance = args.get_or("reflectance", "scene");
+      if (reflectance != "scene" && reflectance != "measured")
+        throw cli::UsageError("--reflectance must be scene or measured, not '" + reflectance + "'");
+      o.measure_reflectance = reflectance == "measured";
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
       catch_interrupts();
       o.stop_requested = [] { return interrupted(); };
@@ -103,6 +127,7 @@ const Command kBenchAppearance{
       o.on_visit = [&](const twin::VisitReport& v) { progress.step(v.visit); };
       const twin::TourReport report = twin::run_tour(scene, o);
       print_table(report);
+      print_albedo(report, scene);
       std::printf("\nroom %.0f lux; projector %.0f lm, gamma %.2f, black %.4f; tour in %.1f s\n", scene.room.ambient_lux,
                   scene.projector.photometry.brightness_lm, scene.projector.photometry.gamma,
                   scene.projector.photometry.black_level, report.wall_s);

@@ -35,17 +35,30 @@ Eigen::Matrix4d spectator_pose(const Eigen::Vector3d& head, const Eigen::Vector3
   return look_at(eye, target_middle);
 }
 
+namespace {
+
+config::ProjectorConfig spectator_eye() {
+  config::ProjectorConfig eye;
+  eye.width_px = SpectatorView::kWidth;
+  eye.height_px = SpectatorView::kHeight;
+  eye.fx_px = eye.fy_px = 660.0;
+  eye.cx_px = (SpectatorView::kWidth - 1) / 2.0;
+  eye.cy_px = (SpectatorView::kHeight - 1) / 2.0;
+  eye.near_m = 0.1;
+  eye.far_m = 20.0;
+  return eye;
+}
+
+}  // namespace
+
 SpectatorView::SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector)
-    : renderer_(renderer), projector_(projector) {
-  pinhole_.width_px = kWidth;
-  pinhole_.height_px = kHeight;
-  pinhole_.fx_px = pinhole_.fy_px = 660.0;
-  pinhole_.cx_px = (kWidth - 1) / 2.0;
-  pinhole_.cy_px = (kHeight - 1) / 2.0;
-  pinhole_.near_m = 0.1;
-  pinhole_.far_m = 20.0;
-  colour_ = renderer_.make_offscreen(kWidth, kHeight);
-  depth_ = renderer_.make_depth_camera(kWidth, kHeight);
+    : SpectatorView(renderer, projector, spectator_eye()) {}
+
+SpectatorView::SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector,
+                             const config::ProjectorConfig& eye)
+    : renderer_(renderer), projector_(projector), pinhole_(eye) {
+  colour_ = renderer_.make_offscreen(pinhole_.width_px, pinhole_.height_px);
+  depth_ = renderer_.make_depth_camera(pinhole_.width_px, pinhole_.height_px);
   projector_depth_ = renderer_.make_depth_camera(projector_.width_px, projector_.height_px);
 }
 
@@ -111,7 +124,8 @@ SpectatorPicture SpectatorView::see(Twin& twin, const Eigen::Matrix4d& T_world_s
   SpectatorPicture out;
   out.albedo = colour_->read_back();
   out.image = out.albedo;
-  out.white_lux.assign(static_cast<std::size_t>(kWidth) * kHeight, 0.0F);
+  const int width = pinhole_.width_px, height = pinhole_.height_px;
+  out.white_lux.assign(static_cast<std::size_t>(width) * height, 0.0F);
   renderer_.draw_frame(*depth_, pinhole_, room);
   const engine::DepthMap depth = depth_->read_back_depth();
   out.z_m = depth.z_m;
@@ -122,9 +136,9 @@ SpectatorPicture SpectatorView::see(Twin& twin, const Eigen::Matrix4d& T_world_s
   const Eigen::Matrix3d R = T_projector_spectator.topLeftCorner<3, 3>();
   const config::ProjectorConfig& k = projector_;
   const double ambient = twin.scene().room.ambient_lux;
-  for (int v = 0; v < kHeight; ++v)
-    for (int u = 0; u < kWidth; ++u) {
-      const std::size_t i = static_cast<std::size_t>(v) * kWidth + u;
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * width + u;
       const float z = depth.z_m[i];
       Eigen::Vector3d lux = Eigen::Vector3d::Constant(ambient);
       if (z > 0.0F) {

@@ -493,7 +493,8 @@ struct Tour {
   std::vector<alignment::PoseTracker*> by_scene;          // the trackers by scene index, for Session::visit
   std::unique_ptr<engine::RenderTarget> projector_frame;  // with --frames or appearance
   std::unique_ptr<SpectatorView> spectator;
-  engine::CompensationPlan plan;  // by index into Twin::targets()
+  std::unique_ptr<SpectatorView> colour_camera;  // the RGB-D camera's colour under the projector's light
+  engine::CompensationPlan plan;                 // by index into Twin::targets()
 };
 
 Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Twin& t)
@@ -518,6 +519,8 @@ Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Tw
     projector_frame = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
     spectator = std::make_unique<SpectatorView>(renderer, scene.projector);
   }
+  if (options.measure_reflectance)
+    colour_camera = std::make_unique<SpectatorView>(renderer, scene.projector, twin.camera_pinhole());
 }
 
 // One visit of the tour as the session runs it (session::Session::visit, in lockstep). On the stop's
@@ -546,6 +549,7 @@ class TourStop final : public session::StopObserver {
   // compensate: the plan's compensation (TourOptions::compensation unless said otherwise).
   assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate = {});
   void measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target);
+  void measure_reflectance();
   assets::Image spectator_picture(const assets::Image& projector);
   void write_pictures(const assets::Image& colour);
   void project(double start_s);
@@ -642,6 +646,7 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
   for (std::size_t k = 1; k < at.lit.size(); ++k)
     lights_.push_back(neighbour_light(tour_.twin, tour_.trackers[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, tour_.models));
   if (!tour_.options.frames_dir.empty()) write_pictures(f.colour);
+  if (tour_.options.measure_reflectance && report.projected) measure_reflectance();
   if (tour_.options.appearance) measure_appearance(false, report.projected, report.T_projector_target_estimated);
 
   dwell_.emplace(DwellContext{tour_.twin, target_index_, tour_.models, truth_, tour_.options, lights_});
@@ -679,6 +684,25 @@ assets::Image TourStop::spectator_picture(const assets::Image& projector) {
   const Eigen::Matrix4d T_world_spectator =
       spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
   return tour_.spectator->draw(tour_.twin, T_world_spectator, truth_.T_world_projector.matrix(), projector);
+}
+
+// The visited target's reflectance: the colour camera's pictures under the projector's black and mid grey
+// (the twin's light), read at the estimated pose; the compensation takes it from now on.
+void TourStop::measure_reflectance() {
+  constexpr std::uint8_t kGrey = 128;
+  const config::ProjectorConfig& p = tour_.scene.projector;
+  assets::Image frame;
+  frame.width = p.width_px, frame.height = p.height_px;
+  frame.rgba.assign(static_cast<std::size_t>(p.width_px) * p.height_px * 4, 0);
+  const Eigen::Matrix4d T_world_camera = truth_.T_world_camera.matrix(), T_world_projector = truth_.T_world_projector.matrix();
+  const assets::Image black = tour_.colour_camera->see(tour_.twin, T_world_camera, T_world_projector, frame).image;
+  std::fill(frame.rgba.begin(), frame.rgba.end(), kGrey);
+  const assets::Image grey = tour_.colour_camera->see(tour_.twin, T_world_camera, T_world_projector, frame).image;
+  const TwinTarget& target = tour_.twin.targets()[target_index_];
+  report.measured_albedo =
+      engine::measure_albedo(target.model, tour_.twin.camera_pinhole(), report.icp.T_scan_model, tour_.models.believed,
+                             report.T_projector_target_estimated, black, grey, kGrey / 255.0);
+  if (report.measured_albedo) tour_.plan.set_albedo(target_index_, *report.measured_albedo);
 }
 
 // What a visitor sees of the visited target drawn at T_projector_target, compensation off and on, against

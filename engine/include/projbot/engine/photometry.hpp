@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "projbot/assets/model.hpp"
@@ -67,6 +68,18 @@ std::vector<SurfaceSample> surface_samples(const assets::Model& model, const con
 double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vector3d& albedo, double ambient_lux,
                    double clip_share = 0.02);
 
+/// A target's reflectance per channel, measured at a stop (issue 43): the colour camera's images of it
+/// under the projector's black and its uniform `grey` input (sRGB, registered to `camera`; a
+/// radiometrically calibrated camera, on which a white surface under kReferenceLux reads 1) and its
+/// estimated pose in the camera's and the projector's frames. Points spread over each triangle that faces
+/// both, lit less than 60 degrees off its normal (about one per 4 x 4 camera pixels), give (grey - black)
+/// kReferenceLux / ((drive(grey) - drive(0)) white_lux) at their pixels (the room's light cancels); the
+/// median over them per channel. Empty when fewer than 20 points can be read unsaturated.
+std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::ProjectorConfig& camera,
+                                              const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
+                                              const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
+                                              const assets::Image& under_grey, double grey);
+
 /// The compensation of each target a session draws (issue 43): a target's gain is chosen the first time it
 /// is drawn in a visit, from its surface at that pose, and kept until the visit changes, so a target that
 /// moves or is tracked does not flicker. Off: every target's content as stored. One thread (the render
@@ -82,6 +95,9 @@ class CompensationPlan {
   /// T_projector_target through `projector`.
   Compensation at(std::size_t target, long visit, const config::ProjectorConfig& projector,
                   const Eigen::Matrix4d& T_projector_target);
+  /// A target's reflectance measured at its stop (measure_albedo) replaces the scene's from now on; its
+  /// gain is chosen again.
+  void set_albedo(std::size_t target, const Eigen::Vector3d& albedo);
   /// The gain chosen for `target` in its latest visit; 1 before any.
   double gain(std::size_t target) const { return chosen_.at(target).gain; }
   bool on() const { return on_; }

@@ -57,6 +57,10 @@ struct TourOptions {
   /// Issue 43: the projector's frames compensate each target's surface (`surface:`) and the room's light;
   /// false sends the content as stored.
   bool compensation = true;
+  /// Issue 43: at each arrival the visited target's reflectance is measured (the colour camera under the
+  /// projector's black and grey, engine::measure_albedo at the estimated pose) and replaces the scene's
+  /// `surface:` in the compensation from then on. False: the scene's is taken as known.
+  bool measure_reflectance = false;
   /// Issue 43: at each arrival (and once in the middle of a scripted motion) the visited target's frame is
   /// drawn with compensation off and on, and what a visitor sees of it scored (VisitReport::appearance).
   bool appearance = false;
@@ -145,8 +149,9 @@ struct VisitReport {
   /// motion.removed: seconds from the first depth frame without the target to the first blank
   /// projector frame; -1 when it was never blanked (or nothing was removed).
   double blank_after_removal_s = -1.0;
-  std::vector<NeighbourReport> neighbours;   ///< other targets in view at this stop, nearest first
-  std::vector<AppearanceSample> appearance;  ///< TourOptions::appearance: off and on at arrival, and while moving
+  std::vector<NeighbourReport> neighbours;         ///< other targets in view at this stop, nearest first
+  std::vector<AppearanceSample> appearance;        ///< TourOptions::appearance: off and on at arrival, and while moving
+  std::optional<Eigen::Vector3d> measured_albedo;  ///< TourOptions::measure_reflectance: what this visit measured
 };
 
 struct TourReport {
