@@ -172,3 +172,31 @@ TEST(Photometry, ThePlanKeepsTheGainThroughAVisit) {
 }
 
 }  // namespace
+
+namespace {
+
+// measure_albedo refuses what it cannot read: pictures of another size than the camera, no grey, or a
+// target the camera does not see; bench appearance --reflectance measured checks it on the twin's shop.
+TEST(Photometry, MeasuringReflectanceNeedsPicturesItCanRead) {
+  const projbot::assets::Model box = projbot::assets::make_box({-0.2, -0.2, -0.2}, {0.2, 0.2, 0.2}, {1.0F, 1.0F, 1.0F, 1.0F});
+  ProjectorConfig camera;
+  camera.width_px = 64, camera.height_px = 48, camera.fx_px = camera.fy_px = 60.0, camera.cx_px = 31.5, camera.cy_px = 23.5;
+  projbot::assets::Image picture;
+  picture.width = 64, picture.height = 48;
+  picture.rgba.assign(64 * 48 * 4, 100);
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T(2, 3) = 2.0;
+  EXPECT_FALSE(engine::measure_albedo(box, camera, T, kProjector, T, picture, picture, 0.0));  // no grey
+  projbot::assets::Image small = picture;
+  small.width = 32;
+  EXPECT_FALSE(engine::measure_albedo(box, camera, T, kProjector, T, small, picture, 0.5));
+  Eigen::Matrix4d behind = T;
+  behind(2, 3) = -2.0;
+  EXPECT_FALSE(engine::measure_albedo(box, camera, behind, kProjector, behind, picture, picture, 0.5));
+  // Seen and lit: the same picture twice is no light added, a reflectance of 0.
+  const auto none = engine::measure_albedo(box, camera, T, kProjector, T, picture, picture, 0.5);
+  ASSERT_TRUE(none);
+  EXPECT_EQ(*none, Eigen::Vector3d::Zero());
+}
+
+}  // namespace
