@@ -167,6 +167,13 @@ TEST(Photometry, ThePlanKeepsTheGainThroughAVisit) {
   EXPECT_EQ(plan.at(0, 1, kProjector, far).scale_lux, first.scale_lux);  // the same visit: kept
   plan.at(0, 2, kProjector, far);
   EXPECT_LT(plan.gain(0), 0.5 * k_near);  // the next visit: chosen again, far away
+  // Measured reflectances replace the scene's, averaged over the visits that measured them.
+  plan.add_measured_albedo(0, Eigen::Vector3d(0.6, 0.4, 0.2));
+  EXPECT_EQ(plan.albedo(0), Eigen::Vector3d(0.6, 0.4, 0.2));
+  plan.add_measured_albedo(0, Eigen::Vector3d(0.7, 0.5, 0.3));
+  EXPECT_TRUE(plan.albedo(0).isApprox(Eigen::Vector3d(0.65, 0.45, 0.25), 1e-12)) << plan.albedo(0).transpose();
+  const engine::Compensation refined = plan.at(0, 2, kProjector, far);  // its gain chosen again for the new albedo
+  EXPECT_FLOAT_EQ(refined.scale_lux[0], static_cast<float>(plan.gain(0) * engine::kReferenceLux / 0.65));
   engine::CompensationPlan off({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5)}}, 20.0, false);
   EXPECT_FALSE(off.at(0, 1, kProjector, near).on);
 }

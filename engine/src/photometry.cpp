@@ -211,9 +211,12 @@ std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const 
   return albedo;
 }
 
-void CompensationPlan::set_albedo(std::size_t target, const Eigen::Vector3d& albedo) {
-  targets_.at(target).albedo = albedo;
-  chosen_.at(target).made = false;
+void CompensationPlan::add_measured_albedo(std::size_t target, const Eigen::Vector3d& albedo) {
+  Chosen& c = chosen_.at(target);
+  Eigen::Vector3d& mean = targets_.at(target).albedo;
+  mean = c.measurements == 0 ? albedo : Eigen::Vector3d((mean * c.measurements + albedo) / (c.measurements + 1));
+  ++c.measurements;
+  c.made = false;
 }
 
 CompensationPlan::CompensationPlan(std::vector<Target> targets, double ambient_lux, bool on)

@@ -147,4 +147,22 @@ AppearanceScore score_appearance(const SpectatorPicture& seen, const ContentView
   return s;
 }
 
+std::optional<Eigen::Vector3d> measured_reflectance(SpectatorView& camera, Twin& twin, std::size_t target,
+                                                    const Eigen::Matrix4d& T_world_camera,
+                                                    const Eigen::Matrix4d& T_world_projector,
+                                                    const Eigen::Matrix4d& T_camera_target,
+                                                    const config::ProjectorConfig& believed,
+                                                    const Eigen::Matrix4d& T_projector_target) {
+  constexpr std::uint8_t kGrey = 128;
+  const config::ProjectorConfig& p = twin.scene().projector;
+  assets::Image frame;
+  frame.width = p.width_px, frame.height = p.height_px;
+  frame.rgba.assign(static_cast<std::size_t>(p.width_px) * p.height_px * 4, 0);
+  const assets::Image black = camera.see(twin, T_world_camera, T_world_projector, frame).image;
+  std::fill(frame.rgba.begin(), frame.rgba.end(), kGrey);
+  const assets::Image grey = camera.see(twin, T_world_camera, T_world_projector, frame).image;
+  return engine::measure_albedo(twin.targets().at(target).model, twin.camera_pinhole(), T_camera_target, believed,
+                                T_projector_target, black, grey, kGrey / 255.0);
+}
+
 }  // namespace projbot::twin

@@ -686,23 +686,13 @@ assets::Image TourStop::spectator_picture(const assets::Image& projector) {
   return tour_.spectator->draw(tour_.twin, T_world_spectator, truth_.T_world_projector.matrix(), projector);
 }
 
-// The visited target's reflectance: the colour camera's pictures under the projector's black and mid grey
-// (the twin's light), read at the estimated pose; the compensation takes it from now on.
+// The visited target's reflectance, measured at its estimated pose; the compensation takes the mean of
+// its measurements so far from now on.
 void TourStop::measure_reflectance() {
-  constexpr std::uint8_t kGrey = 128;
-  const config::ProjectorConfig& p = tour_.scene.projector;
-  assets::Image frame;
-  frame.width = p.width_px, frame.height = p.height_px;
-  frame.rgba.assign(static_cast<std::size_t>(p.width_px) * p.height_px * 4, 0);
-  const Eigen::Matrix4d T_world_camera = truth_.T_world_camera.matrix(), T_world_projector = truth_.T_world_projector.matrix();
-  const assets::Image black = tour_.colour_camera->see(tour_.twin, T_world_camera, T_world_projector, frame).image;
-  std::fill(frame.rgba.begin(), frame.rgba.end(), kGrey);
-  const assets::Image grey = tour_.colour_camera->see(tour_.twin, T_world_camera, T_world_projector, frame).image;
-  const TwinTarget& target = tour_.twin.targets()[target_index_];
-  report.measured_albedo =
-      engine::measure_albedo(target.model, tour_.twin.camera_pinhole(), report.icp.T_scan_model, tour_.models.believed,
-                             report.T_projector_target_estimated, black, grey, kGrey / 255.0);
-  if (report.measured_albedo) tour_.plan.set_albedo(target_index_, *report.measured_albedo);
+  report.measured_albedo = measured_reflectance(*tour_.colour_camera, tour_.twin, target_index_, truth_.T_world_camera.matrix(),
+                                                truth_.T_world_projector.matrix(), report.icp.T_scan_model, tour_.models.believed,
+                                                report.T_projector_target_estimated);
+  if (report.measured_albedo) tour_.plan.add_measured_albedo(target_index_, *report.measured_albedo);
 }
 
 // What a visitor sees of the visited target drawn at T_projector_target, compensation off and on, against

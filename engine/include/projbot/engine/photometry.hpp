@@ -95,9 +95,10 @@ class CompensationPlan {
   /// T_projector_target through `projector`.
   Compensation at(std::size_t target, long visit, const config::ProjectorConfig& projector,
                   const Eigen::Matrix4d& T_projector_target);
-  /// A target's reflectance measured at its stop (measure_albedo) replaces the scene's from now on; its
-  /// gain is chosen again.
-  void set_albedo(std::size_t target, const Eigen::Vector3d& albedo);
+  /// A target's reflectance measured at a stop (measure_albedo): the mean of its measurements so far
+  /// replaces the scene's from now on (refined over visits); its gain is chosen again.
+  void add_measured_albedo(std::size_t target, const Eigen::Vector3d& albedo);
+  const Eigen::Vector3d& albedo(std::size_t target) const { return targets_.at(target).albedo; }
   /// The gain chosen for `target` in its latest visit; 1 before any.
   double gain(std::size_t target) const { return chosen_.at(target).gain; }
   bool on() const { return on_; }
@@ -107,6 +108,7 @@ class CompensationPlan {
     long visit = -1;
     double gain = 1.0;
     bool made = false;
+    int measurements = 0;  // add_measured_albedo's so far
   };
   std::vector<Target> targets_;
   std::vector<Chosen> chosen_;

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "projbot/assets/image.hpp"
@@ -32,5 +33,16 @@ struct AppearanceScore {
 /// tell which pixels any projector input could make right.
 AppearanceScore score_appearance(const SpectatorPicture& seen, const ContentView& view, double k, double ambient_lux,
                                  const config::Photometry& photometry);
+
+/// A target's reflectance as a session measures it at a stop (issue 43): the colour camera (`camera`, a
+/// SpectatorView through the RGB-D camera's pinhole) takes it under the projector's black and mid grey,
+/// lit by the twin from the true frames; engine::measure_albedo reads the pictures at the estimated poses
+/// (T_camera_target, and T_projector_target through the believed projector). Empty when it cannot.
+std::optional<Eigen::Vector3d> measured_reflectance(SpectatorView& camera, Twin& twin, std::size_t target,
+                                                    const Eigen::Matrix4d& T_world_camera,
+                                                    const Eigen::Matrix4d& T_world_projector,
+                                                    const Eigen::Matrix4d& T_camera_target,
+                                                    const config::ProjectorConfig& believed,
+                                                    const Eigen::Matrix4d& T_projector_target);
 
 }  // namespace projbot::twin
