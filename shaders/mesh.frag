@@ -10,6 +10,12 @@ layout(location = 2) in vec3 in_q;
 
 layout(set = 0, binding = 0) uniform sampler2D base_color_texture;
 
+// The projector's response, per frame (renderer.cpp's FrameUniform).
+layout(set = 1, binding = 0) uniform Frame {
+  vec4 unmix[3];  // rows of the mixing matrix's inverse: the channels' drives from the light wanted in R, G, B
+  vec4 response;  // xyz: 1 / each channel's gamma; w: the black level
+} frame;
+
 // glTF alphaMode, fixed per pipeline so OPAQUE and BLEND carry no discard (which would stop early depth
 // testing) and no per-fragment branch: 0 opaque, 1 mask, 2 blend.
 layout(constant_id = 0) const int kAlphaMode = 0;
@@ -18,7 +24,7 @@ layout(push_constant) uniform Draw {
   mat4 clip_from_model;
   vec4 base_color_factor;
   vec4 compensate;  // rgb: the lux content 1 needs (k kReferenceLux / albedo; 0: off); a: the room's lux
-  vec4 projector;   // x: full white's lux at 1 m facing the lens, y: gamma, z: black level, w: MASK alpha cutoff
+  vec4 projector;   // x: full white's lux at 1 m facing the lens, w: MASK alpha cutoff
   vec4 ray;         // see mesh.vert
 } draw;
 
@@ -39,12 +45,14 @@ float white_lux() {
 }
 
 // The input that adds what the surface lacks: the lux needed less the room's, as a share of full white
-// here, through the inverse response.
+// here, unmixed into the channels' drives, through the inverse response.
 vec3 compensated(vec3 c, float white) {
   vec3 needed = draw.compensate.rgb * srgb_to_linear(c) - draw.compensate.a;
-  vec3 d = white > 0.0 ? needed / white : mix(vec3(0.0), vec3(2.0), greaterThan(needed, vec3(0.0)));
-  vec3 x = (d - draw.projector.z) / (1.0 - draw.projector.z);
-  return pow(clamp(x, 0.0, 1.0), vec3(1.0 / draw.projector.y));
+  vec3 light = white > 0.0 ? needed / white : mix(vec3(0.0), vec3(2.0), greaterThan(needed, vec3(0.0)));
+  vec3 d = vec3(dot(frame.unmix[0].xyz, light), dot(frame.unmix[1].xyz, light), dot(frame.unmix[2].xyz, light));
+  float black = frame.response.w;
+  vec3 x = (d - black) / (1.0 - black);
+  return pow(clamp(x, 0.0, 1.0), frame.response.xyz);
 }
 
 void main() {

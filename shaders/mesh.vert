@@ -12,7 +12,7 @@ layout(push_constant) uniform Draw {
   mat4 clip_from_model;
   vec4 base_color_factor;
   vec4 compensate;  // rgb: the lux content 1 needs (0: off); a: the room's lux
-  vec4 projector;   // x: full white's lux at 1 m, y: gamma, z: black level, w: MASK alpha cutoff
+  vec4 projector;   // x: full white's lux at 1 m, w: MASK alpha cutoff
   vec4 ray;         // projector-frame x = clip.x ray.x + clip.w ray.y, y = clip.y ray.z + clip.w ray.w, z = clip.w
 } draw;
 

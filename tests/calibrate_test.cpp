@@ -376,15 +376,16 @@ TEST(Capture, RefusesABadPoseOnTheSpotAndKeepsTheRest) {
 // does not follow its exposure is refused by name.
 TEST(Photometric, RecoversEachChannelsGammaAndTheMixing) {
   projbot::calibrate::PhotometricSim sim;
-  sim.colour.gamma = {2.0, 2.3, 2.5};
-  sim.colour.mixing = projbot::calibrate::typical_mixing();
+  sim.projector.photometry.gamma_rgb = {2.0, 2.3, 2.5};
+  sim.projector.photometry.mixing = projbot::calibrate::typical_mixing();
   sim.camera_gamma = 1.8;
   sim.ambient_lux = 50.0;
   sim.seed = 7;
   const auto rig = projbot::calibrate::make_twin_photometric_rig(sim);
-  const auto r = projbot::calibrate::calibrate_photometric(*rig, sim.colour.black_level);
-  for (std::size_t j = 0; j < 3; ++j) EXPECT_NEAR(r.projector.gamma[j], sim.colour.gamma[j], 0.02 * sim.colour.gamma[j]) << j;
-  EXPECT_LT((r.projector.mixing - sim.colour.mixing).cwiseAbs().maxCoeff(), 0.02) << r.projector.mixing;
+  const auto& truth = sim.projector.photometry;
+  const auto r = projbot::calibrate::calibrate_photometric(*rig, truth.black_level);
+  for (std::size_t j = 0; j < 3; ++j) EXPECT_NEAR(r.projector.gamma_rgb[j], truth.gamma_rgb[j], 0.02 * truth.gamma_rgb[j]) << j;
+  EXPECT_LT((r.projector.mixing - truth.mixing).cwiseAbs().maxCoeff(), 0.02) << r.projector.mixing;
   EXPECT_NEAR(r.camera_gamma, 1.8, 0.02);
   EXPECT_EQ(r.captures, 6 + 2 + 3 * 8);
   struct Stuck final : projbot::calibrate::PhotometricRig {

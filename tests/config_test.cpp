@@ -71,6 +71,8 @@ TEST(SceneTest, ParsesEveryField) {
   EXPECT_DOUBLE_EQ(lit.projector.photometry.brightness_lm, 5000.0);
   EXPECT_DOUBLE_EQ(lit.projector.photometry.gamma, 2.4);
   EXPECT_DOUBLE_EQ(lit.projector.photometry.black_level, 0.001);
+  EXPECT_DOUBLE_EQ(lit.projector.photometry.gamma_rgb[1], 2.4);  // gamma for each channel when not given
+  EXPECT_TRUE(lit.projector.photometry.mixing.isIdentity());
   EXPECT_DOUBLE_EQ(lit.room.ambient_lux, 150.0);
   EXPECT_DOUBLE_EQ(lit.targets[0].surface.albedo.z(), 0.4);
 }
@@ -150,6 +152,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"brightness_zero",
                 "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, brightness_lm: 0}\ntargets: []\n",
                 {"projector.brightness_lm", "1..100000 lumens"}},
+        BadCase{
+            "mixing_singular",
+            "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, mixing: [1, 0, 0, 1, 0, 0, 0, 0, 1]}\ntargets: []\n",
+            {"projector.mixing", "singular"}},
+        BadCase{"gamma_rgb_short",
+                "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, gamma_rgb: [2.2, 2.2]}\ntargets: []\n",
+                {"projector.gamma_rgb", "expected a list of 3 numbers"}},
         BadCase{"black_level_negative",
                 "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2, black_level: -0.1}\ntargets: []\n",
                 {"projector.black_level", "0..0.2"}},
@@ -438,7 +447,10 @@ TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
   const auto measured = projbot::config::load_scene(dir / "scene2.yaml");
   EXPECT_DOUBLE_EQ(measured.projector.photometry.gamma, 2.31);
   EXPECT_DOUBLE_EQ(measured.projector.photometry.black_level, 0.001);
-  EXPECT_DOUBLE_EQ(measured.projector.photometry.brightness_lm, 3000.0);  // not measured: the default
+  EXPECT_DOUBLE_EQ(measured.projector.photometry.brightness_lm, 3000.0);  // not measured: the scene's
+  EXPECT_DOUBLE_EQ(measured.projector.photometry.gamma_rgb[2], 2.32);
+  EXPECT_DOUBLE_EQ(measured.projector.photometry.mixing(0, 1), 0.05);
+  EXPECT_DOUBLE_EQ(measured.projector.photometry.mixing(2, 1), 0.06);
   EXPECT_NE(error("calibration: calib2.yaml\nprojector: {gamma: 2.2}\n", intrinsics + good_pose + photometry)
                 .find("projector.gamma is the calibration's photometry; leave it out of the scene"),
             std::string::npos);

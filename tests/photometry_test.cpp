@@ -18,6 +18,14 @@ namespace engine = projbot::engine;
 // The default projector: 1280 x 800, fx = fy = 1400 px, 3000 lm, gamma 2.2, black 0.0005.
 const ProjectorConfig kProjector;
 
+// The same with a colour wheel's crosstalk and a gamma of its own per channel.
+ProjectorConfig mixed_projector() {
+  ProjectorConfig p;
+  p.photometry.gamma_rgb = {2.1, 2.3, 2.5};
+  p.photometry.mixing << 0.94, 0.05, 0.01, 0.04, 0.92, 0.04, 0.01, 0.06, 0.93;
+  return p;
+}
+
 TEST(Photometry, FullWhiteOnAPatchByHand) {
   // 3000 lm over 1280 x 800 pixels, each (z / 1400)^2 m^2 at depth z: at 2 m facing the lens,
   // 3000 * 1400^2 / (1280 * 800) / 4 = 1435.5 lux.
@@ -53,6 +61,13 @@ TEST(Photometry, CompensationShowsTheContentScaledByItsGain) {
   const engine::Compensation comp = engine::compensation(albedo, ambient, k);
   const Eigen::Vector3d q(0.2, -0.1, 1.8), n = Eigen::Vector3d(0.3, 0.1, -1.0).normalized();
   const double white = engine::white_lux(kProjector, q, n);
+  // With crosstalk and three gammas: the channels unmixed, the same light reaches the visitor.
+  const ProjectorConfig mixed = mixed_projector();
+  const Eigen::Vector3d tan(0.7, 0.6, 0.5);
+  const Eigen::Vector3d through = engine::light(mixed.photometry, engine::compensated_input(mixed, comp, tan, q, n));
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(albedo[i] * (ambient + white * through[i]) / engine::kReferenceLux, k * engine::srgb_to_linear(tan[i]), 1e-6)
+        << "channel " << i << " with mixing";
   for (const Eigen::Vector3d& content :
        {Eigen::Vector3d(0.9, 0.6, 0.3), Eigen::Vector3d(0.4, 0.4, 0.4), Eigen::Vector3d(0.45, 0.7, 0.5)}) {
     bool clipped = true;
@@ -114,7 +129,7 @@ TEST(Photometry, TheShaderMatchesItsCpuReference) {
   material.double_sided = true;
   quad.materials.push_back(material);
   const std::size_t id = renderer.add_model(quad);
-  ProjectorConfig projector;
+  ProjectorConfig projector = mixed_projector();  // crosstalk and a gamma per channel: the shader's set 1
   projector.width_px = 320, projector.height_px = 200, projector.fx_px = projector.fy_px = 350.0;
   projector.cx_px = 150.3, projector.cy_px = 104.1;
   auto target = renderer.make_offscreen(projector.width_px, projector.height_px);

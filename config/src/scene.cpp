@@ -36,7 +36,8 @@ Distortion read_distortion(const MapReader& r, const YAML::Node& d, const std::s
   return k;
 }
 
-// The projector's brightness and response (`brightness_lm`, `gamma`, `black_level`), each optional.
+// The projector's brightness and response (`brightness_lm`, `gamma`, `black_level`, `gamma_rgb`,
+// `mixing`), each optional.
 void read_photometry(MapReader& r, const YAML::Node& node, Photometry& p) {
   p.brightness_lm = r.get<double>("brightness_lm", p.brightness_lm);
   p.gamma = r.get<double>("gamma", p.gamma);
@@ -46,6 +47,24 @@ void read_photometry(MapReader& r, const YAML::Node& node, Photometry& p) {
   if (!(p.gamma >= 1.0 && p.gamma <= 4.0)) r.fail(node["gamma"], r.key_path("gamma"), "must be 1..4");
   if (!(p.black_level >= 0.0 && p.black_level <= 0.2))
     r.fail(node["black_level"], r.key_path("black_level"), "must be 0..0.2 (black's light, of full white's)");
+  p.gamma_rgb = {p.gamma, p.gamma, p.gamma};
+  if (YAML::Node g = r.child("gamma_rgb", false)) {
+    const std::vector<double> v = r.numbers(g, r.key_path("gamma_rgb"), 3);
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (!(v[i] >= 1.0 && v[i] <= 4.0)) r.fail(g, r.key_path("gamma_rgb"), "each must be 1..4");
+      p.gamma_rgb[i] = v[i];
+    }
+  }
+  if (YAML::Node x = r.child("mixing", false)) {
+    const std::vector<double> v = r.numbers(x, r.key_path("mixing"), 9);
+    for (std::size_t i = 0; i < 9; ++i) {
+      if (!(v[i] >= -0.5 && v[i] <= 1.5))
+        r.fail(x, r.key_path("mixing"), "entries must be -0.5..1.5 (shares of each channel's light)");
+      p.mixing(static_cast<Eigen::Index>(i / 3), static_cast<Eigen::Index>(i % 3)) = v[i];
+    }
+    if (!(std::abs(p.mixing.determinant()) >= 0.1))
+      r.fail(x, r.key_path("mixing"), "is (nearly) singular: the channels' colours must be independent");
+  }
 }
 
 // A target's `surface: {albedo: [r, g, b]}`: linear reflectance, each 0..1.
@@ -279,19 +298,12 @@ PanTiltConfig read_robot(MapReader& root, Scene& scene) {
   return c;
 }
 
-// A calibration's `photometry:` (projbot calibrate photometric): gamma, black_level and brightness_lm as a
-// scene's projector gives them, and what the renderer does not use yet, checked.
+// A calibration's `photometry:` (projbot calibrate photometric): the keys a scene's projector gives them by.
 Photometry read_calibrated_photometry(const MapReader& r, const YAML::Node& node) {
   MapReader m(node, "photometry", r.file());
   Photometry p;
   read_photometry(m, node, p);
-  if (YAML::Node g = m.child("gamma_rgb", false))
-    for (const double v : m.numbers(g, "photometry.gamma_rgb", 3))
-      if (!(v >= 1.0 && v <= 4.0)) m.fail(g, "photometry.gamma_rgb", "each must be 1..4");
-  if (YAML::Node x = m.child("mixing", false))
-    for (const double v : m.numbers(x, "photometry.mixing", 9))
-      if (!(v >= -0.5 && v <= 1.5)) m.fail(x, "photometry.mixing", "entries must be -0.5..1.5 (shares of each channel's light)");
-  const double camera_gamma = m.get<double>("camera_gamma", 2.2);
+  const double camera_gamma = m.get<double>("camera_gamma", 2.2);  // how it was measured: informational
   if (!(camera_gamma >= 0.5 && camera_gamma <= 5.0)) m.fail(node["camera_gamma"], "photometry.camera_gamma", "must be 0.5..5");
   m.reject_unknown();
   return p;
@@ -320,13 +332,17 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
   if (!probe) root.fail(node, "calibration", "cannot open '" + path.string() + "'");
   const ProjectorCalibration c = load_calibration(path);
   if (c.photometry)
-    for (const char* key : {"gamma", "black_level", "brightness_lm"})
+    for (const char* key : {"gamma", "gamma_rgb", "mixing", "black_level", "brightness_lm"})
       if (root.has("projector") && root.child("projector", false)[key])
         root.fail(node, "calibration",
                   std::string("projector.") + key + " is the calibration's photometry; leave it out of the scene");
   static_cast<Pinhole&>(scene.projector) = c.projector;
   scene.projector.distortion = c.distortion;
-  if (c.photometry) scene.projector.photometry = *c.photometry;
+  if (c.photometry) {
+    const double lumens = scene.projector.photometry.brightness_lm;
+    scene.projector.photometry = *c.photometry;
+    if (!c.photometry_brightness) scene.projector.photometry.brightness_lm = lumens;
+  }
   scene.pan_tilt.T_projector_camera = c.T_projector_camera;
 }
 
@@ -377,7 +393,10 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
     m.get<double>("projector", 0.0);
     m.reject_unknown();
   }
-  if (YAML::Node ph = r.child("photometry", false)) out.photometry = read_calibrated_photometry(r, ph);
+  if (YAML::Node ph = r.child("photometry", false)) {
+    out.photometry = read_calibrated_photometry(r, ph);
+    out.photometry_brightness = static_cast<bool>(ph["brightness_lm"]);
+  }
   // What `projbot calibrate solve` also reports: the colour camera's own lens (the depth camera is the
   // scene's `camera:`), the projector area covered, the views and warnings. Informational here.
   for (const char* key : {"camera", "projector_coverage", "views", "warnings", "board_poses"}) r.child(key, false);

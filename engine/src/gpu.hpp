@@ -86,6 +86,9 @@ struct FrameImage {
 /// One frame in flight: its commands, fence, acquire semaphore and the timing waiting for its fence.
 struct FrameSlot {
   vk::raii::CommandBuffer cmd{nullptr};
+  Buffer photometry;  ///< the projector's response for mesh.frag (set 1), written before this slot's frame
+  vk::raii::DescriptorPool pool{nullptr};
+  vk::raii::DescriptorSet set{nullptr};
   vk::raii::Fence fence{nullptr};
   vk::raii::Semaphore acquired{nullptr};
   bool pending = false;  ///< a submitted frame whose timing is not yet handed to its profiler

@@ -31,9 +31,13 @@ double white_lux(const config::ProjectorConfig& p, const Eigen::Vector3d& q, con
 
 Eigen::Vector3d drive(const config::Photometry& ph, const Eigen::Vector3d& c) {
   Eigen::Vector3d d;
-  for (int i = 0; i < 3; ++i) d[i] = ph.black_level + (1.0 - ph.black_level) * std::pow(std::clamp(c[i], 0.0, 1.0), ph.gamma);
+  for (int i = 0; i < 3; ++i)
+    d[i] =
+        ph.black_level + (1.0 - ph.black_level) * std::pow(std::clamp(c[i], 0.0, 1.0), ph.gamma_rgb[static_cast<std::size_t>(i)]);
   return d;
 }
+
+Eigen::Vector3d light(const config::Photometry& ph, const Eigen::Vector3d& c) { return ph.mixing * drive(ph, c); }
 
 Compensation compensation(const Eigen::Vector3d& albedo, double ambient_lux, double k) {
   Compensation comp;
@@ -48,15 +52,20 @@ Eigen::Vector3d compensated_input(const config::ProjectorConfig& p, const Compen
                                   const Eigen::Vector3d& q, const Eigen::Vector3d& n, bool* clipped) {
   const double white = white_lux(p, q, n);
   const config::Photometry& ph = p.photometry;
+  // The light wanted per colour channel less the room's, as a share of full white here; unmixed into the
+  // channels' drives; through the inverse response.
+  Eigen::Vector3d wanted;
+  for (int i = 0; i < 3; ++i) {
+    const double needed = comp.scale_lux[static_cast<std::size_t>(i)] * srgb_to_linear(c[i]) - comp.ambient_lux;
+    wanted[i] = white > 0.0 ? needed / white : (needed > 0.0 ? 2.0 : 0.0);
+  }
+  const Eigen::Vector3d d = ph.mixing.inverse() * wanted;
   Eigen::Vector3d out;
   bool clip = false;
   for (int i = 0; i < 3; ++i) {
-    // The lux the projector must add, as a share of full white, then through the inverse response.
-    const double needed = comp.scale_lux[static_cast<std::size_t>(i)] * srgb_to_linear(c[i]) - comp.ambient_lux;
-    const double d = white > 0.0 ? needed / white : (needed > 0.0 ? 2.0 : 0.0);
-    const double x = (d - ph.black_level) / (1.0 - ph.black_level);
+    const double x = (d[i] - ph.black_level) / (1.0 - ph.black_level);
     clip = clip || x > 1.0 + 1e-6 || x < -1e-6;
-    out[i] = std::pow(std::clamp(x, 0.0, 1.0), 1.0 / ph.gamma);
+    out[i] = std::pow(std::clamp(x, 0.0, 1.0), 1.0 / ph.gamma_rgb[static_cast<std::size_t>(i)]);
   }
   if (clipped) *clipped = clip;
   return out;
@@ -114,18 +123,22 @@ std::vector<SurfaceSample> surface_samples(const assets::Model& model, const con
 }
 
 double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vector3d& albedo, double ambient_lux,
-                   double clip_share) {
-  // Per sample, the largest k it can show: rho (ambient + white) / (kReferenceLux linear(c)) per channel.
+                   double clip_share, const Eigen::Matrix3d& mixing) {
+  // Per sample, the largest k it can show: the drives M^-1 (k u - ambient) / white stay <= 1, where
+  // u = kReferenceLux linear(c) / albedo (without mixing: rho (ambient + white) / (kReferenceLux c)).
+  const Eigen::Matrix3d unmix = mixing.inverse();
+  const Eigen::Vector3d room = unmix * Eigen::Vector3d::Constant(ambient_lux);
   std::vector<std::pair<double, double>> k_max;  // (k, weight)
   double total = 0.0;
   for (const SurfaceSample& s : samples) {
+    Eigen::Vector3d u;
+    for (int i = 0; i < 3; ++i) u[i] = kReferenceLux * srgb_to_linear(s.content[i]) / std::max(albedo[i], 1e-3);
+    const Eigen::Vector3d per_drive = unmix * u;
     double k = 1e9;
-    for (int i = 0; i < 3; ++i) {
-      const double c = srgb_to_linear(s.content[i]);
-      if (c > 1e-4) k = std::min(k, albedo[i] * (ambient_lux + s.white_lux) / (kReferenceLux * c));
-    }
+    for (int j = 0; j < 3; ++j)
+      if (per_drive[j] > 1e-6) k = std::min(k, (s.white_lux + room[j]) / per_drive[j]);
     if (k < 1e9 && s.weight > 0.0) {
-      k_max.emplace_back(k, s.weight);
+      k_max.emplace_back(std::max(k, 0.0), s.weight);
       total += s.weight;
     }
   }
@@ -171,8 +184,8 @@ std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const 
   if (under_black.width != camera.width_px || under_black.height != camera.height_px || under_grey.width != camera.width_px ||
       under_grey.height != camera.height_px || !(grey > 0.0 && grey <= 1.0))
     return std::nullopt;
-  const double added =
-      (drive(projector.photometry, Eigen::Vector3d::Constant(grey)) - drive(projector.photometry, Eigen::Vector3d::Zero()))[0];
+  const Eigen::Vector3d added =
+      light(projector.photometry, Eigen::Vector3d::Constant(grey)) - light(projector.photometry, Eigen::Vector3d::Zero());
   std::array<std::vector<double>, 3> ratios;
   const Eigen::Matrix3d Rc = T_camera_target.topLeftCorner<3, 3>(), Rp = T_projector_target.topLeftCorner<3, 3>();
   for (const assets::Primitive& prim : model.primitives)
@@ -192,12 +205,12 @@ std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const 
         const Eigen::Vector2d px = camera.project(qc);
         const long u = std::lround(px.x()), v = std::lround(px.y());
         if (u < 1 || v < 1 || u >= camera.width_px - 1 || v >= camera.height_px - 1) continue;
-        const double lux = white_lux(projector, qp, np) * added;
+        const Eigen::Vector3d lux = white_lux(projector, qp, np) * added;
         const std::uint8_t* b = under_black.pixel(static_cast<int>(u), static_cast<int>(v));
         const std::uint8_t* g = under_grey.pixel(static_cast<int>(u), static_cast<int>(v));
         for (int ch = 0; ch < 3; ++ch) {
           const double lifted = srgb_to_linear(g[ch] / 255.0) - srgb_to_linear(b[ch] / 255.0);
-          if (g[ch] < 250) ratios[static_cast<std::size_t>(ch)].push_back(lifted * kReferenceLux / lux);  // not saturated
+          if (g[ch] < 250) ratios[static_cast<std::size_t>(ch)].push_back(lifted * kReferenceLux / lux[ch]);  // not saturated
         }
       }
     }
@@ -228,7 +241,9 @@ Compensation CompensationPlan::at(std::size_t target, long visit, const config::
   const Target& t = targets_.at(target);
   Chosen& c = chosen_.at(target);
   if (!c.made || c.visit != visit) {
-    c.gain = t.model ? choose_gain(surface_samples(*t.model, projector, T_projector_target), t.albedo, ambient_lux_) : 1.0;
+    c.gain = t.model ? choose_gain(surface_samples(*t.model, projector, T_projector_target), t.albedo, ambient_lux_, 0.02,
+                                   projector.photometry.mixing)
+                     : 1.0;
     c.visit = visit;
     c.made = true;
   }

@@ -30,17 +30,33 @@ struct DrawConstants {
   std::array<float, 16> clip_from_model;
   std::array<float, 4> base_color_factor;
   std::array<float, 4> compensate;  // Compensation::scale_lux (0: off), ambient_lux
-  std::array<float, 4> projector;   // white_gain, gamma, black level, alpha cutoff
+  std::array<float, 4> projector;   // white_gain, -, -, alpha cutoff
   std::array<float, 4> ray;         // the projector-frame position from clip coordinates (mesh.vert)
 };
 static_assert(sizeof(DrawConstants) == 128);
 
-/// What every draw of a frame shares: the projector's photometry, and how mesh.vert recovers the
+/// mesh.frag's set 1 (std140: 64 bytes): the rows of the projector's mixing matrix's inverse, then the
+/// inverse of each channel's gamma and the black level. Per frame in flight, written before its frame.
+struct FrameUniform {
+  std::array<float, 16> values;
+};
+static_assert(sizeof(FrameUniform) == 64);
+
+FrameUniform frame_uniform(const config::Photometry& p) {
+  FrameUniform u{};
+  const Eigen::Matrix3d unmix = p.mixing.inverse();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) u.values[static_cast<std::size_t>(4 * r + c)] = static_cast<float>(unmix(r, c));
+  for (std::size_t i = 0; i < 3; ++i) u.values[12 + i] = static_cast<float>(1.0 / p.gamma_rgb[i]);
+  u.values[15] = static_cast<float>(p.black_level);
+  return u;
+}
+
+/// What every draw of a frame shares: full white's lux at 1 m, and how mesh.vert recovers the
 /// projector-frame position from clip coordinates (x = (clip.x - m02 clip.w) / m00, likewise y).
 DrawConstants frame_constants(const config::ProjectorConfig& projector, const Eigen::Matrix4d& clip_from_projector_m) {
   DrawConstants c{};
-  c.projector = {static_cast<float>(white_gain(projector)), static_cast<float>(projector.photometry.gamma),
-                 static_cast<float>(projector.photometry.black_level), 0.0F};
+  c.projector = {static_cast<float>(white_gain(projector)), 0.0F, 0.0F, 0.0F};
   c.ray = {static_cast<float>(1.0 / clip_from_projector_m(0, 0)),
            static_cast<float>(-clip_from_projector_m(0, 2) / clip_from_projector_m(0, 0)),
            static_cast<float>(1.0 / clip_from_projector_m(1, 1)),
@@ -112,6 +128,7 @@ struct GpuModel {
 struct Renderer::Impl {
   std::shared_ptr<Gpu> gpu;
   vk::raii::DescriptorSetLayout set_layout{nullptr};
+  vk::raii::DescriptorSetLayout frame_set_layout{nullptr};  // set 1: FrameUniform
   vk::raii::PipelineLayout pipeline_layout{nullptr};
   vk::raii::ShaderModule vert{nullptr};
   vk::raii::ShaderModule frag{nullptr};
@@ -135,7 +152,9 @@ struct Renderer::Impl {
     vk::DescriptorSetLayoutBinding binding(0, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment);
     set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, binding));
     vk::PushConstantRange push(vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, sizeof(DrawConstants));
-    const vk::DescriptorSetLayout layouts[] = {*set_layout};
+    vk::DescriptorSetLayoutBinding frame_binding(0, vk::DescriptorType::eUniformBuffer, 1, vk::ShaderStageFlagBits::eFragment);
+    frame_set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, frame_binding));
+    const vk::DescriptorSetLayout layouts[] = {*set_layout, *frame_set_layout};
     pipeline_layout = vk::raii::PipelineLayout(gpu->device, vk::PipelineLayoutCreateInfo({}, layouts, push));
     vert = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_vert_spv), k_mesh_vert_spv));
     frag = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_frag_spv), k_mesh_frag_spv));
@@ -350,11 +369,25 @@ struct Renderer::Impl {
       slot.cmd = std::move(cmds[i]);
       slot.fence = vk::raii::Fence(gpu->device, vk::FenceCreateInfo(vk::FenceCreateFlagBits::eSignaled));
       slot.acquired = vk::raii::Semaphore(gpu->device, vk::SemaphoreCreateInfo());
+      make_frame_set(slot);
       t.slots.push_back(std::move(slot));
     }
     if (gpu->info.gpu_timestamps)
       t.timestamps = vk::raii::QueryPool(
           gpu->device, vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, static_cast<std::uint32_t>(2 * kFramesInFlight)));
+  }
+
+  // A slot's FrameUniform buffer (host visible, mapped) and its descriptor set.
+  void make_frame_set(detail::FrameSlot& slot) {
+    slot.photometry = gpu->make_buffer(sizeof(FrameUniform), vk::BufferUsageFlagBits::eUniformBuffer,
+                                       vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
+    vk::DescriptorPoolSize size(vk::DescriptorType::eUniformBuffer, 1);
+    slot.pool = vk::raii::DescriptorPool(
+        gpu->device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, size));
+    const vk::DescriptorSetLayout layout = *frame_set_layout;
+    slot.set = std::move(vk::raii::DescriptorSets(gpu->device, vk::DescriptorSetAllocateInfo(*slot.pool, layout)).front());
+    const vk::DescriptorBufferInfo info(*slot.photometry.buffer, 0, sizeof(FrameUniform));
+    gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*slot.set, 0, 0, vk::DescriptorType::eUniformBuffer, {}, info), {});
   }
 
   // Waits for a slot's previous frame and hands its timing to its profiler.
@@ -380,9 +413,10 @@ struct Renderer::Impl {
   // `projector`: the pinhole drawn through (a lens canvas's, or the projector's); `panel`: the projector
   // whose light compensation divides out.
   void record_draws(const vk::raii::CommandBuffer& cmd, vk::Format format, const config::ProjectorConfig& projector,
-                    bool depth_camera, const config::ProjectorConfig& panel) {
+                    bool depth_camera, const config::ProjectorConfig& panel, vk::DescriptorSet frame_set) {
     const Eigen::Matrix4d clip_from_projector_m = clip_from_projector(projector);
     const DrawConstants shared = frame_constants(panel, clip_from_projector_m);
+    cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout, 1, frame_set, {});
     // Opaque and masked first, blended after them so they blend over what is behind.
     // A depth camera sees every surface, whatever its material: one opaque pass.
     static constexpr bool kPasses[] = {false, true};
@@ -434,7 +468,7 @@ struct Renderer::Impl {
 
   // The lens pass's first half: the models through the canvas's pinhole, left ready to sample. One canvas
   // serves both frames in flight: the barriers order this frame's drawing after the last frame's sampling.
-  void record_canvas(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t) {
+  void record_canvas(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, vk::DescriptorSet frame_set) {
     detail::LensCanvasImages& c = *t.canvas;  // made by draw_frame before the fence was reset
     detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                        vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eFragmentShader,
@@ -442,7 +476,7 @@ struct Renderer::Impl {
                        vk::AccessFlagBits2::eColorAttachmentWrite);
     transition_depth(cmd, *c.depth.image);
     begin_pass(cmd, *c.color.view, *c.depth.view, c.color.extent, 1.0F);
-    record_draws(cmd, t.color_format(), c.lens.pinhole, false, c.projector);
+    record_draws(cmd, t.color_format(), c.lens.pinhole, false, c.projector, frame_set);
     cmd.endRendering();
     detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eColorAttachmentOptimal,
                        vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
@@ -485,6 +519,8 @@ struct Renderer::Impl {
     if (lens) ensure_canvas(t, projector);
 
     gpu->device.resetFences(*slot.fence);
+    const FrameUniform uniform = frame_uniform(projector.photometry);  // the slot's last frame is done (retired)
+    std::memcpy(slot.photometry.mapped, &uniform, sizeof uniform);
     const vk::raii::CommandBuffer& cmd = slot.cmd;
     cmd.reset();
     cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
@@ -493,7 +529,7 @@ struct Renderer::Impl {
       cmd.resetQueryPool(*t.timestamps, q0, 2);
       cmd.writeTimestamp2(vk::PipelineStageFlagBits2::eTopOfPipe, *t.timestamps, q0);
     }
-    if (lens) record_canvas(cmd, t);
+    if (lens) record_canvas(cmd, t, *slot.set);
     detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                        vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
                        vk::AccessFlagBits2::eNone, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
@@ -504,7 +540,7 @@ struct Renderer::Impl {
       transition_depth(cmd, *t.depth().image);
       begin_pass(cmd, frame->color_view, *t.depth().view, t.extent(), t.depth_output() ? 0.0F : 1.0F);
       // The projector image (width x height of the intrinsics) is stretched onto the target.
-      record_draws(cmd, t.color_format(), projector, t.depth_output(), projector);
+      record_draws(cmd, t.color_format(), projector, t.depth_output(), projector, *slot.set);
       cmd.endRendering();
     }
     const bool to_present = frame->color_final_layout == vk::ImageLayout::ePresentSrcKHR;

@@ -15,10 +15,11 @@ namespace projbot::tools {
 namespace {
 
 void print_against_truth(const calibrate::PhotometricResult& r, const calibrate::PhotometricSim& sim) {
+  const config::Photometry& truth = sim.projector.photometry;
   double worst_gamma = 0.0;
   for (std::size_t j = 0; j < 3; ++j)
-    worst_gamma = std::max(worst_gamma, std::abs(r.projector.gamma[j] / sim.colour.gamma[j] - 1.0));
-  const double worst_mix = (r.projector.mixing - sim.colour.mixing).cwiseAbs().maxCoeff();
+    worst_gamma = std::max(worst_gamma, std::abs(r.projector.gamma_rgb[j] / truth.gamma_rgb[j] - 1.0));
+  const double worst_mix = (r.projector.mixing - truth.mixing).cwiseAbs().maxCoeff();
   std::printf(
       "against the twin's truth: gamma within %.2f %% (worst channel), mixing within %.4f (worst entry), "
       "camera gamma %.3f (truth %.3f)\n",
@@ -33,9 +34,8 @@ int run_photometric(const cli::Args& args) {
   const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
   calibrate::PhotometricSim sim;
   sim.projector = scene.projector;
-  sim.colour.gamma = {scene.projector.photometry.gamma, scene.projector.photometry.gamma, scene.projector.photometry.gamma};
-  sim.colour.black_level = scene.projector.photometry.black_level;
-  sim.colour.mixing = calibrate::typical_mixing();
+  // The scene's projector is the truth; one without crosstalk gets a DLP's, so there is mixing to find.
+  if (sim.projector.photometry.mixing.isIdentity()) sim.projector.photometry.mixing = calibrate::typical_mixing();
   sim.ambient_lux = scene.room.ambient_lux;
   sim.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
   sim.noise_levels = args.get_double("noise", 2.0);
@@ -43,10 +43,10 @@ int run_photometric(const cli::Args& args) {
   sim.camera_gamma = args.get_double("camera-gamma", 2.2);
   if (!(sim.camera_gamma >= 1.0 && sim.camera_gamma <= 3.0)) throw cli::UsageError("--camera-gamma must be 1..3");
   const auto rig = calibrate::make_twin_photometric_rig(sim);
-  const calibrate::PhotometricResult r = calibrate::calibrate_photometric(*rig, sim.colour.black_level);
+  const calibrate::PhotometricResult r = calibrate::calibrate_photometric(*rig, sim.projector.photometry.black_level);
   const auto& p = r.projector;
   std::printf("%d captures: gamma R %.3f G %.3f B %.3f; camera gamma %.3f\nmixing (column j: channel j's light in R, G, B):\n",
-              r.captures, p.gamma[0], p.gamma[1], p.gamma[2], r.camera_gamma);
+              r.captures, p.gamma_rgb[0], p.gamma_rgb[1], p.gamma_rgb[2], r.camera_gamma);
   for (int i = 0; i < 3; ++i) std::printf("  %.4f %.4f %.4f\n", p.mixing(i, 0), p.mixing(i, 1), p.mixing(i, 2));
   print_against_truth(r, sim);
   const std::string out = *args.get("out");
@@ -66,8 +66,9 @@ const Command kCalibratePhotometric{
     "eight-step ramp per channel. From the linearised values: each channel's gamma (its ramp's share of its\n"
     "full light, log against log) and the colour mixing (each primary's light in the camera's R, G, B as a\n"
     "share of white's). Black level and the room's light cannot be told apart with the projector on: the\n"
-    "scene's black_level is kept. With --sim the twin's projector (the scene's lumens, gamma and room light,\n"
-    "and a DLP's few percent of crosstalk) and an 8-bit camera; the result is compared with that truth.\n"
+    "scene's black_level is kept. With --sim the twin's projector (the scene's lumens, gammas, mixing (a DLP's\n"
+    "few percent of crosstalk where the scene has none) and room light) and an 8-bit camera; the result is\n"
+    "compared with that truth. Paste its photometry: section into a calibration file to project with it.\n"
     "The projector and camera of a site config are not driven yet.\n",
     {{"sim", "", "the twin's projector and camera"},
      {"out", "FILE", "the photometry to write (YAML, `photometry:` as a calibration file carries it)",

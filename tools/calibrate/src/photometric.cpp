@@ -67,8 +67,9 @@ PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level)
     }
     if (!(den > 0.0) || !(num / den > 0.5 && num / den < 5.0))
       throw CalibrationError("photometric: channel " + std::to_string(j) + "'s ramp gives no response to fit");
-    r.projector.gamma[static_cast<std::size_t>(j)] = num / den;
+    r.projector.gamma_rgb[static_cast<std::size_t>(j)] = num / den;
   }
+  r.projector.gamma = (r.projector.gamma_rgb[0] + r.projector.gamma_rgb[1] + r.projector.gamma_rgb[2]) / 3.0;
   return r;
 }
 
@@ -89,12 +90,8 @@ class TwinPhotometricRig final : public PhotometricRig {
     scale_ = 0.9 / (kAlbedo * (sim.ambient_lux + white_lux_));
   }
   Eigen::Vector3d show_and_measure(const Eigen::Vector3d& input, double exposure) override {
-    const ProjectorColour& c = sim_.colour;
-    Eigen::Vector3d drive;
-    for (int j = 0; j < 3; ++j)
-      drive[j] =
-          c.black_level + (1.0 - c.black_level) * std::pow(std::clamp(input[j], 0.0, 1.0), c.gamma[static_cast<std::size_t>(j)]);
-    const Eigen::Vector3d lux = Eigen::Vector3d::Constant(sim_.ambient_lux) + white_lux_ * c.mixing * drive;
+    const Eigen::Vector3d lux =
+        Eigen::Vector3d::Constant(sim_.ambient_lux) + white_lux_ * engine::light(sim_.projector.photometry, input);
     std::normal_distribution<double> noise(0.0, sim_.noise_levels);
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     constexpr int kPixels = 32 * 32;
@@ -127,8 +124,8 @@ void write_photometric(const PhotometricResult& r, const std::filesystem::path& 
     << "# The projector's response per channel (input c gives black + (1 - black) c^gamma of its light) and its\n"
     << "# colour mixing (column j: channel j's light in the camera's R, G, B; rows sum to 1).\n"
     << "photometry:\n"
-    << "  gamma: " << (p.gamma[0] + p.gamma[1] + p.gamma[2]) / 3.0 << "\n"
-    << "  gamma_rgb: [" << p.gamma[0] << ", " << p.gamma[1] << ", " << p.gamma[2] << "]\n"
+    << "  gamma: " << p.gamma << "\n"
+    << "  gamma_rgb: [" << p.gamma_rgb[0] << ", " << p.gamma_rgb[1] << ", " << p.gamma_rgb[2] << "]\n"
     << "  black_level: " << p.black_level << "\n"
     << "  mixing: [";
   for (int i = 0; i < 9; ++i) y << (i ? ", " : "") << p.mixing(i / 3, i % 3);

@@ -108,6 +108,7 @@ AppearanceScore score_appearance(const SpectatorPicture& seen, const ContentView
   std::vector<double> de;
   double squared = 0.0;
   std::size_t clipped = 0, unreachable = 0;
+  const Eigen::Matrix3d unmix = photometry.mixing.inverse();
   for (std::size_t i = 0; i < scored.size(); ++i) {
     const double white = seen.white_lux[i];
     if (!view.mask[i] || !(white > 0.0)) continue;
@@ -116,19 +117,22 @@ AppearanceScore score_appearance(const SpectatorPicture& seen, const ContentView
     std::uint8_t* w = wanted.rgba.data() + 4 * i;
     const std::uint8_t* got = seen.image.rgba.data() + 4 * i;
     const std::uint8_t* c = view.content.rgba.data() + 4 * i;
-    bool over = false;
-    Eigen::Vector3d want, best;  // sRGB: what it should show, and the nearest any input gets there
+    Eigen::Vector3d want, needed, rho;  // sRGB wanted; the lux the projector must add per colour channel
     for (int ch = 0; ch < 3; ++ch) {
       const double target = k * engine::srgb_to_linear(c[ch] / 255.0);
       w[ch] = static_cast<std::uint8_t>(std::lround(255.0 * engine::linear_to_srgb(target)));
-      const double rho = std::max(engine::srgb_to_linear(seen.albedo.rgba[4 * i + ch] / 255.0), 1e-4);
-      const double needed = target * engine::kReferenceLux / rho - ambient_lux;  // lux the projector must add
-      over = over || needed > white * (1.0 + 1e-6);
-      const double added = std::clamp(needed, white * photometry.black_level, white);
-      best[ch] = engine::linear_to_srgb(rho * (ambient_lux + added) / engine::kReferenceLux);
       want[ch] = w[ch] / 255.0;
+      rho[ch] = std::max(engine::srgb_to_linear(seen.albedo.rgba[4 * i + ch] / 255.0), 1e-4);
+      needed[ch] = target * engine::kReferenceLux / rho[ch] - ambient_lux;
       squared += std::pow(static_cast<double>(w[ch]) - got[ch], 2);
     }
+    // The channels' drives that light needs, and the nearest any input gets: each clamped between black
+    // and full, mixed back.
+    const Eigen::Vector3d drives = unmix * needed / white;
+    const bool over = drives.maxCoeff() > 1.0 + 1e-6;
+    const Eigen::Vector3d added = white * photometry.mixing * drives.cwiseMax(photometry.black_level).cwiseMin(1.0);
+    Eigen::Vector3d best;
+    for (int ch = 0; ch < 3; ++ch) best[ch] = engine::linear_to_srgb(rho[ch] * (ambient_lux + added[ch]) / engine::kReferenceLux);
     // Unreachable: even the best input leaves a visible difference (the room's light on a colour with
     // no blue, a surface too dark for the content).
     const bool reachable = ciede2000(srgb_to_lab(want), srgb_to_lab(best)) <= kReachableDe;

@@ -157,7 +157,7 @@ SpectatorPicture SpectatorView::see(Twin& twin, const Eigen::Matrix4d& T_world_s
             const Eigen::Vector3d n = facets[i].isZero() ? normal_at(depth, pinhole_, u, v) : facets[i].cast<double>();
             const double white = engine::white_lux(k, q, R * n);
             const std::uint8_t* c = projector_frame.pixel(static_cast<int>(pu), static_cast<int>(pv));
-            lux += white * engine::drive(k.photometry, Eigen::Vector3d(c[0], c[1], c[2]) / 255.0);
+            lux += white * engine::light(k.photometry, Eigen::Vector3d(c[0], c[1], c[2]) / 255.0);
             out.white_lux[i] = static_cast<float>(white);
           }
         }

@@ -441,7 +441,11 @@ ProjectorModels projector_models(const config::Scene& scene, const TourOptions& 
   if (options.calibration) {
     static_cast<config::Pinhole&>(models.believed) = options.calibration->projector;
     models.believed.distortion = options.calibration->distortion;
-    if (options.calibration->photometry) models.believed.photometry = *options.calibration->photometry;
+    if (options.calibration->photometry) {  // its response and mixing; the lumens stay the scene's unless it gave them
+      models.believed.photometry = *options.calibration->photometry;
+      if (!options.calibration->photometry_brightness)
+        models.believed.photometry.brightness_lm = scene.projector.photometry.brightness_lm;
+    }
     models.T_projector_camera = options.calibration->T_projector_camera;
   }
   return models;

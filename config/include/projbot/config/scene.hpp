@@ -32,6 +32,11 @@ struct Photometry {
   double brightness_lm = 3000.0;  ///< `projector.brightness_lm`: full white's flux (1..100000 lm)
   double gamma = 2.2;             ///< `projector.gamma`: the response's exponent (1..4)
   double black_level = 0.0005;    ///< `projector.black_level`: black's light, of full white's (0..0.2)
+  /// `projector.gamma_rgb`: each channel's exponent (1..4); `gamma` for each when not given.
+  std::array<double, 3> gamma_rgb{2.2, 2.2, 2.2};
+  /// `projector.mixing` (9 numbers, row-major): column j is channel j's light in R, G, B (a colour wheel's
+  /// crosstalk; rows sum to 1 so white stays white). Identity when not given.
+  Eigen::Matrix3d mixing = Eigen::Matrix3d::Identity();
 };
 
 /// The projector as a scene gives it (`projector:`), and a depth camera's pinhole with its clip range
@@ -180,9 +185,10 @@ struct ProjectorCalibration {
   Pinhole projector;
   Distortion distortion{};  ///< the projector's lens, k1 k2 p1 p2 k3
   Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();
-  /// `photometry:` (projbot calibrate photometric): gamma and black_level (brightness_lm when given) replace
-  /// the scene's; the per-channel gammas, mixing and camera gamma are read and checked, not yet drawn by.
+  /// `photometry:` (projbot calibrate photometric): its gammas, mixing and black level (brightness_lm when
+  /// given) replace the scene's.
   std::optional<Photometry> photometry;
+  bool photometry_brightness = false;  ///< its `photometry:` gave brightness_lm (else the scene's stays)
 };
 /// Reads and validates one (a scene's `calibration:` reads it so). Throws ConfigError naming file:line.
 ProjectorCalibration load_calibration(const std::filesystem::path& path);

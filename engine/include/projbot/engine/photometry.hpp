@@ -4,8 +4,8 @@
 // (forward) and the renderer's compensation (inverse, here as the CPU reference of mesh.frag).
 //
 // Light, per channel: a surface of reflectance rho lit by E lux is seen as rho E / kReferenceLux (linear,
-// 1 = a white surface under the reference light). The projector adds E_p = white_lux(q, n) drive(c), where
-// drive(c) = black + (1 - black) c^gamma and white_lux spreads the projector's lumens evenly over its
+// 1 = a white surface under the reference light). The projector adds E_p = white_lux(q, n) M drive(c), where
+// drive(c) = black + (1 - black) c^gamma per channel, M its colour mixing, and white_lux spreads its lumens over its
 // pixels: a pixel's footprint on a plane facing the lens at depth z is (z / fx)(z / fy), tilted by the
 // surface's incidence. Content c (sRGB) should be seen as k linear(c): the content under the reference
 // light, scaled by the target's gain k (< 1 where the projector cannot make it brighter).
@@ -32,8 +32,10 @@ double white_gain(const config::ProjectorConfig& projector);
 /// Full white's lux on a surface at projector-frame point q (metres, z > 0) with normal n (either sign);
 /// 0 behind the projector or edge-on.
 double white_lux(const config::ProjectorConfig& projector, const Eigen::Vector3d& q, const Eigen::Vector3d& n);
-/// The projector's light for input c (0..1 per channel), of full white's: black + (1 - black) c^gamma.
+/// Each channel's drive for input c (0..1 per channel), of its full light: black + (1 - black) c^gamma.
 Eigen::Vector3d drive(const config::Photometry& photometry, const Eigen::Vector3d& c);
+/// The projector's light in R, G, B for input c, of full white's: its mixing of the channels' drives.
+Eigen::Vector3d light(const config::Photometry& photometry, const Eigen::Vector3d& c);
 
 /// A drawn target's compensation: its surface shows content c as k linear(c). Off: the content is sent as
 /// stored.
@@ -66,7 +68,7 @@ std::vector<SurfaceSample> surface_samples(const assets::Model& model, const con
 /// for more than full white (albedo, ambient as above), at most 1 (the content under the reference light); 1 when
 /// nothing asks. Chosen once per visit, so frames do not flicker.
 double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vector3d& albedo, double ambient_lux,
-                   double clip_share = 0.02);
+                   double clip_share = 0.02, const Eigen::Matrix3d& mixing = Eigen::Matrix3d::Identity());
 
 /// A target's reflectance per channel, measured at a stop (issue 43): the colour camera's images of it
 /// under the projector's black and its uniform `grey` input (sRGB, registered to `camera`; a

@@ -16,15 +16,6 @@
 
 namespace projbot::calibrate {
 
-/// A projector's colour as the camera sees it: per channel c in 0..1 gives black + (1 - black) c^gamma of
-/// that channel's full light, and `mixing` spreads channel j's light over the camera's R, G, B (column j;
-/// rows sum to 1, so white is white). The twin's default has a DLP's few percent of crosstalk.
-struct ProjectorColour {
-  std::array<double, 3> gamma{2.2, 2.2, 2.2};
-  double black_level = 0.0005;
-  Eigen::Matrix3d mixing = Eigen::Matrix3d::Identity();
-};
-
 /// What a photometric session drives: the projector showing one colour over its whole image, and the
 /// colour camera's mean R, G, B (8-bit levels, 0..255) over the patch of surface it lights, at an exposure
 /// relative to the session's first.
@@ -34,9 +25,11 @@ class PhotometricRig {
   virtual Eigen::Vector3d show_and_measure(const Eigen::Vector3d& input, double exposure) = 0;
 };
 
+/// The projector's colour is a config::Photometry: each channel's gamma (`gamma_rgb`), its black level and
+/// its `mixing` (column j: channel j's light in the camera's R, G, B; rows sum to 1, so white is white).
 struct PhotometricResult {
-  ProjectorColour projector;  ///< gamma per channel and mixing measured; black_level as given
-  double camera_gamma = 0.0;  ///< the camera's response: value = 255 (exposure x light)^(1 / camera_gamma)
+  config::Photometry projector;  ///< gamma_rgb (gamma their mean) and mixing measured; black_level as given
+  double camera_gamma = 0.0;     ///< the camera's response: value = 255 (exposure x light)^(1 / camera_gamma)
   int captures = 0;
 };
 
@@ -46,12 +39,11 @@ struct PhotometricResult {
 PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level);
 
 /// The twin's rig: a light grey patch (reflectance 0.8) facing the projector 1.5 m away, lit by the
-/// room's `ambient_lux` and the projector (its lumens, `colour`), seen by an 8-bit camera whose response
+/// room's `ambient_lux` and the projector (its lumens and photometry, the truth), seen by an 8-bit camera whose response
 /// is x^(1 / camera_gamma), exposed so that white fills 90 % of its range, with Gaussian noise of
 /// `noise_levels` per pixel over a 32 x 32 patch.
 struct PhotometricSim {
-  config::ProjectorConfig projector;
-  ProjectorColour colour;
+  config::ProjectorConfig projector;  ///< its lumens light the patch; its photometry is the truth to recover
   double ambient_lux = 20.0;
   double camera_gamma = 2.2;
   double noise_levels = 2.0;
