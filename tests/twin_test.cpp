@@ -1235,8 +1235,9 @@ TEST_F(ShopDuckStop, TheVisitorSeesReflectanceTimesLight) {
         on ? projbot::engine::compensation(albedo, ambient, k) : projbot::engine::Compensation{};
     renderer.draw_frame(*frame, scene.projector,
                         std::vector<projbot::engine::DrawItem>{{twin.target_model_ids()[duck], T_projector_duck, comp}});
-    const auto picture = view.see(twin, T_world_spectator, T_world_projector, frame->read_back());
-    const auto content = view.content(twin, duck, T_world_spectator, picture);
+    const auto looked = view.look(twin, T_world_spectator, T_world_projector);
+    const auto picture = view.light(looked, frame->read_back());
+    const auto content = view.content(twin, duck, T_world_spectator, looked);
     scores[on ? 1 : 0] = projbot::twin::score_appearance(picture, content, k, ambient, scene.projector.photometry);
   }
   EXPECT_GT(scores[1].pixels, 5000U);

@@ -162,9 +162,10 @@ std::optional<Eigen::Vector3d> measured_reflectance(SpectatorView& camera, Twin&
   assets::Image frame;
   frame.width = p.width_px, frame.height = p.height_px;
   frame.rgba.assign(static_cast<std::size_t>(p.width_px) * p.height_px * 4, 0);
-  const assets::Image black = camera.see(twin, T_world_camera, T_world_projector, frame).image;
+  const SpectatorScene seen = camera.look(twin, T_world_camera, T_world_projector);
+  const assets::Image black = camera.light(seen, frame).image;
   std::fill(frame.rgba.begin(), frame.rgba.end(), kGrey);
-  const assets::Image grey = camera.see(twin, T_world_camera, T_world_projector, frame).image;
+  const assets::Image grey = camera.light(seen, frame).image;
   return engine::measure_albedo(twin.targets().at(target).model, twin.camera_pinhole(), T_camera_target, believed,
                                 T_projector_target, black, grey, kGrey / 255.0);
 }

@@ -112,20 +112,16 @@ std::vector<Eigen::Vector3f> SpectatorView::facet_normals(Twin& twin, const Eige
   return out;
 }
 
-SpectatorPicture SpectatorView::see(Twin& twin, const Eigen::Matrix4d& T_world_spectator,
-                                    const Eigen::Matrix4d& T_world_projector, const assets::Image& projector_frame) {
-  if (projector_frame.width != projector_.width_px || projector_frame.height != projector_.height_px ||
-      projector_frame.rgba.size() != static_cast<std::size_t>(projector_frame.width) * projector_frame.height * 4)
-    throw TwinError("spectator view: the projector frame is " + std::to_string(projector_frame.width) + "x" +
-                    std::to_string(projector_frame.height) + ", the projector " + std::to_string(projector_.width_px) + "x" +
-                    std::to_string(projector_.height_px));
+SpectatorScene SpectatorView::look(Twin& twin, const Eigen::Matrix4d& T_world_spectator,
+                                   const Eigen::Matrix4d& T_world_projector) {
   const std::vector<engine::DrawItem> room = twin.surface_items(T_world_spectator);
   renderer_.draw_frame(*colour_, pinhole_, room);
-  SpectatorPicture out;
+  SpectatorScene out;
   out.albedo = colour_->read_back();
-  out.image = out.albedo;
+  out.ambient_lux = twin.scene().room.ambient_lux;
   const int width = pinhole_.width_px, height = pinhole_.height_px;
   out.white_lux.assign(static_cast<std::size_t>(width) * height, 0.0F);
+  out.panel.assign(out.white_lux.size(), -1);
   renderer_.draw_frame(*depth_, pinhole_, room);
   const engine::DepthMap depth = depth_->read_back_depth();
   out.z_m = depth.z_m;
@@ -135,45 +131,55 @@ SpectatorPicture SpectatorView::see(Twin& twin, const Eigen::Matrix4d& T_world_s
   const Eigen::Matrix4d T_projector_spectator = alignment::rigid_inverse(T_world_projector) * T_world_spectator;
   const Eigen::Matrix3d R = T_projector_spectator.topLeftCorner<3, 3>();
   const config::ProjectorConfig& k = projector_;
-  const double ambient = twin.scene().room.ambient_lux;
   for (int v = 0; v < height; ++v)
     for (int u = 0; u < width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * width + u;
       const float z = depth.z_m[i];
-      Eigen::Vector3d lux = Eigen::Vector3d::Constant(ambient);
-      if (z > 0.0F) {
-        const Eigen::Vector3d q = (T_projector_spectator * pinhole_.back_project(u, v, z).homogeneous()).head<3>();
-        // Eq. 3: the projector pixel that reaches this point through its lens, if nothing nearer the
-        // projector blocks it (the projector's depth image is a pinhole's: looked up along the ray).
-        const bool ahead = q.z() > k.near_m;
-        const Eigen::Vector2d x = ahead ? k.project_lit(q) : Eigen::Vector2d(-1.0, -1.0);
-        const Eigen::Vector2d ray = ahead ? k.project(q) : Eigen::Vector2d(-1.0, -1.0);
-        const long pu = std::lround(x.x()), pv = std::lround(x.y()), ru = std::lround(ray.x()), rv = std::lround(ray.y());
-        if (pu >= 0 && pv >= 0 && pu < k.width_px && pv < k.height_px && ru >= 0 && rv >= 0 && ru < k.width_px &&
-            rv < k.height_px) {
-          const float seen = lit_depth.z_m[static_cast<std::size_t>(rv) * k.width_px + ru];
-          if (seen > 0.0F && std::abs(seen - q.z()) < 0.01 + 0.01 * q.z()) {
-            // The targets' true facets; the room's flat faces from the depth.
-            const Eigen::Vector3d n = facets[i].isZero() ? normal_at(depth, pinhole_, u, v) : facets[i].cast<double>();
-            const double white = engine::white_lux(k, q, R * n);
-            const std::uint8_t* c = projector_frame.pixel(static_cast<int>(pu), static_cast<int>(pv));
-            lux += white * engine::light(k.photometry, Eigen::Vector3d(c[0], c[1], c[2]) / 255.0);
-            out.white_lux[i] = static_cast<float>(white);
-          }
-        }
-      }
-      std::uint8_t* px = out.image.pixel(u, v);
-      for (int ch = 0; ch < 3; ++ch) {
-        const double seen = engine::srgb_to_linear(px[ch] / 255.0) * lux[ch] / engine::kReferenceLux;
-        px[ch] = static_cast<std::uint8_t>(std::lround(255.0 * engine::linear_to_srgb(seen)));
-      }
-      px[3] = 255;
+      if (!(z > 0.0F)) continue;
+      const Eigen::Vector3d q = (T_projector_spectator * pinhole_.back_project(u, v, z).homogeneous()).head<3>();
+      // Eq. 3: the projector pixel that reaches this point through its lens, if nothing nearer the
+      // projector blocks it (the projector's depth image is a pinhole's: looked up along the ray).
+      const bool ahead = q.z() > k.near_m;
+      const Eigen::Vector2d x = ahead ? k.project_lit(q) : Eigen::Vector2d(-1.0, -1.0);
+      const Eigen::Vector2d ray = ahead ? k.project(q) : Eigen::Vector2d(-1.0, -1.0);
+      const long pu = std::lround(x.x()), pv = std::lround(x.y()), ru = std::lround(ray.x()), rv = std::lround(ray.y());
+      if (pu < 0 || pv < 0 || pu >= k.width_px || pv >= k.height_px || ru < 0 || rv < 0 || ru >= k.width_px || rv >= k.height_px)
+        continue;
+      const float seen = lit_depth.z_m[static_cast<std::size_t>(rv) * k.width_px + ru];
+      if (!(seen > 0.0F) || !(std::abs(seen - q.z()) < 0.01 + 0.01 * q.z())) continue;
+      // The targets' true facets; the room's flat faces from the depth.
+      const Eigen::Vector3d n = facets[i].isZero() ? normal_at(depth, pinhole_, u, v) : facets[i].cast<double>();
+      out.white_lux[i] = static_cast<float>(engine::white_lux(k, q, R * n));
+      out.panel[i] = static_cast<std::int32_t>(pv * k.width_px + pu);
     }
   return out;
 }
 
+SpectatorPicture SpectatorView::light(const SpectatorScene& scene, const assets::Image& projector_frame) const {
+  if (projector_frame.width != projector_.width_px || projector_frame.height != projector_.height_px ||
+      projector_frame.rgba.size() != static_cast<std::size_t>(projector_frame.width) * projector_frame.height * 4)
+    throw TwinError("spectator view: the projector frame is " + std::to_string(projector_frame.width) + "x" +
+                    std::to_string(projector_frame.height) + ", the projector " + std::to_string(projector_.width_px) + "x" +
+                    std::to_string(projector_.height_px));
+  SpectatorPicture out{scene.albedo, scene.albedo, scene.white_lux, scene.z_m};
+  for (std::size_t i = 0; i < scene.panel.size(); ++i) {
+    Eigen::Vector3d lux = Eigen::Vector3d::Constant(scene.ambient_lux);
+    if (scene.panel[i] >= 0) {
+      const std::uint8_t* c = projector_frame.rgba.data() + 4 * static_cast<std::size_t>(scene.panel[i]);
+      lux += scene.white_lux[i] * engine::light(projector_.photometry, Eigen::Vector3d(c[0], c[1], c[2]) / 255.0);
+    }
+    std::uint8_t* px = out.image.rgba.data() + 4 * i;
+    for (int ch = 0; ch < 3; ++ch) {
+      const double seen = engine::srgb_to_linear(px[ch] / 255.0) * lux[ch] / engine::kReferenceLux;
+      px[ch] = static_cast<std::uint8_t>(std::lround(255.0 * engine::linear_to_srgb(seen)));
+    }
+    px[3] = 255;
+  }
+  return out;
+}
+
 ContentView SpectatorView::content(Twin& twin, std::size_t target, const Eigen::Matrix4d& T_world_spectator,
-                                   const SpectatorPicture& picture) {
+                                   const SpectatorScene& picture) {
   const TwinTarget& t = twin.targets().at(target);
   const Eigen::Matrix4d T_spectator_target = alignment::rigid_inverse(T_world_spectator) * t.T_world_target_true;
   ContentView view;

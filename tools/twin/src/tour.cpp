@@ -707,12 +707,14 @@ void TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& 
       spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
   tour_.plan.at(target_index_, visit_, tour_.models.believed, T_projector_target);  // the visit's gain, if not yet chosen
   const double gain = tour_.plan.gain(target_index_);
+  // The geometry and the content once; each frame's light on them.
+  const SpectatorScene scene = tour_.spectator->look(tour_.twin, T_world_spectator, truth_.T_world_projector.matrix());
+  const ContentView view = tour_.spectator->content(tour_.twin, target_index_, T_world_spectator, scene);
   for (const bool on : {false, true}) {
     const auto t0 = Clock::now();
     const auto image = projector_image(lit, T_projector_target, on);
     const double ms = ms_since(t0);
-    const SpectatorPicture seen = tour_.spectator->see(tour_.twin, T_world_spectator, truth_.T_world_projector.matrix(), image);
-    const ContentView view = tour_.spectator->content(tour_.twin, target_index_, T_world_spectator, seen);
+    const SpectatorPicture seen = tour_.spectator->light(scene, image);
     const AppearanceScore score = score_appearance(seen, view, gain, tour_.scene.room.ambient_lux, tour_.models.truth.photometry);
     report.appearance.push_back({on, moving, gain, ms, score});
     if (!moving && !tour_.options.frames_dir.empty())

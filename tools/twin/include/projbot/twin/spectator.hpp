@@ -5,6 +5,7 @@
 // (issue 43: engine/photometry.hpp's light, each surface's own reflectance).
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -30,6 +31,17 @@ struct SpectatorPicture {
   std::vector<float> z_m;        ///< the spectator's depth of the surface seen, 0 for none
 };
 
+/// What the eye and the projector see of the true surfaces from two fixed poses: all of see() that does not
+/// depend on the projector's frame, so that several frames can be lit from one look (off and on, black
+/// and grey).
+struct SpectatorScene {
+  assets::Image albedo;             ///< as SpectatorPicture's
+  std::vector<float> white_lux;     ///< likewise
+  std::vector<float> z_m;           ///< likewise
+  std::vector<std::int32_t> panel;  ///< the projector pixel whose light reaches each pixel (row-major), -1 none
+  double ambient_lux = 0.0;         ///< the room's light
+};
+
 /// A target as the spectator would see it: its content (sRGB, the content model drawn from the spectator)
 /// and where the target itself is the nearest surface.
 struct ContentView {
@@ -52,10 +64,16 @@ class SpectatorView {
   /// T_world_projector, blocked by whatever stands nearer the projector; its brightness, response, distance
   /// and incidence). Throws TwinError when the frame is not the projector's size.
   SpectatorPicture see(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const Eigen::Matrix4d& T_world_projector,
-                       const assets::Image& projector_frame);
+                       const assets::Image& projector_frame) {
+    return light(look(twin, T_world_spectator, T_world_projector), projector_frame);
+  }
+  /// see() in two halves: the geometry from the poses (renders and per-pixel light paths), then a frame's
+  /// light on it (throws TwinError when the frame is not the projector's size).
+  SpectatorScene look(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const Eigen::Matrix4d& T_world_projector);
+  SpectatorPicture light(const SpectatorScene& scene, const assets::Image& projector_frame) const;
   /// Target `target` (index into Twin::targets()) where it stands now, as seen from T_world_spectator: its
-  /// content, and where it is what `picture` (see() from the same place) shows.
-  ContentView content(Twin& twin, std::size_t target, const Eigen::Matrix4d& T_world_spectator, const SpectatorPicture& picture);
+  /// content, and where it is the nearest surface of `scene` (look() from the same place).
+  ContentView content(Twin& twin, std::size_t target, const Eigen::Matrix4d& T_world_spectator, const SpectatorScene& scene);
   /// see()'s picture alone.
   assets::Image draw(Twin& twin, const Eigen::Matrix4d& T_world_spectator, const Eigen::Matrix4d& T_world_projector,
                      const assets::Image& projector_frame) {
