@@ -18,8 +18,8 @@ double wrapped(double x, Wrap w) {
   return std::fmod(std::floor(x), 2.0) == 0.0 ? f : 1.0 - f;  // mirrored (fmod: no overflow for a huge coordinate)
 }
 
-// The colour a material shows at texture coordinate (u, v) with vertex colour `vc`: texture (nearest
-// texel) x base colour factor x vertex colour, RGB 0..1 as stored (what the unlit renderer draws).
+}  // namespace
+
 Eigen::Vector3f surface_colour(const Model& model, int material, double u, double v, const Eigen::Vector3f& vc) {
   if (model.materials.empty()) return vc;
   const Material& m = model.materials[static_cast<std::size_t>(std::max(material, 0)) % model.materials.size()];
@@ -33,8 +33,6 @@ Eigen::Vector3f surface_colour(const Model& model, int material, double u, doubl
   const std::uint8_t* px = img.pixel(x, y);
   return c.cwiseProduct(Eigen::Vector3f(px[0], px[1], px[2]) / 255.0F);
 }
-
-}  // namespace
 
 std::size_t Model::triangle_count() const {
   std::size_t n = 0;

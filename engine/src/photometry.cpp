@@ -73,21 +73,10 @@ Eigen::Vector3d compensated_input(const config::ProjectorConfig& p, const Compen
 
 namespace {
 
-// A material's colour at a vertex: base colour factor x texture (nearest texel, repeated) x vertex colour.
-Eigen::Vector3d vertex_content(const assets::Model& model, const assets::Material& m, const assets::Vertex& v) {
-  Eigen::Vector3d c(m.base_color_factor[0], m.base_color_factor[1], m.base_color_factor[2]);
-  for (int i = 0; i < 3; ++i) c[i] *= v.color[static_cast<std::size_t>(i)];
-  if (m.base_color_image >= 0 && static_cast<std::size_t>(m.base_color_image) < model.images.size()) {
-    const assets::Image& img = model.images[static_cast<std::size_t>(m.base_color_image)];
-    if (img.width > 0 && img.height > 0 && !img.rgba.empty()) {
-      const double u = v.uv[0] - std::floor(v.uv[0]), t = v.uv[1] - std::floor(v.uv[1]);
-      const int x = std::clamp(static_cast<int>(u * img.width), 0, img.width - 1);
-      const int y = std::clamp(static_cast<int>(t * img.height), 0, img.height - 1);
-      const std::uint8_t* px = img.rgba.data() + 4 * (static_cast<std::size_t>(y) * img.width + x);
-      for (int i = 0; i < 3; ++i) c[i] *= px[i] / 255.0;
-    }
-  }
-  return c;
+// A vertex's content: what the renderer draws there (assets::surface_colour at its UV and colour).
+Eigen::Vector3d vertex_content(const assets::Model& model, int material, const assets::Vertex& v) {
+  return assets::surface_colour(model, material, v.uv[0], v.uv[1], Eigen::Vector3f(v.color[0], v.color[1], v.color[2]))
+      .cast<double>();
 }
 
 }  // namespace
@@ -111,9 +100,10 @@ std::vector<SurfaceSample> surface_samples(const assets::Model& model, const con
       const Eigen::Vector2d x = p.project(q);
       if (x.x() < -0.5 || x.y() < -0.5 || x.x() > p.width_px - 0.5 || x.y() > p.height_px - 0.5) continue;
       SurfaceSample s;
-      s.content = (vertex_content(model, m, prim.vertices[a]) + vertex_content(model, m, prim.vertices[b]) +
-                   vertex_content(model, m, prim.vertices[c])) /
-                  3.0;
+      s.content =
+          (vertex_content(model, prim.material, prim.vertices[a]) + vertex_content(model, prim.material, prim.vertices[b]) +
+           vertex_content(model, prim.material, prim.vertices[c])) /
+          3.0;
       s.white_lux = white_lux(p, q, n);
       s.weight = std::abs(n.dot(q)) / (2.0 * q.norm() * q.squaredNorm());  // its solid angle: the projector's pixels on it
       if (s.weight > 0.0) out.push_back(s);

@@ -80,6 +80,11 @@ Model load_model(const std::filesystem::path& path);
 /// Scales the model frame uniformly, then (if recenter) moves the origin to the surface centroid.
 void scale_and_recenter(Model& model, double scale, bool recenter);
 
+/// The colour material `material` shows at texture coordinate (u, v) with vertex colour `vc`: texture
+/// (nearest texel, the sampler's wrap) x base colour factor x vertex colour, RGB 0..1 as stored (what the
+/// unlit renderer draws).
+Eigen::Vector3f surface_colour(const Model& model, int material, double u, double v, const Eigen::Vector3f& vc);
+
 /// Points with normals sampled uniformly by area over the surface, model frame.
 struct SurfaceSamples {
   std::vector<Eigen::Vector3f> points;
