@@ -13,7 +13,7 @@ packages=(
   libglm-dev libeigen3-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
   libglfw3-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
   libpcl-dev libopenni2-dev libfreenect-dev libfreenect-bin cyclonedds-dev cyclonedds-tools libtiff-dev libboost-dev libmrpt-dev
-  libopencv-dev libopencv-contrib-dev libassimp-dev
+  libopencv-dev libopencv-contrib-dev libassimp-dev libavformat-dev libavcodec-dev libswscale-dev libavutil-dev
   libx11-dev libxrandr-dev xvfb x11-apps xauth bc valgrind
 )
 
