@@ -8,6 +8,7 @@
 #include <random>
 
 #include "projbot/assets/model.hpp"
+#include "projbot/assets/video.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/projection.hpp"
 #include "projbot/engine/renderer.hpp"
@@ -540,4 +541,34 @@ TEST_F(RenderTest, LensPassFillsThePanelOutToTheCorners) {
   std::size_t dark = 0;
   for (std::size_t i = 0; i < img.rgba.size(); i += 4) dark += img.rgba[i + 1] != 255 ? 1 : 0;
   EXPECT_EQ(dark, 0U) << "panel pixels left unlit";
+}
+
+TEST_F(RenderTest, StreamedTextureShowsTheFrameOfEachDraw) {
+  // A video on a material (issue 44): each frame drawn shows the texels streamed for it, through both frame
+  // slots, the quad's texture filling pixels 25..174 of the target.
+  Model m = quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
+                  Eigen::Vector3d(-0.5, 0.5, 1)},
+                 {1, 1, 1, 1});
+  const std::size_t model = renderer_->add_model(m);
+  const std::size_t tex = renderer_->add_streamed_texture(model, 0, 320, 240);
+  const ProjectorConfig p = projector(200, 200, 150, 150, 99.5, 99.5);
+  auto target = renderer_->make_offscreen(p.width_px, p.height_px);
+  const std::vector<DrawItem> items{{model, Eigen::Matrix4d::Identity()}};
+  ASSERT_TRUE(renderer_->draw_frame(*target, p, items));
+  EXPECT_EQ(target->read_back().pixel(100, 150)[0], 0);  // black until a frame comes
+  projbot::engine::FrameProfiler profiler;
+  for (std::int64_t n : {3, 4, 5, 900, 901}) {
+    renderer_->stream_frame(tex, std::make_shared<Image>(projbot::assets::frame_code_image(n, 320, 240)));
+    ASSERT_TRUE(renderer_->draw_frame(*target, p, items, &profiler));
+    EXPECT_EQ(projbot::assets::read_frame_code(target->read_back(), 25, 25, 150, 150), n);
+  }
+  // Drawn again with nothing new streamed: the last frame stays.
+  ASSERT_TRUE(renderer_->draw_frame(*target, p, items, &profiler));
+  EXPECT_EQ(projbot::assets::read_frame_code(target->read_back(), 25, 25, 150, 150), 901);
+  renderer_->finish(*target);
+  ASSERT_EQ(profiler.records().size(), 6U);
+  EXPECT_GT(profiler.records()[0].upload_ms, 0.0);
+  EXPECT_THROW(renderer_->stream_frame(tex, std::make_shared<Image>(projbot::assets::frame_code_image(1, 32, 24))),
+               projbot::engine::EngineError);
+  EXPECT_THROW(renderer_->add_streamed_texture(model, 1, 32, 32), projbot::engine::EngineError);
 }

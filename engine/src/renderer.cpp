@@ -123,6 +123,16 @@ struct GpuModel {
   std::vector<vk::raii::DescriptorSet> sets;  // one per material
 };
 
+// A texture rewritten while it is drawn (a video on a material): the image the material samples, and one
+// staging buffer per frame slot that has uploaded into it (reused only after that slot's fence).
+struct StreamedTexture {
+  std::size_t model = 0;
+  std::size_t material = 0;
+  detail::Image image;
+  std::map<const detail::FrameSlot*, Buffer> staging;
+  std::shared_ptr<const assets::Image> pending;  // texels for the next frame
+};
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -145,6 +155,7 @@ struct Renderer::Impl {
   std::map<vk::Format, vk::raii::Pipeline> lens_pipelines;
   detail::Image white;  // bound where a material has no texture
   std::vector<GpuModel> models;
+  std::vector<StreamedTexture> streamed;
   std::vector<DrawItem> items;
   std::uint64_t frame_index = 0;
 
@@ -360,6 +371,64 @@ struct Renderer::Impl {
     return models.size() - 1;
   }
 
+  std::size_t add_streamed_texture(std::size_t model, int material, int width, int height) {
+    if (model >= models.size()) throw EngineError("streamed texture for model " + std::to_string(model) + ", not uploaded");
+    GpuModel& g = models[model];
+    if (material < 0 || static_cast<std::size_t>(material) >= g.materials.size())
+      throw EngineError("streamed texture for material " + std::to_string(material) + ", but the model has " +
+                        std::to_string(g.materials.size()));
+    if (width <= 0 || height <= 0 || width > 16384 || height > 16384)
+      throw EngineError("a streamed texture of " + std::to_string(width) + "x" + std::to_string(height) + " px");
+    StreamedTexture tex;
+    tex.model = model;
+    tex.material = static_cast<std::size_t>(material);
+    const std::vector<std::uint8_t> black(static_cast<std::size_t>(width) * height * 4, 0);
+    tex.image = upload_image(vk::Extent2D(static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)),
+                             vk::Format::eR8G8B8A8Unorm, black.data(), black.size());
+    gpu->device.waitIdle();  // the material's descriptor set may be in a frame in flight
+    vk::DescriptorImageInfo info(*g.samplers[tex.material], *tex.image.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+    gpu->device.updateDescriptorSets(
+        vk::WriteDescriptorSet(*g.sets[tex.material], 0, 0, vk::DescriptorType::eCombinedImageSampler, info), {});
+    streamed.push_back(std::move(tex));
+    return streamed.size() - 1;
+  }
+
+  void stream_frame(std::size_t id, std::shared_ptr<const assets::Image> image) {
+    if (id >= streamed.size()) throw EngineError("no streamed texture " + std::to_string(id));
+    const vk::Extent2D e = streamed[id].image.extent;
+    if (!image || image->width != static_cast<int>(e.width) || image->height != static_cast<int>(e.height) ||
+        image->rgba.size() != static_cast<std::size_t>(e.width) * e.height * 4)
+      throw EngineError("a frame for streamed texture " + std::to_string(id) + " that is not its " + std::to_string(e.width) +
+                        "x" + std::to_string(e.height) + " RGBA8");
+    streamed[id].pending = std::move(image);
+  }
+
+  // The pending texels of every streamed texture into this slot's staging memory (the render thread's
+  // share of an upload: one copy), and the GPU's copy into the image before anything draws.
+  void record_uploads(const vk::raii::CommandBuffer& cmd, const detail::FrameSlot& slot) {
+    for (StreamedTexture& tex : streamed) {
+      if (!tex.pending) continue;
+      const std::size_t bytes = tex.pending->rgba.size();
+      auto [it, fresh] = tex.staging.try_emplace(&slot);
+      if (fresh)
+        it->second = gpu->make_buffer(bytes, vk::BufferUsageFlagBits::eTransferSrc,
+                                      vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
+      std::memcpy(it->second.mapped, tex.pending->rgba.data(), bytes);  // the slot's last frame is done (retired)
+      tex.pending.reset();
+      detail::transition(cmd, *tex.image.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eShaderReadOnlyOptimal,
+                         vk::ImageLayout::eTransferDstOptimal, vk::PipelineStageFlagBits2::eFragmentShader,
+                         vk::AccessFlagBits2::eShaderSampledRead, vk::PipelineStageFlagBits2::eCopy,
+                         vk::AccessFlagBits2::eTransferWrite);
+      cmd.copyBufferToImage(*it->second.buffer, *tex.image.image, vk::ImageLayout::eTransferDstOptimal,
+                            vk::BufferImageCopy(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, 1),
+                                                {0, 0, 0}, vk::Extent3D(tex.image.extent, 1)));
+      detail::transition(cmd, *tex.image.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eTransferDstOptimal,
+                         vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eCopy,
+                         vk::AccessFlagBits2::eTransferWrite, vk::PipelineStageFlagBits2::eFragmentShader,
+                         vk::AccessFlagBits2::eShaderSampledRead);
+    }
+  }
+
   void ensure_slots(detail::TargetBackend& t) {
     if (!t.slots.empty()) return;
     vk::raii::CommandBuffers cmds(gpu->device, vk::CommandBufferAllocateInfo(*gpu->command_pool, vk::CommandBufferLevel::ePrimary,
@@ -529,6 +598,9 @@ struct Renderer::Impl {
       cmd.resetQueryPool(*t.timestamps, q0, 2);
       cmd.writeTimestamp2(vk::PipelineStageFlagBits2::eTopOfPipe, *t.timestamps, q0);
     }
+    const double upload_start_ms = profiler ? profiler->now_ms() : 0.0;
+    record_uploads(cmd, slot);
+    if (profiler) rec.upload_ms = profiler->now_ms() - upload_start_ms;
     if (lens) record_canvas(cmd, t, *slot.set);
     detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                        vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
@@ -585,6 +657,12 @@ Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl
 Renderer::~Renderer() = default;
 const DeviceInfo& Renderer::device_info() const { return impl_->gpu->info; }
 std::size_t Renderer::add_model(const assets::Model& model) { return impl_->add_model(model); }
+std::size_t Renderer::add_streamed_texture(std::size_t model, int material, int width_px, int height_px) {
+  return impl_->add_streamed_texture(model, material, width_px, height_px);
+}
+void Renderer::stream_frame(std::size_t texture, std::shared_ptr<const assets::Image> image) {
+  impl_->stream_frame(texture, std::move(image));
+}
 
 std::unique_ptr<RenderTarget> Renderer::make_offscreen(int width_px, int height_px) {
   if (width_px <= 0 || height_px <= 0) throw EngineError("offscreen target size must be positive");

@@ -128,6 +128,15 @@ class Renderer {
 
   /// Uploads a model's meshes and textures; returns its id for DrawItem::model.
   std::size_t add_model(const assets::Model& model);
+  /// A texture whose texels change while it is drawn (a video on a material, issue 44): made black at
+  /// width x height px, it becomes material `material`'s base colour texture of model `model` (the material's
+  /// sampler, base colour factor and the vertex colours still apply). Waits for the frames in flight.
+  /// Returns its id for stream_frame. Throws EngineError for a model or material that is not there.
+  std::size_t add_streamed_texture(std::size_t model, int material, int width_px, int height_px);
+  /// Texels (RGBA8, the texture's size) for streamed texture `texture`: the next draw_frame copies them into
+  /// its frame's staging memory (the render thread's whole share, FrameRecord::upload_ms) and the GPU uploads
+  /// them before it draws. Until then the image is held. May be called from a PoseReader.
+  void stream_frame(std::size_t texture, std::shared_ptr<const assets::Image> image);
 
   /// An offscreen RGBA8 target of the given size.
   std::unique_ptr<RenderTarget> make_offscreen(int width_px, int height_px);
