@@ -77,6 +77,32 @@ TEST(SceneTest, ParsesEveryField) {
   EXPECT_DOUBLE_EQ(lit.targets[0].surface.albedo.z(), 0.4);
 }
 
+TEST(SceneTest, TargetContent) {
+  const auto s = parse_scene(
+      "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2}\n"
+      "targets:\n"
+      "  - {name: a, model: a.glb, pose: {translation: [0, 0, 1]}, content: {video: clips/a.mp4}}\n"
+      "  - {name: b, model: b.glb, pose: {translation: [0, 0, 1]}, content: {video: /v/b.mkv, material: Label, loop: false, "
+      "start: tour}}\n"
+      "  - {name: c, model: c.glb, pose: {translation: [0, 0, 1]}, content: {video: c.mp4, material: 2, start: 12.5}}\n"
+      "  - {name: d, model: d.glb, pose: {translation: [0, 0, 1]}}\n",
+      "/scenes/s.yaml");
+  using Start = projbot::config::TargetContent::Start;
+  ASSERT_TRUE(s.targets[0].content);
+  EXPECT_EQ(s.targets[0].content->video, std::filesystem::path("/scenes/clips/a.mp4"));  // beside the scene
+  EXPECT_TRUE(s.targets[0].content->material.empty());
+  EXPECT_TRUE(s.targets[0].content->loop);
+  EXPECT_EQ(s.targets[0].content->start, Start::kArrival);
+  EXPECT_EQ(s.targets[1].content->video, std::filesystem::path("/v/b.mkv"));
+  EXPECT_EQ(s.targets[1].content->material, "Label");
+  EXPECT_FALSE(s.targets[1].content->loop);
+  EXPECT_EQ(s.targets[1].content->start, Start::kTour);
+  EXPECT_EQ(s.targets[2].content->material, "2");
+  EXPECT_EQ(s.targets[2].content->start, Start::kAt);
+  EXPECT_DOUBLE_EQ(s.targets[2].content->at_s, 12.5);
+  EXPECT_FALSE(s.targets[3].content);
+}
+
 TEST(SceneTest, RpyIsRzRyRx) {
   const auto s = parse_scene(kGood, "/scenes/s.yaml");
   const double d = M_PI / 180.0;
@@ -171,6 +197,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"surface_texture_not_yet",
                 kProj + "targets:\n  - name: a\n    model: a.glb\n    surface: {texture: a.png}\n",
                 {"targets[0].surface.texture", "not supported yet"}},
+        BadCase{"content_without_video",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {loop: false}\n",
+                {"targets[0].content.video", "missing"}},
+        BadCase{"content_start_negative",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {video: v.mp4, start: -2}\n",
+                {"targets[0].content.start", "'-2'"}},
+        BadCase{"content_unknown_key",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {video: v.mp4, speed: 2}\n",
+                {"targets[0].content", "speed"}},
         BadCase{"ambient_negative",
                 kProj + "targets: []\nroom: {width: 4, depth: 4, ambient_lux: -3}\n",
                 {"room.ambient_lux", "0..100000 lux"}},

@@ -2,14 +2,18 @@
 // the GPU image is checked against an independent CPU projection of the same mesh (Eq. 3).
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <chrono>
 #include <cmath>
 #include <random>
+#include <thread>
 
 #include "projbot/assets/model.hpp"
 #include "projbot/assets/video.hpp"
 #include "projbot/config/scene.hpp"
+#include "projbot/engine/content.hpp"
 #include "projbot/engine/projection.hpp"
 #include "projbot/engine/renderer.hpp"
 
@@ -571,4 +575,75 @@ TEST_F(RenderTest, StreamedTextureShowsTheFrameOfEachDraw) {
   EXPECT_THROW(renderer_->stream_frame(tex, std::make_shared<Image>(projbot::assets::frame_code_image(1, 32, 24))),
                projbot::engine::EngineError);
   EXPECT_THROW(renderer_->add_streamed_texture(model, 1, 32, 32), projbot::engine::EngineError);
+}
+
+TEST(SceneContentMaterial, ByNameIndexOrFirstTextured) {
+  Model m;
+  m.source = "m.glb";
+  m.materials.resize(3);
+  m.materials[1].name = "Label";
+  m.images.resize(1);
+  m.materials[2].base_color_image = 0;
+  EXPECT_EQ(projbot::engine::content_material(m, ""), 2);
+  EXPECT_EQ(projbot::engine::content_material(m, "Label"), 1);
+  EXPECT_EQ(projbot::engine::content_material(m, "0"), 0);
+  try {
+    projbot::engine::content_material(m, "glass");
+    ADD_FAILURE() << "no throw";
+  } catch (const projbot::assets::AssetError& e) {
+    EXPECT_NE(std::string(e.what()).find("m.glb: no material 'glass' for the content (it has 0, 1 'Label', 2)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(projbot::engine::content_material(m, "3"), projbot::assets::AssetError);
+  m.materials[2].base_color_image = -1;
+  EXPECT_EQ(projbot::engine::content_material(m, ""), 0);
+}
+
+TEST_F(RenderTest, SceneContentDrawsTheVideoFrameOfEachDisplayTime) {
+  // A 30 fps clip on a quad (issue 44): the frame drawn for content time t shows video frame floor(30 t).
+  const fs::path clip = fs::temp_directory_path() / ("projbot_render_content_" + std::to_string(::getpid()) + ".mp4");
+  {
+    projbot::assets::VideoWriter w(clip, 320, 240, 30);
+    for (int i = 0; i < 40; ++i) w.write(projbot::assets::frame_code_image(i, 320, 240));
+    w.finish();
+  }
+  projbot::config::Scene scene;
+  scene.projector = projector(200, 200, 150, 150, 99.5, 99.5);
+  projbot::config::TargetConfig t;
+  t.name = "a";
+  t.content = projbot::config::TargetContent{};
+  t.content->video = clip;
+  t.content->loop = false;
+  scene.targets.push_back(t);
+  std::vector<Model> models{quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
+                                  Eigen::Vector3d(-0.5, 0.5, 1)},
+                                 {1, 1, 1, 1})};
+  const std::size_t model = renderer_->add_model(models[0]);
+  projbot::engine::SceneContent content(*renderer_, scene, models, {model});
+  ASSERT_TRUE(content.has(0));
+  EXPECT_FALSE(content.has(1));
+  auto target = renderer_->make_offscreen(200, 200);
+  const std::vector<DrawItem> items{{model, Eigen::Matrix4d::Identity()}};
+  for (const double at : {0.0, 0.02, 0.034, 0.1, 0.25, 0.5, 0.9}) {
+    const auto expected = static_cast<std::int64_t>(std::floor(at * 30.0 + 1e-9));
+    // The test waits for the decoder (a renderer never does): up to 2 s for the frame of `at` to be decoded.
+    projbot::engine::SceneContent::Sample s;
+    for (int k = 0; k < 1000; ++k) {
+      s = content.show(0, at);
+      if (std::abs(s.pts_s - static_cast<double>(expected) / 30.0) < 1e-3) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    ASSERT_TRUE(renderer_->draw_frame(*target, scene.projector, items));
+    EXPECT_EQ(projbot::assets::read_frame_code(target->read_back(), 25, 25, 150, 150), expected) << "content time " << at;
+  }
+  // Past its end without looping: the last frame stays.
+  content.show(0, 5.0);
+  for (int k = 0; k < 500 && content.show(0, 5.0).pts_s < 39.0 / 30.0 - 1e-3; ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ASSERT_TRUE(renderer_->draw_frame(*target, scene.projector, items));
+  EXPECT_EQ(projbot::assets::read_frame_code(target->read_back(), 25, 25, 150, 150), 39);
+  EXPECT_TRUE(content.take_errors().empty());
+  renderer_->finish(*target);
+  fs::remove(clip);
 }

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Fuzzes one reader of user files with libFuzzer (clang + AddressSanitizer):
-#   tools/fuzz.sh TARGET [SECONDS]     TARGET: gltf scene pcd ply depth_png depth_tiff oni rawlog ini mesh bop, or all
+#   tools/fuzz.sh TARGET [SECONDS]     TARGET: gltf scene pcd ply depth_png depth_tiff oni rawlog ini mesh bop video, or all
 # Seeds: tests/fuzz/corpus/TARGET (committed) plus, for gltf, the shared models. The growing corpus is
 # build/fuzz/corpus/TARGET; a finding (crash, ASan report, allocation over 512 MB, 10 s on one input) is
 # saved under build/fuzz/findings/TARGET/ and the script exits 1: make it a regression test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-targets=(gltf scene pcd ply depth_png depth_tiff oni rawlog ini mesh bop)
+targets=(gltf scene pcd ply depth_png depth_tiff oni rawlog ini mesh bop video)
 usage() { echo "usage: tools/fuzz.sh TARGET [SECONDS]   (TARGET: ${targets[*]} or all; SECONDS default 60)"; exit 2; }
 [[ $# -ge 1 ]] || usage
 target=$1

@@ -403,6 +403,7 @@ class Loader {
       const auto& gm = g_.materials[i];
       const std::string name = "material " + std::to_string(i);
       Material m;
+      m.name = gm.name;
       const auto& f = gm.pbrMetallicRoughness.baseColorFactor;
       if (f.size() == 4)
         for (std::size_t k = 0; k < 4; ++k) {

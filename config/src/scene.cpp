@@ -83,6 +83,37 @@ TargetSurface read_surface(MapReader& t, const std::string& path) {
   return surface;
 }
 
+// A target's `content: {video: F, material: NAME_OR_INDEX, loop: B, start: arrival | tour | SECONDS}`.
+std::optional<TargetContent> read_content(MapReader& t, const std::string& path, const std::filesystem::path& base) {
+  YAML::Node node = t.child("content", false);
+  if (!node) return std::nullopt;
+  MapReader m(node, path, t.file());
+  if (m.has("timeline"))
+    m.fail(node["timeline"], m.key_path("timeline"), "an animated material timeline is not supported yet: give content.video");
+  TargetContent c;
+  const auto video = m.get<std::string>("video", "", true);
+  if (video.empty()) m.fail(node, m.key_path("video"), "must not be empty");
+  c.video = beside_scene(video, base);
+  c.material = m.get<std::string>("material", "");
+  c.loop = m.get<bool>("loop", true);
+  if (YAML::Node st = m.child("start", false)) {
+    if (!st.IsScalar()) m.fail(st, m.key_path("start"), "expected arrival, tour or seconds after the tour began");
+    double at = 0.0;
+    if (st.Scalar() == "arrival") {
+      c.start = TargetContent::Start::kArrival;
+    } else if (st.Scalar() == "tour") {
+      c.start = TargetContent::Start::kTour;
+    } else if (YAML::convert<double>::decode(st, at) && at >= 0.0 && at <= 1e6) {
+      c.start = TargetContent::Start::kAt;
+      c.at_s = at;
+    } else {
+      m.fail(st, m.key_path("start"), "expected arrival, tour or 0..1e6 seconds after the tour began, not '" + st.Scalar() + "'");
+    }
+  }
+  m.reject_unknown();
+  return c;
+}
+
 // A pinhole section (`projector:`, `camera:`): every intrinsic required unless defaults are given.
 ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std::optional<ProjectorConfig>& defaults) {
   YAML::Node node = root.child(key, !defaults);
@@ -511,6 +542,7 @@ TargetConfig read_target(const YAML::Node& node, const std::string& path, const 
   target.present = t.get<bool>("present", true);
   target.support = read_support(t, path + ".support");
   target.surface = read_surface(t, path + ".surface");
+  target.content = read_content(t, path + ".content", base);
   target.T_projector_target = read_pose(t, path + ".pose");
   if (t.has("world_pose")) target.T_world_target = read_pose(t, path + ".world_pose", "world_pose");
   if (t.has("map_pose")) {

@@ -126,8 +126,6 @@ struct GpuModel {
 // A texture rewritten while it is drawn (a video on a material): the image the material samples, and one
 // staging buffer per frame slot that has uploaded into it (reused only after that slot's fence).
 struct StreamedTexture {
-  std::size_t model = 0;
-  std::size_t material = 0;
   detail::Image image;
   std::map<const detail::FrameSlot*, Buffer> staging;
   std::shared_ptr<const assets::Image> pending;  // texels for the next frame
@@ -380,17 +378,26 @@ struct Renderer::Impl {
     if (width <= 0 || height <= 0 || width > 16384 || height > 16384)
       throw EngineError("a streamed texture of " + std::to_string(width) + "x" + std::to_string(height) + " px");
     StreamedTexture tex;
-    tex.model = model;
-    tex.material = static_cast<std::size_t>(material);
     const std::vector<std::uint8_t> black(static_cast<std::size_t>(width) * height * 4, 0);
     tex.image = upload_image(vk::Extent2D(static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)),
                              vk::Format::eR8G8B8A8Unorm, black.data(), black.size());
-    gpu->device.waitIdle();  // the material's descriptor set may be in a frame in flight
-    vk::DescriptorImageInfo info(*g.samplers[tex.material], *tex.image.view, vk::ImageLayout::eShaderReadOnlyOptimal);
-    gpu->device.updateDescriptorSets(
-        vk::WriteDescriptorSet(*g.sets[tex.material], 0, 0, vk::DescriptorType::eCombinedImageSampler, info), {});
     streamed.push_back(std::move(tex));
+    bind_streamed_texture(streamed.size() - 1, model, material);
     return streamed.size() - 1;
+  }
+
+  void bind_streamed_texture(std::size_t id, std::size_t model, int material) {
+    if (id >= streamed.size()) throw EngineError("no streamed texture " + std::to_string(id));
+    if (model >= models.size()) throw EngineError("streamed texture for model " + std::to_string(model) + ", not uploaded");
+    GpuModel& g = models[model];
+    if (material < 0 || static_cast<std::size_t>(material) >= g.materials.size())
+      throw EngineError("streamed texture for material " + std::to_string(material) + ", but the model has " +
+                        std::to_string(g.materials.size()));
+    const auto m = static_cast<std::size_t>(material);
+    gpu->device.waitIdle();  // the material's descriptor set may be in a frame in flight
+    vk::DescriptorImageInfo info(*g.samplers[m], *streamed[id].image.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+    gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*g.sets[m], 0, 0, vk::DescriptorType::eCombinedImageSampler, info),
+                                     {});
   }
 
   void stream_frame(std::size_t id, std::shared_ptr<const assets::Image> image) {
@@ -405,7 +412,9 @@ struct Renderer::Impl {
 
   // The pending texels of every streamed texture into this slot's staging memory (the render thread's
   // share of an upload: one copy), and the GPU's copy into the image before anything draws.
-  void record_uploads(const vk::raii::CommandBuffer& cmd, const detail::FrameSlot& slot) {
+  // Returns the number of textures uploaded.
+  std::size_t record_uploads(const vk::raii::CommandBuffer& cmd, const detail::FrameSlot& slot) {
+    std::size_t uploaded = 0;
     for (StreamedTexture& tex : streamed) {
       if (!tex.pending) continue;
       const std::size_t bytes = tex.pending->rgba.size();
@@ -426,7 +435,9 @@ struct Renderer::Impl {
                          vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eCopy,
                          vk::AccessFlagBits2::eTransferWrite, vk::PipelineStageFlagBits2::eFragmentShader,
                          vk::AccessFlagBits2::eShaderSampledRead);
+      ++uploaded;
     }
+    return uploaded;
   }
 
   void ensure_slots(detail::TargetBackend& t) {
@@ -599,8 +610,7 @@ struct Renderer::Impl {
       cmd.writeTimestamp2(vk::PipelineStageFlagBits2::eTopOfPipe, *t.timestamps, q0);
     }
     const double upload_start_ms = profiler ? profiler->now_ms() : 0.0;
-    record_uploads(cmd, slot);
-    if (profiler) rec.upload_ms = profiler->now_ms() - upload_start_ms;
+    if (record_uploads(cmd, slot) > 0 && profiler) rec.upload_ms = profiler->now_ms() - upload_start_ms;
     if (lens) record_canvas(cmd, t, *slot.set);
     detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                        vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
@@ -659,6 +669,9 @@ const DeviceInfo& Renderer::device_info() const { return impl_->gpu->info; }
 std::size_t Renderer::add_model(const assets::Model& model) { return impl_->add_model(model); }
 std::size_t Renderer::add_streamed_texture(std::size_t model, int material, int width_px, int height_px) {
   return impl_->add_streamed_texture(model, material, width_px, height_px);
+}
+void Renderer::bind_streamed_texture(std::size_t texture, std::size_t model, int material) {
+  impl_->bind_streamed_texture(texture, model, material);
 }
 void Renderer::stream_frame(std::size_t texture, std::shared_ptr<const assets::Image> image) {
   impl_->stream_frame(texture, std::move(image));

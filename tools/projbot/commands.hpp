@@ -25,6 +25,7 @@ extern const Command kAlign;
 extern const Command kBenchTrack;
 extern const Command kBenchMotion;
 extern const Command kBenchAppearance;
+extern const Command kBenchContent;
 extern const Command kBenchAcquire;
 extern const Command kBenchDataset;
 extern const Command kBenchSensor;

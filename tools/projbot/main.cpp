@@ -27,6 +27,7 @@ const std::vector<const Command*>& commands() {
                                                &projbot::tools::kBenchTrack,
                                                &projbot::tools::kBenchMotion,
                                                &projbot::tools::kBenchAppearance,
+                                               &projbot::tools::kBenchContent,
                                                &projbot::tools::kBenchAcquire,
                                                &projbot::tools::kBenchDataset,
                                                &projbot::tools::kBenchSensor,
@@ -105,11 +106,17 @@ static int dispatch(int argc, char** argv, std::string& name) {
   int first = 2;
   if (name == "bench") {  // "bench render", "bench track", ...: the benchmark of a subsystem
     const std::string what = argc < 3 ? std::string() : argv[2];
-    if (what != "render" && what != "track" && what != "motion" && what != "acquire" && what != "localize" && what != "dataset" &&
-        what != "sensor" && what != "appearance") {
+    std::string known;  // the benchmarks, from the command list: "render | track | ..."
+    bool found = false;
+    for (const Command* c : commands())
+      if (c->name.rfind("bench ", 0) == 0) {
+        known += (known.empty() ? "" : " | ") + c->name.substr(6);
+        found = found || c->name.substr(6) == what;
+      }
+    if (!found) {
       std::cerr << "projbot bench: "
                 << (argc < 3 ? std::string("say what to benchmark") : "no benchmark '" + std::string(argv[2]) + "'")
-                << ": projbot bench render | track | motion | appearance | acquire | localize | dataset | sensor\n";
+                << ": projbot bench " << known << "\n";
       return 2;
     }
     name = std::string("bench ") + argv[2];

@@ -8,6 +8,8 @@
 
 #include "commands.hpp"
 #include "projbot/assets/model.hpp"
+#include "projbot/config/clock.hpp"
+#include "projbot/engine/content.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
 #include "scene_setup.hpp"
@@ -85,7 +87,8 @@ const Command kShow{
     "show", "open the projector output in a window (fullscreen on a projector, or a preview)",
     "projbot show [--scene S.yaml] [--fullscreen] [--monitor N] [--present-mode fifo|mailbox|immediate]\n\n"
     "Opens a window showing the projector image and redraws it every frame until the window is closed\n"
-    "(or --frames have been drawn). Without --fullscreen the window has the projector's size.\n",
+    "(or --frames have been drawn). Without --fullscreen the window has the projector's size. Targets with\n"
+    "`content:` play their videos from the moment the window opens.\n",
     with_scene_options({{"fullscreen", "", "fullscreen on --monitor (the projector)"},
                         {"monitor", "N", "monitor index for --fullscreen (default 0)"},
                         {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
@@ -98,12 +101,23 @@ const Command kShow{
           args, scene.projector, "projbot: " + (scene.source.empty() ? std::string("model") : scene.source.filename().string()));
       engine::Renderer renderer(renderer_options(args, true));
       std::cout << "device: " << renderer.device_info().name << '\n';
-      const auto items = upload_scene(renderer, scene);
+      std::vector<assets::Model> models;
+      const auto items = upload_scene(renderer, scene, &models);
+      std::vector<std::size_t> model_ids;
+      for (const auto& item : items) model_ids.push_back(item.model);
+      engine::SceneContent content(renderer, scene, models, model_ids);  // the targets' videos, previewed
       auto window = open_window(renderer, w, scene.projector);
       engine::FrameProfiler profiler;
       int drawn = 0;
+      const double t0 = config::steady_now_s();  // every content start (arrival, tour) is the window's opening
+      const auto read = [&](std::vector<engine::DrawItem>& out) {
+        out.assign(items.begin(), items.end());
+        const double now = config::steady_now_s();
+        for (int i = 0; i < static_cast<int>(items.size()); ++i)
+          if (content.has(i)) content.show(i, now - content.start_s(i, t0, t0));
+      };
       while (!window->poll_close() && (frames == 0 || drawn < frames))
-        if (renderer.draw_frame(*window, scene.projector, items, &profiler)) ++drawn;
+        if (renderer.draw_frame(*window, scene.projector, read, &profiler)) ++drawn;
       renderer.finish(*window);
       finish_profile(args, profiler);
       return report_validation(args, renderer) ? 0 : 1;

@@ -20,6 +20,7 @@
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/config/clock.hpp"
 #include "projbot/config/output_file.hpp"
+#include "projbot/engine/content.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
 #include "projbot/hardware/devices.hpp"
@@ -313,6 +314,9 @@ const Command kRun{
       std::vector<engine::CompensationPlan::Target> surfaces;
       for (std::size_t i = 0; i < models.size(); ++i) surfaces.push_back({&models[i], scene.targets[i].surface.albedo});
       engine::CompensationPlan plan(std::move(surfaces), scene.room.ambient_lux, compensate);
+      std::vector<std::size_t> model_ids;
+      for (const auto& item : items) model_ids.push_back(item.model);
+      engine::SceneContent content(renderer, scene, models, model_ids);  // a bad video: one line, exit 1
       std::unique_ptr<engine::RenderTarget> target;
       if (headless) {
         target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
@@ -384,6 +388,8 @@ const Command kRun{
           for (const session::DrawnPose& d : frames.compose(config::steady_now_s(), now, pose_of)) {
             const auto t = static_cast<std::size_t>(d.target);
             out.push_back({items[t].model, d.T_projector_target, plan.at(t, robot.visit, scene.projector, d.T_projector_target)});
+            if (content.has(d.target))  // on the display clock of this frame, as its pose
+              content.show(d.target, d.display_s - content.start_s(d.target, t0, robot.since_s));
             const auto lit =
                 std::find_if(robot.lit.begin(), robot.lit.end(), [&](const DrawnTarget& l) { return l.target == d.target; });
             drawn.push_back({&*lit, d.capture_s, d.display_s, d.T_camera_target});
@@ -397,6 +403,8 @@ const Command kRun{
         const double start_ms = profiler.now_ms(), start_s = config::steady_now_s();
         frames.frame_started(start_s);
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
+        for (const std::string& e : content.take_errors())  // the last good frame stays up; said once
+          std::cerr << "content: " << e << " (its last good frame stays)" << std::endl;
         const double nan = std::nan("");
         if (drawn.empty()) {
           ++blank;

@@ -27,6 +27,7 @@ struct Sampler {
 
 /// Unlit material: a pixel shows texture * base_color_factor * vertex colour.
 struct Material {
+  std::string name;                                                ///< as the file names it (glTF), or empty
   std::array<float, 4> base_color_factor{1.0F, 1.0F, 1.0F, 1.0F};  ///< linear RGBA multiplier
   int base_color_image = -1;                                       ///< index into Model::images, -1 for none
   Sampler sampler;

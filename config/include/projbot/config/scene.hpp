@@ -102,6 +102,21 @@ struct TargetSurface {
   Eigen::Vector3d albedo{0.75, 0.75, 0.75};  ///< `surface: {albedo: [r, g, b]}`; default a light grey
 };
 
+/// Content that moves on a target (`content:`, issue 44): a video in place of one material's base colour
+/// texture, on the display clock of each frame drawn.
+struct TargetContent {
+  enum class Start { kArrival, kTour, kAt };
+  std::filesystem::path video;  ///< `video:`; relative paths resolved against the scene's folder
+  /// `material:` as written: a material's name or its index; empty: the model's first textured material
+  /// (material 0 where none is textured).
+  std::string material;
+  bool loop = true;  ///< `loop:`; false holds the last frame
+  /// `start:` arrival (content time 0 when the robot reaches the target's stop, again at every visit), tour
+  /// (when the tour began), or a number: that many seconds after the tour began (kAt, at_s).
+  Start start = Start::kArrival;
+  double at_s = 0.0;
+};
+
 /// A static thing in the twin's room that is not a target (`props:`): a neighbour, a distractor, a
 /// pillar that hides part of a target. A glTF model placed like a target, or a plain coloured box.
 struct PropConfig {
@@ -141,8 +156,9 @@ struct TargetConfig {
   /// Marker points on the model (model frame after scale and recenter, metres): where the
   /// projection error is measured.
   std::vector<Eigen::Vector3d> markers_m;
-  TargetSupport support;  ///< the twin only
-  TargetSurface surface;  ///< its own colour under white light
+  TargetSupport support;                 ///< the twin only
+  TargetSurface surface;                 ///< its own colour under white light
+  std::optional<TargetContent> content;  ///< moving content, where there is any
   /// Scripted moves in the twin (`motion:`, one or a list), at most one per visit of this target.
   std::vector<TargetMotion> motions;
   /// The move scripted for this target's `visit`-th visit, or nullptr.

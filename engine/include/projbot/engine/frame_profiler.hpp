@@ -20,7 +20,7 @@ struct FrameRecord {
   double presented_ms = 0.0;  ///< present returned (swapchain) or = submitted (offscreen)
   double completed_ms = 0.0;  ///< the frame's fence was seen signalled
   double gpu_ms = 0.0;        ///< GPU time from timestamp queries, NaN if the device has none
-  double upload_ms = 0.0;     ///< render-thread time copying streamed texels (video) into staging memory
+  double upload_ms = 0.0;     ///< render-thread time copying streamed texels (video) into staging memory; 0: none this frame
 };
 
 /// Percentiles of frame time (start to next start) and GPU time, milliseconds.

@@ -133,6 +133,9 @@ class Renderer {
   /// sampler, base colour factor and the vertex colours still apply). Waits for the frames in flight.
   /// Returns its id for stream_frame. Throws EngineError for a model or material that is not there.
   std::size_t add_streamed_texture(std::size_t model, int material, int width_px, int height_px);
+  /// Makes streamed texture `texture` also material `material`'s base colour of model `model` (one video on
+  /// several targets: decoded and uploaded once). Waits for the frames in flight.
+  void bind_streamed_texture(std::size_t texture, std::size_t model, int material);
   /// Texels (RGBA8, the texture's size) for streamed texture `texture`: the next draw_frame copies them into
   /// its frame's staging memory (the render thread's whole share, FrameRecord::upload_ms) and the GPU uploads
   /// them before it draws. Until then the image is held. May be called from a PoseReader.

@@ -1,0 +1,107 @@
+// The scene's moving content: players per target, bound to materials, sampled on the display clock.
+#include "projbot/engine/content.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+namespace projbot::engine {
+
+int content_material(const assets::Model& model, const std::string& spec) {
+  const auto n = static_cast<int>(model.materials.size());
+  if (spec.empty()) {
+    for (int i = 0; i < n; ++i)
+      if (model.materials[static_cast<std::size_t>(i)].base_color_image >= 0) return i;
+    return 0;
+  }
+  for (int i = 0; i < n; ++i)
+    if (model.materials[static_cast<std::size_t>(i)].name == spec) return i;
+  int index = -1;
+  const auto [end, ec] = std::from_chars(spec.data(), spec.data() + spec.size(), index);
+  if (ec == std::errc() && end == spec.data() + spec.size() && index >= 0 && index < n) return index;
+  std::string names;
+  for (int i = 0; i < n; ++i) {
+    const std::string& name = model.materials[static_cast<std::size_t>(i)].name;
+    names += (i > 0 ? ", " : "") + std::to_string(i) + (name.empty() ? "" : " '" + name + "'");
+  }
+  throw assets::AssetError(model.source + ": no material '" + spec + "' for the content (it has " + names + ")");
+}
+
+SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const std::vector<assets::Model>& models,
+                           const std::vector<std::size_t>& model_ids)
+    : renderer_(renderer) {
+  for (std::size_t i = 0; i < scene.targets.size() && i < models.size() && i < model_ids.size(); ++i) {
+    const auto& content = scene.targets[i].content;
+    if (!content) continue;
+    Stream s;
+    s.target = static_cast<int>(i);
+    s.spec = *content;
+    const int material = content_material(models[i], content->material);
+    // The same video from the same start on several targets: one player and one texture (decoded and
+    // uploaded once, and in step by construction).
+    const auto same = std::find_if(players_.begin(), players_.end(), [&](const Stream& o) {
+      return o.spec.video == content->video && o.spec.loop == content->loop && o.spec.start == content->start &&
+             o.spec.at_s == content->at_s;
+    });
+    if (same != players_.end()) {
+      s.player = same->player;
+      s.texture = same->texture;
+      renderer.bind_streamed_texture(s.texture, model_ids[i], material);
+    } else {
+      s.player = std::make_shared<assets::VideoPlayer>(std::make_unique<assets::VideoDecoder>(content->video), content->loop);
+      s.texture = renderer.add_streamed_texture(model_ids[i], material, s.player->info().width, s.player->info().height);
+    }
+    players_.push_back(std::move(s));
+  }
+}
+
+const SceneContent::Stream* SceneContent::find(int target) const {
+  for (const Stream& s : players_)
+    if (s.target == target) return &s;
+  return nullptr;
+}
+
+bool SceneContent::has(int target) const { return find(target) != nullptr; }
+
+double SceneContent::start_s(int target, double tour_start_s, double arrival_s) const {
+  const Stream* s = find(target);
+  if (s == nullptr) return tour_start_s;
+  switch (s->spec.start) {
+    case config::TargetContent::Start::kArrival:
+      return arrival_s;
+    case config::TargetContent::Start::kAt:
+      return tour_start_s + s->spec.at_s;
+    default:
+      return tour_start_s;
+  }
+}
+
+SceneContent::Sample SceneContent::show(int target, double content_s) {
+  Sample out;
+  out.content_s = content_s;
+  out.pts_s = std::nan("");
+  const Stream* s = find(target);
+  if (s == nullptr) return out;
+  // Before its start the content waits on its first frame.
+  const assets::VideoPlayer::Shown shown = s->player->frame_at(std::max(0.0, content_s));
+  if (!shown.frame) return out;
+  out.pts_s = shown.frame->pts_s;
+  out.fresh = shown.fresh;
+  if (shown.fresh) renderer_.stream_frame(s->texture, std::shared_ptr<const assets::Image>(shown.frame, &shown.frame->image));
+  return out;
+}
+
+const assets::VideoPlayer& SceneContent::player(int target) const {
+  const Stream* s = find(target);
+  if (s == nullptr) throw EngineError("target " + std::to_string(target) + " has no content");
+  return *s->player;
+}
+
+std::vector<std::string> SceneContent::take_errors() {
+  std::vector<std::string> out;
+  for (Stream& s : players_)  // a shared player says its error once: take_error empties it
+    if (std::string e = s.player->take_error(); !e.empty()) out.push_back(e);
+  return out;
+}
+
+}  // namespace projbot::engine
