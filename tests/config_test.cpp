@@ -101,6 +101,17 @@ TEST(SceneTest, TargetContent) {
   EXPECT_EQ(s.targets[2].content->start, Start::kAt);
   EXPECT_DOUBLE_EQ(s.targets[2].content->at_s, 12.5);
   EXPECT_FALSE(s.targets[3].content);
+  EXPECT_TRUE(s.targets[0].content->timeline.empty());
+  const auto t = parse_scene(
+      "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2}\n"
+      "targets:\n  - name: a\n    model: a.glb\n    pose: {translation: [0, 0, 1]}\n"
+      "    content: {timeline: [{at_s: 0, base_color_factor: [1, 0, 0, 1]}, {at_s: 2.5, base_color_factor: [0, 0, 1, 0.5]}]}\n",
+      "/scenes/s.yaml");
+  ASSERT_EQ(t.targets[0].content->timeline.size(), 2U);
+  EXPECT_TRUE(t.targets[0].content->video.empty());
+  EXPECT_DOUBLE_EQ(t.targets[0].content->timeline[1].at_s, 2.5);
+  EXPECT_DOUBLE_EQ(t.targets[0].content->timeline[1].base_color_factor[2], 1.0);
+  EXPECT_DOUBLE_EQ(t.targets[0].content->timeline[1].base_color_factor[3], 0.5);
 }
 
 TEST(SceneTest, RpyIsRzRyRx) {
@@ -199,7 +210,13 @@ INSTANTIATE_TEST_SUITE_P(
                 {"targets[0].surface.texture", "not supported yet"}},
         BadCase{"content_without_video",
                 kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {loop: false}\n",
-                {"targets[0].content.video", "missing"}},
+                {"targets[0].content", "needs a video or a timeline"}},
+        BadCase{"content_timeline_empty",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {timeline: []}\n",
+                {"targets[0].content.timeline", "non-empty list"}},
+        BadCase{"content_timeline_key_without_time",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {timeline: [{base_color_factor: [1, 1, 1, 1]}]}\n",
+                {"targets[0].content.timeline[0].at_s", "missing"}},
         BadCase{"content_start_negative",
                 kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {video: v.mp4, start: -2}\n",
                 {"targets[0].content.start", "'-2'"}},

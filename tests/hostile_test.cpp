@@ -309,6 +309,12 @@ std::vector<Hostile> clash_cases() {
                     {"cut.mp4", "@head:4000:{src}/assets/videos/countdown.mp4"}},
               1,
               {"cut.mp4: "}},
+      Hostile{"bench_content_video_mov_table_713mb",
+              "bench content --scene {dir}/bad.yaml",
+              "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: a, model: {duck}, scale: "
+              "0.25, pose: {translation: [0, 0, 1]}, content: {video: {src}/tests/hostile/mp4_table_713mb.mp4}}\n",
+              1,
+              {"mp4_table_713mb.mp4: "}},
       Hostile{"bench_content_video_is_a_folder",
               "bench content --scene {dir}/bad.yaml",
               "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: a, model: {duck}, scale: "
@@ -327,12 +333,19 @@ std::vector<Hostile> clash_cases() {
               1,
               {"no target has `content:` to play"}},
       Hostile{"bench_content_seconds_zero", "bench content --seconds 0", "", 2, {"--seconds must be 0.1..86400"}},
-      Hostile{"scene_content_timeline",
+      Hostile{"scene_content_timeline_backwards",
               "bench content --scene {dir}/bad.yaml",
               "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: a, model: {duck}, scale: "
-              "0.25, pose: {translation: [0, 0, 1]}, content: {video: a.mp4, timeline: []}}\n",
+              "0.25, pose: {translation: [0, 0, 1]}, content: {timeline: [{at_s: 1, base_color_factor: [1, 1, 1, 1]}, {at_s: "
+              "0.5, base_color_factor: [0, 0, 0, 1]}]}}\n",
               1,
-              {"content.timeline: an animated material timeline is not supported yet"}},
+              {"content.timeline[1].at_s: must come after the key before it"}},
+      Hostile{"scene_content_timeline_colour_over_one",
+              "bench content --scene {dir}/bad.yaml",
+              "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: a, model: {duck}, scale: "
+              "0.25, pose: {translation: [0, 0, 1]}, content: {timeline: [{at_s: 0, base_color_factor: [2, 1, 1, 1]}]}}\n",
+              1,
+              {"content.timeline[0].base_color_factor: each of r, g, b, a must be 0..1"}},
       Hostile{"scene_content_start_tomorrow",
               "bench content --scene {dir}/bad.yaml",
               "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: a, model: {duck}, scale: "

@@ -647,3 +647,34 @@ TEST_F(RenderTest, SceneContentDrawsTheVideoFrameOfEachDisplayTime) {
   renderer_->finish(*target);
   fs::remove(clip);
 }
+
+TEST_F(RenderTest, SceneContentTimelineAnimatesTheBaseColourFactor) {
+  // A timeline (issue 44) on a white quad: red at 0 s, blue at 2 s, looping; the colour drawn at each content
+  // time against the linear interpolation between the keys (CPU reference), within one 8-bit step.
+  projbot::config::Scene scene;
+  scene.projector = projector(100, 100, 80, 80, 49.5, 49.5);
+  projbot::config::TargetConfig t;
+  t.name = "a";
+  t.content = projbot::config::TargetContent{};
+  t.content->timeline = {{0.0, {1.0, 0.0, 0.0, 1.0}}, {2.0, {0.0, 0.0, 1.0, 1.0}}};
+  scene.targets.push_back(t);
+  std::vector<Model> models{quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
+                                  Eigen::Vector3d(-0.5, 0.5, 1)},
+                                 {1, 1, 1, 1})};
+  const std::size_t model = renderer_->add_model(models[0]);
+  projbot::engine::SceneContent content(*renderer_, scene, models, {model});
+  ASSERT_TRUE(content.has(0));
+  EXPECT_FALSE(content.has_video(0));
+  for (const double at : {0.0, 0.5, 1.5, 2.5, -1.0}) {
+    std::vector<DrawItem> items{{model, Eigen::Matrix4d::Identity()}};
+    content.animate(0, at, items[0]);
+    const Image img = render(scene.projector, items);
+    const double phase = std::fmod(std::max(0.0, at), 2.0) / 2.0;  // looping every 2 s
+    EXPECT_NEAR(img.pixel(50, 50)[0], 255.0 * (1.0 - phase), 1.0) << at;
+    EXPECT_NEAR(img.pixel(50, 50)[1], 0.0, 1.0) << at;
+    EXPECT_NEAR(img.pixel(50, 50)[2], 255.0 * phase, 1.0) << at;
+  }
+  // Without the timeline's item override the quad is its own white.
+  const Image plain = render(scene.projector, {{model, Eigen::Matrix4d::Identity()}});
+  EXPECT_EQ(plain.pixel(50, 50)[1], 255);
+}

@@ -73,6 +73,18 @@ struct MemoryInput {
   }
 };
 
+// FFmpeg's own log is quiet (what goes wrong is one line naming the file, ours), and no single block it
+// allocates may exceed 256 MiB: a container's header claims table sizes (a fuzzed mp4 had the mov demuxer
+// ask for 713 MB before reading a byte of them); a frame within the size limits needs at most 128 MiB.
+void set_up_ffmpeg() {
+  static const bool done = [] {
+    av_log_set_level(AV_LOG_QUIET);
+    av_max_alloc(std::size_t{256} << 20);
+    return true;
+  }();
+  (void)done;
+}
+
 }  // namespace
 
 struct VideoDecoder::Impl {
@@ -198,7 +210,7 @@ struct VideoDecoder::Impl {
 };
 
 VideoDecoder::VideoDecoder(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
-  av_log_set_level(AV_LOG_QUIET);  // what goes wrong is one line naming the file, ours, not FFmpeg's log
+  set_up_ffmpeg();
   impl_->name = path.string();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) impl_->fail("does not exist");
@@ -210,7 +222,7 @@ VideoDecoder::VideoDecoder(const std::filesystem::path& path) : impl_(std::make_
 }
 
 VideoDecoder::VideoDecoder(std::span<const std::uint8_t> bytes, std::string name) : impl_(std::make_unique<Impl>()) {
-  av_log_set_level(AV_LOG_QUIET);
+  set_up_ffmpeg();
   impl_->name = std::move(name);
   impl_->memory = std::make_unique<MemoryInput>();
   impl_->memory->bytes.assign(bytes.begin(), bytes.end());

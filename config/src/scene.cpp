@@ -83,17 +83,44 @@ TargetSurface read_surface(MapReader& t, const std::string& path) {
   return surface;
 }
 
-// A target's `content: {video: F, material: NAME_OR_INDEX, loop: B, start: arrival | tour | SECONDS}`.
+// `content.timeline`: keys of a material's base colour factor over content time, times increasing.
+std::vector<TargetContent::Key> read_timeline(MapReader& m, const YAML::Node& list, const std::string& path) {
+  if (!list.IsSequence() || list.size() == 0)
+    m.fail(list, path, "expected a non-empty list of {at_s: S, base_color_factor: [r, g, b, a]}");
+  std::vector<TargetContent::Key> keys;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string where = path + "[" + std::to_string(k) + "]";
+    MapReader key(list[k], where, m.file());
+    TargetContent::Key out;
+    out.at_s = key.get<double>("at_s", 0.0, true);
+    if (!(out.at_s >= 0.0 && out.at_s <= 1e6)) key.fail(list[k]["at_s"], where + ".at_s", "must be 0..1e6 seconds");
+    if (!keys.empty() && !(out.at_s > keys.back().at_s))
+      key.fail(list[k]["at_s"], where + ".at_s", "must come after the key before it (times increase)");
+    const YAML::Node f = key.child("base_color_factor", true);
+    const auto v = key.numbers(f, where + ".base_color_factor", 4);
+    for (std::size_t i = 0; i < 4; ++i) {
+      if (!(v[i] >= 0.0 && v[i] <= 1.0)) key.fail(f, where + ".base_color_factor", "each of r, g, b, a must be 0..1");
+      out.base_color_factor[i] = v[i];
+    }
+    key.reject_unknown();
+    keys.push_back(out);
+  }
+  return keys;
+}
+
+// A target's `content: {video: F, material: NAME_OR_INDEX, loop: B, start: arrival | tour | SECONDS, timeline: [...]}`.
 std::optional<TargetContent> read_content(MapReader& t, const std::string& path, const std::filesystem::path& base) {
   YAML::Node node = t.child("content", false);
   if (!node) return std::nullopt;
   MapReader m(node, path, t.file());
-  if (m.has("timeline"))
-    m.fail(node["timeline"], m.key_path("timeline"), "an animated material timeline is not supported yet: give content.video");
   TargetContent c;
-  const auto video = m.get<std::string>("video", "", true);
-  if (video.empty()) m.fail(node, m.key_path("video"), "must not be empty");
-  c.video = beside_scene(video, base);
+  if (m.has("video")) {
+    const auto video = m.get<std::string>("video", "");
+    if (video.empty()) m.fail(node["video"], m.key_path("video"), "must not be empty");
+    c.video = beside_scene(video, base);
+  }
+  if (YAML::Node tl = m.child("timeline", false)) c.timeline = read_timeline(m, tl, m.key_path("timeline"));
+  if (c.video.empty() && c.timeline.empty()) m.fail(node, path, "needs a video or a timeline (or both): nothing would move");
   c.material = m.get<std::string>("material", "");
   c.loop = m.get<bool>("loop", true);
   if (YAML::Node st = m.child("start", false)) {

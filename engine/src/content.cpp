@@ -37,10 +37,15 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
     s.target = static_cast<int>(i);
     s.spec = *content;
     const int material = content_material(models[i], content->material);
+    s.material = material;
+    if (content->video.empty()) {  // a timeline alone
+      players_.push_back(std::move(s));
+      continue;
+    }
     // The same video from the same start on several targets: one player and one texture (decoded and
     // uploaded once, and in step by construction).
     const auto same = std::find_if(players_.begin(), players_.end(), [&](const Stream& o) {
-      return o.spec.video == content->video && o.spec.loop == content->loop && o.spec.start == content->start &&
+      return o.player && o.spec.video == content->video && o.spec.loop == content->loop && o.spec.start == content->start &&
              o.spec.at_s == content->at_s;
     });
     if (same != players_.end()) {
@@ -62,6 +67,28 @@ const SceneContent::Stream* SceneContent::find(int target) const {
 }
 
 bool SceneContent::has(int target) const { return find(target) != nullptr; }
+bool SceneContent::has_video(int target) const {
+  const Stream* s = find(target);
+  return s != nullptr && s->player != nullptr;
+}
+
+void SceneContent::animate(int target, double content_s, DrawItem& item) const {
+  const Stream* s = find(target);
+  if (s == nullptr || s->spec.timeline.empty()) return;
+  const auto& keys = s->spec.timeline;
+  double t = std::max(0.0, content_s);
+  const double period = keys.back().at_s;
+  if (s->spec.loop && period > 0.0) t = std::fmod(t, period);
+  std::size_t k = 0;
+  while (k + 1 < keys.size() && keys[k + 1].at_s <= t) ++k;
+  const auto& a = keys[k];
+  const auto& b = keys[std::min(k + 1, keys.size() - 1)];
+  const double w = b.at_s > a.at_s ? std::clamp((t - a.at_s) / (b.at_s - a.at_s), 0.0, 1.0) : 0.0;
+  item.animated_material = s->material;
+  for (std::size_t c = 0; c < 4; ++c)
+    item.base_color_factor[c] =
+        static_cast<float>(a.base_color_factor[c] + w * (b.base_color_factor[c] - a.base_color_factor[c]));
+}
 
 double SceneContent::start_s(int target, double tour_start_s, double arrival_s) const {
   const Stream* s = find(target);
@@ -81,7 +108,7 @@ SceneContent::Sample SceneContent::show(int target, double content_s) {
   out.content_s = content_s;
   out.pts_s = std::nan("");
   const Stream* s = find(target);
-  if (s == nullptr) return out;
+  if (s == nullptr || !s->player) return out;
   // Before its start the content waits on its first frame.
   const assets::VideoPlayer::Shown shown = s->player->frame_at(std::max(0.0, content_s));
   if (!shown.frame) return out;
@@ -93,14 +120,15 @@ SceneContent::Sample SceneContent::show(int target, double content_s) {
 
 const assets::VideoPlayer& SceneContent::player(int target) const {
   const Stream* s = find(target);
-  if (s == nullptr) throw EngineError("target " + std::to_string(target) + " has no content");
+  if (s == nullptr || !s->player) throw EngineError("target " + std::to_string(target) + " plays no video");
   return *s->player;
 }
 
 std::vector<std::string> SceneContent::take_errors() {
   std::vector<std::string> out;
   for (Stream& s : players_)  // a shared player says its error once: take_error empties it
-    if (std::string e = s.player->take_error(); !e.empty()) out.push_back(e);
+    if (s.player)
+      if (std::string e = s.player->take_error(); !e.empty()) out.push_back(e);
   return out;
 }
 

@@ -516,7 +516,8 @@ struct Renderer::Impl {
           cmd.bindPipeline(vk::PipelineBindPoint::eGraphics,
                            *pipeline(format, !mat.double_sided, depth_camera ? 0 : alpha_mode_id(mat.alpha_mode), depth_camera));
           cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout, 0, *m.sets[part.material], {});
-          c.base_color_factor = mat.base_color_factor;
+          c.base_color_factor =
+              static_cast<int>(part.material) == item.animated_material ? item.base_color_factor : mat.base_color_factor;
           c.projector[3] = mat.alpha_cutoff;
           cmd.pushConstants<DrawConstants>(*pipeline_layout,
                                            vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, c);

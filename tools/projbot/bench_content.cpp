@@ -60,7 +60,10 @@ ContentRun run_content(engine::Renderer& renderer, engine::RenderTarget& target,
       double lo = INFINITY, hi = -INFINITY;
       for (int i = 0; i < static_cast<int>(items.size()); ++i) {
         if (!content.has(i)) continue;
-        const auto s = content.show(i, display_s - content.start_s(i, t0, t0));
+        const double content_s = display_s - content.start_s(i, t0, t0);
+        content.animate(i, content_s, out[static_cast<std::size_t>(i)]);
+        if (!content.has_video(i)) continue;
+        const auto s = content.show(i, content_s);
         if (std::isnan(s.pts_s)) continue;
         const double offset = 1000.0 * (std::max(0.0, s.content_s) - s.pts_s);
         run.offset_ms.push_back(offset);
@@ -79,7 +82,7 @@ ContentRun run_content(engine::Renderer& renderer, engine::RenderTarget& target,
     if (r.upload_ms > 0.0) run.upload_ms.push_back(r.upload_ms);
   std::set<const assets::VideoPlayer*> counted;  // targets with the same video and start share a player
   for (int i = 0; i < static_cast<int>(items.size()); ++i) {
-    if (!content.has(i) || !counted.insert(&content.player(i)).second) continue;
+    if (!content.has_video(i) || !counted.insert(&content.player(i)).second) continue;
     const auto st = content.player(i).stats();
     run.waits += st.waits;
     run.repeated += st.repeated;
@@ -161,7 +164,7 @@ const Command kBenchContent{
       for (const auto& item : items) ids.push_back(item.model);
       engine::SceneContent content(renderer, scene, models, ids);
       for (int i = 0; i < static_cast<int>(scene.targets.size()); ++i)
-        if (content.has(i)) {
+        if (content.has_video(i)) {
           const auto& info = content.player(i).info();
           std::printf("%s: %s, %dx%d %s at %.2f fps\n", scene.targets[static_cast<std::size_t>(i)].name.c_str(),
                       content.player(i).name().c_str(), info.width, info.height, info.codec.c_str(), info.fps);

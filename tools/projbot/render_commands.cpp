@@ -114,7 +114,11 @@ const Command kShow{
         out.assign(items.begin(), items.end());
         const double now = config::steady_now_s();
         for (int i = 0; i < static_cast<int>(items.size()); ++i)
-          if (content.has(i)) content.show(i, now - content.start_s(i, t0, t0));
+          if (content.has(i)) {
+            const double content_s = now - content.start_s(i, t0, t0);
+            content.show(i, content_s);
+            content.animate(i, content_s, out[static_cast<std::size_t>(i)]);
+          }
       };
       while (!window->poll_close() && (frames == 0 || drawn < frames))
         if (renderer.draw_frame(*window, scene.projector, read, &profiler)) ++drawn;

@@ -388,8 +388,11 @@ const Command kRun{
           for (const session::DrawnPose& d : frames.compose(config::steady_now_s(), now, pose_of)) {
             const auto t = static_cast<std::size_t>(d.target);
             out.push_back({items[t].model, d.T_projector_target, plan.at(t, robot.visit, scene.projector, d.T_projector_target)});
-            if (content.has(d.target))  // on the display clock of this frame, as its pose
-              content.show(d.target, d.display_s - content.start_s(d.target, t0, robot.since_s));
+            if (content.has(d.target)) {  // on the display clock of this frame, as its pose
+              const double content_s = d.display_s - content.start_s(d.target, t0, robot.since_s);
+              content.show(d.target, content_s);
+              content.animate(d.target, content_s, out.back());
+            }
             const auto lit =
                 std::find_if(robot.lit.begin(), robot.lit.end(), [&](const DrawnTarget& l) { return l.target == d.target; });
             drawn.push_back({&*lit, d.capture_s, d.display_s, d.T_camera_target});

@@ -106,7 +106,13 @@ struct TargetSurface {
 /// texture, on the display clock of each frame drawn.
 struct TargetContent {
   enum class Start { kArrival, kTour, kAt };
-  std::filesystem::path video;  ///< `video:`; relative paths resolved against the scene's folder
+  /// One key of `timeline:`: the material's base colour factor (linear RGBA, each 0..1) at at_s seconds of
+  /// content time; between keys it is interpolated linearly, before the first and after the last it holds.
+  struct Key {
+    double at_s = 0.0;
+    std::array<double, 4> base_color_factor{1.0, 1.0, 1.0, 1.0};
+  };
+  std::filesystem::path video;  ///< `video:`; relative paths resolved against the scene's folder; empty: none
   /// `material:` as written: a material's name or its index; empty: the model's first textured material
   /// (material 0 where none is textured).
   std::string material;
@@ -115,6 +121,9 @@ struct TargetContent {
   /// (when the tour began), or a number: that many seconds after the tour began (kAt, at_s).
   Start start = Start::kArrival;
   double at_s = 0.0;
+  /// `timeline: [{at_s: 0, base_color_factor: [r, g, b, a]}, ...]`: the material's colour over content time
+  /// (times increasing; with loop, it repeats every last at_s). A model's own animations are not used.
+  std::vector<Key> timeline;
 };
 
 /// A static thing in the twin's room that is not a target (`props:`): a neighbour, a distractor, a

@@ -28,7 +28,8 @@ class SceneContent {
   SceneContent(Renderer& renderer, const config::Scene& scene, const std::vector<assets::Model>& models,
                const std::vector<std::size_t>& model_ids);
   bool empty() const { return players_.empty(); }
-  bool has(int target) const;
+  bool has(int target) const;        ///< target `target` has content (a video, a timeline or both)
+  bool has_video(int target) const;  ///< target `target` plays a video
 
   /// When target `target`'s content time is 0, on the display clock: the tour's start, the arrival at its stop
   /// (`arrival_s`, the stop's start), or at_s after the tour's start.
@@ -43,7 +44,12 @@ class SceneContent {
   /// to the renderer for the next draw. A target without content gives NaN pts.
   Sample show(int target, double content_s);
 
-  /// Target `target`'s player (it must have content; targets with the same video and start share one).
+  /// Target `target`'s animated material at `content_s`: its timeline's base colour factor (linear between
+  /// keys, held outside them, repeating every last key's time where it loops) set on `item`. A target
+  /// without a timeline leaves `item` as it is.
+  void animate(int target, double content_s, DrawItem& item) const;
+
+  /// Target `target`'s player (it must have a video; targets with the same video and start share one).
   const assets::VideoPlayer& player(int target) const;
   /// Playback errors not reported before, one line each naming the file.
   std::vector<std::string> take_errors();
@@ -54,6 +60,7 @@ class SceneContent {
     config::TargetContent spec;
     std::shared_ptr<assets::VideoPlayer> player;  ///< shared by targets with the same video and start
     std::size_t texture = 0;
+    int material = 0;
   };
   const Stream* find(int target) const;
   Renderer& renderer_;

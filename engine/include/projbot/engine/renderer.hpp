@@ -81,6 +81,10 @@ struct DrawItem {
   std::size_t model = 0;
   Eigen::Matrix4d T_projector_target = Eigen::Matrix4d::Identity();
   Compensation compensation;  ///< off: the content as stored; on: what makes its surface show it (issue 43)
+  /// An animated material (issue 44): material `animated_material` of the model draws with this base colour
+  /// factor in place of its own; -1: none.
+  int animated_material = -1;
+  std::array<float, 4> base_color_factor{1.0F, 1.0F, 1.0F, 1.0F};
 };
 
 /// Called once per frame, as late as possible, to fill the poses to draw (the newest ones).
