@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <random>
 #include <thread>
 
@@ -677,4 +678,64 @@ TEST_F(RenderTest, SceneContentTimelineAnimatesTheBaseColourFactor) {
   // Without the timeline's item override the quad is its own white.
   const Image plain = render(scene.projector, {{model, Eigen::Matrix4d::Identity()}});
   EXPECT_EQ(plain.pixel(50, 50)[1], 255);
+}
+
+TEST_F(RenderTest, SceneContentSwapsAChangedVideoAndKeepsTheOldOneWhenTheNewFails) {
+  // run's watch on content files (issue 44): a clip replaced on disk plays from its own start at a later
+  // frame; a replacement that does not decode leaves the playing one and says why.
+  const fs::path dir = fs::temp_directory_path() / ("projbot_render_swap_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path clip = dir / "clip.mp4";
+  const auto write = [&](std::int64_t first, int w, int h) {
+    projbot::assets::VideoWriter writer(clip, w, h, 30);
+    for (int i = 0; i < 10; ++i) writer.write(projbot::assets::frame_code_image(first + i, w, h));
+    writer.finish();
+  };
+  write(0, 320, 240);
+  projbot::config::Scene scene;
+  scene.projector = projector(200, 200, 150, 150, 99.5, 99.5);
+  projbot::config::TargetConfig t;
+  t.name = "a";
+  t.content = projbot::config::TargetContent{};
+  t.content->video = clip;
+  t.content->loop = false;
+  scene.targets.push_back(t);
+  std::vector<Model> models{quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
+                                  Eigen::Vector3d(-0.5, 0.5, 1)},
+                                 {1, 1, 1, 1})};
+  const std::size_t model = renderer_->add_model(models[0]);
+  projbot::engine::SceneContent content(*renderer_, scene, models, {model});
+  auto target = renderer_->make_offscreen(200, 200);
+  const std::vector<DrawItem> items{{model, Eigen::Matrix4d::Identity()}};
+  const auto code_at = [&](double at) {  // waits (the test, not a renderer) for a frame, then draws it
+    for (int k = 0; k < 500 && std::isnan(content.show(0, at).pts_s); ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    EXPECT_TRUE(renderer_->draw_frame(*target, scene.projector, items));
+    return projbot::assets::read_frame_code(target->read_back(), 25, 25, 150, 150);
+  };
+  EXPECT_EQ(code_at(0.0), 0);
+  EXPECT_TRUE(content.reload_changed(0.0).empty());  // unchanged
+  write(500, 160, 120);                              // another size: a new texture
+  std::vector<std::string> said;
+  for (int k = 0; k < 1000 && said.empty(); ++k) {
+    said = content.reload_changed(1.0 + k, 0.5);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_EQ(said.size(), 1U);
+  EXPECT_NE(said[0].find("clip.mp4: changed; the new video plays from its start"), std::string::npos) << said[0];
+  EXPECT_EQ(code_at(0.0), 500);  // content time 0 of the old is the new one's start
+  // A replacement that is not a video: the last good one stays, said once.
+  std::ofstream(clip, std::ios::binary | std::ios::trunc) << "not a video at all, and longer than before............";
+  said.clear();
+  for (int k = 0; k < 1000 && said.empty(); ++k) {
+    said = content.reload_changed(2000.0 + k, 0.5);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_EQ(said.size(), 1U);
+  EXPECT_NE(said[0].find("clip.mp4: not a video FFmpeg can read"), std::string::npos) << said[0];
+  EXPECT_NE(said[0].find("the old video goes on"), std::string::npos) << said[0];
+  EXPECT_EQ(code_at(0.0), 500);
+  EXPECT_TRUE(content.reload_changed(5000.0).empty());  // said once
+  renderer_->finish(*target);
+  fs::remove_all(dir);
 }

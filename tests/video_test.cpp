@@ -235,3 +235,30 @@ TEST(VideoPlayer, ADecoderBehindRepeatsTheLastFrameAndCountsIt) {
   EXPECT_EQ(p.stats().shown + p.stats().skipped, 28U);
   EXPECT_GE(p.stats().skipped, 1U);
 }
+
+TEST(VideoPlayer, ContentFarAheadIsJumpedToNotDecodedThrough) {
+  // A target not drawn for a while, its content's time going on: asked 7.5 s in, a looping 3 s clip jumps
+  // (from the key frame before) to frame 45 of its third pass instead of decoding 225 frames.
+  const fs::path clip = write_clip("seek.mp4", 90, 64, 48);
+  VideoPlayer p(std::make_unique<VideoDecoder>(clip), true, 4);
+  auto s = settle(p, 0.0);
+  ASSERT_TRUE(s.frame);
+  for (int i = 0; i < 1000; ++i) {
+    s = p.frame_at(7.5);
+    if (s.frame && std::abs(s.frame->pts_s - 7.5) < 1e-3) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_NEAR(s.frame->pts_s, 7.5, 1e-3);
+  EXPECT_EQ(read_frame_code(s.frame->image, 0, 0, 64, 48), 45);
+  EXPECT_EQ(p.stats().seeks, 1U);
+  EXPECT_LT(p.stats().decoded, 20U);  // the frames around the jump, not the 225 before it
+  // Not looping: past the end, a jump lands on the last frame.
+  VideoPlayer once(std::make_unique<VideoDecoder>(clip), false, 4);
+  s = settle(once, 0.0);
+  for (int i = 0; i < 1000; ++i) {
+    s = once.frame_at(60.0);
+    if (s.frame && read_frame_code(s.frame->image, 0, 0, 64, 48) == 89) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_EQ(read_frame_code(s.frame->image, 0, 0, 64, 48), 89);
+}

@@ -102,6 +102,7 @@ struct VideoDecoder::Impl {
   std::int64_t first_pts = AV_NOPTS_VALUE;
   std::int64_t decoded = 0;
   bool draining = false;
+  double seek_to_s = -1.0;  // after a seek: frames whose time has passed by then are decoded and dropped
 
   [[noreturn]] void fail(const std::string& what) const { throw AssetError(name + ": " + what); }
 
@@ -251,6 +252,18 @@ const std::string& VideoDecoder::name() const { return impl_->name; }
 bool VideoDecoder::next(VideoFrame& out) {
   Impl& d = *impl_;
   if (!d.decode_one()) return false;
+  while (d.seek_to_s > 0.0) {  // after a seek: decoded from the key frame before, kept from the frame showing then
+    const std::int64_t pts = d.frame->best_effort_timestamp;
+    const double duration =
+        d.frame->pkt_duration > 0 ? static_cast<double>(d.frame->pkt_duration) * av_q2d(d.time_base) : 1.0 / d.info.fps;
+    if (pts == AV_NOPTS_VALUE || d.first_pts == AV_NOPTS_VALUE ||
+        static_cast<double>(pts - d.first_pts) * av_q2d(d.time_base) + duration > d.seek_to_s + 1e-6)
+      break;
+    av_frame_unref(d.frame.get());
+    ++d.decoded;
+    if (!d.decode_one()) return false;
+  }
+  d.seek_to_s = -1.0;
   if (d.info.width == 0) {  // the first frame fixes the size every later one must keep
     d.check_size(d.frame->width, d.frame->height);
     d.info.width = d.frame->width;
@@ -260,6 +273,23 @@ bool VideoDecoder::next(VideoFrame& out) {
   d.stamp(out);
   av_frame_unref(d.frame.get());
   return true;
+}
+
+void VideoDecoder::seek(double t_s) {
+  Impl& d = *impl_;
+  if (!(t_s > 0.0) || d.first_pts == AV_NOPTS_VALUE) {
+    rewind();
+    return;
+  }
+  const auto ts = d.first_pts + static_cast<std::int64_t>(t_s / av_q2d(d.time_base));
+  if (av_seek_frame(d.format.get(), d.stream, ts, AVSEEK_FLAG_BACKWARD) < 0) {
+    rewind();  // a container that cannot seek: decoded from the start, dropped up to the time
+  } else {
+    avcodec_flush_buffers(d.codec.get());
+    d.draining = false;
+    d.decoded = 0;
+  }
+  d.seek_to_s = t_s;
 }
 
 void VideoDecoder::rewind() {
@@ -273,6 +303,7 @@ void VideoDecoder::rewind() {
   avcodec_flush_buffers(d.codec.get());
   d.draining = false;
   d.decoded = 0;
+  d.seek_to_s = -1.0;
 }
 
 }  // namespace projbot::assets

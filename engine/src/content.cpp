@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <charconv>
+#include <chrono>
 #include <cmath>
+#include <optional>
 
 namespace projbot::engine {
 
@@ -38,6 +40,7 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
     s.spec = *content;
     const int material = content_material(models[i], content->material);
     s.material = material;
+    s.model = model_ids[i];
     if (content->video.empty()) {  // a timeline alone
       players_.push_back(std::move(s));
       continue;
@@ -55,6 +58,13 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
     } else {
       s.player = std::make_shared<assets::VideoPlayer>(std::make_unique<assets::VideoDecoder>(content->video), content->loop);
       s.texture = renderer.add_streamed_texture(model_ids[i], material, s.player->info().width, s.player->info().height);
+      Watch w;
+      w.player = s.player;
+      w.file = content->video;
+      std::error_code ec;
+      w.written = std::filesystem::last_write_time(w.file, ec);
+      w.size = std::filesystem::file_size(w.file, ec);
+      watches_.push_back(std::move(w));
     }
     players_.push_back(std::move(s));
   }
@@ -107,10 +117,13 @@ SceneContent::Sample SceneContent::show(int target, double content_s) {
   Sample out;
   out.content_s = content_s;
   out.pts_s = std::nan("");
-  const Stream* s = find(target);
+  auto* s = const_cast<Stream*>(find(target));
   if (s == nullptr || !s->player) return out;
+  if (content_s < s->offset_s) s->offset_s = 0.0;  // the content began again (an arrival): so does a swapped-in video
+  s->last_s = content_s;
   // Before its start the content waits on its first frame.
-  const assets::VideoPlayer::Shown shown = s->player->frame_at(std::max(0.0, content_s));
+  out.content_s = std::max(0.0, content_s - s->offset_s);
+  const assets::VideoPlayer::Shown shown = s->player->frame_at(out.content_s);
   if (!shown.frame) return out;
   out.pts_s = shown.frame->pts_s;
   out.fresh = shown.fresh;
@@ -118,10 +131,72 @@ SceneContent::Sample SceneContent::show(int target, double content_s) {
   return out;
 }
 
+std::vector<std::string> SceneContent::reload_changed(double now_s, double interval_s) {
+  std::vector<std::string> said;
+  for (Watch& w : watches_) {  // loads that have finished
+    if (!w.loading.valid() || w.loading.wait_for(std::chrono::seconds(0)) != std::future_status::ready) continue;
+    try {
+      swap_in(w, w.loading.get());
+      said.push_back(w.file.string() + ": changed; the new video plays from its start");
+    } catch (const std::exception& e) {
+      said.push_back(std::string(e.what()) + " (changed on disk; the old video goes on)");
+    }
+  }
+  if (now_s - last_look_s_ < interval_s) return said;
+  last_look_s_ = now_s;
+  for (Watch& w : watches_) {
+    if (w.loading.valid()) continue;
+    std::error_code ec1, ec2;
+    const auto written = std::filesystem::last_write_time(w.file, ec1);
+    const auto size = std::filesystem::file_size(w.file, ec2);
+    if (ec1 || ec2 || (written == w.written && size == w.size)) continue;  // gone for now, or as it was
+    w.written = written;
+    w.size = size;
+    w.loading = std::async(std::launch::async, [file = w.file] { return std::make_unique<assets::VideoDecoder>(file); });
+  }
+  return said;
+}
+
+void SceneContent::swap_in(Watch& w, std::unique_ptr<assets::VideoDecoder> decoder) {
+  const bool loop =
+      std::find_if(players_.begin(), players_.end(), [&](const Stream& s) { return s.player == w.player; })->spec.loop;
+  auto fresh = std::make_shared<assets::VideoPlayer>(std::move(decoder), loop);
+  const bool same_size = fresh->info().width == w.player->info().width && fresh->info().height == w.player->info().height;
+  std::optional<std::size_t> texture;
+  for (Stream& s : players_) {
+    if (s.player != w.player) continue;
+    if (!same_size) {  // a new texture of the new size, bound to every material the old one was
+      if (!texture)
+        texture = renderer_.add_streamed_texture(s.model, s.material, fresh->info().width, fresh->info().height);
+      else
+        renderer_.bind_streamed_texture(*texture, s.model, s.material);
+      s.texture = *texture;
+    }
+    s.player = fresh;
+    s.offset_s = s.last_s;
+  }
+  w.player = fresh;
+}
+
 const assets::VideoPlayer& SceneContent::player(int target) const {
   const Stream* s = find(target);
   if (s == nullptr || !s->player) throw EngineError("target " + std::to_string(target) + " plays no video");
   return *s->player;
+}
+
+std::string SceneContent::summary() const {
+  std::string out;
+  std::vector<const assets::VideoPlayer*> seen;
+  for (const Stream& s : players_) {
+    if (!s.player || std::find(seen.begin(), seen.end(), s.player.get()) != seen.end()) continue;
+    seen.push_back(s.player.get());
+    const assets::PlaybackStats st = s.player->stats();
+    out += (out.empty() ? "" : "; ") + s.player->name() + ": " + std::to_string(st.shown) + " video frames shown, " +
+           std::to_string(st.skipped) + " skipped, " + std::to_string(st.repeated) + " repeated, " + std::to_string(st.loops) +
+           " loops, " + std::to_string(st.seeks) + " jumps ahead, the renderer waited on its decoder " +
+           std::to_string(st.waits) + " times";
+  }
+  return out;
 }
 
 std::vector<std::string> SceneContent::take_errors() {

@@ -262,6 +262,9 @@ const Command kRun{
     "what they answered then, each stop's frames play at their recorded pace and are tracked in lockstep,\n"
     "and every pose is compared with the recording's (the largest difference is printed); no device and\n"
     "no twin is used, so nothing is measured against a truth.\n"
+    "Targets with `content:` (a video, a timeline) play it on each frame's display time; a video file that\n"
+    "changes on disk is loaded again and swapped in at a later frame (tracking goes on), and one that fails\n"
+    "to load leaves the old one playing and says why.\n"
     "Without --config the shipped demo tour runs in the twin.\n",
     {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)", cli::PathRole::input_file},
      {"sim", "", "run against the digital twin, whatever `devices:` configures (the default without one)"},
@@ -372,6 +375,7 @@ const Command kRun{
       RobotState robot;
       const double t0 = config::steady_now_s();
       std::size_t blank = 0, frames_with_neighbours = 0;
+      std::vector<double> content_offsets_ms;  // per target-frame with video: its time less the shown frame's
       const session::PoseSource pose_of = [&](int index, alignment::PoseSample& pose) {
         return workers[static_cast<std::size_t>(index)]->latest(pose);
       };
@@ -385,12 +389,22 @@ const Command kRun{
           drawn.clear();
           session::LitNow now{{}, robot.since_s, handoffs.last_s};
           for (const DrawnTarget& lit : robot.lit) now.targets.push_back(lit.target);
-          for (const session::DrawnPose& d : frames.compose(config::steady_now_s(), now, pose_of)) {
+          const double now_s = config::steady_now_s();
+          const std::vector<session::DrawnPose> poses = frames.compose(now_s, now, pose_of);
+          // A lit target's content runs before its pose is found (the acquisition's first second), so that the
+          // video has caught up with its clock when it is first drawn.
+          const double display_s = now_s + frames.period_s() + 1e-3 * pc.input_lag_ms;
+          for (const DrawnTarget& lit : robot.lit)
+            if (content.has_video(lit.target) &&
+                std::none_of(poses.begin(), poses.end(), [&](const session::DrawnPose& d) { return d.target == lit.target; }))
+              content.show(lit.target, display_s - content.start_s(lit.target, t0, robot.since_s));
+          for (const session::DrawnPose& d : poses) {
             const auto t = static_cast<std::size_t>(d.target);
             out.push_back({items[t].model, d.T_projector_target, plan.at(t, robot.visit, scene.projector, d.T_projector_target)});
             if (content.has(d.target)) {  // on the display clock of this frame, as its pose
               const double content_s = d.display_s - content.start_s(d.target, t0, robot.since_s);
-              content.show(d.target, content_s);
+              const auto shown = content.show(d.target, content_s);
+              if (!std::isnan(shown.pts_s)) content_offsets_ms.push_back(1000.0 * (shown.content_s - shown.pts_s));
               content.animate(d.target, content_s, out.back());
             }
             const auto lit =
@@ -408,6 +422,8 @@ const Command kRun{
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
         for (const std::string& e : content.take_errors())  // the last good frame stays up; said once
           std::cerr << "content: " << e << " (its last good frame stays)" << std::endl;
+        for (const std::string& e : content.reload_changed(config::steady_now_s()))  // a video changed on disk
+          std::cout << "content: " << e << std::endl;
         const double nan = std::nan("");
         if (drawn.empty()) {
           ++blank;
@@ -463,6 +479,15 @@ const Command kRun{
         std::cout << "; " << frames.silent_frames() << " frames blanked because the camera had handed over no frame for "
                   << std::lround(1000.0 * pc.silent_camera_s) << " ms";
       std::cout << "\n";
+      if (const std::string played = content.summary(); !played.empty()) {
+        std::vector<double> uploads;
+        for (const auto& r : profiler.records())
+          if (r.upload_ms > 0.0) uploads.push_back(r.upload_ms);
+        std::cout << "content: " << played << "; content time less the shown frame's: p50 "
+                  << engine::percentile(content_offsets_ms, 0.5) << " ms, p99 " << engine::percentile(content_offsets_ms, 0.99)
+                  << " ms; upload on the render thread p50 " << std::setprecision(2) << engine::percentile(uploads, 0.5)
+                  << " ms, p99 " << engine::percentile(uploads, 0.99) << " ms" << std::setprecision(1) << "\n";
+      }
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
       if (recording) {

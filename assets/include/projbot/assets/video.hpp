@@ -31,7 +31,7 @@ struct VideoInfo {
 
 /// One decoded frame.
 struct VideoFrame {
-  std::int64_t index = 0;   ///< decoded frames before it since the stream (re)started
+  std::int64_t index = 0;   ///< decoded frames before it since the stream (re)started or a seek
   double pts_s = 0.0;       ///< presentation time, seconds after the stream's first frame (loops add on)
   double duration_s = 0.0;  ///< until the next frame's presentation time
   Image image;              ///< RGBA8, the video's size, alpha 255
@@ -60,6 +60,9 @@ class VideoDecoder {
   bool next(VideoFrame& out);
   /// Back to the first frame.
   void rewind();
+  /// On to the frame presented at `t_s` seconds after the first: from the key frame before it, the frames
+  /// between decoded and dropped by the next next(). A time past the end leaves nothing to decode.
+  void seek(double t_s);
 
  private:
   struct Impl;
@@ -74,6 +77,7 @@ struct PlaybackStats {
   std::size_t repeated = 0;  ///< asks answered with an older frame because the due one was not decoded yet
   std::size_t waits = 0;     ///< asks that found the queue locked by the decoder thread and waited for it
   std::size_t loops = 0;     ///< times the stream started again from its first frame
+  std::size_t seeks = 0;     ///< jumps ahead: content asked for more than a second past what was decoded
 };
 
 /// Plays a video against a content clock: a decoder thread keeps up to `queue_frames` decoded frames
@@ -119,6 +123,8 @@ class VideoPlayer {
   std::vector<std::shared_ptr<VideoFrame>> spare_;  // buffers to decode into again
   std::shared_ptr<VideoFrame> current_;             // the frame last handed out
   bool restart_ = false, ended_ = false, error_reported_ = false;
+  bool seeking_ = false;  // a jump asked for whose first frame is not queued yet
+  double seek_s_ = -1.0;  // a content time the decoder thread is asked to jump to (the content ran on unseen); < 0: none
   std::string error_;
   double last_ask_s_ = 0.0;
   PlaybackStats stats_;

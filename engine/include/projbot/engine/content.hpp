@@ -6,6 +6,8 @@
 // threads).
 
 #include <cstddef>
+#include <filesystem>
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,7 +38,7 @@ class SceneContent {
   double start_s(int target, double tour_start_s, double arrival_s) const;
 
   struct Sample {
-    double content_s = 0.0;  ///< the content time asked for
+    double content_s = 0.0;  ///< the video's own time asked for (content time since it began, or since a swap)
     double pts_s = 0.0;      ///< the presentation time of the frame shown (NaN: none decoded yet)
     bool fresh = false;      ///< a new frame went to the renderer
   };
@@ -49,8 +51,17 @@ class SceneContent {
   /// without a timeline leaves `item` as it is.
   void animate(int target, double content_s, DrawItem& item) const;
 
+  /// Watches the content files while it runs: at most every `interval_s` (on `now_s`'s clock) it looks at
+  /// each video's size and modification time; a changed one is opened again on a loader thread, and a later
+  /// call swaps it in (the texture kept where the size is the same) from content time 0 of its own; a file
+  /// that fails to load leaves the old one playing. Call once per frame on the render thread. Returns one
+  /// line per swap or failure, naming the file.
+  std::vector<std::string> reload_changed(double now_s, double interval_s = 0.5);
+
   /// Target `target`'s player (it must have a video; targets with the same video and start share one).
   const assets::VideoPlayer& player(int target) const;
+  /// Each video's playback so far, for people: frames shown, skipped, repeated, loops, waits ("" without video).
+  std::string summary() const;
   /// Playback errors not reported before, one line each naming the file.
   std::vector<std::string> take_errors();
 
@@ -61,10 +72,24 @@ class SceneContent {
     std::shared_ptr<assets::VideoPlayer> player;  ///< shared by targets with the same video and start
     std::size_t texture = 0;
     int material = 0;
+    std::size_t model = 0;  ///< its model in the renderer
+    double offset_s = 0.0;  ///< content time when its video was swapped in (it plays from its own start)
+    double last_s = 0.0;    ///< the content time last shown
+  };
+  // A video file as it was when loaded, and its reload under way.
+  struct Watch {
+    std::shared_ptr<assets::VideoPlayer> player;
+    std::filesystem::path file;
+    std::filesystem::file_time_type written{};
+    std::uintmax_t size = 0;
+    std::future<std::unique_ptr<assets::VideoDecoder>> loading;
   };
   const Stream* find(int target) const;
+  void swap_in(Watch& w, std::unique_ptr<assets::VideoDecoder> decoder);
   Renderer& renderer_;
   std::vector<Stream> players_;
+  std::vector<Watch> watches_;
+  double last_look_s_ = -1e300;
 };
 
 }  // namespace projbot::engine
