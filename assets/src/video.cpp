@@ -190,8 +190,17 @@ struct VideoDecoder::Impl {
     if (!sws) fail("its pixel format cannot be converted to RGBA");
     out.image.width = f->width;
     out.image.height = f->height;
-    out.image.rgba.resize(static_cast<std::size_t>(f->width) * f->height * 4);
-    std::uint8_t* dst[4] = {out.image.rgba.data(), nullptr, nullptr, nullptr};
+    const std::size_t bytes = static_cast<std::size_t>(f->width) * f->height * 4;
+    std::uint8_t* to = nullptr;
+    if (out.pixels.data != nullptr && out.pixels.size >= bytes) {
+      to = out.pixels.data;
+      out.image.rgba.clear();
+    } else {
+      out.pixels = {};
+      out.image.rgba.resize(bytes);
+      to = out.image.rgba.data();
+    }
+    std::uint8_t* dst[4] = {to, nullptr, nullptr, nullptr};
     const int dst_stride[4] = {f->width * 4, 0, 0, 0};
     sws_scale(sws.get(), f->data, f->linesize, 0, f->height, dst, dst_stride);
   }

@@ -13,12 +13,23 @@ constexpr double kEpsS = 1e-6;  // presentation times are compared with this sla
 constexpr double kSeekAheadS = 1.0;
 }  // namespace
 
-VideoPlayer::VideoPlayer(std::unique_ptr<VideoDecoder> decoder, bool loop, std::size_t queue_frames)
+// Frames go back to the pool when their last holder lets go (the queue, the frame shown, a renderer's frame
+// in flight), on whichever thread that is: decoded into again, never while anyone still reads them.
+struct VideoPlayer::FramePool {
+  std::mutex mutex;
+  std::vector<std::unique_ptr<VideoFrame>> spare;
+  std::size_t keep = 0;  // at most this many spare frames are kept
+};
+
+VideoPlayer::VideoPlayer(std::unique_ptr<VideoDecoder> decoder, bool loop, std::size_t queue_frames, PixelAllocator allocator)
     : decoder_(std::move(decoder)),
+      allocator_(std::move(allocator)),
       info_(decoder_->info()),
       name_(decoder_->name()),
       loop_(loop),
-      capacity_(std::max<std::size_t>(1, queue_frames)) {
+      capacity_(std::max<std::size_t>(1, queue_frames)),
+      pool_(std::make_shared<FramePool>()) {
+  pool_->keep = capacity_ + 4;  // the queue, the frame shown, one being decoded, two in a renderer's frames in flight
   thread_ = std::jthread([this](const std::stop_token& stop) { decode_loop(stop); });
 }
 
@@ -28,10 +39,26 @@ VideoPlayer::~VideoPlayer() {
 }
 
 std::shared_ptr<VideoFrame> VideoPlayer::spare_frame() {
-  if (spare_.empty()) return std::make_shared<VideoFrame>();
-  auto f = std::move(spare_.back());
-  spare_.pop_back();
-  return f;
+  std::unique_ptr<VideoFrame> f;
+  {
+    std::lock_guard lock(pool_->mutex);
+    if (!pool_->spare.empty()) {
+      f = std::move(pool_->spare.back());
+      pool_->spare.pop_back();
+    }
+  }
+  if (!f) f = std::make_unique<VideoFrame>();
+  std::weak_ptr<FramePool> pool = pool_;
+  return {f.release(), [pool](VideoFrame* done) {
+            if (const auto p = pool.lock()) {
+              std::lock_guard lock(p->mutex);
+              if (p->spare.size() < p->keep) {
+                p->spare.emplace_back(done);
+                return;
+              }
+            }
+            delete done;
+          }};
 }
 
 void VideoPlayer::decode_loop(const std::stop_token& stop) {
@@ -60,6 +87,8 @@ void VideoPlayer::decode_loop(const std::stop_token& stop) {
     std::string error;
     bool looped = false;
     try {
+      const std::size_t bytes = static_cast<std::size_t>(info_.width) * info_.height * 4;
+      if (allocator_ && f->pixels.size != bytes) f->pixels = allocator_(bytes);  // outside the lock: frame_at never waits
       if (rewind) {
         decoder_->rewind();
         offset_s = pass_end_s = 0.0;
@@ -121,14 +150,9 @@ VideoPlayer::Shown VideoPlayer::frame_at(double content_s) {
     return {current_, false};
   }
   last_ask_s_ = content_s;
-  const auto recycle = [this](std::shared_ptr<VideoFrame>& f) {
-    if (f && f.use_count() == 1 && spare_.size() < capacity_ + 2) spare_.push_back(std::move(f));
-    f.reset();
-  };
   std::shared_ptr<VideoFrame> due;
   while (!queue_.empty() && !restart_ && queue_.front()->pts_s <= content_s + kEpsS) {
     if (due) ++stats_.skipped;
-    recycle(due);
     due = std::move(queue_.front());
     queue_.pop_front();
   }
@@ -143,7 +167,6 @@ VideoPlayer::Shown VideoPlayer::frame_at(double content_s) {
   }
   Shown out;
   if (due) {
-    recycle(current_);
     current_ = std::move(due);
     ++stats_.shown;
     out.fresh = true;

@@ -56,7 +56,8 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
       s.texture = same->texture;
       renderer.bind_streamed_texture(s.texture, model_ids[i], material);
     } else {
-      s.player = std::make_shared<assets::VideoPlayer>(std::make_unique<assets::VideoDecoder>(content->video), content->loop);
+      s.player = std::make_shared<assets::VideoPlayer>(std::make_unique<assets::VideoDecoder>(content->video), content->loop, 4,
+                                                       [&renderer](std::size_t bytes) { return renderer.frame_memory(bytes); });
       s.texture = renderer.add_streamed_texture(model_ids[i], material, s.player->info().width, s.player->info().height);
       Watch w;
       w.player = s.player;
@@ -127,7 +128,11 @@ SceneContent::Sample SceneContent::show(int target, double content_s) {
   if (!shown.frame) return out;
   out.pts_s = shown.frame->pts_s;
   out.fresh = shown.fresh;
-  if (shown.fresh) renderer_.stream_frame(s->texture, std::shared_ptr<const assets::Image>(shown.frame, &shown.frame->image));
+  if (!shown.fresh) return out;
+  if (shown.frame->pixels.data != nullptr)  // decoded into the renderer's frame memory: no copy here
+    renderer_.stream_pixels(s->texture, shown.frame->pixels, shown.frame);
+  else
+    renderer_.stream_frame(s->texture, std::shared_ptr<const assets::Image>(shown.frame, &shown.frame->image));
   return out;
 }
 
@@ -160,7 +165,8 @@ std::vector<std::string> SceneContent::reload_changed(double now_s, double inter
 void SceneContent::swap_in(Watch& w, std::unique_ptr<assets::VideoDecoder> decoder) {
   const bool loop =
       std::find_if(players_.begin(), players_.end(), [&](const Stream& s) { return s.player == w.player; })->spec.loop;
-  auto fresh = std::make_shared<assets::VideoPlayer>(std::move(decoder), loop);
+  auto fresh = std::make_shared<assets::VideoPlayer>(std::move(decoder), loop, 4,
+                                                     [this](std::size_t bytes) { return renderer_.frame_memory(bytes); });
   const bool same_size = fresh->info().width == w.player->info().width && fresh->info().height == w.player->info().height;
   std::optional<std::size_t> texture;
   for (Stream& s : players_) {

@@ -91,7 +91,8 @@ struct FrameSlot {
   vk::raii::DescriptorSet set{nullptr};
   vk::raii::Fence fence{nullptr};
   vk::raii::Semaphore acquired{nullptr};
-  bool pending = false;  ///< a submitted frame whose timing is not yet handed to its profiler
+  std::vector<std::shared_ptr<const void>> held;  ///< what this slot's frame reads from host memory (video frames)
+  bool pending = false;                           ///< a submitted frame whose timing is not yet handed to its profiler
   FrameRecord record;
   FrameProfiler* profiler = nullptr;
 };

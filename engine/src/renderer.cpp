@@ -128,7 +128,15 @@ struct GpuModel {
 struct StreamedTexture {
   detail::Image image;
   std::map<const detail::FrameSlot*, Buffer> staging;
-  std::shared_ptr<const assets::Image> pending;  // texels for the next frame
+  std::shared_ptr<const assets::Image> pending;  // texels for the next frame, copied into staging
+  const Buffer* pending_buffer = nullptr;        // or texels already in host memory the GPU copies from
+  std::shared_ptr<const void> pending_keep;      // what keeps pending_buffer's contents unchanged
+};
+
+// Host memory handed out for decoding into (Renderer::frame_memory): the GPU copies textures from it.
+struct HostFrameBuffer {
+  std::shared_ptr<Gpu> gpu;  // first: outlives the buffer
+  Buffer buffer;
 };
 
 }  // namespace
@@ -400,6 +408,26 @@ struct Renderer::Impl {
                                      {});
   }
 
+  assets::PixelMemory frame_memory(std::size_t bytes) {
+    if (bytes == 0 || bytes > (std::size_t{1} << 30)) throw EngineError("frame memory of " + std::to_string(bytes) + " bytes");
+    auto host = std::make_shared<HostFrameBuffer>();
+    host->gpu = gpu;
+    host->buffer = gpu->make_buffer(bytes, vk::BufferUsageFlagBits::eTransferSrc,
+                                    vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
+    auto* data = static_cast<std::uint8_t*>(host->buffer.mapped);
+    return {data, bytes, std::move(host), this};
+  }
+
+  void stream_pixels(std::size_t id, const assets::PixelMemory& pixels, std::shared_ptr<const void> keep) {
+    if (id >= streamed.size()) throw EngineError("no streamed texture " + std::to_string(id));
+    const vk::Extent2D e = streamed[id].image.extent;
+    if (pixels.tag != this || !pixels.owner || pixels.size < static_cast<std::size_t>(e.width) * e.height * 4)
+      throw EngineError("pixels for streamed texture " + std::to_string(id) + " not in this renderer's frame memory of its size");
+    streamed[id].pending.reset();
+    streamed[id].pending_buffer = &static_cast<const HostFrameBuffer*>(pixels.owner.get())->buffer;
+    streamed[id].pending_keep = std::move(keep);
+  }
+
   void stream_frame(std::size_t id, std::shared_ptr<const assets::Image> image) {
     if (id >= streamed.size()) throw EngineError("no streamed texture " + std::to_string(id));
     const vk::Extent2D e = streamed[id].image.extent;
@@ -408,27 +436,36 @@ struct Renderer::Impl {
       throw EngineError("a frame for streamed texture " + std::to_string(id) + " that is not its " + std::to_string(e.width) +
                         "x" + std::to_string(e.height) + " RGBA8");
     streamed[id].pending = std::move(image);
+    streamed[id].pending_buffer = nullptr;
+    streamed[id].pending_keep.reset();
   }
 
   // The pending texels of every streamed texture into this slot's staging memory (the render thread's
   // share of an upload: one copy), and the GPU's copy into the image before anything draws.
   // Returns the number of textures uploaded.
-  std::size_t record_uploads(const vk::raii::CommandBuffer& cmd, const detail::FrameSlot& slot) {
+  std::size_t record_uploads(const vk::raii::CommandBuffer& cmd, detail::FrameSlot& slot) {
     std::size_t uploaded = 0;
     for (StreamedTexture& tex : streamed) {
-      if (!tex.pending) continue;
-      const std::size_t bytes = tex.pending->rgba.size();
-      auto [it, fresh] = tex.staging.try_emplace(&slot);
-      if (fresh)
-        it->second = gpu->make_buffer(bytes, vk::BufferUsageFlagBits::eTransferSrc,
-                                      vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
-      std::memcpy(it->second.mapped, tex.pending->rgba.data(), bytes);  // the slot's last frame is done (retired)
-      tex.pending.reset();
+      if (!tex.pending && !tex.pending_buffer) continue;
+      const Buffer* from = tex.pending_buffer;
+      if (from != nullptr) {  // decoded into frame memory: the GPU copies it; held until the slot's fence
+        slot.held.push_back(std::move(tex.pending_keep));
+        tex.pending_buffer = nullptr;
+      } else {
+        const std::size_t bytes = tex.pending->rgba.size();
+        auto [it, fresh] = tex.staging.try_emplace(&slot);
+        if (fresh)
+          it->second = gpu->make_buffer(bytes, vk::BufferUsageFlagBits::eTransferSrc,
+                                        vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
+        std::memcpy(it->second.mapped, tex.pending->rgba.data(), bytes);  // the slot's last frame is done (retired)
+        tex.pending.reset();
+        from = &it->second;
+      }
       detail::transition(cmd, *tex.image.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eShaderReadOnlyOptimal,
                          vk::ImageLayout::eTransferDstOptimal, vk::PipelineStageFlagBits2::eFragmentShader,
                          vk::AccessFlagBits2::eShaderSampledRead, vk::PipelineStageFlagBits2::eCopy,
                          vk::AccessFlagBits2::eTransferWrite);
-      cmd.copyBufferToImage(*it->second.buffer, *tex.image.image, vk::ImageLayout::eTransferDstOptimal,
+      cmd.copyBufferToImage(*from->buffer, *tex.image.image, vk::ImageLayout::eTransferDstOptimal,
                             vk::BufferImageCopy(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, 1),
                                                 {0, 0, 0}, vk::Extent3D(tex.image.extent, 1)));
       detail::transition(cmd, *tex.image.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eTransferDstOptimal,
@@ -475,6 +512,7 @@ struct Renderer::Impl {
     detail::FrameSlot& slot = t.slots[index];
     if (gpu->device.waitForFences(*slot.fence, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
       throw EngineError("a frame's fence never signalled");
+    slot.held.clear();  // the GPU has copied what the frame read from host memory
     if (!slot.pending) return;
     slot.pending = false;
     if (slot.profiler == nullptr) return;
@@ -673,6 +711,10 @@ std::size_t Renderer::add_streamed_texture(std::size_t model, int material, int 
 }
 void Renderer::bind_streamed_texture(std::size_t texture, std::size_t model, int material) {
   impl_->bind_streamed_texture(texture, model, material);
+}
+assets::PixelMemory Renderer::frame_memory(std::size_t bytes) { return impl_->frame_memory(bytes); }
+void Renderer::stream_pixels(std::size_t texture, const assets::PixelMemory& pixels, std::shared_ptr<const void> keep) {
+  impl_->stream_pixels(texture, pixels, std::move(keep));
 }
 void Renderer::stream_frame(std::size_t texture, std::shared_ptr<const assets::Image> image) {
   impl_->stream_frame(texture, std::move(image));

@@ -122,7 +122,7 @@ void print(const ContentRun& r, const engine::FrameSummary& frames) {
       engine::percentile(r.offset_ms, 0.5), engine::percentile(r.offset_ms, 0.99), 100.0 * r.within_one_frame);
   std::printf("video frames shown %zu, skipped %zu, repeated %zu; the renderer waited on a decoder %zu times\n", r.shown,
               r.skipped, r.repeated, r.waits);
-  std::printf("upload on the render thread: p50 %.2f ms, p99 %.2f ms (%zu uploads)\n", engine::percentile(r.upload_ms, 0.5),
+  std::printf("upload on the render thread: p50 %.3f ms, p99 %.3f ms (%zu uploads)\n", engine::percentile(r.upload_ms, 0.5),
               engine::percentile(r.upload_ms, 0.99), r.upload_ms.size());
   std::printf("targets in step: offsets within one frame differ by at most %.2f ms\n", r.in_step_ms_max);
   std::printf("memory (RSS): %.0f MB at the start, %.0f MB at the end\n", r.rss_start_mb, r.rss_end_mb);

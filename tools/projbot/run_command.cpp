@@ -485,7 +485,7 @@ const Command kRun{
           if (r.upload_ms > 0.0) uploads.push_back(r.upload_ms);
         std::cout << "content: " << played << "; content time less the shown frame's: p50 "
                   << engine::percentile(content_offsets_ms, 0.5) << " ms, p99 " << engine::percentile(content_offsets_ms, 0.99)
-                  << " ms; upload on the render thread p50 " << std::setprecision(2) << engine::percentile(uploads, 0.5)
+                  << " ms; upload on the render thread p50 " << std::setprecision(3) << engine::percentile(uploads, 0.5)
                   << " ms, p99 " << engine::percentile(uploads, 0.99) << " ms" << std::setprecision(1) << "\n";
       }
       std::size_t tracked = 0;

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <deque>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -29,12 +30,26 @@ struct VideoInfo {
   std::string codec;        ///< FFmpeg's decoder name, e.g. "h264"
 };
 
+/// Memory a frame's RGBA8 pixels are decoded into when a player is given an allocator: memory its consumer
+/// reads directly (the renderer's upload buffers, which the GPU copies from without a CPU copy).
+struct PixelMemory {
+  std::uint8_t* data = nullptr;
+  std::size_t size = 0;
+  std::shared_ptr<void> owner;  ///< keeps the memory alive
+  const void* tag = nullptr;    ///< who made it (the consumer recognises its own)
+};
+using PixelAllocator = std::function<PixelMemory(std::size_t bytes)>;
+
 /// One decoded frame.
 struct VideoFrame {
   std::int64_t index = 0;   ///< decoded frames before it since the stream (re)started or a seek
   double pts_s = 0.0;       ///< presentation time, seconds after the stream's first frame (loops add on)
   double duration_s = 0.0;  ///< until the next frame's presentation time
-  Image image;              ///< RGBA8, the video's size, alpha 255
+  /// RGBA8, the video's size, alpha 255: in image.rgba, or (width and height in image, rgba empty) in
+  /// `pixels` where those were given before decoding.
+  Image image;
+  PixelMemory pixels;
+  const std::uint8_t* rgba() const { return pixels.data != nullptr ? pixels.data : image.rgba.data(); }
 };
 
 /// A video stream decoded frame by frame, in presentation order. Not thread-safe: one thread at a time.
@@ -87,7 +102,8 @@ struct PlaybackStats {
 /// error is kept for error() and reported once.
 class VideoPlayer {
  public:
-  VideoPlayer(std::unique_ptr<VideoDecoder> decoder, bool loop, std::size_t queue_frames = 4);
+  /// `allocator`: where frames are decoded into (null: their own vectors); called on the decoder thread.
+  VideoPlayer(std::unique_ptr<VideoDecoder> decoder, bool loop, std::size_t queue_frames = 4, PixelAllocator allocator = {});
   ~VideoPlayer();
   VideoPlayer(const VideoPlayer&) = delete;
   VideoPlayer& operator=(const VideoPlayer&) = delete;
@@ -110,18 +126,20 @@ class VideoPlayer {
 
  private:
   void decode_loop(const std::stop_token& stop);
-  std::shared_ptr<VideoFrame> spare_frame();  // caller holds mutex_
+  struct FramePool;
+  std::shared_ptr<VideoFrame> spare_frame();  // a frame to decode into, back to the pool when let go
 
   std::unique_ptr<VideoDecoder> decoder_;
+  PixelAllocator allocator_;
   VideoInfo info_;
   std::string name_;
   bool loop_ = true;
   std::size_t capacity_ = 4;
   mutable std::mutex mutex_;
   std::condition_variable_any wake_;
-  std::deque<std::shared_ptr<VideoFrame>> queue_;   // decoded, not yet due; presentation order
-  std::vector<std::shared_ptr<VideoFrame>> spare_;  // buffers to decode into again
-  std::shared_ptr<VideoFrame> current_;             // the frame last handed out
+  std::deque<std::shared_ptr<VideoFrame>> queue_;  // decoded, not yet due; presentation order
+  std::shared_ptr<FramePool> pool_;                // frames to decode into again
+  std::shared_ptr<VideoFrame> current_;            // the frame last handed out
   bool restart_ = false, ended_ = false, error_reported_ = false;
   bool seeking_ = false;  // a jump asked for whose first frame is not queued yet
   double seek_s_ = -1.0;  // a content time the decoder thread is asked to jump to (the content ran on unseen); < 0: none

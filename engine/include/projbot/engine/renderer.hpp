@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "projbot/assets/model.hpp"
+#include "projbot/assets/video.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/photometry.hpp"
@@ -144,6 +145,14 @@ class Renderer {
   /// its frame's staging memory (the render thread's whole share, FrameRecord::upload_ms) and the GPU uploads
   /// them before it draws. Until then the image is held. May be called from a PoseReader.
   void stream_frame(std::size_t texture, std::shared_ptr<const assets::Image> image);
+  /// Host memory the GPU copies streamed textures from: a video player decodes into it (its PixelAllocator),
+  /// and stream_pixels then costs the render thread no copy at all. Thread-safe (the decoder thread calls it);
+  /// the memory lives while PixelMemory::owner does. Throws EngineError.
+  assets::PixelMemory frame_memory(std::size_t bytes);
+  /// As stream_frame, from texels (the texture's size, RGBA8) in this renderer's frame_memory: the next
+  /// draw_frame's GPU copy reads them there, and `keep` (what keeps them unchanged, the video frame) is held
+  /// until that frame is done.
+  void stream_pixels(std::size_t texture, const assets::PixelMemory& pixels, std::shared_ptr<const void> keep);
 
   /// An offscreen RGBA8 target of the given size.
   std::unique_ptr<RenderTarget> make_offscreen(int width_px, int height_px);
