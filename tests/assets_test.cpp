@@ -357,3 +357,29 @@ TEST_F(CorruptBox, RandomByteFlipsNeverCrash) {
     }
   }
 }
+
+// KHR_texture_transform (issue 44) on the base colour texture: baked into the UVs as uv' = T R S uv.
+TEST_F(CorruptBox, TextureTransformIsAppliedToTheUvs) {
+  const Model original = load_gltf(gltf());
+  const double ox = 0.25, oy = 0.5, r = 0.3, sx = 2.0, sy = 0.5;
+  json_["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"] = {
+      {"offset", {ox, oy}}, {"rotation", r}, {"scale", {sx, sy}}};
+  json_["extensionsUsed"] = {"KHR_texture_transform"};
+  save();
+  const Model m = load_gltf(gltf());
+  ASSERT_EQ(m.primitives[0].vertices.size(), original.primitives[0].vertices.size());
+  for (std::size_t i = 0; i < m.primitives[0].vertices.size(); ++i) {
+    const double u = original.primitives[0].vertices[i].uv[0], v = original.primitives[0].vertices[i].uv[1];
+    // The extension's own matrices, multiplied out here: T * R * S.
+    const Eigen::Matrix3d T = (Eigen::Matrix3d() << 1, 0, ox, 0, 1, oy, 0, 0, 1).finished();
+    const Eigen::Matrix3d R =
+        (Eigen::Matrix3d() << std::cos(r), std::sin(r), 0, -std::sin(r), std::cos(r), 0, 0, 0, 1).finished();
+    const Eigen::Matrix3d S = Eigen::Vector3d(sx, sy, 1).asDiagonal();
+    const Eigen::Vector3d want = T * R * S * Eigen::Vector3d(u, v, 1);
+    EXPECT_NEAR(m.primitives[0].vertices[i].uv[0], want.x(), 1e-5) << i;
+    EXPECT_NEAR(m.primitives[0].vertices[i].uv[1], want.y(), 1e-5) << i;
+  }
+  json_["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["offset"] = "left";
+  save();
+  expect_contains(error(), "material 0: KHR_texture_transform.offset is not two numbers");
+}

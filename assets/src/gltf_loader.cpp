@@ -9,6 +9,8 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <iostream>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -36,6 +38,10 @@ class Loader {
       visit_node(root, Eigen::Matrix4d::Identity(), path, out);
     }
     if (out.primitives.empty()) fail("no triangle meshes in the scene");
+    apply_texture_transforms(out);
+    if (!g_.animations.empty())
+      warn_once("its " + std::to_string(g_.animations.size()) +
+                " animation(s) are not played (the object does not move with them)");
     detail::give_default_material(out);
     return out;
   }
@@ -451,6 +457,60 @@ class Loader {
       m.double_sided = gm.doubleSided;
       out.materials.push_back(m);
     }
+  }
+
+  // KHR_texture_transform on a material's base colour texture (uv' = T R S uv, rotation counter-clockwise in
+  // UV space), row-major 2x3; identity without the extension.
+  std::array<double, 6> texture_transform(const tinygltf::Material& gm, const std::string& name) const {
+    std::array<double, 6> m{1, 0, 0, 0, 1, 0};
+    const auto& ext = gm.pbrMetallicRoughness.baseColorTexture.extensions;
+    const auto it = ext.find("KHR_texture_transform");
+    if (it == ext.end()) return m;
+    const tinygltf::Value& t = it->second;
+    if (!t.IsObject()) fail(name + ": KHR_texture_transform is not an object");
+    const auto pair = [&](const char* key, double fallback, std::size_t i) {
+      if (!t.Has(key)) return fallback;
+      const tinygltf::Value& v = t.Get(key);
+      if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(static_cast<int>(i)).IsNumber())
+        fail(name + ": KHR_texture_transform." + key + " is not two numbers");
+      return v.Get(static_cast<int>(i)).GetNumberAsDouble();
+    };
+    const double ox = pair("offset", 0.0, 0), oy = pair("offset", 0.0, 1);
+    const double sx = pair("scale", 1.0, 0), sy = pair("scale", 1.0, 1);
+    double r = 0.0;
+    if (t.Has("rotation")) {
+      if (!t.Get("rotation").IsNumber()) fail(name + ": KHR_texture_transform.rotation is not a number");
+      r = t.Get("rotation").GetNumberAsDouble();
+    }
+    if (t.Has("texCoord") && t.Get("texCoord").GetNumberAsInt() != 0)
+      fail(name + ": KHR_texture_transform.texCoord names another UV set; only TEXCOORD_0 is supported");
+    for (const double x : {ox, oy, sx, sy, r})
+      if (!std::isfinite(x) || std::abs(x) > 1e6) fail(name + ": KHR_texture_transform has a value that is not finite");
+    const double c = std::cos(r), sn = std::sin(r);
+    return {c * sx, sn * sy, ox, -sn * sx, c * sy, oy};
+  }
+
+  // The materials' texture transforms baked into their primitives' UVs (each primitive has its own
+  // vertices): the renderer and the CPU samplers then read the same coordinates.
+  void apply_texture_transforms(Model& out) const {
+    for (auto& p : out.primitives) {
+      if (p.material < 0 || static_cast<std::size_t>(p.material) >= g_.materials.size()) continue;
+      const auto m =
+          texture_transform(g_.materials[static_cast<std::size_t>(p.material)], "material " + std::to_string(p.material));
+      if (m == std::array<double, 6>{1, 0, 0, 0, 1, 0}) continue;
+      for (auto& v : p.vertices) {
+        const double u = v.uv[0], w = v.uv[1];
+        v.uv = {static_cast<float>(m[0] * u + m[1] * w + m[2]), static_cast<float>(m[3] * u + m[4] * w + m[5])};
+      }
+    }
+  }
+
+  // A warning on stderr, once per file and process (a tour loads its models several times).
+  void warn_once(const std::string& what) const {
+    static std::mutex mutex;
+    static std::set<std::string> said;
+    std::lock_guard lock(mutex);
+    if (said.insert(file_ + what).second) std::cerr << file_ << ": warning: " << what << '\n';
   }
 
   const tinygltf::Model& g_;
