@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 
 #include "commands.hpp"
 #include "projbot/assets/model.hpp"
@@ -40,6 +41,25 @@ void finish_profile(const cli::Args& args, const engine::FrameProfiler& profiler
   }
 }
 
+// A still frame's content: each target's video frame and timeline at content time `at_s`. Offline, so it
+// waits (up to 10 s a video) for the decoder to reach the frame of that time.
+void content_at(engine::SceneContent& content, std::vector<engine::DrawItem>& items, double at_s) {
+  for (int i = 0; i < static_cast<int>(items.size()); ++i) {
+    if (!content.has(i)) continue;
+    content.animate(i, at_s, items[static_cast<std::size_t>(i)]);
+    if (!content.has_video(i)) continue;
+    const auto& info = content.player(i).info();
+    const double period = 1.0 / info.fps;
+    double want = at_s;  // a clip that does not loop holds its last frame
+    if (!content.player(i).loop() && info.duration_s > 0.0) want = std::min(at_s, info.duration_s - 0.5 * period);
+    for (int k = 0; k < 5000; ++k) {
+      const auto s = content.show(i, want);
+      if (s.pts_s <= want + 1e-6 && want - s.pts_s < period - 1e-6) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+}
+
 }  // namespace
 
 const Command kRender{
@@ -47,9 +67,11 @@ const Command kRender{
     "projbot render [--scene S.yaml] --out frame.png [--frames N] [--profile p.csv] [overrides]\n\n"
     "Draws every target of the scene through the projector's intrinsics, with no window system, and\n"
     "writes the last frame as an RGBA PNG: exactly the image the projector must show. With --model\n"
-    "alone the model is framed whole, seen from its front (glTF +Z). Exit status 3: the frame came\n"
-    "out empty (written all the same).\n",
+    "alone the model is framed whole, seen from its front (glTF +Z). Targets with `content:` show their\n"
+    "video's frame and timeline at --content-time (default 0 s). Exit status 3: the frame came out empty\n"
+    "(written all the same).\n",
     with_scene_options({{"out", "FILE", "PNG to write (required)", cli::PathRole::output_file},
+                        {"content-time", "S", "content time of the targets' videos and timelines, seconds (default 0)"},
                         {"frames", "N", "frames to draw, for timing (default 1)"},
                         {"profile", "FILE", "write one CSV row of timings per frame", cli::PathRole::output_file}}),
     [](const cli::Args& args) {
@@ -61,7 +83,14 @@ const Command kRender{
       const config::Scene scene = scene_from_args(args);
       engine::Renderer renderer(renderer_options(args, false));
       std::cout << "device: " << renderer.device_info().name << '\n';
-      const auto items = upload_scene(renderer, scene);
+      const double content_time = args.get_double("content-time", 0.0);
+      if (!(content_time >= 0.0 && content_time <= 1e6)) throw cli::UsageError("--content-time must be 0..1e6 seconds");
+      std::vector<assets::Model> models;
+      auto items = upload_scene(renderer, scene, &models);
+      std::vector<std::size_t> model_ids;
+      for (const auto& item : items) model_ids.push_back(item.model);
+      engine::SceneContent content(renderer, scene, models, model_ids);
+      content_at(content, items, content_time);
       auto target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
       engine::FrameProfiler profiler;
       for (int i = 0; i < frames; ++i) renderer.draw_frame(*target, scene.projector, items, &profiler);

@@ -123,6 +123,7 @@ class VideoPlayer {
   std::string take_error();
   const VideoInfo& info() const { return info_; }
   const std::string& name() const { return name_; }
+  bool loop() const { return loop_; }
 
  private:
   void decode_loop(const std::stop_token& stop);
