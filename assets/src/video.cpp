@@ -1,6 +1,8 @@
 // Video decoding and encoding through FFmpeg's libraries; the player's decoder thread.
 #include "projbot/assets/video.hpp"
 
+#include "ffmpeg_util.hpp"
+
 extern "C" {
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
@@ -17,12 +19,6 @@ extern "C" {
 
 namespace projbot::assets {
 namespace {
-
-std::string av_message(int code) {
-  char text[AV_ERROR_MAX_STRING_SIZE] = {};
-  av_strerror(code, text, sizeof text);
-  return text;
-}
 
 struct FormatCloser {
   void operator()(AVFormatContext* f) const { avformat_close_input(&f); }
@@ -73,12 +69,14 @@ struct MemoryInput {
   }
 };
 
-// FFmpeg's own log is quiet (what goes wrong is one line naming the file, ours), and no single block it
-// allocates may exceed 256 MiB: a container's header claims table sizes (a fuzzed mp4 had the mov demuxer
-// ask for 713 MB before reading a byte of them); a frame within the size limits needs at most 128 MiB.
+using detail::av_message;
+
+// FFmpeg's own log is quiet, and no single block it allocates may exceed 256 MiB: a container's header
+// claims table sizes (a fuzzed mp4 had the mov demuxer ask for 713 MB before reading a byte of them); a
+// frame within the size limits needs at most 128 MiB.
 void set_up_ffmpeg() {
   static const bool done = [] {
-    av_log_set_level(AV_LOG_QUIET);
+    detail::quiet_ffmpeg();
     av_max_alloc(std::size_t{256} << 20);
     return true;
   }();
@@ -205,16 +203,22 @@ struct VideoDecoder::Impl {
     sws_scale(sws.get(), f->data, f->linesize, 0, f->height, dst, dst_stride);
   }
 
+  // The decoded frame's duration: its packet's, else one frame period.
+  double frame_duration_s() const {
+    return frame->pkt_duration > 0 ? static_cast<double>(frame->pkt_duration) * av_q2d(time_base) : 1.0 / info.fps;
+  }
+  // The decoded frame's presentation time after the stream's first, or NaN where it has none.
+  double frame_time_s() const {
+    const std::int64_t pts = frame->best_effort_timestamp;
+    if (pts == AV_NOPTS_VALUE || first_pts == AV_NOPTS_VALUE) return std::nan("");
+    return static_cast<double>(pts - first_pts) * av_q2d(time_base);
+  }
+
   void stamp(VideoFrame& out) {
-    const double period = 1.0 / info.fps;
-    std::int64_t pts = frame->best_effort_timestamp;
-    out.duration_s = frame->pkt_duration > 0 ? static_cast<double>(frame->pkt_duration) * av_q2d(time_base) : period;
-    if (pts == AV_NOPTS_VALUE) {
-      out.pts_s = static_cast<double>(decoded) * period;
-    } else {
-      if (first_pts == AV_NOPTS_VALUE) first_pts = pts;
-      out.pts_s = static_cast<double>(pts - first_pts) * av_q2d(time_base);
-    }
+    if (first_pts == AV_NOPTS_VALUE) first_pts = frame->best_effort_timestamp;  // stays unknown without one
+    const double t = frame_time_s();
+    out.duration_s = frame_duration_s();
+    out.pts_s = std::isnan(t) ? static_cast<double>(decoded) / info.fps : t;
     out.index = decoded++;
   }
 };
@@ -226,6 +230,10 @@ VideoDecoder::VideoDecoder(const std::filesystem::path& path) : impl_(std::make_
   if (!std::filesystem::exists(path, ec)) impl_->fail("does not exist");
   if (!std::filesystem::is_regular_file(path, ec)) impl_->fail("is not a regular file");
   impl_->open(nullptr, path.c_str());
+  check_first_frame();
+}
+
+void VideoDecoder::check_first_frame() {
   VideoFrame first;
   if (!next(first)) impl_->fail("holds no video frame that decodes (a zero-length stream)");
   rewind();
@@ -249,9 +257,7 @@ VideoDecoder::VideoDecoder(std::span<const std::uint8_t> bytes, std::string name
   ctx->pb = impl_->io.get();
   ctx->flags |= AVFMT_FLAG_CUSTOM_IO;
   impl_->open(ctx, nullptr);
-  VideoFrame first;
-  if (!next(first)) impl_->fail("holds no video frame that decodes (a zero-length stream)");
-  rewind();
+  check_first_frame();
 }
 
 VideoDecoder::~VideoDecoder() = default;
@@ -262,12 +268,8 @@ bool VideoDecoder::next(VideoFrame& out) {
   Impl& d = *impl_;
   if (!d.decode_one()) return false;
   while (d.seek_to_s > 0.0) {  // after a seek: decoded from the key frame before, kept from the frame showing then
-    const std::int64_t pts = d.frame->best_effort_timestamp;
-    const double duration =
-        d.frame->pkt_duration > 0 ? static_cast<double>(d.frame->pkt_duration) * av_q2d(d.time_base) : 1.0 / d.info.fps;
-    if (pts == AV_NOPTS_VALUE || d.first_pts == AV_NOPTS_VALUE ||
-        static_cast<double>(pts - d.first_pts) * av_q2d(d.time_base) + duration > d.seek_to_s + 1e-6)
-      break;
+    const double t = d.frame_time_s();
+    if (std::isnan(t) || t + d.frame_duration_s() > d.seek_to_s + 1e-6) break;
     av_frame_unref(d.frame.get());
     ++d.decoded;
     if (!d.decode_one()) return false;

@@ -93,8 +93,7 @@ void VideoPlayer::decode_loop(const std::stop_token& stop) {
         decoder_->rewind();
         offset_s = pass_end_s = 0.0;
         in_pass = 0;
-      } else if (seek >= 0.0) {  // into the pass that holds the time asked for (the last frame, not looping)
-        if (!loop_ && length_s > 0.0) seek = std::min(seek, length_s - 0.5 / info_.fps);
+      } else if (seek >= 0.0) {  // into the pass holding that time (frame_at keeps it within a clip that does not loop)
         const double passes = loop_ && length_s > 0.0 ? std::floor(seek / length_s) : 0.0;
         offset_s = passes * length_s;
         decoder_->seek(seek - offset_s);
@@ -176,14 +175,6 @@ VideoPlayer::Shown VideoPlayer::frame_at(double content_s) {
     ++stats_.repeated;  // the due frame is not decoded yet: an older one stays up
   out.frame = current_;
   return out;
-}
-
-void VideoPlayer::restart() {
-  std::lock_guard lock(mutex_);
-  restart_ = true;
-  queue_.clear();
-  last_ask_s_ = 0.0;
-  wake_.notify_all();
 }
 
 PlaybackStats VideoPlayer::stats() const {

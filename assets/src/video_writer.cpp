@@ -3,6 +3,7 @@
 #include <cmath>
 #include <system_error>
 
+#include "ffmpeg_util.hpp"
 #include "projbot/assets/video.hpp"
 
 extern "C" {
@@ -28,11 +29,7 @@ struct VideoWriter::Impl {
 
   [[noreturn]] void fail(const std::string& what) const { throw AssetError(path.string() + ": " + what); }
   void check(int r, const char* what) const {
-    if (r < 0) {
-      char text[AV_ERROR_MAX_STRING_SIZE] = {};
-      av_strerror(r, text, sizeof text);
-      fail(std::string(what) + " (" + text + ")");
-    }
+    if (r < 0) fail(std::string(what) + " (" + detail::av_message(r) + ")");
   }
 
   void release() noexcept {
@@ -100,7 +97,7 @@ struct VideoWriter::Impl {
 
 VideoWriter::VideoWriter(const std::filesystem::path& path, int width, int height, int fps, const std::string& codec)
     : impl_(std::make_unique<Impl>()) {
-  av_log_set_level(AV_LOG_QUIET);  // the encoder's statistics are not for people; failures are our lines
+  detail::quiet_ffmpeg();
   Impl& w = *impl_;
   w.path = path;
   if (width <= 0 || height <= 0 || width > 16384 || height > 16384 || fps <= 0 || fps > 1000)

@@ -80,6 +80,7 @@ class VideoDecoder {
   void seek(double t_s);
 
  private:
+  void check_first_frame();  // decodes the first frame (or says there is none), then rewinds
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -116,8 +117,6 @@ class VideoPlayer {
   /// at or before it. Never waits for decoding. Content times before the previous ask's mean the content
   /// began again (a new arrival): the stream restarts from its first frame.
   Shown frame_at(double content_s);
-  /// Starts the stream again from its first frame (content time 0).
-  void restart();
   PlaybackStats stats() const;
   /// The playback error, once: empty after the first call that returned it, and while there is none.
   std::string take_error();
