@@ -216,18 +216,25 @@ struct Renderer::Impl {
                                       vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
     std::memcpy(staging.mapped, bytes, size);
     gpu->one_shot([&](vk::raii::CommandBuffer& cmd) {
-      detail::transition(cmd, *tex.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
-                         vk::ImageLayout::eTransferDstOptimal, vk::PipelineStageFlagBits2::eNone, vk::AccessFlagBits2::eNone,
-                         vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite);
-      cmd.copyBufferToImage(*staging.buffer, *tex.image, vk::ImageLayout::eTransferDstOptimal,
-                            vk::BufferImageCopy(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, 1),
-                                                {0, 0, 0}, vk::Extent3D(extent, 1)));
-      detail::transition(cmd, *tex.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eTransferDstOptimal,
-                         vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eCopy,
-                         vk::AccessFlagBits2::eTransferWrite, vk::PipelineStageFlagBits2::eFragmentShader,
-                         vk::AccessFlagBits2::eShaderSampledRead);
+      record_image_copy(cmd, *staging.buffer, tex, vk::ImageLayout::eUndefined, vk::PipelineStageFlagBits2::eNone,
+                        vk::AccessFlagBits2::eNone);
     });
     return tex;
+  }
+
+  // A whole colour image from `from`, left for fragment shaders to read; `before` is the image's layout
+  // and the last use to wait for.
+  static void record_image_copy(const vk::raii::CommandBuffer& cmd, vk::Buffer from, const detail::Image& image,
+                                vk::ImageLayout before, vk::PipelineStageFlags2 before_stage, vk::AccessFlags2 before_access) {
+    detail::transition(cmd, *image.image, vk::ImageAspectFlagBits::eColor, before, vk::ImageLayout::eTransferDstOptimal,
+                       before_stage, before_access, vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite);
+    cmd.copyBufferToImage(from, *image.image, vk::ImageLayout::eTransferDstOptimal,
+                          vk::BufferImageCopy(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, 1),
+                                              {0, 0, 0}, vk::Extent3D(image.extent, 1)));
+    detail::transition(cmd, *image.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eTransferDstOptimal,
+                       vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eCopy,
+                       vk::AccessFlagBits2::eTransferWrite, vk::PipelineStageFlagBits2::eFragmentShader,
+                       vk::AccessFlagBits2::eShaderSampledRead);
   }
 
   // One pipeline builder: every variant differs only in target format, culling and blending.
@@ -377,12 +384,18 @@ struct Renderer::Impl {
     return models.size() - 1;
   }
 
-  std::size_t add_streamed_texture(std::size_t model, int material, int width, int height) {
+  // Model `model`'s uploaded copy, checked to have material `material`.
+  GpuModel& model_with_material(std::size_t model, int material) {
     if (model >= models.size()) throw EngineError("streamed texture for model " + std::to_string(model) + ", not uploaded");
     GpuModel& g = models[model];
     if (material < 0 || static_cast<std::size_t>(material) >= g.materials.size())
       throw EngineError("streamed texture for material " + std::to_string(material) + ", but the model has " +
                         std::to_string(g.materials.size()));
+    return g;
+  }
+
+  std::size_t add_streamed_texture(std::size_t model, int material, int width, int height) {
+    model_with_material(model, material);  // refused before anything is made
     if (width <= 0 || height <= 0 || width > 16384 || height > 16384)
       throw EngineError("a streamed texture of " + std::to_string(width) + "x" + std::to_string(height) + " px");
     StreamedTexture tex;
@@ -396,11 +409,7 @@ struct Renderer::Impl {
 
   void bind_streamed_texture(std::size_t id, std::size_t model, int material) {
     if (id >= streamed.size()) throw EngineError("no streamed texture " + std::to_string(id));
-    if (model >= models.size()) throw EngineError("streamed texture for model " + std::to_string(model) + ", not uploaded");
-    GpuModel& g = models[model];
-    if (material < 0 || static_cast<std::size_t>(material) >= g.materials.size())
-      throw EngineError("streamed texture for material " + std::to_string(material) + ", but the model has " +
-                        std::to_string(g.materials.size()));
+    GpuModel& g = model_with_material(model, material);
     const auto m = static_cast<std::size_t>(material);
     gpu->device.waitIdle();  // the material's descriptor set may be in a frame in flight
     vk::DescriptorImageInfo info(*g.samplers[m], *streamed[id].image.view, vk::ImageLayout::eShaderReadOnlyOptimal);
@@ -461,17 +470,9 @@ struct Renderer::Impl {
         tex.pending.reset();
         from = &it->second;
       }
-      detail::transition(cmd, *tex.image.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eShaderReadOnlyOptimal,
-                         vk::ImageLayout::eTransferDstOptimal, vk::PipelineStageFlagBits2::eFragmentShader,
-                         vk::AccessFlagBits2::eShaderSampledRead, vk::PipelineStageFlagBits2::eCopy,
-                         vk::AccessFlagBits2::eTransferWrite);
-      cmd.copyBufferToImage(*from->buffer, *tex.image.image, vk::ImageLayout::eTransferDstOptimal,
-                            vk::BufferImageCopy(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, 1),
-                                                {0, 0, 0}, vk::Extent3D(tex.image.extent, 1)));
-      detail::transition(cmd, *tex.image.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eTransferDstOptimal,
-                         vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eCopy,
-                         vk::AccessFlagBits2::eTransferWrite, vk::PipelineStageFlagBits2::eFragmentShader,
-                         vk::AccessFlagBits2::eShaderSampledRead);
+      // After the frames before it have sampled the image (earlier in submission order: the barrier waits).
+      record_image_copy(cmd, *from->buffer, tex.image, vk::ImageLayout::eShaderReadOnlyOptimal,
+                        vk::PipelineStageFlagBits2::eFragmentShader, vk::AccessFlagBits2::eShaderSampledRead);
       ++uploaded;
     }
     return uploaded;
