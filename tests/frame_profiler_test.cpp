@@ -50,3 +50,26 @@ TEST(FrameProfilerTest, SummaryUsesStartToStartFrameTimes) {
   std::filesystem::remove(csv);
   EXPECT_THROW(prof.write_csv("/nonexistent-dir/p.csv"), std::runtime_error);
 }
+
+TEST(FrameProfilerTest, UploadPercentilesOverTheFramesThatUploaded) {
+  FrameProfiler prof;
+  const double uploads[] = {0.0, 0.5, 0.0, 1.5, 1.0};  // 0: the frame streamed nothing
+  for (std::uint64_t i = 0; i < 5; ++i) {
+    FrameRecord r;
+    r.index = i;
+    r.start_ms = 10.0 * static_cast<double>(i);
+    r.completed_ms = r.start_ms + 5.0;
+    r.upload_ms = uploads[i];
+    prof.add(r);
+  }
+  const auto s = prof.summary();
+  EXPECT_EQ(s.uploads, 3U);
+  EXPECT_DOUBLE_EQ(s.upload_p50_ms, 1.0);
+  EXPECT_NEAR(s.upload_p99_ms, 1.49, 1e-9);
+  FrameProfiler none;
+  FrameRecord r;
+  r.completed_ms = 5.0;
+  none.add(r);
+  EXPECT_EQ(none.summary().uploads, 0U);
+  EXPECT_TRUE(std::isnan(none.summary().upload_p50_ms));
+}

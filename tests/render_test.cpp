@@ -578,6 +578,39 @@ TEST_F(RenderTest, StreamedTextureShowsTheFrameOfEachDraw) {
   EXPECT_THROW(renderer_->add_streamed_texture(model, 1, 32, 32), projbot::engine::EngineError);
 }
 
+namespace {
+
+// Issue 44's tests: one target, a white quad 1 m before the projector filling pixels 25..174 of a 200 x 200
+// target (or 20..79 of 100 x 100), wearing `content`, uploaded to `renderer`.
+struct ContentQuad {
+  projbot::config::Scene scene;
+  std::vector<Model> models;
+  std::vector<DrawItem> items;
+};
+
+ContentQuad content_quad(Renderer& renderer, const ProjectorConfig& p, const projbot::config::TargetContent& content) {
+  ContentQuad q;
+  q.scene.projector = p;
+  projbot::config::TargetConfig t;
+  t.name = "a";
+  t.content = content;
+  q.scene.targets.push_back(t);
+  q.models.push_back(quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
+                           Eigen::Vector3d(-0.5, 0.5, 1)},
+                          {1, 1, 1, 1}));
+  q.items.push_back({renderer.add_model(q.models[0]), Eigen::Matrix4d::Identity()});
+  return q;
+}
+
+projbot::config::TargetContent video_content(const fs::path& clip) {
+  projbot::config::TargetContent c;
+  c.video = clip;
+  c.loop = false;
+  return c;
+}
+
+}  // namespace
+
 TEST(SceneContentMaterial, ByNameIndexOrFirstTextured) {
   Model m;
   m.source = "m.glb";
@@ -609,23 +642,13 @@ TEST_F(RenderTest, SceneContentDrawsTheVideoFrameOfEachDisplayTime) {
     for (int i = 0; i < 40; ++i) w.write(projbot::assets::frame_code_image(i, 320, 240));
     w.finish();
   }
-  projbot::config::Scene scene;
-  scene.projector = projector(200, 200, 150, 150, 99.5, 99.5);
-  projbot::config::TargetConfig t;
-  t.name = "a";
-  t.content = projbot::config::TargetContent{};
-  t.content->video = clip;
-  t.content->loop = false;
-  scene.targets.push_back(t);
-  std::vector<Model> models{quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
-                                  Eigen::Vector3d(-0.5, 0.5, 1)},
-                                 {1, 1, 1, 1})};
-  const std::size_t model = renderer_->add_model(models[0]);
-  projbot::engine::SceneContent content(*renderer_, scene, models, {model});
+  const ContentQuad q = content_quad(*renderer_, projector(200, 200, 150, 150, 99.5, 99.5), video_content(clip));
+  const projbot::config::Scene& scene = q.scene;
+  const std::vector<DrawItem>& items = q.items;
+  projbot::engine::SceneContent content(*renderer_, scene, q.models, items);
   ASSERT_TRUE(content.has(0));
   EXPECT_FALSE(content.has(1));
   auto target = renderer_->make_offscreen(200, 200);
-  const std::vector<DrawItem> items{{model, Eigen::Matrix4d::Identity()}};
   for (const double at : {0.0, 0.02, 0.034, 0.1, 0.25, 0.5, 0.9}) {
     const auto expected = static_cast<std::int64_t>(std::floor(at * 30.0 + 1e-9));
     // The test waits for the decoder (a renderer never does): up to 2 s for the frame of `at` to be decoded.
@@ -652,22 +675,16 @@ TEST_F(RenderTest, SceneContentDrawsTheVideoFrameOfEachDisplayTime) {
 TEST_F(RenderTest, SceneContentTimelineAnimatesTheBaseColourFactor) {
   // A timeline (issue 44) on a white quad: red at 0 s, blue at 2 s, looping; the colour drawn at each content
   // time against the linear interpolation between the keys (CPU reference), within one 8-bit step.
-  projbot::config::Scene scene;
-  scene.projector = projector(100, 100, 80, 80, 49.5, 49.5);
-  projbot::config::TargetConfig t;
-  t.name = "a";
-  t.content = projbot::config::TargetContent{};
-  t.content->timeline = {{0.0, {1.0, 0.0, 0.0, 1.0}}, {2.0, {0.0, 0.0, 1.0, 1.0}}};
-  scene.targets.push_back(t);
-  std::vector<Model> models{quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
-                                  Eigen::Vector3d(-0.5, 0.5, 1)},
-                                 {1, 1, 1, 1})};
-  const std::size_t model = renderer_->add_model(models[0]);
-  projbot::engine::SceneContent content(*renderer_, scene, models, {model});
+  projbot::config::TargetContent timeline;
+  timeline.timeline = {{0.0, {1.0, 0.0, 0.0, 1.0}}, {2.0, {0.0, 0.0, 1.0, 1.0}}};
+  const ContentQuad q = content_quad(*renderer_, projector(100, 100, 80, 80, 49.5, 49.5), timeline);
+  const projbot::config::Scene& scene = q.scene;
+  const std::size_t model = q.items[0].model;
+  projbot::engine::SceneContent content(*renderer_, scene, q.models, q.items);
   ASSERT_TRUE(content.has(0));
   EXPECT_FALSE(content.has_video(0));
   for (const double at : {0.0, 0.5, 1.5, 2.5, -1.0}) {
-    std::vector<DrawItem> items{{model, Eigen::Matrix4d::Identity()}};
+    std::vector<DrawItem> items = q.items;
     content.animate(0, at, items[0]);
     const Image img = render(scene.projector, items);
     const double phase = std::fmod(std::max(0.0, at), 2.0) / 2.0;  // looping every 2 s
@@ -692,21 +709,11 @@ TEST_F(RenderTest, SceneContentSwapsAChangedVideoAndKeepsTheOldOneWhenTheNewFail
     writer.finish();
   };
   write(0, 320, 240);
-  projbot::config::Scene scene;
-  scene.projector = projector(200, 200, 150, 150, 99.5, 99.5);
-  projbot::config::TargetConfig t;
-  t.name = "a";
-  t.content = projbot::config::TargetContent{};
-  t.content->video = clip;
-  t.content->loop = false;
-  scene.targets.push_back(t);
-  std::vector<Model> models{quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
-                                  Eigen::Vector3d(-0.5, 0.5, 1)},
-                                 {1, 1, 1, 1})};
-  const std::size_t model = renderer_->add_model(models[0]);
-  projbot::engine::SceneContent content(*renderer_, scene, models, {model});
+  const ContentQuad q = content_quad(*renderer_, projector(200, 200, 150, 150, 99.5, 99.5), video_content(clip));
+  const projbot::config::Scene& scene = q.scene;
+  const std::vector<DrawItem>& items = q.items;
+  projbot::engine::SceneContent content(*renderer_, scene, q.models, items);
   auto target = renderer_->make_offscreen(200, 200);
-  const std::vector<DrawItem> items{{model, Eigen::Matrix4d::Identity()}};
   const auto code_at = [&](double at) {  // waits (the test, not a renderer) for a frame, then draws it
     for (int k = 0; k < 500 && std::isnan(content.show(0, at).pts_s); ++k)
       std::this_thread::sleep_for(std::chrono::milliseconds(2));

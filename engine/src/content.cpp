@@ -29,10 +29,27 @@ int content_material(const assets::Model& model, const std::string& spec) {
   throw assets::AssetError(model.source + ": no material '" + spec + "' for the content (it has " + names + ")");
 }
 
+namespace {
+
+// A file's modification time and size (both unchanged: the file is as it was); false where it cannot be read.
+bool file_stamp(const std::filesystem::path& file, std::filesystem::file_time_type& written, std::uintmax_t& size) {
+  std::error_code ec1, ec2;
+  written = std::filesystem::last_write_time(file, ec1);
+  size = std::filesystem::file_size(file, ec2);
+  return !ec1 && !ec2;
+}
+
+}  // namespace
+
+std::shared_ptr<assets::VideoPlayer> SceneContent::make_player(std::unique_ptr<assets::VideoDecoder> decoder, bool loop) {
+  return std::make_shared<assets::VideoPlayer>(std::move(decoder), loop, 4,
+                                               [this](std::size_t bytes) { return renderer_.frame_memory(bytes); });
+}
+
 SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const std::vector<assets::Model>& models,
-                           const std::vector<std::size_t>& model_ids)
+                           const std::vector<DrawItem>& items)
     : renderer_(renderer) {
-  for (std::size_t i = 0; i < scene.targets.size() && i < models.size() && i < model_ids.size(); ++i) {
+  for (std::size_t i = 0; i < scene.targets.size() && i < models.size() && i < items.size(); ++i) {
     const auto& content = scene.targets[i].content;
     if (!content) continue;
     Stream s;
@@ -40,7 +57,7 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
     s.spec = *content;
     const int material = content_material(models[i], content->material);
     s.material = material;
-    s.model = model_ids[i];
+    s.model = items[i].model;
     if (content->video.empty()) {  // a timeline alone
       players_.push_back(std::move(s));
       continue;
@@ -54,17 +71,14 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
     if (same != players_.end()) {
       s.player = same->player;
       s.texture = same->texture;
-      renderer.bind_streamed_texture(s.texture, model_ids[i], material);
+      renderer.bind_streamed_texture(s.texture, s.model, material);
     } else {
-      s.player = std::make_shared<assets::VideoPlayer>(std::make_unique<assets::VideoDecoder>(content->video), content->loop, 4,
-                                                       [&renderer](std::size_t bytes) { return renderer.frame_memory(bytes); });
-      s.texture = renderer.add_streamed_texture(model_ids[i], material, s.player->info().width, s.player->info().height);
+      s.player = make_player(std::make_unique<assets::VideoDecoder>(content->video), content->loop);
+      s.texture = renderer.add_streamed_texture(s.model, material, s.player->info().width, s.player->info().height);
       Watch w;
       w.player = s.player;
       w.file = content->video;
-      std::error_code ec;
-      w.written = std::filesystem::last_write_time(w.file, ec);
-      w.size = std::filesystem::file_size(w.file, ec);
+      file_stamp(w.file, w.written, w.size);
       watches_.push_back(std::move(w));
     }
     players_.push_back(std::move(s));
@@ -118,7 +132,7 @@ SceneContent::Sample SceneContent::show(int target, double content_s) {
   Sample out;
   out.content_s = content_s;
   out.pts_s = std::nan("");
-  auto* s = const_cast<Stream*>(find(target));
+  Stream* s = find(target);
   if (s == nullptr || !s->player) return out;
   if (content_s < s->offset_s) s->offset_s = 0.0;  // the content began again (an arrival): so does a swapped-in video
   s->last_s = content_s;
@@ -136,6 +150,11 @@ SceneContent::Sample SceneContent::show(int target, double content_s) {
   return out;
 }
 
+SceneContent::Sample SceneContent::apply(int target, double content_s, DrawItem& item) {
+  animate(target, content_s, item);
+  return show(target, content_s);
+}
+
 std::vector<std::string> SceneContent::reload_changed(double now_s, double interval_s) {
   std::vector<std::string> said;
   for (Watch& w : watches_) {  // loads that have finished
@@ -151,10 +170,9 @@ std::vector<std::string> SceneContent::reload_changed(double now_s, double inter
   last_look_s_ = now_s;
   for (Watch& w : watches_) {
     if (w.loading.valid()) continue;
-    std::error_code ec1, ec2;
-    const auto written = std::filesystem::last_write_time(w.file, ec1);
-    const auto size = std::filesystem::file_size(w.file, ec2);
-    if (ec1 || ec2 || (written == w.written && size == w.size)) continue;  // gone for now, or as it was
+    std::filesystem::file_time_type written;
+    std::uintmax_t size = 0;
+    if (!file_stamp(w.file, written, size) || (written == w.written && size == w.size)) continue;  // gone for now, or as it was
     w.written = written;
     w.size = size;
     w.loading = std::async(std::launch::async, [file = w.file] { return std::make_unique<assets::VideoDecoder>(file); });
@@ -165,8 +183,7 @@ std::vector<std::string> SceneContent::reload_changed(double now_s, double inter
 void SceneContent::swap_in(Watch& w, std::unique_ptr<assets::VideoDecoder> decoder) {
   const bool loop =
       std::find_if(players_.begin(), players_.end(), [&](const Stream& s) { return s.player == w.player; })->spec.loop;
-  auto fresh = std::make_shared<assets::VideoPlayer>(std::move(decoder), loop, 4,
-                                                     [this](std::size_t bytes) { return renderer_.frame_memory(bytes); });
+  auto fresh = make_player(std::move(decoder), loop);
   const bool same_size = fresh->info().width == w.player->info().width && fresh->info().height == w.player->info().height;
   std::optional<std::size_t> texture;
   for (Stream& s : players_) {
@@ -190,14 +207,17 @@ const assets::VideoPlayer& SceneContent::player(int target) const {
   return *s->player;
 }
 
+std::vector<const assets::VideoPlayer*> SceneContent::videos() const {
+  std::vector<const assets::VideoPlayer*> out;
+  for (const Watch& w : watches_) out.push_back(w.player.get());
+  return out;
+}
+
 std::string SceneContent::summary() const {
   std::string out;
-  std::vector<const assets::VideoPlayer*> seen;
-  for (const Stream& s : players_) {
-    if (!s.player || std::find(seen.begin(), seen.end(), s.player.get()) != seen.end()) continue;
-    seen.push_back(s.player.get());
-    const assets::PlaybackStats st = s.player->stats();
-    out += (out.empty() ? "" : "; ") + s.player->name() + ": " + std::to_string(st.shown) + " video frames shown, " +
+  for (const assets::VideoPlayer* p : videos()) {
+    const assets::PlaybackStats st = p->stats();
+    out += (out.empty() ? "" : "; ") + p->name() + ": " + std::to_string(st.shown) + " video frames shown, " +
            std::to_string(st.skipped) + " skipped, " + std::to_string(st.repeated) + " repeated, " + std::to_string(st.loops) +
            " loops, " + std::to_string(st.seeks) + " jumps ahead, the renderer waited on its decoder " +
            std::to_string(st.waits) + " times";
@@ -207,9 +227,8 @@ std::string SceneContent::summary() const {
 
 std::vector<std::string> SceneContent::take_errors() {
   std::vector<std::string> out;
-  for (Stream& s : players_)  // a shared player says its error once: take_error empties it
-    if (s.player)
-      if (std::string e = s.player->take_error(); !e.empty()) out.push_back(e);
+  for (Watch& w : watches_)
+    if (std::string e = w.player->take_error(); !e.empty()) out.push_back(e);
   return out;
 }
 

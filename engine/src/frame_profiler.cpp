@@ -35,12 +35,16 @@ FrameSummary FrameProfiler::summary() const {
   std::vector<FrameRecord> r = records_;
   std::sort(r.begin(), r.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
   // Frame time: from one frame's start to the next one's; the last frame ends when its fence signals.
-  std::vector<double> frame, gpu, record;
+  std::vector<double> frame, gpu, record, upload;
   for (std::size_t i = 0; i < r.size(); ++i) {
     frame.push_back((i + 1 < r.size() ? r[i + 1].start_ms : r[i].completed_ms) - r[i].start_ms);
     gpu.push_back(r[i].gpu_ms);
     record.push_back(r[i].recorded_ms - r[i].pose_read_ms);
+    if (r[i].upload_ms > 0.0) upload.push_back(r[i].upload_ms);
   }
+  s.uploads = upload.size();
+  s.upload_p50_ms = percentile(upload, 0.50);
+  s.upload_p99_ms = percentile(upload, 0.99);
   s.p50_ms = percentile(frame, 0.50);
   s.p95_ms = percentile(frame, 0.95);
   s.p99_ms = percentile(frame, 0.99);

@@ -8,7 +8,6 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <set>
 #include <thread>
 
 #include "commands.hpp"
@@ -29,9 +28,8 @@ double rss_mb() {
 }
 
 struct ContentRun {
-  std::size_t frames = 0, frames_with_content = 0;
+  std::size_t frames = 0;
   std::vector<double> offset_ms;  // per target-frame: content time less the shown frame's presentation time
-  std::vector<double> upload_ms;  // per frame that uploaded a video frame
   double in_step_ms_max = 0.0;    // the largest spread of that offset between targets within one frame
   double within_one_frame = 0.0;  // share of target-frames whose offset is under one video frame
   std::size_t waits = 0, repeated = 0, skipped = 0, shown = 0;
@@ -51,21 +49,16 @@ ContentRun run_content(engine::Renderer& renderer, engine::RenderTarget& target,
   auto next = std::chrono::steady_clock::now();
   std::size_t within = 0;
   while (!interrupted() && config::steady_now_s() - t0 < seconds) {
-    next += std::chrono::microseconds(static_cast<std::int64_t>(1e6 * period_s));
-    std::this_thread::sleep_until(next);
-    if (std::chrono::steady_clock::now() > next + std::chrono::milliseconds(50)) next = std::chrono::steady_clock::now();
+    pace_frame(next, std::chrono::microseconds(static_cast<std::int64_t>(1e6 * period_s)));
     const auto read = [&](std::vector<engine::DrawItem>& out) {
       out.assign(items.begin(), items.end());
       const double display_s = config::steady_now_s() + period_s;
       double lo = INFINITY, hi = -INFINITY;
       for (int i = 0; i < static_cast<int>(items.size()); ++i) {
         if (!content.has(i)) continue;
-        const double content_s = display_s - content.start_s(i, t0, t0);
-        content.animate(i, content_s, out[static_cast<std::size_t>(i)]);
-        if (!content.has_video(i)) continue;
-        const auto s = content.show(i, content_s);
-        if (std::isnan(s.pts_s)) continue;
-        const double offset = 1000.0 * (std::max(0.0, s.content_s) - s.pts_s);
+        const auto s = content.apply(i, display_s - content.start_s(i, t0, t0), out[static_cast<std::size_t>(i)]);
+        if (std::isnan(s.pts_s)) continue;  // no video, or none decoded yet
+        const double offset = 1000.0 * (s.content_s - s.pts_s);
         run.offset_ms.push_back(offset);
         within += offset < 1000.0 / content.player(i).info().fps ? 1 : 0;
         lo = std::min(lo, offset);
@@ -78,12 +71,8 @@ ContentRun run_content(engine::Renderer& renderer, engine::RenderTarget& target,
   renderer.finish(target);
   run.seconds = config::steady_now_s() - t0;
   run.interrupted = interrupted();
-  for (const auto& r : profiler.records())
-    if (r.upload_ms > 0.0) run.upload_ms.push_back(r.upload_ms);
-  std::set<const assets::VideoPlayer*> counted;  // targets with the same video and start share a player
-  for (int i = 0; i < static_cast<int>(items.size()); ++i) {
-    if (!content.has_video(i) || !counted.insert(&content.player(i)).second) continue;
-    const auto st = content.player(i).stats();
+  for (const assets::VideoPlayer* video : content.videos()) {
+    const auto st = video->stats();
     run.waits += st.waits;
     run.repeated += st.repeated;
     run.skipped += st.skipped;
@@ -96,7 +85,7 @@ ContentRun run_content(engine::Renderer& renderer, engine::RenderTarget& target,
 
 nlohmann::json finite(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
-void write_report(const std::filesystem::path& file, const ContentRun& r) {
+void write_report(const std::filesystem::path& file, const ContentRun& r, const engine::FrameSummary& frames) {
   const nlohmann::json out = {{"frames", r.frames},
                               {"renderer_waits", r.waits},
                               {"content_offset_ms_p50", finite(engine::percentile(r.offset_ms, 0.5))},
@@ -104,8 +93,8 @@ void write_report(const std::filesystem::path& file, const ContentRun& r) {
                               {"content_within_one_frame", r.within_one_frame},
                               {"repeated", r.repeated},
                               {"skipped", r.skipped},
-                              {"upload_ms_p50", finite(engine::percentile(r.upload_ms, 0.5))},
-                              {"upload_ms_p99", finite(engine::percentile(r.upload_ms, 0.99))},
+                              {"upload_ms_p50", finite(frames.upload_p50_ms)},
+                              {"upload_ms_p99", finite(frames.upload_p99_ms)},
                               {"rss_mb_start", r.rss_start_mb},
                               {"rss_mb_end", r.rss_end_mb},
                               {"targets_in_step_ms_max", r.in_step_ms_max},
@@ -122,8 +111,8 @@ void print(const ContentRun& r, const engine::FrameSummary& frames) {
       engine::percentile(r.offset_ms, 0.5), engine::percentile(r.offset_ms, 0.99), 100.0 * r.within_one_frame);
   std::printf("video frames shown %zu, skipped %zu, repeated %zu; the renderer waited on a decoder %zu times\n", r.shown,
               r.skipped, r.repeated, r.waits);
-  std::printf("upload on the render thread: p50 %.3f ms, p99 %.3f ms (%zu uploads)\n", engine::percentile(r.upload_ms, 0.5),
-              engine::percentile(r.upload_ms, 0.99), r.upload_ms.size());
+  std::printf("upload on the render thread: p50 %.3f ms, p99 %.3f ms (%zu uploads)\n", frames.upload_p50_ms, frames.upload_p99_ms,
+              frames.uploads);
   std::printf("targets in step: offsets within one frame differ by at most %.2f ms\n", r.in_step_ms_max);
   std::printf("memory (RSS): %.0f MB at the start, %.0f MB at the end\n", r.rss_start_mb, r.rss_end_mb);
 }
@@ -160,9 +149,7 @@ const Command kBenchContent{
       std::cout << "device: " << renderer.device_info().name << std::endl;
       std::vector<assets::Model> models;
       const auto items = upload_scene(renderer, scene, &models);
-      std::vector<std::size_t> ids;
-      for (const auto& item : items) ids.push_back(item.model);
-      engine::SceneContent content(renderer, scene, models, ids);
+      engine::SceneContent content(renderer, scene, models, items);
       for (int i = 0; i < static_cast<int>(scene.targets.size()); ++i)
         if (content.has_video(i)) {
           const auto& info = content.player(i).info();
@@ -173,10 +160,11 @@ const Command kBenchContent{
       catch_interrupts();
       engine::FrameProfiler profiler;
       const ContentRun run = run_content(renderer, *target, scene, items, content, seconds, profiler);
-      print(run, profiler.summary());
+      const engine::FrameSummary frames = profiler.summary();
+      print(run, frames);
       if (const auto out = args.get("out")) assets::write_png(*out, target->read_back());
       for (const std::string& e : content.take_errors()) std::cerr << "content: " << e << '\n';
-      if (const auto file = args.get("report")) write_report(*file, run);
+      if (const auto file = args.get("report")) write_report(*file, run, frames);
       if (run.interrupted) return benchmark_interrupted("while drawing (the figures above are those measured)");
       return 0;
     }};

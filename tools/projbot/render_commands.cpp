@@ -45,7 +45,6 @@ void finish_profile(const cli::Args& args, const engine::FrameProfiler& profiler
 // waits (up to 10 s a video) for the decoder to reach the frame of that time.
 void content_at(engine::SceneContent& content, std::vector<engine::DrawItem>& items, double at_s) {
   for (int i = 0; i < static_cast<int>(items.size()); ++i) {
-    if (!content.has(i)) continue;
     content.animate(i, at_s, items[static_cast<std::size_t>(i)]);
     if (!content.has_video(i)) continue;
     const auto& info = content.player(i).info();
@@ -87,9 +86,7 @@ const Command kRender{
       if (!(content_time >= 0.0 && content_time <= 1e6)) throw cli::UsageError("--content-time must be 0..1e6 seconds");
       std::vector<assets::Model> models;
       auto items = upload_scene(renderer, scene, &models);
-      std::vector<std::size_t> model_ids;
-      for (const auto& item : items) model_ids.push_back(item.model);
-      engine::SceneContent content(renderer, scene, models, model_ids);
+      engine::SceneContent content(renderer, scene, models, items);
       content_at(content, items, content_time);
       auto target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
       engine::FrameProfiler profiler;
@@ -132,9 +129,7 @@ const Command kShow{
       std::cout << "device: " << renderer.device_info().name << '\n';
       std::vector<assets::Model> models;
       const auto items = upload_scene(renderer, scene, &models);
-      std::vector<std::size_t> model_ids;
-      for (const auto& item : items) model_ids.push_back(item.model);
-      engine::SceneContent content(renderer, scene, models, model_ids);  // the targets' videos, previewed
+      engine::SceneContent content(renderer, scene, models, items);  // the targets' videos, previewed
       auto window = open_window(renderer, w, scene.projector);
       engine::FrameProfiler profiler;
       int drawn = 0;
@@ -143,11 +138,7 @@ const Command kShow{
         out.assign(items.begin(), items.end());
         const double now = config::steady_now_s();
         for (int i = 0; i < static_cast<int>(items.size()); ++i)
-          if (content.has(i)) {
-            const double content_s = now - content.start_s(i, t0, t0);
-            content.show(i, content_s);
-            content.animate(i, content_s, out[static_cast<std::size_t>(i)]);
-          }
+          if (content.has(i)) content.apply(i, now - content.start_s(i, t0, t0), out[static_cast<std::size_t>(i)]);
       };
       while (!window->poll_close() && (frames == 0 || drawn < frames))
         if (renderer.draw_frame(*window, scene.projector, read, &profiler)) ++drawn;

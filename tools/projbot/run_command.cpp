@@ -317,9 +317,7 @@ const Command kRun{
       std::vector<engine::CompensationPlan::Target> surfaces;
       for (std::size_t i = 0; i < models.size(); ++i) surfaces.push_back({&models[i], scene.targets[i].surface.albedo});
       engine::CompensationPlan plan(std::move(surfaces), scene.room.ambient_lux, compensate);
-      std::vector<std::size_t> model_ids;
-      for (const auto& item : items) model_ids.push_back(item.model);
-      engine::SceneContent content(renderer, scene, models, model_ids);  // a bad video: one line, exit 1
+      engine::SceneContent content(renderer, scene, models, items);  // a bad video: one line, exit 1
       std::unique_ptr<engine::RenderTarget> target;
       if (headless) {
         target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
@@ -402,21 +400,15 @@ const Command kRun{
             const auto t = static_cast<std::size_t>(d.target);
             out.push_back({items[t].model, d.T_projector_target, plan.at(t, robot.visit, scene.projector, d.T_projector_target)});
             if (content.has(d.target)) {  // on the display clock of this frame, as its pose
-              const double content_s = d.display_s - content.start_s(d.target, t0, robot.since_s);
-              const auto shown = content.show(d.target, content_s);
+              const auto shown = content.apply(d.target, d.display_s - content.start_s(d.target, t0, robot.since_s), out.back());
               if (!std::isnan(shown.pts_s)) content_offsets_ms.push_back(1000.0 * (shown.content_s - shown.pts_s));
-              content.animate(d.target, content_s, out.back());
             }
             const auto lit =
                 std::find_if(robot.lit.begin(), robot.lit.end(), [&](const DrawnTarget& l) { return l.target == d.target; });
             drawn.push_back({&*lit, d.capture_s, d.display_s, d.T_camera_target});
           }
         };
-        if (headless) {  // an offscreen target has no vsync: pace it like a 60 Hz projector
-          next_frame += std::chrono::microseconds(16667);
-          std::this_thread::sleep_until(next_frame);
-          if (Clock::now() > next_frame + std::chrono::milliseconds(50)) next_frame = Clock::now();
-        }
+        if (headless) pace_frame(next_frame, std::chrono::microseconds(16667));  // no vsync: like a 60 Hz projector
         const double start_ms = profiler.now_ms(), start_s = config::steady_now_s();
         frames.frame_started(start_s);
         if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
@@ -480,13 +472,11 @@ const Command kRun{
                   << std::lround(1000.0 * pc.silent_camera_s) << " ms";
       std::cout << "\n";
       if (const std::string played = content.summary(); !played.empty()) {
-        std::vector<double> uploads;
-        for (const auto& r : profiler.records())
-          if (r.upload_ms > 0.0) uploads.push_back(r.upload_ms);
+        const engine::FrameSummary drawn_frames = profiler.summary();
         std::cout << "content: " << played << "; content time less the shown frame's: p50 "
                   << engine::percentile(content_offsets_ms, 0.5) << " ms, p99 " << engine::percentile(content_offsets_ms, 0.99)
-                  << " ms; upload on the render thread p50 " << std::setprecision(3) << engine::percentile(uploads, 0.5)
-                  << " ms, p99 " << engine::percentile(uploads, 0.99) << " ms" << std::setprecision(1) << "\n";
+                  << " ms; upload on the render thread p50 " << std::setprecision(3) << drawn_frames.upload_p50_ms << " ms, p99 "
+                  << drawn_frames.upload_p99_ms << " ms" << std::setprecision(1) << "\n";
       }
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;

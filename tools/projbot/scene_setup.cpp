@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <thread>
 
 #include "projbot/assets/model.hpp"
 
@@ -134,6 +135,12 @@ bool on_off(const cli::Args& args, const std::string& name, bool fallback) {
   if (*value == "on") return true;
   if (*value == "off") return false;
   throw cli::UsageError("--" + name + " must be on or off, not '" + *value + "'");
+}
+
+void pace_frame(std::chrono::steady_clock::time_point& next, std::chrono::microseconds period) {
+  next += period;
+  std::this_thread::sleep_until(next);
+  if (std::chrono::steady_clock::now() > next + std::chrono::milliseconds(50)) next = std::chrono::steady_clock::now();
 }
 
 engine::PresentMode present_mode(const std::string& name) {

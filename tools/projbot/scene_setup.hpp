@@ -2,6 +2,7 @@
 // From a command line to a scene on the GPU: the scene file (or the built-in demo), the overrides the
 // render-type subcommands share, and the upload of every target's model.
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -39,6 +40,10 @@ std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const con
                                            std::vector<assets::Model>* models = nullptr);
 /// fifo, mailbox or immediate. Throws cli::UsageError listing them for anything else.
 engine::PresentMode present_mode(const std::string& name);
+
+/// Paces an offscreen target (no vsync) like a projector: sleeps until `next` moved on by one `period`, and
+/// starts the cadence afresh after a frame more than 50 ms late.
+void pace_frame(std::chrono::steady_clock::time_point& next, std::chrono::microseconds period);
 /// The projector window from --fullscreen, --monitor and --present-mode (fifo, mailbox or immediate), the
 /// projector's size when windowed. Throws cli::UsageError.
 engine::WindowOptions window_options(const cli::Args& args, const config::ProjectorConfig& projector, std::string title);

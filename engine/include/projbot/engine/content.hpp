@@ -10,6 +10,7 @@
 #include <future>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "projbot/assets/model.hpp"
@@ -25,10 +26,11 @@ int content_material(const assets::Model& model, const std::string& spec);
 
 class SceneContent {
  public:
-  /// Opens every target's video and makes it its material's base colour (`model_ids[i]`: target i's model
-  /// in `renderer`, `models[i]` its CPU copy). Throws assets::AssetError naming the file or the material.
+  /// Opens every target's video and makes it its material's base colour (`items[i]`: target i's uploaded
+  /// model, as upload_scene gives them; `models[i]` its CPU copy). Throws assets::AssetError naming the file
+  /// or the material.
   SceneContent(Renderer& renderer, const config::Scene& scene, const std::vector<assets::Model>& models,
-               const std::vector<std::size_t>& model_ids);
+               const std::vector<DrawItem>& items);
   bool empty() const { return players_.empty(); }
   bool has(int target) const;        ///< target `target` has content (a video, a timeline or both)
   bool has_video(int target) const;  ///< target `target` plays a video
@@ -46,6 +48,10 @@ class SceneContent {
   /// to the renderer for the next draw. A target without content gives NaN pts.
   Sample show(int target, double content_s);
 
+  /// Both of the below for a target drawn with `item` at `content_s`: its video's frame (show) and its
+  /// timeline (animate).
+  Sample apply(int target, double content_s, DrawItem& item);
+
   /// Target `target`'s animated material at `content_s`: its timeline's base colour factor (linear between
   /// keys, held outside them, repeating every last key's time where it loops) set on `item`. A target
   /// without a timeline leaves `item` as it is.
@@ -60,6 +66,8 @@ class SceneContent {
 
   /// Target `target`'s player (it must have a video; targets with the same video and start share one).
   const assets::VideoPlayer& player(int target) const;
+  /// The videos played, each once (targets with the same video and start share one).
+  std::vector<const assets::VideoPlayer*> videos() const;
   /// Each video's playback so far, for people: frames shown, skipped, repeated, loops, waits ("" without video).
   std::string summary() const;
   /// Playback errors not reported before, one line each naming the file.
@@ -76,7 +84,7 @@ class SceneContent {
     double offset_s = 0.0;  ///< content time when its video was swapped in (it plays from its own start)
     double last_s = 0.0;    ///< the content time last shown
   };
-  // A video file as it was when loaded, and its reload under way.
+  // A video as played (one per player) and its file as it was when loaded, and its reload under way.
   struct Watch {
     std::shared_ptr<assets::VideoPlayer> player;
     std::filesystem::path file;
@@ -85,10 +93,12 @@ class SceneContent {
     std::future<std::unique_ptr<assets::VideoDecoder>> loading;
   };
   const Stream* find(int target) const;
+  Stream* find(int target) { return const_cast<Stream*>(std::as_const(*this).find(target)); }
+  std::shared_ptr<assets::VideoPlayer> make_player(std::unique_ptr<assets::VideoDecoder> decoder, bool loop);
   void swap_in(Watch& w, std::unique_ptr<assets::VideoDecoder> decoder);
   Renderer& renderer_;
   std::vector<Stream> players_;
-  std::vector<Watch> watches_;
+  std::vector<Watch> watches_;  // one per player
   double last_look_s_ = -1e300;
 };
 

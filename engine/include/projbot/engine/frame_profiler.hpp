@@ -27,9 +27,11 @@ struct FrameRecord {
 struct FrameSummary {
   std::size_t frames = 0;
   double p50_ms = 0, p95_ms = 0, p99_ms = 0, max_ms = 0, mean_ms = 0;
-  double fps = 0;                         ///< frames / wall time from first start to last completion
-  double gpu_p50_ms = 0, gpu_p99_ms = 0;  ///< NaN without timestamp queries
-  double cpu_record_p50_ms = 0;           ///< pose read to command buffer recorded
+  double fps = 0;                               ///< frames / wall time from first start to last completion
+  double gpu_p50_ms = 0, gpu_p99_ms = 0;        ///< NaN without timestamp queries
+  double cpu_record_p50_ms = 0;                 ///< pose read to command buffer recorded
+  std::size_t uploads = 0;                      ///< frames that uploaded streamed texels (video)
+  double upload_p50_ms = 0, upload_p99_ms = 0;  ///< over those frames; NaN where frames were drawn but none uploaded
 };
 
 class FrameProfiler {
