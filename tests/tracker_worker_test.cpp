@@ -390,3 +390,28 @@ TEST(TargetFollowerTest, FindsTheTargetAgainAfterDroppedFrames) {
   EXPECT_LT(translation_norm_m(err), 0.002);
   EXPECT_LT(rotation_angle_deg(err), 0.5);
 }
+
+// The outline: a cube standing before a wall ends in a depth step all round; the same cube sunk into the
+// wall (the wall at its front face) has an outline the measured surface runs on past, flush.
+TEST(FreeSpaceTest, TheOutlineOfAnObjectIsAStepAndOfASunkPoseFlush) {
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  const ModelCloud model = cube_model();
+  const Eigen::Matrix4d truth = projbot::config::pose_from_xyz_rpy({0.0, 0.0, 1.2}, {0, 0, 0});
+  auto depth = cube_depth(truth, k, 0.0);
+  const FreeSpaceCheck bare = check_free_space(model, truth, *depth, k);  // nothing measured around it
+  EXPECT_GT(bare.outline_missing, 100U);
+  EXPECT_EQ(bare.outline_flush, 0U);
+  EXPECT_EQ(bare.flush_ratio(), 0.0);
+  for (float& z : depth->depth_m)
+    if (z == 0.0F) z = 1.6F;  // a wall 30 cm behind its back face
+  const FreeSpaceCheck standing = check_free_space(model, truth, *depth, k);
+  EXPECT_GT(standing.outline_step, 100U);
+  EXPECT_LT(standing.flush_ratio(), 0.05);
+  EXPECT_EQ(standing.in_front_ratio(), 0.0);
+  const auto front_face = static_cast<float>(1.2 - kHalf);
+  std::fill(depth->depth_m.begin(), depth->depth_m.end(), front_face);  // the wall where its front face is
+  const FreeSpaceCheck sunk = check_free_space(model, truth, *depth, k);
+  EXPECT_GT(sunk.flush_ratio(), 0.95);
+  EXPECT_GT(sunk.agree_ratio(), 0.95);
+  EXPECT_TRUE(sunk.passes(0.1));  // the free space alone cannot tell
+}

@@ -66,7 +66,8 @@ void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, c
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor) {
   guess_ = T_camera_target;
-  known_ = Known{floor, std::nullopt, std::nullopt};
+  known_ = Known{};
+  known_.floor = floor;
   find_support_ = !floor;  // no map: the first search looks for what the target rests on in the frame
   map_floor_ = floor.has_value();
   have_guess_ = true;
@@ -158,6 +159,7 @@ std::optional<AlignmentResult> TargetFollower::first_acquisition(const DepthImag
   }
   Known known = known_;
   known.deadline = deadline;
+  if (cfg_.guess_bounds_estimate) known.bound = bound_of(guess_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg);
   try {
     last_attempt_ = acquire_known(frame, guess_, known, silhouette_grow_m_, colour);
   } catch (const AlignmentError&) {  // too little depth near the guess (an absent target): as attempt() says

@@ -108,6 +108,103 @@ void drop_cut_neighbours(DepthImage& out, const DepthImage& in, const std::vecto
   }
 }
 
+// The silhouette: the predicted pixels closed over the gaps between the model's samples (gap_px pixels),
+// within `box` grown by gap_px.
+std::vector<unsigned char> silhouette_of(const std::vector<float>& predicted, const std::array<int, 4>& box, int w, int h,
+                                         int gap_px) {
+  std::vector<unsigned char> grown(predicted.size(), 0), mask(predicted.size(), 0);
+  const auto index = [w](int x, int y) { return static_cast<std::size_t>(y) * w + x; };
+  for (int y = box[1]; y <= box[3]; ++y)
+    for (int x = box[0]; x <= box[2]; ++x)
+      if (std::isfinite(predicted[index(x, y)]))
+        for (int dy = std::max(0, y - gap_px); dy <= std::min(h - 1, y + gap_px); ++dy)
+          for (int dx = std::max(0, x - gap_px); dx <= std::min(w - 1, x + gap_px); ++dx) grown[index(dx, dy)] = 1;
+  // Eroded back: a pixel stays where every pixel within gap_px was reached.
+  for (int y = std::max(0, box[1] - gap_px); y <= std::min(h - 1, box[3] + gap_px); ++y)
+    for (int x = std::max(0, box[0] - gap_px); x <= std::min(w - 1, box[2] + gap_px); ++x) {
+      bool all = true;
+      for (int dy = -gap_px; dy <= gap_px && all; ++dy)
+        for (int dx = -gap_px; dx <= gap_px && all; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          all = xx >= 0 && yy >= 0 && xx < w && yy < h && grown[index(xx, yy)];
+        }
+      mask[index(x, y)] = all ? 1 : 0;
+    }
+  return mask;
+}
+
+// The model's depth at or next to outline pixel (x, y): the nearest predicted within 2 pixels.
+float edge_depth(const std::vector<float>& predicted, int x, int y, int w, int h) {
+  float z = std::numeric_limits<float>::infinity();
+  for (int dy = -2; dy <= 2; ++dy)
+    for (int dx = -2; dx <= 2; ++dx) {
+      const int xx = x + dx, yy = y + dy;
+      if (xx >= 0 && yy >= 0 && xx < w && yy < h) z = std::min(z, predicted[static_cast<std::size_t>(yy) * w + xx]);
+    }
+  return z;
+}
+
+// check_free_space's outline counts: from each outline pixel outwards (each side the silhouette ends),
+// the first measurement 2 to 5 pixels beyond twice the samples' spacing, past the band of mixed pixels at
+// depth steps (bench sensor).
+void check_outline(const std::vector<float>& predicted, const std::array<int, 4>& box, const DepthImage& depth,
+                   const CameraIntrinsics& k, FreeSpaceCheck& c) {
+  if (box[2] < 0) return;
+  const int w = k.width_px, h = k.height_px;
+  // The samples' spacing in pixels (1 / sqrt of the share of the silhouette's pixels they land on): the
+  // silhouette is closed over twice that, and its edge may lie that far past the outermost sample, so
+  // the probe starts beyond it.
+  std::vector<unsigned char> mask = silhouette_of(predicted, box, w, h, 2);
+  std::size_t hit = 0, area = 0;
+  for (int y = box[1]; y <= box[3]; ++y)
+    for (int x = box[0]; x <= box[2]; ++x)
+      if (mask[static_cast<std::size_t>(y) * w + x])
+        ++area, hit += std::isfinite(predicted[static_cast<std::size_t>(y) * w + x]) ? 1 : 0;
+  if (hit == 0) return;
+  const int gap = static_cast<int>(std::lround(2.0 * std::sqrt(static_cast<double>(area) / static_cast<double>(hit))));
+  if (gap > 2) mask = silhouette_of(predicted, box, w, h, gap);
+  const auto inside = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < w && y < h && mask[static_cast<std::size_t>(y) * w + x];
+  };
+  const int first = 2 + gap, last = first + 3;
+  for (int y = box[1]; y <= box[3]; ++y)
+    for (int x = box[0]; x <= box[2]; ++x) {
+      if (!inside(x, y)) continue;
+      for (const auto& [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+        if (inside(x + dx, y + dy)) continue;
+        const float z = edge_depth(predicted, x, y, w, h);
+        if (!std::isfinite(z)) continue;
+        // Only where the ray stays outside all the way: a gap between the model's samples or a narrow
+        // gap between its parts (a mug's handle) is no outline. A probe counts only with the silhouette
+        // `gap` pixels away across the ray too (a ray along a ragged edge runs beside the model).
+        const auto clear = [&](int xx, int yy) {
+          for (int s = -gap; s <= gap; ++s)
+            if (inside(xx + s * dy, yy + s * dx)) return false;
+          return true;
+        };
+        float measured = 0.0F;
+        bool outline = true, probed = false;
+        for (int o = 1; o <= last && outline; ++o) {
+          const int xx = x + o * dx, yy = y + o * dy;
+          outline = xx >= 0 && yy >= 0 && xx < w && yy < h && !inside(xx, yy);
+          if (!outline || o < first || has_depth(measured) || !clear(xx, yy)) continue;
+          probed = true;
+          measured = depth.at(xx, yy);
+        }
+        if (!outline || !probed) continue;
+        const float tolerance = 0.015F + 0.005F * z * z;
+        if (!has_depth(measured))
+          ++c.outline_missing;
+        else if (measured > z + tolerance)
+          ++c.outline_step;
+        else if (measured < z - tolerance)
+          ++c.outline_front;
+        else
+          ++c.outline_flush;
+      }
+    }
+}
+
 }  // namespace
 
 DepthImage crop_to_silhouette(const DepthImage& depth, const CameraIntrinsics& k, const ModelCloud& model,
@@ -163,6 +260,7 @@ FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& 
   std::array<int, 4> box{};
   const std::vector<float> predicted = predicted_depth(model, T_camera_model, k, box);
   const auto at = [&](int x, int y) { return predicted[static_cast<std::size_t>(y) * k.width_px + x]; };
+  check_outline(predicted, box, depth, k, c);
   constexpr int kRim = 2;  // pixels of the silhouette's rim left out
   const int x0 = std::max(box[0], kRim), x1 = std::min(box[2], k.width_px - 1 - kRim);
   const int y0 = std::max(box[1], kRim), y1 = std::min(box[3], k.height_px - 1 - kRim);

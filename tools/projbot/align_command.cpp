@@ -100,10 +100,10 @@ Eigen::Matrix4d initial_guess(const cli::Args& args) {
 }
 
 // How far the guess may be off (--guess-error MM,DEG): the depth image is cropped to the guess's
-// silhouette grown by how far that can move a model point.
-double guess_reach(const cli::Args& args, const alignment::ModelCloud& model) {
+// silhouette grown by how far that can move a model point, and an estimate beyond it is refused.
+alignment::GuessError guess_error(const cli::Args& args) {
   const auto [mm, deg] = cli::parse_distance_angle(args.get_or("guess-error", "50,15"), "guess-error", "mm", 500);
-  return alignment::guess_reach_m(model, mm / 1000.0, deg);
+  return {mm / 1000.0, deg};
 }
 
 }  // namespace
@@ -148,7 +148,7 @@ const Command kAlign{
       if (!(cfg.voxel_m > 0.0) || cfg.voxel_m > 0.1) throw cli::UsageError("--voxel must be in (0, 0.1] metres");
       const double model_scale = model_scale_option(args, 1.0);
       const alignment::ModelCloud model = alignment::load_model_cloud(*args.get("model"), 50000, model_scale);
-      const double grow_m = guess_reach(args, model);
+      const alignment::GuessError error = guess_error(args);
       const Scan loaded = load_scan(args);
       const alignment::PointCloud& scan = loaded.cloud;
       if (const std::size_t valid = scan.finite_count(); valid < cfg.min_points)
@@ -164,10 +164,9 @@ const Command kAlign{
         // the model at the estimate, it is in the wrong place, however well it fits.
         alignment::WorkerConfig worker;
         worker.acquisition = cfg;
-        worker.guess_bounds_estimate = true;  // --guess-error is a bound: an estimate beyond it is something else
         const alignment::TargetFollower follower(model, loaded.k, worker);
         try {
-          r = follower.acquire(*loaded.depth, T_init, grow_m);
+          r = follower.acquire(*loaded.depth, T_init, error);
         } catch (const alignment::AlignmentError& e) {  // too little depth near the guess: nothing to align, refused
           std::cerr << "projbot align: " << e.what() << "\n";
           r.T_scan_model = T_init;

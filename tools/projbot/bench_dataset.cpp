@@ -42,6 +42,7 @@ struct Row {
   bool accepted = false;
   double time_ms = 0.0, error_mm = 0.0;
   double inlier_ratio = 0.0, rmse_mm = 0.0, behind_ratio = 0.0, agree_ratio = 0.0;  // what the gate and the free-space check saw
+  double flush_ratio = 0.0;
 };
 
 Row row_for(const std::string& scene, const char* mode, int image, int gt_index, int obj_id, const Perturbation& p) {
@@ -100,7 +101,8 @@ double timed_ms(F&& f) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The starts' error is known (the perturbation): an estimate beyond it is something else that fits.
+// The starts' error is known (the perturbation): an estimate beyond it is something else that fits
+// (as a GuessError given to acquire() says without --track).
 alignment::WorkerConfig bounded_guess() {
   alignment::WorkerConfig c;
   c.guess_bounds_estimate = true;
@@ -131,11 +133,10 @@ class Bench {
         Row row = row_for(scene.name, "acquire", image.id, inst.gt_index, inst.obj_id, perturbations_[p]);
         row.T_start = perturbed(inst.T_camera_model, m.centre, perturbations_[p],
                                 start_seed(seed_, scene.name, image.id, inst.gt_index, p));
-        const double grow = alignment::guess_reach_m(m.cloud, perturbations_[p].mm / 1000.0, perturbations_[p].deg);
         alignment::AlignmentResult r;
         row.time_ms = timed_ms([&] {
           try {
-            r = e.ours.acquire(depth, row.T_start, grow);
+            r = e.ours.acquire(depth, row.T_start, alignment::GuessError{perturbations_[p].mm / 1000.0, perturbations_[p].deg});
           } catch (const alignment::AlignmentError&) {  // too little depth left near the start: blank
             r.T_scan_model = row.T_start;
           }
@@ -143,6 +144,7 @@ class Bench {
           row.accepted = r.converged && e.ours.passes(check);
           row.behind_ratio = check.behind_ratio();
           row.agree_ratio = check.agree_ratio();
+          row.flush_ratio = check.flush_ratio();
         });
         row.inlier_ratio = r.inlier_ratio, row.rmse_mm = r.rmse_mm;
         row.T_est = r.T_scan_model;
@@ -177,7 +179,7 @@ class Bench {
   void follow(const alignment::BopScene& scene, const std::vector<alignment::DepthImage>& frames,
               const alignment::CameraIntrinsics& k, const ObjectModel& m, const alignment::BopInstance& start, std::size_t p,
               std::vector<Row>& rows) {
-    // The follower knows how far its guess may be off, as the acquisition without --track is told (grow).
+    // The follower knows how far its guess may be off, as the acquisition without --track is told.
     alignment::WorkerConfig config = bounded_guess();
     config.guess_uncertainty_m = perturbations_[p].mm / 1000.0;
     config.guess_uncertainty_deg = perturbations_[p].deg;
@@ -232,7 +234,7 @@ class Bench {
     if (it == estimators_.end())
       it = estimators_
                .emplace(m.info->id,
-                        std::make_pair(k, Estimators{alignment::TargetFollower(m.cloud, k, bounded_guess()),
+                        std::make_pair(k, Estimators{alignment::TargetFollower(m.cloud, k, alignment::WorkerConfig{}),
                                                      alignment::Aligner(m.cloud, alignment::pcl_pipeline_config(true))}))
                .first;
     return it->second.second;
@@ -310,6 +312,7 @@ void write_report(const fs::path& file, const std::vector<Row>& rows, bool inter
                                 {"rmse_mm", std::isfinite(r.rmse_mm) ? nlohmann::json(r.rmse_mm) : nlohmann::json(nullptr)},
                                 {"behind_ratio", r.behind_ratio},
                                 {"agree_ratio", r.agree_ratio},
+                                {"flush_ratio", r.flush_ratio},
                                 {"time_ms", r.time_ms}});
   config::write_file_atomically(file, out.dump(1) + "\n");
 }

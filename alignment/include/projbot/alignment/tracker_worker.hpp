@@ -68,10 +68,11 @@ struct WorkerConfig {
   double guess_uncertainty_deg = 3.0;
   /// Once ICP has an estimate the depth is cropped again at it, grown by this (m), and ICP refines there.
   double recrop_m = 0.03;
-  /// Whether the guess's uncertainty is a bound (`align --guess-error`, `bench dataset`'s perturbations):
-  /// an estimate's centroid may then lie no farther from the guess's than that uncertainty plus
-  /// reach_margin_m (m). False: no bound (a map's guess of a target that may have been moved).
+  /// Whether the configured uncertainty is a bound on the first acquisition's answer (`bench dataset
+  /// --track`), as a GuessError given to acquire() is: see GuessError. False: no bound (a map's guess of
+  /// a target that may have been moved).
   bool guess_bounds_estimate = false;
+  /// How much farther than a bounded guess's error an estimate's centroid may lie (m): the estimate's own.
   double reach_margin_m = 0.02;
   /// Colour at acquisition: a move along the weakest slides is taken only if the depth's RMS error grows
   /// by at most this share...
@@ -100,7 +101,21 @@ struct WorkerConfig {
   /// Of the candidates that converge, the one whose centre lies nearest the guess is the estimate; the
   /// search stops at one within this share of the guess's reach (a fit farther off may be a neighbour).
   double nearest_candidate_share = 0.9;
+  /// A candidate's fit that hides (FreeSpaceCheck): more than hidden_flush_ratio of its outline runs on
+  /// flush into the surface around it, and more than hidden_front_ratio of its silhouette lies behind
+  /// something nearer, is a pose sunk into what stands behind the target, not the target.
+  double hidden_flush_ratio = 0.55;
+  double hidden_front_ratio = 0.2;
   CoarseSearch coarse;
+};
+
+/// How far a stated guess may be off (`align --guess-error`, `bench dataset`'s perturbations): the model
+/// moved at most move_m and turned at most turn_deg about its origin. The depth is searched within that
+/// reach, and an estimate whose centroid lies farther from the guess's than the move (plus the turn's
+/// sweep of the centroid about the origin, plus reach_margin_m) is something else that fits.
+struct GuessError {
+  double move_m = 0.05;
+  double turn_deg = 15.0;
 };
 
 /// What searching for a target has cost since its stop began.
@@ -183,11 +198,12 @@ class TargetFollower {
   /// confirmed by then is returned unconverged (blank). Throws AlignmentError when too little depth is left.
   AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const Footing& footing, double grow_m,
                           const assets::Image* colour = nullptr) const;
-  /// The same without a map (a real frame of objects on a table, `projbot align` on a depth image, a BOP
-  /// dataset): the support under the guess is found in the frame (support_in_frame, within grow_m) and
-  /// stands in for the footing (the target rests on it, any way up); where none is found, nothing is
-  /// left out and no footing is asked for.
-  AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, double grow_m,
+  /// The same without a map and from a guess whose error is stated (a real frame of objects on a table,
+  /// `projbot align` on a depth image, a BOP dataset): the support under the guess is found in the frame
+  /// (support_in_frame, within the error's reach) and stands in for the footing (the target rests on it,
+  /// any way up; where none is found, nothing is left out and no footing is asked for); an estimate
+  /// beyond the error is refused (GuessError).
+  AlignmentResult acquire(const DepthImage& frame, const Eigen::Matrix4d& guess, const GuessError& error,
                           const assets::Image* colour = nullptr) const;
   double silhouette_grow_m() const { return silhouette_grow_m_; }
 
@@ -198,6 +214,12 @@ class TargetFollower {
     std::optional<ThreadCpuClock::time_point> deadline;  // acquire()'s: no new search step after it
     bool close = false;          // the guess is known to within half the model's size (Aligner::align's close_guess)
     bool frame_support = false;  // no map: the floor and footing are the support found in the frame
+    // A stated guess's bound: where its error lets the model's centroid lie (beyond_bound).
+    struct Bound {
+      Eigen::Matrix4d guess;
+      double centre_m;  // how far from where `guess` puts the centroid (m)
+    };
+    std::optional<Bound> bound;
   };
   /// How an acquisition places the view's weak directions (a box seen face-on, along its face).
   enum class Weak {
@@ -228,14 +250,18 @@ class TargetFollower {
   AlignmentResult searched(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
                            const assets::Image* colour) const;
   /// The close acquisition from each of coarse_candidates around `guess` (within grow_m) in turn: of
-  /// those that converge (and, with guess_bounds_estimate, stay within grow_m of the guess) the nearest
+  /// those that converge (and stay within the known bound) the nearest
   /// the guess, stopping at one within nearest_candidate_share of grow_m; else the unconverged one with
   /// the most inliers; nothing when there are no candidates.
   std::optional<AlignmentResult> from_candidates(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known,
                                                  double grow_m, const assets::Image* colour) const;
-  /// With guess_bounds_estimate: whether T puts the model's centroid farther from where `guess` put it
-  /// than grow_m (the guess's reach) plus reach_margin_m: something else that fits, not the target.
-  bool beyond_bound(const Eigen::Matrix4d& guess, const Eigen::Matrix4d& T, double grow_m) const;
+  /// Whether T puts the model's centroid beyond the known bound (plus reach_margin_m): something else
+  /// that fits, not the target.
+  bool beyond_bound(const Known& known, const Eigen::Matrix4d& T) const;
+  /// Whether a candidate's fit T hides behind something nearer (hidden_flush_ratio, hidden_front_ratio).
+  bool hidden(const DepthImage& frame, const Eigen::Matrix4d& T) const;
+  /// The bound of a guess off by `move_m` and `turn_deg` (GuessError).
+  Known::Bound bound_of(const Eigen::Matrix4d& guess, double move_m, double turn_deg) const;
   /// The acquisition from one guess.
   AlignmentResult acquire_at(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
                              const assets::Image* colour, SearchStage stage = SearchStage::full) const;
@@ -277,7 +303,7 @@ class TargetFollower {
   MotionFilter filter_;           // fed with every pose found, reset when the target is lost or a stop begins
   double silhouette_grow_m_;      // how far the guess's configured uncertainty reaches
   double model_radius_m_;         // the model's farthest point from its origin
-  Eigen::Vector3d model_centre_;  // its centroid (guess_bounds_estimate bounds how far it moves)
+  Eigen::Vector3d model_centre_;  // its centroid (a stated guess bounds how far it moves)
   double last_found_s_ = 0.0;     // capture time of the newest pose found
   // Where a textured model may look like itself turned (box_turns; none without colour contrast): a
   // found pose is turned to the look-alike nearest the stop's guess (nearest_look_alike).

@@ -21,8 +21,22 @@ struct FreeSpaceCheck {
   std::size_t behind = 0;     ///< measured farther than the model's surface by more than the tolerance
   std::size_t in_front = 0;   ///< measured nearer: occluded, neutral
   std::size_t agree = 0;      ///< measured within the tolerance of the model's surface
+  /// The silhouette's outline: what the camera measures a few pixels outside it, past the band of mixed
+  /// pixels, against the model's depth at the outline.
+  std::size_t outline_step = 0;     ///< farther: the model's edge is a step to what lies behind
+  std::size_t outline_flush = 0;    ///< within the tolerance: the surface runs on past the outline
+  std::size_t outline_front = 0;    ///< nearer: an occluder beside it (neutral)
+  std::size_t outline_missing = 0;  ///< nothing measured there (the IR shadow, a step's lost pixels)
+  /// Share of the outline (occluded pixels left out) where the measured surface runs on flush past it:
+  /// the model's edge is no edge in the depth (a pose sunk into a larger surface); 0 with no outline.
+  double flush_ratio() const {
+    const std::size_t n = outline_step + outline_flush + outline_missing;
+    return n == 0 ? 0.0 : static_cast<double>(outline_flush) / static_cast<double>(n);
+  }
   /// Share of the predicted pixels where the camera looks through the model; 0 with nothing predicted.
   double behind_ratio() const { return predicted == 0 ? 0.0 : static_cast<double>(behind) / static_cast<double>(predicted); }
+  /// Share of the predicted pixels measured nearer than the model: occluded.
+  double in_front_ratio() const { return predicted == 0 ? 0.0 : static_cast<double>(in_front) / static_cast<double>(predicted); }
   /// Share of the predicted pixels where the measured surface is the model's.
   double agree_ratio() const { return predicted == 0 ? 0.0 : static_cast<double>(agree) / static_cast<double>(predicted); }
   /// Fewer predicted pixels than this and the check cannot vouch for an estimate (the model is out of
