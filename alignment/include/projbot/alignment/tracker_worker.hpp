@@ -250,9 +250,9 @@ class TargetFollower {
   AlignmentResult searched(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known, double grow_m,
                            const assets::Image* colour) const;
   /// The close acquisition from each of coarse_candidates around `guess` (within grow_m) in turn: of
-  /// those that converge (and stay within the known bound) the nearest
-  /// the guess, stopping at one within nearest_candidate_share of grow_m; else the unconverged one with
-  /// the most inliers; nothing when there are no candidates.
+  /// those that converge, stay within the known bound and do not hide, the nearest the guess, stopping
+  /// at one within nearest_candidate_share of grow_m; else the unconverged one with the most inliers;
+  /// nothing when there are no candidates.
   std::optional<AlignmentResult> from_candidates(const DepthImage& frame, const Eigen::Matrix4d& guess, const Known& known,
                                                  double grow_m, const assets::Image* colour) const;
   /// Whether T puts the model's centroid beyond the known bound (plus reach_margin_m): something else
