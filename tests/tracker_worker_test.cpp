@@ -398,20 +398,23 @@ TEST(FreeSpaceTest, TheOutlineOfAnObjectIsAStepAndOfASunkPoseFlush) {
   const ModelCloud model = cube_model();
   const Eigen::Matrix4d truth = projbot::config::pose_from_xyz_rpy({0.0, 0.0, 1.2}, {0, 0, 0});
   auto depth = cube_depth(truth, k, 0.0);
-  const FreeSpaceCheck bare = check_free_space(model, truth, *depth, k);  // nothing measured around it
+  const FreeSpaceCheck bare = check_free_space(model, truth, *depth, k, true);  // nothing measured around it
   EXPECT_GT(bare.outline_missing, 100U);
   EXPECT_EQ(bare.outline_flush, 0U);
   EXPECT_EQ(bare.flush_ratio(), 0.0);
   for (float& z : depth->depth_m)
     if (z == 0.0F) z = 1.6F;  // a wall 30 cm behind its back face
-  const FreeSpaceCheck standing = check_free_space(model, truth, *depth, k);
+  const FreeSpaceCheck standing = check_free_space(model, truth, *depth, k, true);
   EXPECT_GT(standing.outline_step, 100U);
   EXPECT_LT(standing.flush_ratio(), 0.05);
   EXPECT_EQ(standing.in_front_ratio(), 0.0);
   const auto front_face = static_cast<float>(1.2 - kHalf);
   std::fill(depth->depth_m.begin(), depth->depth_m.end(), front_face);  // the wall where its front face is
-  const FreeSpaceCheck sunk = check_free_space(model, truth, *depth, k);
+  const FreeSpaceCheck sunk = check_free_space(model, truth, *depth, k, true);
   EXPECT_GT(sunk.flush_ratio(), 0.95);
   EXPECT_GT(sunk.agree_ratio(), 0.95);
-  EXPECT_TRUE(sunk.passes(0.1));  // the free space alone cannot tell
+  EXPECT_TRUE(sunk.passes(0.1));                                             // the free space alone cannot tell
+  const FreeSpaceCheck without = check_free_space(model, truth, *depth, k);  // tracking's: no outline asked for
+  EXPECT_EQ(without.outline_flush + without.outline_step + without.outline_missing + without.outline_front, 0U);
+  EXPECT_EQ(without.agree, sunk.agree);
 }

@@ -213,7 +213,7 @@ bool TargetFollower::hidden(const DepthImage& frame, const Eigen::Matrix4d& T) c
   // what it carries (21 mm off: 0.61 and 0.29); of 1733 right estimates none passed both (the wood block,
   // carrying a box and a banana, 0.47 and 0.43; the potted meat can packed among its neighbours, 0.65
   // and 0.01).
-  const FreeSpaceCheck c = verify(frame, T);
+  const FreeSpaceCheck c = verify(frame, T, true);
   return c.flush_ratio() > cfg_.hidden_flush_ratio && c.in_front_ratio() > cfg_.hidden_front_ratio;
 }
 

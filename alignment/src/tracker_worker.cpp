@@ -88,8 +88,8 @@ void TargetFollower::set_pose(const Eigen::Matrix4d& T_camera_target) {
   pose_ = T_camera_target;
 }
 
-FreeSpaceCheck TargetFollower::verify(const DepthImage& frame, const Eigen::Matrix4d& T_camera_target) const {
-  return check_free_space(model_, T_camera_target, frame, k_);
+FreeSpaceCheck TargetFollower::verify(const DepthImage& frame, const Eigen::Matrix4d& T_camera_target, bool outline) const {
+  return check_free_space(model_, T_camera_target, frame, k_, outline);
 }
 
 bool TargetFollower::verified(const DepthImage& frame, const Eigen::Matrix4d& T) {

@@ -254,13 +254,13 @@ double guess_reach_m(const ModelCloud& model, double translation_m, double rotat
 }
 
 FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
-                                const CameraIntrinsics& k) {
+                                const CameraIntrinsics& k, bool outline) {
   FreeSpaceCheck c;
   if (depth.width != k.width_px || depth.height != k.height_px || !T_camera_model.allFinite()) return c;
   std::array<int, 4> box{};
   const std::vector<float> predicted = predicted_depth(model, T_camera_model, k, box);
   const auto at = [&](int x, int y) { return predicted[static_cast<std::size_t>(y) * k.width_px + x]; };
-  check_outline(predicted, box, depth, k, c);
+  if (outline) check_outline(predicted, box, depth, k, c);
   constexpr int kRim = 2;  // pixels of the silhouette's rim left out
   const int x0 = std::max(box[0], kRim), x1 = std::min(box[2], k.width_px - 1 - kRim);
   const int y0 = std::max(box[1], kRim), y1 = std::min(box[3], k.height_px - 1 - kRim);

@@ -140,7 +140,7 @@ class Bench {
           } catch (const alignment::AlignmentError&) {  // too little depth left near the start: blank
             r.T_scan_model = row.T_start;
           }
-          const alignment::FreeSpaceCheck check = e.ours.verify(depth, r.T_scan_model);
+          const alignment::FreeSpaceCheck check = e.ours.verify(depth, r.T_scan_model, true);
           row.accepted = r.converged && e.ours.passes(check);
           row.behind_ratio = check.behind_ratio();
           row.agree_ratio = check.agree_ratio();

@@ -180,7 +180,8 @@ class TargetFollower {
   /// The newest acquisition attempt's result (refine or search stage), if any since the last guess.
   const std::optional<AlignmentResult>& last_attempt() const { return last_attempt_; }
   /// The free-space check of a pose on a frame, and whether it passes (see max_behind_ratio).
-  FreeSpaceCheck verify(const DepthImage& frame, const Eigen::Matrix4d& T_camera_target) const;
+  /// With `outline`, also the outline's counts (check_free_space).
+  FreeSpaceCheck verify(const DepthImage& frame, const Eigen::Matrix4d& T_camera_target, bool outline = false) const;
   bool passes(const FreeSpaceCheck& check) const { return check.passes(cfg_.max_behind_ratio); }
   /// The newest free-space check (of the last pose accepted or refused).
   const FreeSpaceCheck& last_check() const { return check_; }

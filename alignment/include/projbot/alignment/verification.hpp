@@ -62,9 +62,10 @@ double guess_reach_m(const ModelCloud& model, double translation_m, double rotat
 
 /// The model's visible surface (samples whose normals face the camera, nearest per pixel) under
 /// T_camera_model compared with `depth`. The tolerance grows with range like the Kinect v1's error:
-/// 15 mm + 5 mm per square metre of depth (35 mm at 2 m).
+/// 15 mm + 5 mm per square metre of depth (35 mm at 2 m). The outline's counts (outline_*) only with
+/// `outline`: they cost two passes over the silhouette that tracking, which checks every frame, does not use.
 FreeSpaceCheck check_free_space(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const DepthImage& depth,
-                                const CameraIntrinsics& k);
+                                const CameraIntrinsics& k, bool outline = false);
 
 /// A direction of rigid motion the view hardly constrains: moving the model along it changes the
 /// point-to-plane distances of its visible surface least (a box seen face-on slides along its face).
