@@ -11,7 +11,7 @@ namespace {
 std::filesystem::path dataset() {
   namespace fs = std::filesystem;
   static const fs::path root = [] {
-    const fs::path r = fs::temp_directory_path() / ("projbot_fuzz_bop_" + std::to_string(::getpid()));
+    const fs::path r = projbot::fuzz::scratch().path("projbot_fuzz_bop_");
     fs::create_directories(r / "models");
     fs::create_directories(r / "test" / "000000" / "depth");
     std::ofstream(r / "models" / "models_info.json") << R"({"1": {"diameter": 100.0}, "2": {"diameter": 50.0}})";
