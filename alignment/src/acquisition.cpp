@@ -132,7 +132,7 @@ AlignmentResult TargetFollower::acquire_known(const DepthImage& frame, const Eig
   // Where colour cannot say how far the target is turned about an axis its view leaves free (a plain
   // mug with its handle hidden), the guess does: ICP's turn there follows noise and neighbours.
   if (r.converged && !(colour && colour_contrast_))
-    r.T_scan_model = nearest_unseen_turn(model_, r.T_scan_model, guess, frame, k_);
+    r.T_scan_model = nearest_unseen_turn(model_, r.T_scan_model, guess, frame, k_, &samples_);
   return r;
 }
 

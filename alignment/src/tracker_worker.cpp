@@ -52,11 +52,12 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
       silhouette_grow_m_(guess_reach_m(model_, cfg_.guess_uncertainty_m, cfg_.guess_uncertainty_deg)),
       model_radius_m_(guess_reach_m(model_, 0.0, 60.0)),  // a 60 degree turn moves the farthest point by the radius
       model_centre_(centroid_of(model_)),
-      turns_(colour_contrast_ ? box_turns(model_) : std::vector<Eigen::Matrix4d>{}) {}
+      turns_(colour_contrast_ ? box_turns(model_) : std::vector<Eigen::Matrix4d>{}),
+      samples_(model_.points) {}
 
 Eigen::Matrix4d TargetFollower::nearest_guess(const DepthImage& frame, const Eigen::Matrix4d& T,
                                               const Eigen::Matrix4d& guess) const {
-  return nearest_look_alike(model_, T, guess, turns_, frame, k_);
+  return nearest_look_alike(model_, T, guess, turns_, frame, k_, 20.0, &samples_);
 }
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing) {

@@ -40,16 +40,18 @@ namespace {
 // Whether the samples `probes` seen at T, moved to where T_model_model takes them, still lie on the
 // model's surface: all but 2 % within twice their own spacing to a sample plus 2 mm (the
 // depth's noise at a metre; the real mug's scanned model is round to about 1.5 mm).
-bool stays_on_surface(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, const std::vector<std::size_t>& probes) {
+bool stays_on_surface(const ModelCloud& model, const NearestPoints& samples, const Eigen::Matrix4d& T_model_model,
+                      const std::vector<std::size_t>& probes) {
   const Eigen::Matrix3f R = T_model_model.topLeftCorner<3, 3>().cast<float>();
   const Eigen::Vector3f t = T_model_model.topRightCorner<3, 1>().cast<float>();
   const std::size_t n = model.points.size();
   std::size_t off = 0;
   for (const std::size_t i : probes) {
     const Eigen::Vector3f& p = model.points[i];
-    const float own = (model.points[nearest_sample(model, p, i)] - p).norm();
+    const std::size_t own = samples.nearest(p, i);
     const Eigen::Vector3f q = R * p + t;
-    if ((model.points[nearest_sample(model, q, n)] - q).norm() > 2.0F * own + 0.002F) ++off;
+    const std::size_t moved = samples.nearest(q, n);
+    if (own >= n || moved >= n || (model.points[moved] - q).norm() > 2.0F * (model.points[own] - p).norm() + 0.002F) ++off;
   }
   return static_cast<double>(off) <= 0.02 * static_cast<double>(probes.size());
 }
@@ -57,7 +59,7 @@ bool stays_on_surface(const ModelCloud& model, const Eigen::Matrix4d& T_model_mo
 }  // namespace
 
 Eigen::Matrix4d nearest_unseen_turn(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const Eigen::Matrix4d& prior,
-                                    const DepthImage& depth, const CameraIntrinsics& k) {
+                                    const DepthImage& depth, const CameraIntrinsics& k, const NearestPoints* samples) {
   constexpr double kMinTurnDeg = 1.0;  // nearer than that: not worth a check
   constexpr std::size_t kProbes = 200;
   // The turn a body of revolution's seen surface leaves free is its weakest direction, but not below
@@ -68,15 +70,17 @@ Eigen::Matrix4d nearest_unseen_turn(const ModelCloud& model, const Eigen::Matrix
   const ViewConstraints view = view_constraints(model, T_camera_model, k);
   std::vector<std::size_t> probes;         // the samples seen at T: found once a turn is worth checking
   std::optional<FreeSpaceCheck> unturned;  // T's own free-space check: once, when a turn stays on the surface
+  std::optional<NearestPoints> built;      // the samples' index, when none is given: once a turn is worth checking
   for (const WeakDirection& weak : view.all) {
     if (weak.strength > kMaxStrength) break;
     const Eigen::Matrix4d turn = turn_towards(view, weak, T_camera_model, prior);
     if (rotation_angle_deg(turn) < kMinTurnDeg) continue;
     if (probes.empty()) probes = visible_samples(model, T_camera_model, depth, k, kProbes);
     if (probes.size() < kProbes / 4) return T_camera_model;
+    if (!samples || samples->size() != model.points.size()) samples = &built.emplace(model.points);
     const Eigen::Matrix4d turned = turn * T_camera_model;
     // A point seen at T (T p) lies on the turned model where it draws turned^-1 T p.
-    if (!stays_on_surface(model, rigid_inverse(turned) * T_camera_model, probes)) continue;
+    if (!stays_on_surface(model, *samples, rigid_inverse(turned) * T_camera_model, probes)) continue;
     if (!unturned) unturned = check_free_space(model, T_camera_model, depth, k);
     const FreeSpaceCheck after = check_free_space(model, turned, depth, k);
     if (after.predicted == 0 ||

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "projbot/alignment/equations.hpp"
@@ -555,22 +556,14 @@ bool has_colour_contrast(const ModelCloud& model) {
   return n >= static_cast<double>(kMinColourSamples) && sum2 - sum * sum / n > 1e-6 * n;  // as correlation()'s test
 }
 
-// The model sample nearest `q` other than `skip` (brute force: a few hundred probes per call).
-std::size_t nearest_sample(const ModelCloud& model, const Eigen::Vector3f& q, std::size_t skip) {
-  std::size_t best = skip;
-  float best_d = std::numeric_limits<float>::infinity();
-  for (std::size_t j = 0; j < model.points.size(); ++j) {
-    const float d = (model.points[j] - q).squaredNorm();
-    if (j != skip && d < best_d) best_d = d, best = j;
-  }
-  return best;
-}
-
-bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, const std::vector<std::size_t>& probes) {
+bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, const std::vector<std::size_t>& probes,
+                 const NearestPoints* samples) {
   const std::size_t n = model.points.size();
   // Without colours that vary, every slide along the model's own surface would look alike: the shop's
   // plain figure, slid 10-20 mm by PCL's ICP, would pass. Such a model's content is where its shape is.
   if (n < 2 || !T_model_model.allFinite() || !has_colour_contrast(model)) return false;
+  std::optional<NearestPoints> built;
+  if (!samples || samples->size() != n) samples = &built.emplace(model.points);
   std::vector<std::size_t> spread;
   if (probes.empty())
     for (std::size_t i = 0; i < n; i += std::max<std::size_t>(1, n / 300)) spread.push_back(i);
@@ -581,9 +574,10 @@ bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, 
   for (const std::size_t i : at) {
     if (i >= n) return false;
     const Eigen::Vector3f& p = model.points[i];
-    const std::size_t own = nearest_sample(model, p, i);
+    const std::size_t own = samples->nearest(p, i);
     const Eigen::Vector3f q = R * p + t;
-    const std::size_t moved = nearest_sample(model, q, n);
+    const std::size_t moved = samples->nearest(q, n);
+    if (own >= n || moved >= n) return false;
     own_d += (model.points[own] - p).norm();
     moved_d += (model.points[moved] - q).norm();
     own_c += (model.colours[own] - model.colours[i]).norm();
@@ -631,20 +625,22 @@ std::vector<Eigen::Matrix4d> box_turns(const ModelCloud& model) {
 
 Eigen::Matrix4d nearest_look_alike(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const Eigen::Matrix4d& prior,
                                    const std::vector<Eigen::Matrix4d>& turns, const DepthImage& depth, const CameraIntrinsics& k,
-                                   double margin_deg) {
+                                   double margin_deg, const NearestPoints* samples) {
   const auto off_deg = [&](const Eigen::Matrix4d& T) { return rotation_angle_deg(rigid_inverse(prior) * T); };
   Eigen::Matrix4d best = T_camera_model;
   double best_deg = off_deg(T_camera_model) - margin_deg;
   std::vector<std::size_t> seen;  // looked for only when a turn would be nearer the prior
+  std::optional<NearestPoints> built;
   for (const Eigen::Matrix4d& turn : turns) {
     const Eigen::Matrix4d candidate = T_camera_model * turn;
     const double deg = off_deg(candidate);
     if (!(deg < best_deg)) continue;
     if (seen.empty()) seen = visible_samples(model, T_camera_model, depth, k, 100);
     if (seen.empty()) break;
+    if (!samples || samples->size() != model.points.size()) samples = &built.emplace(model.points);
     // The candidate draws model point turn * p where T draws p: the content it puts on the seen surfaces
     // is T's where the model turned back onto itself looks alike there.
-    if (!looks_alike(model, rigid_inverse(turn), seen)) continue;
+    if (!looks_alike(model, rigid_inverse(turn), seen, samples)) continue;
     best = candidate;
     best_deg = deg;
   }

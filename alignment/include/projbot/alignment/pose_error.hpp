@@ -11,7 +11,7 @@ namespace projbot::alignment {
 /// ADD in metres over `vertices` (model frame, metres).
 double add_error_m(const std::vector<Eigen::Vector3f>& vertices, const Eigen::Matrix4d& T_est, const Eigen::Matrix4d& T_true);
 
-/// ADD-S in metres: each vertex under T_est to its nearest vertex under T_true (exact, by a uniform grid).
+/// ADD-S in metres: each vertex under T_est to its nearest vertex under T_true (exact: NearestPoints, the distance in double).
 double adds_error_m(const std::vector<Eigen::Vector3f>& vertices, const Eigen::Matrix4d& T_est, const Eigen::Matrix4d& T_true);
 
 }  // namespace projbot::alignment

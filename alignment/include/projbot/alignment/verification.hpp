@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
+#include "projbot/alignment/nearest_points.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/assets/image.hpp"
 
@@ -121,9 +122,6 @@ inline constexpr std::size_t kMinColourSamples = 200;
 /// one plain material).
 bool has_colour_contrast(const ModelCloud& model);
 
-/// The model sample nearest `q` other than the one at index `skip` (model.points.size(): none skipped).
-std::size_t nearest_sample(const ModelCloud& model, const Eigen::Vector3f& q, std::size_t skip);
-
 /// Whether the model moved by `T_model_model` looks the same as unmoved at the model points `probes`
 /// (indices into model.points; empty: 300 spread over all of them): moved, they land on the model's
 /// surface (as near, on average, as a probe's nearest other sample) and carry the colour found there
@@ -131,7 +129,9 @@ std::size_t nearest_sample(const ModelCloud& model, const Eigen::Vector3f& q, st
 /// estimate^-1 * truth, it says whether the content an estimate puts on the seen surfaces is the
 /// truth's: a textured box turned 180 degrees onto a face that shows the same texture. False for a
 /// model without colour contrast (has_colour_contrast), whose content is where its shape is.
-bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, const std::vector<std::size_t>& probes = {});
+/// `samples`: an index of model.points (built here when null; a caller that asks often keeps one).
+bool looks_alike(const ModelCloud& model, const Eigen::Matrix4d& T_model_model, const std::vector<std::size_t>& probes = {},
+                 const NearestPoints* samples = nullptr);
 
 /// The turns that take the model's bounding box onto itself if it were a cube: the 23 rotations of a
 /// cube (90, 180 and 270 degrees about each of its axes, 180 about the diagonals of its faces, 120 and
@@ -147,7 +147,7 @@ std::vector<Eigen::Matrix4d> box_turns(const ModelCloud& model);
 /// (every turn is 90 degrees or more).
 Eigen::Matrix4d nearest_look_alike(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const Eigen::Matrix4d& prior,
                                    const std::vector<Eigen::Matrix4d>& turns, const DepthImage& depth, const CameraIntrinsics& k,
-                                   double margin_deg = 20.0);
+                                   double margin_deg = 20.0, const NearestPoints* samples = nullptr);
 
 /// The model points a camera sees with the model at T_camera_model: in its image, facing it, and within
 /// 1 cm of the depth measured there; at most `max` of them, spread over the model.
@@ -175,8 +175,9 @@ Eigen::Matrix4d turn_towards(const ViewConstraints& view, const WeakDirection& w
 /// near as twice its own neighbour's spacing plus 2 mm), and no more of the turned model is seen through
 /// (check_free_space: at most 1 % of its silhouette more). Depth alone says nothing about how far a body
 /// of revolution is turned about its axis (a plain mug with its handle hidden); the prior does.
+/// `samples` as for looks_alike.
 Eigen::Matrix4d nearest_unseen_turn(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const Eigen::Matrix4d& prior,
-                                    const DepthImage& depth, const CameraIntrinsics& k);
+                                    const DepthImage& depth, const CameraIntrinsics& k, const NearestPoints* samples = nullptr);
 
 /// A pose moved to where colour agrees best, in the plane of its two weakest slides.
 struct ColourRefinement {
