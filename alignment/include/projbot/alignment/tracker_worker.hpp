@@ -106,6 +106,9 @@ struct WorkerConfig {
   /// something nearer, is a pose sunk into what stands behind the target, not the target.
   double hidden_flush_ratio = 0.55;
   double hidden_front_ratio = 0.2;
+  /// ...or more than embedded_flush_ratio of its outline runs on flush, whatever lies in front: a patch
+  /// of a larger surface, not an object standing out of it.
+  double embedded_flush_ratio = 0.8;
   CoarseSearch coarse;
 };
 
@@ -259,7 +262,8 @@ class TargetFollower {
   /// Whether T puts the model's centroid beyond the known bound (plus reach_margin_m): something else
   /// that fits, not the target.
   bool beyond_bound(const Known& known, const Eigen::Matrix4d& T) const;
-  /// Whether a candidate's fit T hides behind something nearer (hidden_flush_ratio, hidden_front_ratio).
+  /// Whether a candidate's fit T hides behind something nearer (hidden_flush_ratio, hidden_front_ratio)
+  /// or lies embedded in a surface (embedded_flush_ratio).
   bool hidden(const DepthImage& frame, const Eigen::Matrix4d& T) const;
   /// The bound of a guess off by `move_m` and `turn_deg` (GuessError).
   Known::Bound bound_of(const Eigen::Matrix4d& guess, double move_m, double turn_deg) const;
