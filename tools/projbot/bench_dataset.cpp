@@ -63,7 +63,8 @@ std::vector<Perturbation> parse_perturbations(const std::vector<std::string>& te
 }
 
 // The truth moved `mm` in a random direction and turned `deg` about a random axis through the model's
-// centre; the generator is seeded per instance, so a start does not depend on which scenes run.
+// centre; the generator is seeded per instance and perturbation, so a start does not depend on which
+// scenes or which other perturbations run (`--perturb 50,15` alone gives the starts it gives beside 20,5).
 Eigen::Matrix4d perturbed(const Eigen::Matrix4d& T, const Eigen::Vector3d& centre_model, const Perturbation& p,
                           std::uint32_t seed) {
   std::mt19937 rng(seed);
@@ -78,9 +79,9 @@ Eigen::Matrix4d perturbed(const Eigen::Matrix4d& T, const Eigen::Vector3d& centr
   return turn * T;
 }
 
-std::uint32_t start_seed(std::uint64_t seed, const std::string& scene, int image, int gt_index, std::size_t perturbation) {
+std::uint32_t start_seed(std::uint64_t seed, const std::string& scene, int image, int gt_index, const Perturbation& p) {
   const std::size_t h = std::hash<std::string>{}(scene + "/" + std::to_string(image) + "/" + std::to_string(gt_index) + "/" +
-                                                 std::to_string(perturbation) + "/" + std::to_string(seed));
+                                                 std::to_string(p.mm) + "," + std::to_string(p.deg) + "/" + std::to_string(seed));
   return static_cast<std::uint32_t>(h ^ (h >> 32));
 }
 
@@ -132,7 +133,7 @@ class Bench {
       for (std::size_t p = 0; p < perturbations_.size() && !interrupted(); ++p) {
         Row row = row_for(scene.name, "acquire", image.id, inst.gt_index, inst.obj_id, perturbations_[p]);
         row.T_start = perturbed(inst.T_camera_model, m.centre, perturbations_[p],
-                                start_seed(seed_, scene.name, image.id, inst.gt_index, p));
+                                start_seed(seed_, scene.name, image.id, inst.gt_index, perturbations_[p]));
         alignment::AlignmentResult r;
         row.time_ms = timed_ms([&] {
           try {
@@ -184,8 +185,9 @@ class Bench {
     config.guess_uncertainty_m = perturbations_[p].mm / 1000.0;
     config.guess_uncertainty_deg = perturbations_[p].deg;
     alignment::TargetFollower follower(m.cloud, k, config);
-    const Eigen::Matrix4d T_start = perturbed(start.T_camera_model, m.centre, perturbations_[p],
-                                              start_seed(seed_, scene.name, scene.images.front().id, start.gt_index, p));
+    const Eigen::Matrix4d T_start =
+        perturbed(start.T_camera_model, m.centre, perturbations_[p],
+                  start_seed(seed_, scene.name, scene.images.front().id, start.gt_index, perturbations_[p]));
     follower.set_initial_guess(T_start);
     std::optional<alignment::PoseSample> shown;
     for (std::size_t f = 0; f < frames.size() && !interrupted(); ++f) {
@@ -381,23 +383,23 @@ const Command kBenchDataset{
     "pose estimation on a BOP dataset's real frames, ours beside PCL's pipeline",
     "projbot bench dataset DIR [--perturb MM,DEG]... [--seed K] [--min-visible PX] [--scenes A,B] [--max-instances N]\n"
     "                          [--model-scale S] [--track] [--report FILE.json]\n\n"
-    "DIR is a BOP dataset (models/ with models_info.json, test/SCENE/ with depth/, mask_visib/, scene_camera.json,\n"
-    "scene_gt.json, scene_gt_info.json). Each object instance with at least PX visible pixels is estimated from its\n"
-    "ground truth moved MM in a random direction and turned DEG about a random axis through the model's centre\n"
-    "(seeded per instance), by ours (the acquisition `align`, the tour and the tracker run: the support under\n"
-    "the start found in the frame and left out, the depth cropped to the start's silhouette, projective and\n"
-    "point-to-plane ICP, the quality gate and the free-space check; from a start off by more than half the\n"
-    "model's size, poses around it scored against the depth first and the best three acquired in turn) and by\n"
-    "PCL's pipeline from the same start\n"
-    "(crop around the start, normals, ICP; lit whenever it converges). Error: ADD, the mean distance of the\n"
-    "model's vertices under the estimate and under the truth; ADD-S (to the nearest vertex) for symmetric\n"
-    "shapes (models_info.json's symmetries; for YCB-V without them, ids 1 4 6 13 16 18 19 20 21). Per object\n"
-    "and overall: lit within 5 and 10 mm, false accepts (lit, more than 20 mm off), false rejects (blank,\n"
-    "within 10 mm), time. The ground truth itself agrees with real depth to about 2 mm: within 3 mm is as\n"
-    "good as the data can tell. With --track, each object of a scene's first image is started once from its\n"
-    "perturbed truth and followed through the scene's images in order by the tracker as `run` uses it (track,\n"
-    "refine, search when lost); each image's row is the pose the renderer would show then (blank when lost).\n"
-    "Ctrl-C prints and reports the estimates done (\"interrupted\": true).\n",
+    "DIR is a BOP dataset (models/ with models_info.json, test/SCENE/ with depth/, mask_visib/,\n"
+    "scene_camera.json, scene_gt.json, scene_gt_info.json). Each object instance with at least PX visible pixels\n"
+    "is estimated from its ground truth moved MM in a random direction and turned DEG about a random axis through\n"
+    "the model's centre (seeded per instance and perturbation), by ours (the acquisition `align`, the tour and\n"
+    "the tracker run: the support under the start found in the frame and left out, the depth cropped to the\n"
+    "start's silhouette, projective and point-to-plane ICP, the quality gate and the free-space check; from a\n"
+    "start off by more than half the model's size, poses around it scored against the depth first and the best\n"
+    "three acquired in turn) and by PCL's pipeline from the same start (crop around the start, normals, ICP; lit\n"
+    "whenever it converges). Error: ADD, the mean distance of the model's vertices under the estimate and under\n"
+    "the truth; ADD-S (to the nearest vertex) for symmetric shapes (models_info.json's symmetries; for YCB-V\n"
+    "without them, ids 1 4 6 13 16 18 19 20 21). Per object and overall: lit within 5 and 10 mm, false accepts\n"
+    "(lit, more than 20 mm off), false rejects (blank, within 10 mm), time. The ground truth itself agrees with\n"
+    "real depth to about 2 mm: within 3 mm is as good as the data can tell. With --track, each object of a\n"
+    "scene's first image is started once from its perturbed truth and followed through the scene's images in\n"
+    "order by the tracker as `run` uses it (track, refine, search when lost); each image's row is the pose the\n"
+    "renderer would show then (blank when lost). Ctrl-C prints and reports the estimates done (\"interrupted\":\n"
+    "true).\n",
     {{"perturb", "MM,DEG", "the start's error; repeat for several (default 20,5)"},
      {"seed", "K", "seed of the starts (default 1)"},
      {"min-visible", "PX", "skip instances with fewer visible pixels (default 1500)"},
