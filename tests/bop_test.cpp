@@ -7,11 +7,13 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
 
+#include "projbot/alignment/nearest_points.hpp"
 #include "projbot/alignment/pose_error.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/verification.hpp"
@@ -190,6 +192,22 @@ TEST(PoseError, AddIsTheMeanVertexDistanceAndAddsForgivesASymmetry) {
   Eigen::Matrix4d far = I;
   far(2, 3) = 1.0;
   EXPECT_NEAR(projbot::alignment::adds_error_m(ring, far, I), 1.0, 1e-9);
+}
+
+// The nearest-point index the look-alike and unseen-turn checks and ADD-S use: the nearest other than a
+// skipped index, and "none" (size()) where there is nothing to find.
+TEST(NearestPoints, FindsTheNearestOtherThanTheSkippedOne) {
+  using projbot::alignment::NearestPoints;
+  const std::vector<Eigen::Vector3f> points{{0, 0, 0}, {0.01F, 0, 0}, {0.03F, 0, 0}, {0, 0.05F, 0}};
+  const NearestPoints index(points);
+  EXPECT_EQ(index.size(), 4U);
+  EXPECT_EQ(index.nearest(Eigen::Vector3f(0.001F, 0, 0), 4), 0U);
+  EXPECT_EQ(index.nearest(Eigen::Vector3f(0.001F, 0, 0), 0), 1U);                  // itself skipped: the next nearest
+  EXPECT_EQ(index.nearest(points[2], 2), 1U);                                      // 2 cm to point 1, 3 cm to point 0
+  EXPECT_EQ(index.nearest(Eigen::Vector3f(0, 1.0F, 0), 4), 3U);                    // far outside the points
+  EXPECT_EQ(index.nearest(Eigen::Vector3f(std::nanf(""), 0, 0), 4), 4U);           // not finite: none
+  EXPECT_EQ(NearestPoints({}).nearest(Eigen::Vector3f::Zero(), 0), 0U);            // empty: none
+  EXPECT_EQ(NearestPoints({{1, 2, 3}}).nearest(Eigen::Vector3f(1, 2, 3), 0), 1U);  // only the skipped one
 }
 
 TEST(RigidInput, AFloat32RotationIsTakenAndMadeOrthonormal) {
