@@ -385,13 +385,15 @@ TEST_F(CliTest, RunInterruptedKeepsTheProfile) {
     for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
     if (f.size() < 6 || f[2].empty()) continue;  // a blank frame (the last cell, empty, is not read)
     ++lit;
-    // Capture before the frame started; display one refresh after the pose was read, which is at or
-    // after the frame's start (later when acquiring an image waited). The refresh is the measured present
-    // cadence, the median of the last 31 frame intervals: about 16.7 ms at 60 Hz, a little under when
-    // frames catch up after a late one (16.47 ms in a clean-clone CI). The age at least the time between
-    // capture and display (more when the frame took longer than a refresh).
+    // Display one refresh after the pose was read, which is at or after the frame's start (later when
+    // acquiring an image waited); the capture before that read, so at least a refresh before display (not
+    // before the frame's start: a pose captured while the frame waited for its image is read, 3304 ms
+    // against a start at 3294 in a clean-clone CI). The refresh is the measured present cadence, the
+    // median of the last 31 frame intervals: about 16.7 ms at 60 Hz, a little under when frames catch up
+    // after a late one (16.47 ms in a clean-clone CI). The age at least the time between capture and
+    // display (more when the frame took longer than a refresh).
     const double start = std::stod(f[1]), age = std::stod(f[2]), capture = std::stod(f[4]), display = std::stod(f[5]);
-    EXPECT_LT(capture, start) << line;
+    EXPECT_LT(capture, display - 15.0) << line;
     EXPECT_GE(display - start, 15.0) << line;
     EXPECT_LT(display - start, 16.7 + 100.0) << line;
     EXPECT_GE(age, display - capture - 0.01) << line;
