@@ -57,7 +57,7 @@ TargetFollower::TargetFollower(ModelCloud model, CameraIntrinsics intrinsics, Wo
 
 Eigen::Matrix4d TargetFollower::nearest_guess(const DepthImage& frame, const Eigen::Matrix4d& T,
                                               const Eigen::Matrix4d& guess) const {
-  return nearest_look_alike(model_, T, guess, turns_, frame, k_, 20.0, &samples_);
+  return nearest_look_alike(model_, T, guess, turns_, frame, k_, kLookAlikeMarginDeg, &samples_);
 }
 
 void TargetFollower::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing) {

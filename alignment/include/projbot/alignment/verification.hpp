@@ -145,9 +145,10 @@ std::vector<Eigen::Matrix4d> box_turns(const ModelCloud& model);
 /// does: a textured box found turned 180 degrees onto a face with the same texture, from a guess 40
 /// degrees off, is turned back. A pose within (90 + margin_deg) / 2 degrees of the prior is never moved
 /// (every turn is 90 degrees or more).
+inline constexpr double kLookAlikeMarginDeg = 20.0;
 Eigen::Matrix4d nearest_look_alike(const ModelCloud& model, const Eigen::Matrix4d& T_camera_model, const Eigen::Matrix4d& prior,
                                    const std::vector<Eigen::Matrix4d>& turns, const DepthImage& depth, const CameraIntrinsics& k,
-                                   double margin_deg = 20.0, const NearestPoints* samples = nullptr);
+                                   double margin_deg = kLookAlikeMarginDeg, const NearestPoints* samples = nullptr);
 
 /// The model points a camera sees with the model at T_camera_model: in its image, facing it, and within
 /// 1 cm of the depth measured there; at most `max` of them, spread over the model.
