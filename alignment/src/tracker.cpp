@@ -272,25 +272,38 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
     return p;
   };
 
-  for (int l = cfg_.pyramid_levels - 1; l >= 0; --l) {
-    const auto li = static_cast<std::size_t>(cfg_.pyramid_levels - 1 - l);  // coarsest first in the config
-    const Level& lv = levels[static_cast<std::size_t>(l)];
-    const double reach = li == 0 ? std::max(cfg_.max_distance_m, cfg_.coarse_max_distance_m) : cfg_.max_distance_m;
-    for (int it = 0; it < cfg_.iterations[li]; ++it) {
-      Pass p = run(lv, cfg_.model_points[li], T, reach);
-      ++out.iterations;
-      if (p.used < 6 * 3) break;
-      p.H.triangularView<Eigen::Lower>() = p.H.transpose();
-      if (T_hold)
-        add_start_prior(p.H, p.g, T, *T_hold, cfg_.hold_prior, model_radius_m_);
-      else
-        add_start_prior(p.H, p.g, T, T_prev, cfg_.start_prior, model_radius_m_);
-      const Eigen::Matrix<double, 6, 1> xi = p.H.ldlt().solve(-p.g);
-      if (!xi.allFinite()) break;
-      T = twist_to_transform(xi) * T;
-      if (xi.head<3>().norm() + xi.tail<3>().norm() * model_radius_m_ < cfg_.converged_step_m) break;
+  // Coarse to fine from T, the start prior at `anchor`; returns how far the last step moved the surface
+  // along its normals (RMS over the correspondences): the data's own measure of being still on the way.
+  const auto descend = [&](const Eigen::Matrix4d& anchor) {
+    double shift = 0.0;
+    for (int l = cfg_.pyramid_levels - 1; l >= 0; --l) {
+      const auto li = static_cast<std::size_t>(cfg_.pyramid_levels - 1 - l);  // coarsest first in the config
+      const Level& lv = levels[static_cast<std::size_t>(l)];
+      const double reach = li == 0 ? std::max(cfg_.max_distance_m, cfg_.coarse_max_distance_m) : cfg_.max_distance_m;
+      for (int it = 0; it < cfg_.iterations[li]; ++it) {
+        Pass p = run(lv, cfg_.model_points[li], T, reach);
+        ++out.iterations;
+        if (p.used < 6 * 3) break;
+        p.H.triangularView<Eigen::Lower>() = p.H.transpose();
+        const Eigen::Matrix<double, 6, 6> H_data = p.H;
+        if (T_hold)
+          add_start_prior(p.H, p.g, T, *T_hold, cfg_.hold_prior, model_radius_m_);
+        else
+          add_start_prior(p.H, p.g, T, anchor, cfg_.start_prior, model_radius_m_);
+        const Eigen::Matrix<double, 6, 1> xi = p.H.ldlt().solve(-p.g);
+        if (!xi.allFinite()) break;
+        T = twist_to_transform(xi) * T;
+        shift = std::sqrt(std::max(0.0, xi.dot(H_data * xi)) / static_cast<double>(p.used));
+        if (xi.head<3>().norm() + xi.tail<3>().norm() * model_radius_m_ < cfg_.converged_step_m) break;
+      }
     }
-  }
+    return shift;
+  };
+  // A descent that ends still moving (a start far along a direction the depth constrains weakly, or the
+  // prior holding it back there) goes on from where it got to, the prior moved there with it.
+  double shift = descend(T_prev);
+  for (int round = 0; round < cfg_.extra_descents && shift > cfg_.settled_shift_m; ++round) shift = descend(T);
+  out.last_shift_m = shift;
   const Pass q = run(levels[0], cfg_.model_points.back(), T, cfg_.max_distance_m);
   out.T_camera_target = T;
   out.correspondences = q.used;
