@@ -199,6 +199,18 @@ std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
   if (frame.capture_time_s - last_found_s_ > 2.5 / cfg_.camera_hz) {
     const auto a = attempt(frame, start, SearchStage::refine);
     if (a && a->converged && verified(frame, a->T_scan_model)) return found(frame, a->T_scan_model, a->inlier_ratio, a->rmse_mm);
+  } else if (r.accepted) {
+    // Tracked, but refused by the free-space check: the acquisition's local step (the support left out,
+    // the crop around the silhouette, neighbours clustered away, the gate) from where it was. On the real
+    // YCB-V frames the projective tracker pulled the mug, seen from above with its inside showing, 17 mm
+    // and 14 degrees off on every image (0.17-0.19 of it seen through); refused, it blanked and was found
+    // again by a search every third image (--track: the mug 70 -> 95 %, all 96.9 -> 99.2 %).
+    try {
+      const auto a = attempt(frame, start, SearchStage::local);
+      if (a && a->converged && verified(frame, a->T_scan_model))
+        return found(frame, a->T_scan_model, a->inlier_ratio, a->rmse_mm);
+    } catch (const AlignmentError&) {  // too little depth near it: as a refused frame
+    }
   }
   if (++rejected_ < cfg_.lost_after) return std::nullopt;  // one bad frame: keep showing the last pose
   // Lost: blank it now and search from where it was last seen, or where its motion was taking it.
