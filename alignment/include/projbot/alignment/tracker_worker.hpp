@@ -91,6 +91,9 @@ struct WorkerConfig {
   /// of its thread's CPU time, and blanks what it has not confirmed by then; the stage running at the
   /// deadline finishes. Tracking's search attempts have their own (AcquisitionConfig::attempt_budget_ms).
   double acquire_budget_ms = 1500.0;
+  /// A frame tracking lost (both reaches refused it) gets the acquisition's local step from where the
+  /// target was, with this much of the thread's CPU time (ms); the stage running at the deadline finishes.
+  double rescue_budget_ms = 100.0;
   /// From a guess not known to within half the model's size (a gross one) whose reach (the silhouette's
   /// growth) is at most coarse_max_reach_m, and from a close guess whose own ICP fails, acquisition
   /// scores poses around the guess against the depth (coarse_candidates) and acquires from the best
@@ -336,7 +339,8 @@ class TargetFollower {
   std::optional<Eigen::Matrix4d> hold_;  // where colour placed the target, while it stays still
   // r moved by colour where depth allows, and refused when colour disagrees (see acquire).
   void by_colour(const DepthImage& frame, const Known& known, const assets::Image& colour, AlignmentResult& r) const;
-  std::optional<AlignmentResult> attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage);
+  std::optional<AlignmentResult> attempt(const DepthImage& frame, const Eigen::Matrix4d& from, SearchStage stage,
+                                         std::optional<ThreadCpuClock::time_point> deadline = std::nullopt);
   /// The first search from a new guess: acquire() from guess_, with what is known (or found) of its support.
   std::optional<AlignmentResult> first_acquisition(const DepthImage& frame, const assets::Image* colour);
 };
