@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -211,100 +212,96 @@ bool ProjectiveTracker::add_edge(const Level& lv, const std::vector<float>& outl
   return true;
 }
 
+ProjectiveTracker::Pass ProjectiveTracker::pass(const Level& lv, std::size_t count, const Eigen::Matrix4d& T, double reach,
+                                                const Outline* outline) const {
+  Pass p;
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T.topRightCorner<3, 1>();
+  const std::size_t n = std::min(count, model_.points.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = R * model_.points[i].cast<double>() + t;
+    const Eigen::Vector3d nrm = R * model_.normals[i].cast<double>();
+    if (x.z() <= 0.05 || nrm.dot(x) >= 0.0) continue;  // behind the camera, or facing away
+    if (outline && -nrm.dot(x) < cfg_.edge_max_cos * x.norm() &&
+        add_edge(lv, outline->grid, x,
+                 outline->T.topLeftCorner<3, 3>() * model_.points[i].cast<double>() + outline->T.topRightCorner<3, 1>(), nrm, p.H,
+                 p.g))
+      ++p.edges;
+    int u = 0, v = 0;
+    if (!lv.k.nearest_pixel(x, u, v)) continue;
+    const float zs = lv.z[static_cast<std::size_t>(v) * lv.k.width_px + u];
+    if (!has_depth(zs)) continue;
+    if (zs < x.z() - cfg_.occlusion_margin_m) continue;  // something in front of the model: occluded
+    ++p.candidates;
+    const Eigen::Vector3d q((u - lv.k.cx_px) * zs / lv.k.fx_px, (v - lv.k.cy_px) * zs / lv.k.fy_px, zs);
+    const Eigen::Vector3d d = x - q;
+    if (d.squaredNorm() > reach * reach) continue;
+    const double r = nrm.dot(d);  // point-to-plane, the plane of the model's exact normal
+    if (std::abs(r) <= cfg_.inlier_distance_m) {
+      ++p.inliers;
+      p.inlier_sq += r * r;
+    }
+    // Huber weight with a threshold that grows with the sensor's noise at this depth.
+    const double delta = cfg_.huber_sigmas * sensor_sigma(zs);
+    const double w = std::abs(r) <= delta ? 1.0 : delta / std::abs(r);
+    Eigen::Matrix<double, 6, 1> J;
+    J.head<3>() = nrm;           // d r / d v
+    J.tail<3>() = x.cross(nrm);  // d r / d w, for x -> x + w x x + v
+    p.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
+    p.g += w * r * J;
+    ++p.used;
+  }
+  return p;
+}
+
+double ProjectiveTracker::descend(const std::vector<Level>& levels, const Outline* outline, const Eigen::Matrix4d& anchor,
+                                  double prior, Eigen::Matrix4d& T, int& iterations) const {
+  double shift = 0.0;
+  for (int l = cfg_.pyramid_levels - 1; l >= 0; --l) {
+    const auto li = static_cast<std::size_t>(cfg_.pyramid_levels - 1 - l);  // coarsest first in the config
+    const Level& lv = levels[static_cast<std::size_t>(l)];
+    const double reach = li == 0 ? std::max(cfg_.max_distance_m, cfg_.coarse_max_distance_m) : cfg_.max_distance_m;
+    for (int it = 0; it < cfg_.iterations[li]; ++it) {
+      Pass p = pass(lv, cfg_.model_points[li], T, reach, l == 0 ? outline : nullptr);
+      ++iterations;
+      if (p.used < 6 * 3) break;
+      p.H.triangularView<Eigen::Lower>() = p.H.transpose();
+      const Eigen::Matrix<double, 6, 6> H_data = p.H;
+      add_start_prior(p.H, p.g, T, anchor, prior, model_radius_m_);
+      const Eigen::Matrix<double, 6, 1> xi = p.H.ldlt().solve(-p.g);
+      if (!xi.allFinite()) break;
+      T = twist_to_transform(xi) * T;
+      // How far the step moved the surface along its normals (RMS over the correspondences): the data's
+      // own measure of still being on the way (a move along a direction it leaves free counts nothing).
+      shift = std::sqrt(std::max(0.0, xi.dot(H_data * xi)) / static_cast<double>(p.used));
+      if (xi.head<3>().norm() + xi.tail<3>().norm() * model_radius_m_ < cfg_.converged_step_m) break;
+    }
+  }
+  return shift;
+}
+
 TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matrix4d& T_prev,
                                      const Eigen::Matrix4d* T_hold) const {
   const auto t0 = std::chrono::steady_clock::now();
   if (!T_prev.allFinite()) throw AlignmentError("tracker: previous pose is not finite");
   if (T_hold && !T_hold->allFinite()) throw AlignmentError("tracker: held pose is not finite");
   const std::vector<Level> levels = pyramid(depth);
+  // The outline under the start pose (a frame's steps are millimetres), for the finest level's edges.
+  std::optional<Outline> outline;
+  if (cfg_.edge_weight > 0.0) outline = Outline{outline_grid(T_prev, cfg_.model_points.back()), T_prev};
+  const Outline* edges = outline ? &*outline : nullptr;
   TrackResult out;
   Eigen::Matrix4d T = T_prev;
-
-  // One pass over the model points of a level: the normal equations, or the quality numbers.
-  struct Pass {
-    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    std::size_t used = 0, candidates = 0, inliers = 0, edges = 0;
-    double inlier_sq = 0.0;
-  };
-  // The outline under the start pose (a frame's steps are millimetres), for the finest level's edges.
-  const bool edges = cfg_.edge_weight > 0.0;
-  const std::vector<float> outline = edges ? outline_grid(T_prev, cfg_.model_points.back()) : std::vector<float>{};
-  const Eigen::Matrix3d R0 = T_prev.topLeftCorner<3, 3>();
-  const Eigen::Vector3d t_0 = T_prev.topRightCorner<3, 1>();
-  const auto run = [&](const Level& lv, std::size_t count, const Eigen::Matrix4d& T_cur, double reach) {
-    Pass p;
-    const Eigen::Matrix3d R = T_cur.topLeftCorner<3, 3>();
-    const Eigen::Vector3d t = T_cur.topRightCorner<3, 1>();
-    const std::size_t n = std::min(count, model_.points.size());
-    const bool finest = edges && lv.z == levels[0].z;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Eigen::Vector3d x = R * model_.points[i].cast<double>() + t;
-      const Eigen::Vector3d nrm = R * model_.normals[i].cast<double>();
-      if (x.z() <= 0.05 || nrm.dot(x) >= 0.0) continue;  // behind the camera, or facing away
-      if (finest && -nrm.dot(x) < cfg_.edge_max_cos * x.norm() &&
-          add_edge(lv, outline, x, R0 * model_.points[i].cast<double>() + t_0, nrm, p.H, p.g))
-        ++p.edges;
-      int u = 0, v = 0;
-      if (!lv.k.nearest_pixel(x, u, v)) continue;
-      const float zs = lv.z[static_cast<std::size_t>(v) * lv.k.width_px + u];
-      if (!has_depth(zs)) continue;
-      if (zs < x.z() - cfg_.occlusion_margin_m) continue;  // something in front of the model: occluded
-      ++p.candidates;
-      const Eigen::Vector3d q((u - lv.k.cx_px) * zs / lv.k.fx_px, (v - lv.k.cy_px) * zs / lv.k.fy_px, zs);
-      const Eigen::Vector3d d = x - q;
-      if (d.squaredNorm() > reach * reach) continue;
-      const double r = nrm.dot(d);  // point-to-plane, the plane of the model's exact normal
-      if (std::abs(r) <= cfg_.inlier_distance_m) {
-        ++p.inliers;
-        p.inlier_sq += r * r;
-      }
-      // Huber weight with a threshold that grows with the sensor's noise at this depth.
-      const double delta = cfg_.huber_sigmas * sensor_sigma(zs);
-      const double w = std::abs(r) <= delta ? 1.0 : delta / std::abs(r);
-      Eigen::Matrix<double, 6, 1> J;
-      J.head<3>() = nrm;           // d r / d v
-      J.tail<3>() = x.cross(nrm);  // d r / d w, for x -> x + w x x + v
-      p.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
-      p.g += w * r * J;
-      ++p.used;
-    }
-    return p;
-  };
-
-  // Coarse to fine from T, the start prior at `anchor`; returns how far the last step moved the surface
-  // along its normals (RMS over the correspondences): the data's own measure of being still on the way.
-  const auto descend = [&](const Eigen::Matrix4d& anchor) {
-    double shift = 0.0;
-    for (int l = cfg_.pyramid_levels - 1; l >= 0; --l) {
-      const auto li = static_cast<std::size_t>(cfg_.pyramid_levels - 1 - l);  // coarsest first in the config
-      const Level& lv = levels[static_cast<std::size_t>(l)];
-      const double reach = li == 0 ? std::max(cfg_.max_distance_m, cfg_.coarse_max_distance_m) : cfg_.max_distance_m;
-      for (int it = 0; it < cfg_.iterations[li]; ++it) {
-        Pass p = run(lv, cfg_.model_points[li], T, reach);
-        ++out.iterations;
-        if (p.used < 6 * 3) break;
-        p.H.triangularView<Eigen::Lower>() = p.H.transpose();
-        const Eigen::Matrix<double, 6, 6> H_data = p.H;
-        if (T_hold)
-          add_start_prior(p.H, p.g, T, *T_hold, cfg_.hold_prior, model_radius_m_);
-        else
-          add_start_prior(p.H, p.g, T, anchor, cfg_.start_prior, model_radius_m_);
-        const Eigen::Matrix<double, 6, 1> xi = p.H.ldlt().solve(-p.g);
-        if (!xi.allFinite()) break;
-        T = twist_to_transform(xi) * T;
-        shift = std::sqrt(std::max(0.0, xi.dot(H_data * xi)) / static_cast<double>(p.used));
-        if (xi.head<3>().norm() + xi.tail<3>().norm() * model_radius_m_ < cfg_.converged_step_m) break;
-      }
-    }
-    return shift;
-  };
+  const double prior = T_hold ? cfg_.hold_prior : cfg_.start_prior;
+  double shift = descend(levels, edges, T_hold ? *T_hold : T_prev, prior, T, out.iterations);
   // A descent that ends still moving (a start far along a direction the depth constrains weakly, or the
-  // prior holding it back there) goes on from where it got to, the prior moved there with it.
-  double shift = descend(T_prev);
-  for (int round = 0; round < cfg_.extra_descents && shift > cfg_.settled_shift_m; ++round) shift = descend(T);
+  // prior holding it back there) goes on from where it got to, the start prior moved there with it.
+  for (int round = 0; round < cfg_.extra_descents && shift > cfg_.settled_shift_m; ++round) {
+    const Eigen::Matrix4d from = T;
+    shift = descend(levels, edges, T_hold ? *T_hold : from, prior, T, out.iterations);
+  }
   out.last_shift_m = shift;
-  const Pass q = run(levels[0], cfg_.model_points.back(), T, cfg_.max_distance_m);
+  const Pass q = pass(levels[0], cfg_.model_points.back(), T, cfg_.max_distance_m, edges);  // edges: counted
   out.T_camera_target = T;
   out.correspondences = q.used;
   out.edge_points = q.edges;

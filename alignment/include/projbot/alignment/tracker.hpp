@@ -101,6 +101,24 @@ class ProjectiveTracker {
   /// x0: the same point under the pose the outline was drawn at.
   bool add_edge(const Level& lv, const std::vector<float>& outline, const Eigen::Vector3d& x, const Eigen::Vector3d& x0,
                 const Eigen::Vector3d& nrm, Eigen::Matrix<double, 6, 6>& H, Eigen::Matrix<double, 6, 1>& g) const;
+  /// One pass over a level's first `count` model points under T: the normal equations, and the quality numbers.
+  struct Pass {
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();  // upper triangle
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    std::size_t used = 0, candidates = 0, inliers = 0, edges = 0;
+    double inlier_sq = 0.0;
+  };
+  /// The model's outline under the start pose T, for the finest level's edges (TrackerConfig::edge_weight).
+  struct Outline {
+    std::vector<float> grid;
+    Eigen::Matrix4d T;
+  };
+  /// `outline` is given on the finest level when edges are used, else null.
+  Pass pass(const Level& lv, std::size_t count, const Eigen::Matrix4d& T, double reach, const Outline* outline) const;
+  /// Coarse to fine from T (moved in place), pulled towards `anchor` with weight `prior`; counts its
+  /// iterations into `iterations` and returns the last step's RMS move along the normals (settled_shift_m).
+  double descend(const std::vector<Level>& levels, const Outline* outline, const Eigen::Matrix4d& anchor, double prior,
+                 Eigen::Matrix4d& T, int& iterations) const;
 
   ModelCloud model_;  // shuffled once, so any prefix is a uniform subsample
   CameraIntrinsics k_;
