@@ -54,6 +54,14 @@ ModelCloud cube_model() {
   return model_cloud_from(box, 20000);
 }
 
+// The cube's path in the worker tests: frame f moves it 3 mm across, 2 mm away and half a degree.
+Eigen::Matrix4d cube_path(int f) {
+  return projbot::config::pose_from_xyz_rpy({0.05 + 0.003 * f, -0.02, 1.0 + 0.002 * f}, {20 + 0.5 * f, 30, 10});
+}
+
+// Eq. 1's guess of the path's first pose, 1 cm and 3 degrees off.
+Eigen::Matrix4d cube_path_guess() { return projbot::config::pose_from_xyz_rpy({0.06, -0.02, 1.0}, {23, 30, 10}); }
+
 // Polls the reader side until `done` holds or 20 s pass (a deadlock guard, not a speed check).
 template <typename Pred>
 bool poll(TrackerWorker& w, PoseSample& s, Pred done) {
@@ -100,13 +108,9 @@ TEST(TrackerWorkerTest, AcquiresTracksAndReportsLost) {
   cfg.acquisition.attempt_budget_ms = 1e9;
   cfg.search_duty = 1.0;
   TrackerWorker worker(cube_model(), k, cfg);
-  const auto truth = [](int f) {
-    return projbot::config::pose_from_xyz_rpy({0.05 + 0.003 * f, -0.02, 1.0 + 0.002 * f}, {20 + 0.5 * f, 30, 10});
-  };
   std::vector<std::shared_ptr<DepthImage>> frames;
-  for (int f = 0; f < 40; ++f) frames.push_back(cube_depth(truth(f), k, f));
-  // Eq. 1's guess, 1 cm and 3 degrees off.
-  worker.set_initial_guess(projbot::config::pose_from_xyz_rpy({0.06, -0.02, 1.0}, {23, 30, 10}));
+  for (int f = 0; f < 40; ++f) frames.push_back(cube_depth(cube_path(f), k, f));
+  worker.set_initial_guess(cube_path_guess());
 
   std::jthread sensor([&] {  // the camera: frames at 200 Hz, faster than needed, so some are dropped
     for (const auto& f : frames) {
@@ -126,13 +130,13 @@ TEST(TrackerWorkerTest, AcquiresTracksAndReportsLost) {
       << s.capture_time_s << (s.lost ? " (lost)" : "") << ", sequence " << s.sequence;
   sensor.join();
   EXPECT_FALSE(s.lost);
-  const Eigen::Matrix4d err = rigid_inverse(truth(39)) * s.T_camera_target;
+  const Eigen::Matrix4d err = rigid_inverse(cube_path(39)) * s.T_camera_target;
   EXPECT_LT(translation_norm_m(err), 0.002);
   EXPECT_LT(rotation_angle_deg(err), 0.5);
   EXPECT_GE(worker.frames_processed(), 2U);  // acquired one frame, then tracked at least one more
 
   // The target disappears: after lost_after rejected frames the worker says so.
-  auto empty = cube_depth(truth(39), k, 40.0);
+  auto empty = cube_depth(cube_path(39), k, 40.0);
   std::fill(empty->depth_m.begin(), empty->depth_m.end(), 1.5F);  // a wall behind it
   const std::uint64_t before = worker.frames_processed();         // before the first empty frame can be taken
   std::jthread gone([&](std::stop_token stop) {                   // the camera keeps streaming the empty view
@@ -157,22 +161,19 @@ TEST(TrackerWorkerTest, TrackInLockstepTakesEveryFrameAndRepeatsItself) {
   WorkerConfig cfg;
   cfg.acquisition.reinitialise = false;
   cfg.acquisition.attempt_budget_ms = std::numeric_limits<double>::infinity();
-  const auto truth = [](int f) {
-    return projbot::config::pose_from_xyz_rpy({0.05 + 0.003 * f, -0.02, 1.0 + 0.002 * f}, {20 + 0.5 * f, 30, 10});
-  };
   std::vector<std::shared_ptr<DepthImage>> frames;
-  for (int f = 0; f < 12; ++f) frames.push_back(cube_depth(truth(f), k, f));
+  for (int f = 0; f < 12; ++f) frames.push_back(cube_depth(cube_path(f), k, f));
   std::vector<Eigen::Matrix4d> first;
   for (int run = 0; run < 2; ++run) {
     TrackerWorker worker(cube_model(), k, cfg);
-    worker.set_initial_guess(projbot::config::pose_from_xyz_rpy({0.06, -0.02, 1.0}, {23, 30, 10}));
+    worker.set_initial_guess(cube_path_guess());
     for (int f = 0; f < 12; ++f) {
       const auto s = worker.track(frames[static_cast<std::size_t>(f)]);
       ASSERT_TRUE(s.has_value()) << "frame " << f;
       EXPECT_EQ(worker.frames_processed(), static_cast<std::uint64_t>(f + 1));  // none dropped
       EXPECT_EQ(s->capture_time_s, frames[static_cast<std::size_t>(f)]->capture_time_s);
       EXPECT_FALSE(s->lost) << "frame " << f;
-      EXPECT_LT(translation_norm_m(rigid_inverse(truth(f)) * s->T_camera_target), 0.002) << "frame " << f;
+      EXPECT_LT(translation_norm_m(rigid_inverse(cube_path(f)) * s->T_camera_target), 0.002) << "frame " << f;
       if (run == 0)
         first.push_back(s->T_camera_target);
       else
@@ -190,17 +191,14 @@ TEST(TrackerWorkerTest, FramesDroppedByABusyWorkerStillEndOnTheTruth) {
   WorkerConfig cfg;
   cfg.acquisition.reinitialise = false;
   cfg.acquisition.attempt_budget_ms = std::numeric_limits<double>::infinity();
-  const auto truth = [](int f) {
-    return projbot::config::pose_from_xyz_rpy({0.05 + 0.003 * f, -0.02, 1.0 + 0.002 * f}, {20 + 0.5 * f, 30, 10});
-  };
   for (const int middle : {7, 11, 17, 27, 31}) {
     TrackerWorker worker(cube_model(), k, cfg);
-    worker.set_initial_guess(projbot::config::pose_from_xyz_rpy({0.06, -0.02, 1.0}, {23, 30, 10}));
+    worker.set_initial_guess(cube_path_guess());
     for (const int f : {0, middle, 39}) {
-      const auto s = worker.track(cube_depth(truth(f), k, f));
+      const auto s = worker.track(cube_depth(cube_path(f), k, f));
       ASSERT_TRUE(s.has_value()) << "frames 0, " << middle << ", 39: frame " << f;
       EXPECT_FALSE(s->lost) << "frames 0, " << middle << ", 39: frame " << f;
-      const Eigen::Matrix4d err = rigid_inverse(truth(f)) * s->T_camera_target;
+      const Eigen::Matrix4d err = rigid_inverse(cube_path(f)) * s->T_camera_target;
       EXPECT_LT(translation_norm_m(err), 0.002) << "frames 0, " << middle << ", 39: frame " << f;
       EXPECT_LT(rotation_angle_deg(err), 0.5) << "frames 0, " << middle << ", 39: frame " << f;
     }
@@ -399,20 +397,17 @@ TEST(TargetFollowerTest, AnAbsentTargetCostsABoundedNumberOfAttempts) {
 // for that way (tested in the twin: blanked within 100 ms).
 TEST(TargetFollowerTest, FindsTheTargetAgainAfterDroppedFrames) {
   const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
-  const auto truth = [](int f) {
-    return projbot::config::pose_from_xyz_rpy({0.05 + 0.003 * f, -0.02, 1.0 + 0.002 * f}, {20 + 0.5 * f, 30, 10});
-  };
   WorkerConfig cfg;
   cfg.acquisition.reinitialise = false;
   cfg.acquisition.attempt_budget_ms = 1e9;  // under ThreadSanitizer the ICP's stages run many times slower
   TargetFollower follower(cube_model(), k, cfg);
-  follower.set_initial_guess(projbot::config::pose_from_xyz_rpy({0.06, -0.02, 1.0}, {23, 30, 10}));
-  const auto found = follower.step(*cube_depth(truth(0), k, 0.0));
+  follower.set_initial_guess(cube_path_guess());
+  const auto found = follower.step(*cube_depth(cube_path(0), k, 0.0));
   ASSERT_TRUE(found && !found->lost);
-  const auto again = follower.step(*cube_depth(truth(39), k, 39.0 / 30.0));  // 38 frames dropped at 30 Hz
+  const auto again = follower.step(*cube_depth(cube_path(39), k, 39.0 / 30.0));  // 38 frames dropped at 30 Hz
   ASSERT_TRUE(again.has_value());
   EXPECT_FALSE(again->lost);
-  const Eigen::Matrix4d err = rigid_inverse(truth(39)) * again->T_camera_target;
+  const Eigen::Matrix4d err = rigid_inverse(cube_path(39)) * again->T_camera_target;
   EXPECT_LT(translation_norm_m(err), 0.002);
   EXPECT_LT(rotation_angle_deg(err), 0.5);
 }
