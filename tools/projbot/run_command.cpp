@@ -24,7 +24,7 @@
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
 #include "projbot/hardware/devices.hpp"
-#include "projbot/session/projection.hpp"
+#include "projbot/session/live_loop.hpp"
 #include "projbot/session/session.hpp"
 #include "projbot/twin/camera.hpp"
 #include "projbot/twin/world.hpp"
@@ -33,8 +33,6 @@
 
 namespace projbot::tools {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // What the render thread draws at a stop (session::LitTarget, as the render thread needs it): the visited
 // target or a neighbour expected in the projector's view there (issue 11, item 5), with the twin's truth.
@@ -58,41 +56,43 @@ struct RobotState {
 
 // The error of the frames drawn, against the twin's truth at each frame's display time: the mean
 // distance between the markers as drawn and where they truly are then (mm, object space).
-struct DisplayErrors {
-  std::vector<double> moving_mm, still_mm;
-  void print(std::ostream& out) const {
-    double still = 0.0, moving = 0.0;
-    for (const double e : still_mm) still += e / static_cast<double>(still_mm.size());
-    for (const double e : moving_mm) moving += e / static_cast<double>(moving_mm.size());
-    out << "error at display (markers drawn vs true, twin): ";
-    if (moving_mm.empty())
-      out << "no frame while a target moved";
-    else
-      out << "while moving mean " << moving << " mm, p95 " << engine::percentile(moving_mm, 0.95) << " mm, max "
-          << engine::percentile(moving_mm, 1.0) << " mm over " << moving_mm.size() << " frames";
-    out << "; still mean " << (still_mm.empty() ? std::nan("") : still) << " mm over " << still_mm.size() << " frames\n";
-  }
-};
+void print_display_errors(std::ostream& out, const session::LiveFigures& f) {
+  double still = 0.0, moving = 0.0;
+  for (const double e : f.still_mm) still += e / static_cast<double>(f.still_mm.size());
+  for (const double e : f.moving_mm) moving += e / static_cast<double>(f.moving_mm.size());
+  out << "error at display (markers drawn vs true, twin): ";
+  if (f.moving_mm.empty())
+    out << "no frame while a target moved";
+  else
+    out << "while moving mean " << moving << " mm, p95 " << engine::percentile(f.moving_mm, 0.95) << " mm, max "
+        << engine::percentile(f.moving_mm, 1.0) << " mm over " << f.moving_mm.size() << " frames";
+  out << "; still mean " << (f.still_mm.empty() ? std::nan("") : still) << " mm over " << f.still_mm.size() << " frames\n";
+}
 
-// The mean marker error of a target drawn at T_camera_target, against the twin's truth at display_s.
-// Returns NaN for a target without markers; sets `moving` when its motion script runs at that instant.
-double marker_error_mm(const config::TargetConfig& target, const RobotState& robot, const DrawnTarget& lit,
-                       const Eigen::Matrix4d& T_camera_target, double display_s, bool& moving) {
-  const double t = display_s - robot.since_s;
-  const config::TargetMotion* m = target.motion_on(lit.target_visit);
-  moving = m && m->moving_at(t);
-  if (target.markers_m.empty()) return std::nan("");
-  const Eigen::Matrix4d T_true = robot.T_camera_world * twin::scripted_pose(target, lit.T_world_home, lit.target_visit, t);
+// The mean marker error of a target drawn (at its display time and pose), against the twin's truth then;
+// NaN for a target without markers or a stop without a truth (a replay, the configured robot).
+session::DisplayError marker_error(const config::Scene& scene, const RobotState& robot, const session::DrawnPose& drawn) {
+  const auto lit =
+      std::find_if(robot.lit.begin(), robot.lit.end(), [&](const DrawnTarget& l) { return l.target == drawn.target; });
+  if (!robot.measured || lit == robot.lit.end()) return {std::nan(""), false};
+  const config::TargetConfig& target = scene.targets[static_cast<std::size_t>(drawn.target)];
+  const double t = drawn.display_s - robot.since_s;
+  const config::TargetMotion* m = target.motion_on(lit->target_visit);
+  const bool moving = m && m->moving_at(t);
+  if (target.markers_m.empty()) return {std::nan(""), moving};
+  const Eigen::Matrix4d T_true = robot.T_camera_world * twin::scripted_pose(target, lit->T_world_home, lit->target_visit, t);
   double sum = 0.0;
   for (const auto& p : target.markers_m)
-    sum += ((T_camera_target * p.homogeneous()).head<3>() - (T_true * p.homogeneous()).head<3>()).norm();
-  return 1000.0 * sum / static_cast<double>(target.markers_m.size());
+    sum += ((drawn.T_camera_target * p.homogeneous()).head<3>() - (T_true * p.homogeneous()).head<3>()).norm();
+  return {1000.0 * sum / static_cast<double>(target.markers_m.size()), moving};
 }
 
 struct RunOptions {
   int visits = 0;
   double dwell_s = 4.0;
   std::uint64_t seed = 1;
+  double seconds = 0.0;  // 0: until the tour ends
+  bool headless = false, predict = true, compensate = true;
 };
 
 // Per live frame: from the camera's capture stamp, and from its next() returning, to the frame handed to
@@ -227,6 +227,77 @@ std::optional<config::Recording> replay_of(const cli::Args& args) {
   return config::load_recording(*dir);
 }
 
+// The run's options beyond the scene and the recording: a bad value is a usage error before anything opens.
+RunOptions run_options(const cli::Args& args) {
+  RunOptions o;
+  o.visits = args.get_int("visits", 0, 1, 1000);
+  o.dwell_s = args.get_double("dwell", 4.0);
+  if (!(o.dwell_s > 0.0 && o.dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
+  o.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
+  o.seconds = args.get_double("seconds", 0.0);
+  if (!(o.seconds >= 0.0 && o.seconds <= 1e6)) throw cli::UsageError("--seconds must be 0 (until the tour ends) to 1e6");
+  o.headless = args.flag("headless");
+  present_mode(args.get_or("present-mode", "fifo"));  // a bad mode is an error with --headless too
+  args.get_int("monitor", 0, 0, 64);                  // so is a bad monitor
+  o.compensate = on_off(args, "compensation", true);
+  o.predict = !args.flag("no-predict");
+  return o;
+}
+
+// The projector's output: offscreen at its size with --headless, else a window; on the config's projector
+// (its monitor, fullscreen) when `configured`, unless the command line says otherwise.
+std::unique_ptr<engine::RenderTarget> open_output(engine::Renderer& renderer, const cli::Args& args, const config::Scene& scene,
+                                                  bool headless, bool configured) {
+  if (headless) return renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
+  engine::WindowOptions wo = window_options(args, scene.projector, "projbot run: " + scene.source.filename().string());
+  if (configured && scene.devices.projector) {
+    wo.fullscreen = args.flag("fullscreen") || scene.devices.projector->fullscreen;
+    if (!args.get("monitor")) wo.monitor = scene.devices.projector->monitor;
+  }
+  return open_window(renderer, wo, scene.projector);
+}
+
+void print_frames(std::ostream& out, const session::LiveFigures& f, const engine::FrameSummary& summary,
+                  std::size_t silent_frames, double silent_s, engine::SceneContent& content) {
+  out << engine::format_summary(summary) << '\n';
+  out << std::fixed << std::setprecision(1) << "pose age at display (depth capture to expected display), " << f.ages_ms.size()
+      << " frames with a target: p50 " << engine::percentile(f.ages_ms, 0.5) << " ms, p95 " << engine::percentile(f.ages_ms, 0.95)
+      << " ms, p99 " << engine::percentile(f.ages_ms, 0.99) << " ms, max " << engine::percentile(f.ages_ms, 1.0) << " ms; "
+      << f.blank << " frames blank (driving, acquiring or lost)";
+  if (f.with_neighbours > 0) out << "; " << f.with_neighbours << " frames lit a neighbour too";
+  if (silent_frames > 0)
+    out << "; " << silent_frames << " frames blanked because the camera had handed over no frame for "
+        << std::lround(1000.0 * silent_s) << " ms";
+  out << "\n";
+  if (const std::string played = content.summary(); !played.empty())
+    out << "content: " << played << "; content time less the shown frame's: p50 " << engine::percentile(f.content_offsets_ms, 0.5)
+        << " ms, p99 " << engine::percentile(f.content_offsets_ms, 0.99) << " ms; upload on the render thread p50 "
+        << std::setprecision(3) << summary.upload_p50_ms << " ms, p99 " << summary.upload_p99_ms << " ms" << std::setprecision(1)
+        << "\n";
+}
+
+void print_replay(std::ostream& out, const config::Recording& recording, int visits, std::size_t tracked,
+                  const PoseCheck& check) {
+  out << "replay of " << recording.folder().string() << ": " << visits << " of " << recording.stops.size() << " stops, "
+      << tracked << " poses tracked in lockstep (each lit target's, every frame); against the recording's: " << check.compared
+      << " compared, largest difference " << std::setprecision(4) << check.max_mm << " mm, " << check.max_deg << " deg; "
+      << check.mismatched << " found or lost in one and not the other; " << check.unreached()
+      << " recorded rows for frames the replay did not reach\n";
+}
+
+// Per frame: when it started, the capture time of the depth its pose came from and its expected display
+// time (empty for a blank frame), all on the frame profiler's clock.
+void write_profile(const std::string& csv, const std::vector<session::LiveRow>& rows, const config::Scene& scene) {
+  std::ostringstream f;
+  f << "frame,start_ms,pose_age_ms,target,capture_ms,display_ms,error_mm\n";
+  const auto opt = [](double v) { return std::isnan(v) ? std::string() : std::to_string(v); };
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    f << i << ',' << rows[i].start_ms << ',' << (rows[i].age_ms >= 0 ? std::to_string(rows[i].age_ms) : std::string()) << ','
+      << (rows[i].target >= 0 ? scene.targets[static_cast<std::size_t>(rows[i].target)].name : std::string()) << ','
+      << opt(rows[i].capture_ms) << ',' << opt(rows[i].display_ms) << ',' << opt(rows[i].error_mm) << '\n';
+  config::write_file_atomically(csv, f.str());
+  std::cout << "per-frame profile written to " << csv << '\n';
+}
 }  // namespace
 
 const Command kRun{
@@ -296,51 +367,34 @@ const Command kRun{
       if (recording) check.emplace(recording->folder() / "poses.csv");
       hardware::Devices devices =
           args.flag("sim") || recording ? hardware::Devices{} : open_configured(scene, args.flag("headless"));
-      RunOptions o;
-      o.visits = args.get_int("visits", 0, 1, 1000);
-      o.dwell_s = args.get_double("dwell", 4.0);
-      if (!(o.dwell_s > 0.0 && o.dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
-      o.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
-      const double seconds = args.get_double("seconds", 0.0);
-      if (!(seconds >= 0.0 && seconds <= 1e6)) throw cli::UsageError("--seconds must be 0 (until the tour ends) to 1e6");
-      const bool headless = args.flag("headless");
-      present_mode(args.get_or("present-mode", "fifo"));  // a bad mode is an error with --headless too
-      args.get_int("monitor", 0, 0, 64);                  // so is a bad monitor
-      const bool compensate = on_off(args, "compensation", true);
+      const RunOptions o = run_options(args);
 
       engine::RendererOptions ro;
-      ro.windowing = !headless;
+      ro.windowing = !o.headless;
       engine::Renderer renderer(ro);
       std::cout << "device: " << renderer.device_info().name << std::endl;  // flushed: a log shows it has started
       std::vector<assets::Model> models;
       const auto items = upload_scene(renderer, scene, &models);
       std::vector<engine::CompensationPlan::Target> surfaces;
       for (std::size_t i = 0; i < models.size(); ++i) surfaces.push_back({&models[i], scene.targets[i].surface.albedo});
-      engine::CompensationPlan plan(std::move(surfaces), scene.room.ambient_lux, compensate);
+      engine::CompensationPlan plan(std::move(surfaces), scene.room.ambient_lux, o.compensate);
       engine::SceneContent content(renderer, scene, models, items);  // a bad video: one line, exit 1
-      std::unique_ptr<engine::RenderTarget> target;
-      if (headless) {
-        target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
-      } else {
-        engine::WindowOptions wo = window_options(args, scene.projector, "projbot run: " + scene.source.filename().string());
-        if (scene.devices.projector && !args.flag("sim") &&
-            !recording) {  // the config's projector, unless the command line says otherwise
-          wo.fullscreen = args.flag("fullscreen") || scene.devices.projector->fullscreen;
-          if (!args.get("monitor")) wo.monitor = scene.devices.projector->monitor;
-        }
-        target = open_window(renderer, wo, scene.projector);
-      }
+      const std::unique_ptr<engine::RenderTarget> target =
+          open_output(renderer, args, scene, o.headless, !args.flag("sim") && !recording);
 
+      session::LiveLoopConfig lc;
+      lc.projection.T_projector_camera = scene.pan_tilt.T_projector_camera;
+      lc.projection.refresh_hz = scene.projector.refresh_hz;
+      lc.projection.input_lag_ms = scene.projector.input_lag_ms;
+      lc.projection.predict = o.predict;
+      if (recording) lc.projection.silent_camera_s = 0.0;  // a replay's frames play in lockstep
+      lc.seconds = o.seconds;
+      lc.paced_hz = o.headless ? 60.0 : 0.0;  // offscreen, no vsync: like a 60 Hz projector
+      session::LiveLoop loop(renderer, scene.projector, items, lc);
+      loop.set_compensation(&plan);
+      loop.set_content(&content);
       // One tracker worker per target on the map.
-      const bool predict = !args.flag("no-predict");
-      session::ProjectionConfig pc;
-      pc.T_projector_camera = scene.pan_tilt.T_projector_camera;
-      pc.refresh_hz = scene.projector.refresh_hz;
-      pc.input_lag_ms = scene.projector.input_lag_ms;
-      pc.predict = predict;
-      pc.silent_camera_s = recording ? 0.0 : pc.silent_camera_s;  // a replay's frames play in lockstep
-      session::ProjectionFrames frames(pc);
-      SceneTrackers trackers = make_trackers(scene, worker_config(predict, recording.has_value()));
+      SceneTrackers trackers = make_trackers(scene, worker_config(o.predict, recording.has_value()));
       const auto& workers = trackers.owned;
 
       alignment::LatestValue<RobotState> state;
@@ -357,92 +411,27 @@ const Command kRun{
         robot_done = true;
       });
 
-      engine::FrameProfiler profiler;
-      std::vector<double> ages_ms;
-      DisplayErrors errors;
-      struct Row {  // times in ms on the profiler's clock; capture and display are NaN for a blank frame
-        double start_ms, age_ms, capture_ms, display_ms, error_mm;
-        int target;
-      };
-      std::vector<Row> rows;
-      struct Drawn {  // a target drawn in this frame: from which capture, for which display time, where
-        const DrawnTarget* lit;
-        double capture_s, display_s;
-        Eigen::Matrix4d T_camera_target;
-      };
-      RobotState robot;
-      const double t0 = config::steady_now_s();
-      std::size_t blank = 0, frames_with_neighbours = 0;
-      std::vector<double> content_offsets_ms;  // per target-frame with video: its time less the shown frame's
-      const session::PoseSource pose_of = [&](int index, alignment::PoseSample& pose) {
-        return workers[static_cast<std::size_t>(index)]->latest(pose);
-      };
-      auto next_frame = Clock::now();
-      while (!interrupted() && !target->poll_close() && !robot_done &&
-             (seconds == 0.0 || config::steady_now_s() - t0 < seconds)) {
+      RobotState robot;  // as the render thread last read it
+      session::LiveInputs in;
+      in.stop = [&] {
         state.read(robot);
-        std::vector<Drawn> drawn;  // this frame's lit targets, the visited one first
-        const auto read_poses = [&](std::vector<engine::DrawItem>& out) {
-          out.clear();
-          drawn.clear();
-          session::LitNow now{{}, robot.since_s, handoffs.last_s};
-          for (const DrawnTarget& lit : robot.lit) now.targets.push_back(lit.target);
-          const double now_s = config::steady_now_s();
-          const std::vector<session::DrawnPose> poses = frames.compose(now_s, now, pose_of);
-          // A lit target's content runs before its pose is found (the acquisition's first second), so that the
-          // video has caught up with its clock when it is first drawn.
-          const double display_s = now_s + frames.period_s() + 1e-3 * pc.input_lag_ms;
-          for (const DrawnTarget& lit : robot.lit)
-            if (content.has_video(lit.target) &&
-                std::none_of(poses.begin(), poses.end(), [&](const session::DrawnPose& d) { return d.target == lit.target; }))
-              content.show(lit.target, display_s - content.start_s(lit.target, t0, robot.since_s));
-          for (const session::DrawnPose& d : poses) {
-            const auto t = static_cast<std::size_t>(d.target);
-            out.push_back({items[t].model, d.T_projector_target, plan.at(t, robot.visit, scene.projector, d.T_projector_target)});
-            if (content.has(d.target)) {  // on the display clock of this frame, as its pose
-              const auto shown = content.apply(d.target, d.display_s - content.start_s(d.target, t0, robot.since_s), out.back());
-              if (!std::isnan(shown.pts_s)) content_offsets_ms.push_back(1000.0 * (shown.content_s - shown.pts_s));
-            }
-            const auto lit =
-                std::find_if(robot.lit.begin(), robot.lit.end(), [&](const DrawnTarget& l) { return l.target == d.target; });
-            drawn.push_back({&*lit, d.capture_s, d.display_s, d.T_camera_target});
-          }
-        };
-        if (headless) pace_frame(next_frame, std::chrono::microseconds(16667));  // no vsync: like a 60 Hz projector
-        const double start_ms = profiler.now_ms(), start_s = config::steady_now_s();
-        frames.frame_started(start_s);
-        if (!renderer.draw_frame(*target, scene.projector, read_poses, &profiler)) continue;
+        session::LiveStop stop{{}, robot.since_s, robot.visit};
+        for (const DrawnTarget& lit : robot.lit) stop.targets.push_back(lit.target);
+        return stop;
+      };
+      in.poses = [&](int index, alignment::PoseSample& pose) { return workers[static_cast<std::size_t>(index)]->latest(pose); };
+      in.camera_last_s = [&] { return handoffs.last_s.load(); };
+      in.keep_going = [&] { return !interrupted() && !robot_done; };
+      in.meter = [&](const session::DrawnPose& drawn) { return marker_error(scene, robot, drawn); };
+      in.after_frame = [&] {
         for (const std::string& e : content.take_errors())  // the last good frame stays up; said once
           std::cerr << "content: " << e << " (its last good frame stays)" << std::endl;
         for (const std::string& e : content.reload_changed(config::steady_now_s()))  // a video changed on disk
           std::cout << "content: " << e << std::endl;
-        const double nan = std::nan("");
-        if (drawn.empty()) {
-          ++blank;
-          rows.push_back({start_ms, -1.0, nan, nan, nan, -1});
-          continue;
-        }
-        // Each lit target's error against the twin's truth at the display time; the row (and the pose's
-        // age, capture to the expected display time) is the first drawn one's.
-        std::vector<double> row_error;
-        for (const Drawn& d : drawn) {
-          if (!robot.measured) {  // no truth to measure against (a replay)
-            row_error.push_back(std::nan(""));
-            continue;
-          }
-          bool moving = false;
-          const double e = marker_error_mm(scene.targets[static_cast<std::size_t>(d.lit->target)], robot, *d.lit,
-                                           d.T_camera_target, d.display_s, moving);
-          if (!std::isnan(e)) (moving ? errors.moving_mm : errors.still_mm).push_back(e);
-          row_error.push_back(e);
-        }
-        if (drawn.size() > 1) ++frames_with_neighbours;
-        const Drawn& first = drawn.front();
-        const double age_ms = 1000.0 * (std::max(config::steady_now_s(), first.display_s) - first.capture_s);
-        ages_ms.push_back(age_ms);
-        rows.push_back({start_ms, age_ms, start_ms + 1000.0 * (first.capture_s - start_s),
-                        start_ms + 1000.0 * (first.display_s - start_s), row_error.front(), first.lit->target});
-      }
+      };
+      engine::FrameProfiler profiler;
+      const session::LiveFigures figures = loop.run(*target, in, profiler);
+
       // A device (or the twin) failed while projecting: black at once, so nothing it last showed stays lit;
       // what was measured until then is still printed and written, then the failure is reported.
       std::string failure;
@@ -461,52 +450,19 @@ const Command kRun{
       for (const auto& w : workers)
         if (w && w->error()) std::rethrow_exception(w->error());
 
-      std::cout << engine::format_summary(profiler.summary()) << '\n';
-      std::cout << std::fixed << std::setprecision(1) << "pose age at display (depth capture to expected display), "
-                << ages_ms.size() << " frames with a target: p50 " << engine::percentile(ages_ms, 0.5) << " ms, p95 "
-                << engine::percentile(ages_ms, 0.95) << " ms, p99 " << engine::percentile(ages_ms, 0.99) << " ms, max "
-                << engine::percentile(ages_ms, 1.0) << " ms; " << blank << " frames blank (driving, acquiring or lost)";
-      if (frames_with_neighbours > 0) std::cout << "; " << frames_with_neighbours << " frames lit a neighbour too";
-      if (frames.silent_frames() > 0)
-        std::cout << "; " << frames.silent_frames() << " frames blanked because the camera had handed over no frame for "
-                  << std::lround(1000.0 * pc.silent_camera_s) << " ms";
-      std::cout << "\n";
-      if (const std::string played = content.summary(); !played.empty()) {
-        const engine::FrameSummary drawn_frames = profiler.summary();
-        std::cout << "content: " << played << "; content time less the shown frame's: p50 "
-                  << engine::percentile(content_offsets_ms, 0.5) << " ms, p99 " << engine::percentile(content_offsets_ms, 0.99)
-                  << " ms; upload on the render thread p50 " << std::setprecision(3) << drawn_frames.upload_p50_ms << " ms, p99 "
-                  << drawn_frames.upload_p99_ms << " ms" << std::setprecision(1) << "\n";
-      }
+      print_frames(std::cout, figures, profiler.summary(), loop.silent_frames(), lc.projection.silent_camera_s, content);
       std::size_t tracked = 0;
       for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
       if (recording) {
-        std::cout << "replay of " << recording->folder().string() << ": " << robot.visit << " of " << recording->stops.size()
-                  << " stops, " << tracked
-                  << " poses tracked in lockstep (each lit target's, every frame); against the recording's: " << check->compared
-                  << " compared, largest difference " << std::setprecision(4) << check->max_mm << " mm, " << check->max_deg
-                  << " deg; " << check->mismatched << " found or lost in one and not the other; " << check->unreached()
-                  << " recorded rows for frames the replay did not reach\n";
+        print_replay(std::cout, *recording, robot.visit, tracked, *check);
       } else {
         if (devices.base)
           std::cout << "error at display: not measured (the configured robot: no truth to measure against)\n";
         else
-          errors.print(std::cout);
+          print_display_errors(std::cout, figures);
         print_robot(std::cout, robot, devices.camera != nullptr, handoffs, tracked);
       }
-      if (const auto csv = args.get("profile")) {
-        std::ostringstream f;
-        // Per frame: when it started, the capture time of the depth its pose came from and its expected
-        // display time (empty for a blank frame), all on the frame profiler's clock.
-        f << "frame,start_ms,pose_age_ms,target,capture_ms,display_ms,error_mm\n";
-        const auto opt = [](double v) { return std::isnan(v) ? std::string() : std::to_string(v); };
-        for (std::size_t i = 0; i < rows.size(); ++i)
-          f << i << ',' << rows[i].start_ms << ',' << (rows[i].age_ms >= 0 ? std::to_string(rows[i].age_ms) : std::string())
-            << ',' << (rows[i].target >= 0 ? scene.targets[static_cast<std::size_t>(rows[i].target)].name : std::string()) << ','
-            << opt(rows[i].capture_ms) << ',' << opt(rows[i].display_ms) << ',' << opt(rows[i].error_mm) << '\n';
-        config::write_file_atomically(*csv, f.str());
-        std::cout << "per-frame profile written to " << *csv << '\n';
-      }
+      if (const auto csv = args.get("profile")) write_profile(*csv, figures.rows, scene);
       if (!failure.empty()) {
         std::cerr << "projbot run: " << failure << " (the projection was blanked; what was measured until then is above)\n";
         return 1;

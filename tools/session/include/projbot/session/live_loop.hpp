@@ -1,0 +1,107 @@
+#pragma once
+// The live projection loop (`run`, `run --replay`): every projector frame draws each lit target at its
+// newest accepted pose, moved on to the frame's display time (ProjectionFrames: Eq. 2), with its content
+// and compensation, or a blank frame; and measures it (the pose's age at display, the display error where
+// a truth is known). Times are seconds on the loop's clock; rows' times are the frame profiler's ms.
+// Runs on the render thread; the robot's state, the poses and the truth come in through callbacks.
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "projbot/engine/content.hpp"
+#include "projbot/engine/frame_profiler.hpp"
+#include "projbot/engine/photometry.hpp"
+#include "projbot/engine/renderer.hpp"
+#include "projbot/session/projection.hpp"
+
+namespace projbot::session {
+
+/// The stop as the robot thread last published it.
+struct LiveStop {
+  std::vector<int> targets;  ///< lit targets, scene indices, the visited one first
+  double since_s = 0.0;      ///< the stop began: poses captured before are an earlier stop's
+  int visit = 0;             ///< the visit (a target's compensation gain is chosen once per visit)
+};
+
+/// The loop's clock: the steady clock and a sleep on it, or a test's.
+struct LiveClock {
+  std::function<double()> now_s;                    ///< seconds
+  std::function<void(double until_s)> sleep_until;  ///< returns at until_s (or at once, when past)
+  static LiveClock steady();
+};
+
+/// A drawn target's error against a truth at its display time: the mean marker error (mm; NaN where
+/// it is not measured) and whether the target was moving then.
+struct DisplayError {
+  double error_mm = 0.0;
+  bool moving = false;
+};
+using DisplayMeter = std::function<DisplayError(const DrawnPose& drawn)>;
+
+/// One frame: start (profiler ms), the first drawn target's pose age (capture to expected display, ms;
+/// -1 for a blank frame), its capture and display times (profiler ms, NaN blank) and error (mm, NaN).
+struct LiveRow {
+  double start_ms = 0.0, age_ms = -1.0, capture_ms = 0.0, display_ms = 0.0, error_mm = 0.0;
+  int target = -1;  ///< scene index of the first drawn target; -1: blank
+};
+
+/// What the loop measured.
+struct LiveFigures {
+  std::vector<LiveRow> rows;                ///< one per frame drawn
+  std::vector<double> ages_ms;              ///< pose age at display, frames with a target
+  std::vector<double> moving_mm, still_mm;  ///< display errors, per drawn target and frame, where measured
+  std::vector<double> content_offsets_ms;   ///< per target-frame with video: its content time less the shown frame's
+  std::size_t blank = 0;                    ///< frames with no target drawn
+  std::size_t with_neighbours = 0;          ///< frames that drew more than one target
+};
+
+struct LiveLoopConfig {
+  ProjectionConfig projection;
+  double seconds = 0.0;   ///< stop after this long on the loop's clock; 0: until `keep_going` says no
+  double paced_hz = 0.0;  ///< offscreen: frames paced at this rate (no vsync to pace them); 0: the target paces
+};
+
+/// What the loop reads and calls each frame. `stop`, `poses`, `camera_last_s` and `keep_going` are needed.
+struct LiveInputs {
+  std::function<LiveStop()> stop;         ///< the robot's newest state, read once per frame
+  PoseSource poses;                       ///< each target's newest accepted pose
+  std::function<double()> camera_last_s;  ///< the camera's newest hand-off to the trackers
+  std::function<bool()> keep_going;       ///< asked before each frame
+  DisplayMeter meter;                     ///< empty: nothing measured against a truth
+  std::function<void()> after_frame;      ///< after each frame drawn (the content's messages)
+};
+
+/// The render thread's loop. Not thread-safe: one owner, the thread that owns the renderer.
+class LiveLoop {
+ public:
+  /// `items[i]` draws scene target i (its model). `plan` and `content` may be null (no compensation, no
+  /// content); they and the renderer must outlive the loop.
+  LiveLoop(engine::Renderer& renderer, const config::ProjectorConfig& projector, std::vector<engine::DrawItem> items,
+           LiveLoopConfig config, LiveClock clock = LiveClock::steady());
+  void set_compensation(engine::CompensationPlan* plan) { plan_ = plan; }
+  void set_content(engine::SceneContent* content) { content_ = content; }
+  /// Draws frames into `target` until `in.keep_going` says no, `seconds` have passed or the target is
+  /// closed; what was measured.
+  LiveFigures run(engine::RenderTarget& target, const LiveInputs& in, engine::FrameProfiler& profiler);
+  /// Frames blanked because the camera was silent.
+  std::size_t silent_frames() const { return frames_.silent_frames(); }
+
+ private:
+  void compose(const LiveStop& stop, const LiveInputs& in, std::vector<engine::DrawItem>& out, std::vector<DrawnPose>& drawn);
+  void measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s);
+
+  engine::Renderer& renderer_;
+  const config::ProjectorConfig& projector_;
+  std::vector<engine::DrawItem> items_;
+  LiveLoopConfig cfg_;
+  LiveClock clock_;
+  ProjectionFrames frames_;
+  engine::CompensationPlan* plan_ = nullptr;
+  engine::SceneContent* content_ = nullptr;
+  double t0_s_ = 0.0;
+  LiveFigures figures_;
+};
+
+}  // namespace projbot::session

@@ -1,0 +1,101 @@
+#include "projbot/session/live_loop.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "projbot/config/clock.hpp"
+
+namespace projbot::session {
+
+LiveClock LiveClock::steady() {
+  return {config::steady_now_s, [](double until_s) {
+            const double wait_s = until_s - config::steady_now_s();
+            if (wait_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
+          }};
+}
+
+LiveLoop::LiveLoop(engine::Renderer& renderer, const config::ProjectorConfig& projector, std::vector<engine::DrawItem> items,
+                   LiveLoopConfig config, LiveClock clock)
+    : renderer_(renderer),
+      projector_(projector),
+      items_(std::move(items)),
+      cfg_(config),
+      clock_(std::move(clock)),
+      frames_(config.projection) {}
+
+// This frame's draw items: each lit target found, at its pose for the display time, with its content on
+// that display time's clock. A lit target's video runs before its pose is found (the acquisition's first
+// second), so that it has caught up with its clock when it is first drawn.
+void LiveLoop::compose(const LiveStop& stop, const LiveInputs& in, std::vector<engine::DrawItem>& out,
+                       std::vector<DrawnPose>& drawn) {
+  out.clear();
+  const double now_s = clock_.now_s();
+  drawn = frames_.compose(now_s, {stop.targets, stop.since_s, in.camera_last_s()}, in.poses);
+  const auto content_s = [&](int target, double display_s) { return display_s - content_->start_s(target, t0_s_, stop.since_s); };
+  if (content_) {
+    const double display_s = now_s + frames_.period_s() + 1e-3 * cfg_.projection.input_lag_ms;
+    for (const int target : stop.targets)
+      if (content_->has_video(target) &&
+          std::none_of(drawn.begin(), drawn.end(), [&](const DrawnPose& d) { return d.target == target; }))
+        content_->show(target, content_s(target, display_s));
+  }
+  for (const DrawnPose& d : drawn) {
+    const auto t = static_cast<std::size_t>(d.target);
+    out.push_back({items_.at(t).model, d.T_projector_target,
+                   plan_ ? plan_->at(t, stop.visit, projector_, d.T_projector_target) : engine::Compensation{}});
+    if (content_ && content_->has(d.target)) {  // on the display clock of this frame, as its pose
+      const auto shown = content_->apply(d.target, content_s(d.target, d.display_s), out.back());
+      if (!std::isnan(shown.pts_s)) figures_.content_offsets_ms.push_back(1000.0 * (shown.content_s - shown.pts_s));
+    }
+  }
+}
+
+// Each drawn target's error against the truth at its display time; the row (and the pose's age, capture
+// to the expected display time) is the first drawn one's.
+void LiveLoop::measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s) {
+  const double nan = std::nan("");
+  if (drawn.empty()) {
+    ++figures_.blank;
+    figures_.rows.push_back({start_ms, -1.0, nan, nan, nan, -1});
+    return;
+  }
+  double first_error = nan;
+  for (const DrawnPose& d : drawn) {
+    const DisplayError e = meter ? meter(d) : DisplayError{nan, false};
+    if (!std::isnan(e.error_mm)) (e.moving ? figures_.moving_mm : figures_.still_mm).push_back(e.error_mm);
+    if (&d == &drawn.front()) first_error = e.error_mm;
+  }
+  if (drawn.size() > 1) ++figures_.with_neighbours;
+  const DrawnPose& first = drawn.front();
+  const double age_ms = 1000.0 * (std::max(clock_.now_s(), first.display_s) - first.capture_s);
+  figures_.ages_ms.push_back(age_ms);
+  figures_.rows.push_back({start_ms, age_ms, start_ms + 1000.0 * (first.capture_s - start_s),
+                           start_ms + 1000.0 * (first.display_s - start_s), first_error, first.target});
+}
+
+LiveFigures LiveLoop::run(engine::RenderTarget& target, const LiveInputs& in, engine::FrameProfiler& profiler) {
+  figures_ = {};
+  t0_s_ = clock_.now_s();
+  double next_s = t0_s_;
+  std::vector<DrawnPose> drawn;
+  while (in.keep_going() && !target.poll_close() && (cfg_.seconds == 0.0 || clock_.now_s() - t0_s_ < cfg_.seconds)) {
+    const LiveStop stop = in.stop();
+    if (cfg_.paced_hz > 0.0) {  // no vsync: paced like a projector at that rate
+      next_s += 1.0 / cfg_.paced_hz;
+      clock_.sleep_until(next_s);
+      if (clock_.now_s() > next_s + 0.05) next_s = clock_.now_s();  // fell behind: do not race to catch up
+    }
+    const double start_ms = profiler.now_ms(), start_s = clock_.now_s();
+    frames_.frame_started(start_s);
+    drawn.clear();
+    const auto read = [&](std::vector<engine::DrawItem>& out) { compose(stop, in, out, drawn); };
+    if (!renderer_.draw_frame(target, projector_, read, &profiler)) continue;
+    if (in.after_frame) in.after_frame();
+    measure(drawn, in.meter, start_ms, start_s);
+  }
+  return std::move(figures_);
+}
+
+}  // namespace projbot::session
