@@ -1,7 +1,10 @@
 #include "projbot/config/lens.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <string>
 
 #include "projbot/config/scene.hpp"
 
@@ -55,6 +58,53 @@ std::optional<Eigen::Vector3d> ProjectorConfig::panel_ray(double u, double v) co
   const auto x = undistort(distortion, {(u - cx_px) / fx_px, (v - cy_px) / fy_px});
   if (!x) return std::nullopt;
   return Eigen::Vector3d(x->x(), x->y(), 1.0);
+}
+
+namespace {
+
+// A lens the renderer can pre-distort for: over a 33 x 33 grid of the panel (its edges included) every
+// position sends its light along one ray, neighbours along neighbouring rays (the lens does not fold the
+// image over), and the rays fit in an undistorted image at most twice the panel's size each way.
+template <typename Fail>
+void validate_lens(const ProjectorConfig& p, const Fail& fail) {
+  for (const double c : p.distortion)
+    if (!std::isfinite(c)) fail("distortion coefficients must be finite");
+  if (!has_distortion(p.distortion)) return;
+  constexpr int kSteps = 32;
+  for (int j = 0; j <= kSteps; ++j)
+    for (int i = 0; i <= kSteps; ++i) {
+      const double u = -0.5 + p.width_px * i / double(kSteps), v = -0.5 + p.height_px * j / double(kSteps);
+      const auto ray = p.panel_ray(u, v);
+      const auto pixel = [](double x, int size) {
+        return std::to_string(std::clamp(std::lround(std::floor(x + 0.5)), 0L, size - 1L));
+      };
+      const auto where = " at panel pixel (" + pixel(u, p.width_px) + ", " + pixel(v, p.height_px) + ")";
+      if (!ray || !(distort_jacobian(p.distortion, ray->head<2>()).determinant() > 0.0))
+        fail("distortion folds the image over" + where + ": no lens the renderer can pre-distort for (check the calibration)");
+      const double iu = p.fx_px * ray->x() + p.cx_px, iv = p.fy_px * ray->y() + p.cy_px;
+      if (std::abs(iu - p.cx_px) > p.width_px || std::abs(iv - p.cy_px) > p.height_px)
+        fail("distortion throws the light of the panel" + where +
+             " more than an image's width or height from the centre: "
+             "too strong to pre-distort for (check the calibration)");
+    }
+}
+
+}  // namespace
+
+void validate_projector(const ProjectorConfig& p, std::string_view where) {
+  const auto fail = [&](const std::string& why) { throw ConfigError(std::string(where) + ": " + why); };
+  if (p.width_px <= 0 || p.height_px <= 0 || p.width_px > 16384 || p.height_px > 16384)
+    fail("size " + std::to_string(p.width_px) + "x" + std::to_string(p.height_px) + " must be 1..16384 pixels each way");
+  if (!(p.fx_px > 0.0) || !(p.fy_px > 0.0) || !std::isfinite(p.fx_px) || !std::isfinite(p.fy_px))
+    fail("fx and fy must be finite and > 0");
+  if (!std::isfinite(p.cx_px) || !std::isfinite(p.cy_px)) fail("cx and cy must be finite");
+  // Bounded below and above, not only positive: near 1e-300 passed "> 0" and tore the depth buffer.
+  if (!(p.near_m >= 1e-4) || !(p.far_m <= 1e4) || !(p.near_m < p.far_m) || !(p.far_m <= p.near_m * 1e7)) {
+    std::ostringstream v;
+    v << "need 0.0001 m <= near < far <= 10000 m with far / near <= 1e7 (near " << p.near_m << ", far " << p.far_m << ")";
+    fail(v.str());
+  }
+  validate_lens(p, fail);
 }
 
 }  // namespace projbot::config

@@ -15,6 +15,7 @@
 #include "map_reader.hpp"
 #include "projbot/config/paths.hpp"
 #include "projbot/config/yaml_keys.hpp"
+#include "target_reader.hpp"
 
 namespace projbot::config {
 namespace {
@@ -67,80 +68,6 @@ void read_photometry(MapReader& r, const YAML::Node& node, Photometry& p) {
   }
 }
 
-// A target's `surface: {albedo: [r, g, b]}`: linear reflectance, each 0..1.
-TargetSurface read_surface(MapReader& t, const std::string& path) {
-  TargetSurface surface;
-  YAML::Node node = t.child("surface", false);
-  if (!node) return surface;
-  MapReader m(node, path, t.file());
-  if (m.has("texture"))
-    m.fail(node["texture"], m.key_path("texture"), "a reflectance texture is not supported yet: give surface.albedo: [r, g, b]");
-  const YAML::Node albedo = m.child("albedo", true);
-  surface.albedo = m.vector3(albedo, m.key_path("albedo"));
-  if (!((surface.albedo.array() >= 0.0).all() && (surface.albedo.array() <= 1.0).all()))
-    m.fail(albedo, m.key_path("albedo"), "each of r, g, b must be 0..1 (linear reflectance)");
-  m.reject_unknown();
-  return surface;
-}
-
-// `content.timeline`: keys of a material's base colour factor over content time, times increasing.
-std::vector<TargetContent::Key> read_timeline(MapReader& m, const YAML::Node& list, const std::string& path) {
-  if (!list.IsSequence() || list.size() == 0)
-    m.fail(list, path, "expected a non-empty list of {at_s: S, base_color_factor: [r, g, b, a]}");
-  std::vector<TargetContent::Key> keys;
-  for (std::size_t k = 0; k < list.size(); ++k) {
-    const std::string where = path + "[" + std::to_string(k) + "]";
-    MapReader key(list[k], where, m.file());
-    TargetContent::Key out;
-    out.at_s = key.get<double>("at_s", 0.0, true);
-    if (!(out.at_s >= 0.0 && out.at_s <= 1e6)) key.fail(list[k]["at_s"], where + ".at_s", "must be 0..1e6 seconds");
-    if (!keys.empty() && !(out.at_s > keys.back().at_s))
-      key.fail(list[k]["at_s"], where + ".at_s", "must come after the key before it (times increase)");
-    const YAML::Node f = key.child("base_color_factor", true);
-    const auto v = key.numbers(f, where + ".base_color_factor", 4);
-    for (std::size_t i = 0; i < 4; ++i) {
-      if (!(v[i] >= 0.0 && v[i] <= 1.0)) key.fail(f, where + ".base_color_factor", "each of r, g, b, a must be 0..1");
-      out.base_color_factor[i] = v[i];
-    }
-    key.reject_unknown();
-    keys.push_back(out);
-  }
-  return keys;
-}
-
-// A target's `content: {video: F, material: NAME_OR_INDEX, loop: B, start: arrival | tour | SECONDS, timeline: [...]}`.
-std::optional<TargetContent> read_content(MapReader& t, const std::string& path, const std::filesystem::path& base) {
-  YAML::Node node = t.child("content", false);
-  if (!node) return std::nullopt;
-  MapReader m(node, path, t.file());
-  TargetContent c;
-  if (m.has("video")) {
-    const auto video = m.get<std::string>("video", "");
-    if (video.empty()) m.fail(node["video"], m.key_path("video"), "must not be empty");
-    c.video = beside_scene(video, base);
-  }
-  if (YAML::Node tl = m.child("timeline", false)) c.timeline = read_timeline(m, tl, m.key_path("timeline"));
-  if (c.video.empty() && c.timeline.empty()) m.fail(node, path, "needs a video or a timeline (or both): nothing would move");
-  c.material = m.get<std::string>("material", "");
-  c.loop = m.get<bool>("loop", true);
-  if (YAML::Node st = m.child("start", false)) {
-    if (!st.IsScalar()) m.fail(st, m.key_path("start"), "expected arrival, tour or seconds after the tour began");
-    double at = 0.0;
-    if (st.Scalar() == "arrival") {
-      c.start = TargetContent::Start::kArrival;
-    } else if (st.Scalar() == "tour") {
-      c.start = TargetContent::Start::kTour;
-    } else if (YAML::convert<double>::decode(st, at) && at >= 0.0 && at <= 1e6) {
-      c.start = TargetContent::Start::kAt;
-      c.at_s = at;
-    } else {
-      m.fail(st, m.key_path("start"), "expected arrival, tour or 0..1e6 seconds after the tour began, not '" + st.Scalar() + "'");
-    }
-  }
-  m.reject_unknown();
-  return c;
-}
-
 // A pinhole section (`projector:`, `camera:`): every intrinsic required unless defaults are given.
 ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std::optional<ProjectorConfig>& defaults) {
   YAML::Node node = root.child(key, !defaults);
@@ -173,30 +100,6 @@ ProjectorConfig read_pinhole(MapReader& root, const std::string& key, const std:
     r.fail(node, "", e.what());
   }
   return p;
-}
-
-TargetMotion read_motion(const YAML::Node& mo, const std::string& path, const std::string& file) {
-  MapReader m(mo, path, file);
-  TargetMotion motion;
-  motion.visit = m.get<int>("visit", motion.visit);
-  if (motion.visit < 1) m.fail(mo["visit"], m.key_path("visit"), "must be >= 1");
-  motion.start_s = m.get<double>("start_s", motion.start_s);
-  motion.duration_s = m.get<double>("duration_s", motion.duration_s);
-  if (motion.start_s < 0.0 || !(motion.duration_s > 0.0)) m.fail(mo, path, "need start_s >= 0 and duration_s > 0");
-  if (YAML::Node tr = m.child("translation", false)) motion.translation_m = m.vector3(tr, m.key_path("translation"));
-  if (YAML::Node rpy = m.child("rpy_deg", false)) motion.rpy_deg = m.vector3(rpy, m.key_path("rpy_deg"));
-  const std::string profile = m.get<std::string>("profile", "smooth");
-  if (profile == "constant")
-    motion.profile = MotionProfile::constant;
-  else if (profile == "accelerate")
-    motion.profile = MotionProfile::accelerate;
-  else if (profile != "smooth")
-    m.fail(mo["profile"], m.key_path("profile"), "must be smooth, constant or accelerate, not '" + profile + "'");
-  motion.stays = m.get<bool>("stays", false);
-  motion.removed = m.get<bool>("removed", false);
-  if (motion.removed && motion.stays) m.fail(mo, path, "a removed target cannot also stay: choose one");
-  m.reject_unknown();
-  return motion;
 }
 
 // Where the robot can stand: inside the room and outside every obstacle. Empty when it can.
@@ -460,53 +363,6 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
   for (const char* key : {"camera", "projector_coverage", "views", "warnings", "board_poses"}) r.child(key, false);
   r.reject_unknown();
   return out;
-}
-
-namespace {
-
-// A lens the renderer can pre-distort for: over a 33 x 33 grid of the panel (its edges included) every
-// position sends its light along one ray, neighbours along neighbouring rays (the lens does not fold the
-// image over), and the rays fit in an undistorted image at most twice the panel's size each way.
-template <typename Fail>
-void validate_lens(const ProjectorConfig& p, const Fail& fail) {
-  for (const double c : p.distortion)
-    if (!std::isfinite(c)) fail("distortion coefficients must be finite");
-  if (!has_distortion(p.distortion)) return;
-  constexpr int kSteps = 32;
-  for (int j = 0; j <= kSteps; ++j)
-    for (int i = 0; i <= kSteps; ++i) {
-      const double u = -0.5 + p.width_px * i / double(kSteps), v = -0.5 + p.height_px * j / double(kSteps);
-      const auto ray = p.panel_ray(u, v);
-      const auto pixel = [](double x, int size) {
-        return std::to_string(std::clamp(std::lround(std::floor(x + 0.5)), 0L, size - 1L));
-      };
-      const auto where = " at panel pixel (" + pixel(u, p.width_px) + ", " + pixel(v, p.height_px) + ")";
-      if (!ray || !(distort_jacobian(p.distortion, ray->head<2>()).determinant() > 0.0))
-        fail("distortion folds the image over" + where + ": no lens the renderer can pre-distort for (check the calibration)");
-      const double iu = p.fx_px * ray->x() + p.cx_px, iv = p.fy_px * ray->y() + p.cy_px;
-      if (std::abs(iu - p.cx_px) > p.width_px || std::abs(iv - p.cy_px) > p.height_px)
-        fail("distortion throws the light of the panel" + where +
-             " more than an image's width or height from the centre: "
-             "too strong to pre-distort for (check the calibration)");
-    }
-}
-
-}  // namespace
-
-void validate_projector(const ProjectorConfig& p, std::string_view where) {
-  const auto fail = [&](const std::string& why) { throw ConfigError(std::string(where) + ": " + why); };
-  if (p.width_px <= 0 || p.height_px <= 0 || p.width_px > 16384 || p.height_px > 16384)
-    fail("size " + std::to_string(p.width_px) + "x" + std::to_string(p.height_px) + " must be 1..16384 pixels each way");
-  if (!(p.fx_px > 0.0) || !(p.fy_px > 0.0) || !std::isfinite(p.fx_px) || !std::isfinite(p.fy_px))
-    fail("fx and fy must be finite and > 0");
-  if (!std::isfinite(p.cx_px) || !std::isfinite(p.cy_px)) fail("cx and cy must be finite");
-  // Bounded below and above, not only positive: near 1e-300 passed "> 0" and tore the depth buffer.
-  if (!(p.near_m >= 1e-4) || !(p.far_m <= 1e4) || !(p.near_m < p.far_m) || !(p.far_m <= p.near_m * 1e7)) {
-    std::ostringstream v;
-    v << "need 0.0001 m <= near < far <= 10000 m with far / near <= 1e7 (near " << p.near_m << ", far " << p.far_m << ")";
-    fail(v.str());
-  }
-  validate_lens(p, fail);
 }
 
 namespace {

@@ -11,6 +11,7 @@
 #include <tuple>
 #include <utility>
 
+#include "marker_errors.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/image.hpp"
@@ -19,120 +20,14 @@
 #include "projbot/engine/projection.hpp"
 #include "projbot/twin/spectator.hpp"
 #include "projbot/twin/world.hpp"
+#include "sim_clock_devices.hpp"
 
 namespace projbot::twin {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-constexpr double kCameraHz = 30.0;
 constexpr double kConvergedMm = 3.0;  // the issue's goal for a visit's mean error
-
-struct Errors {
-  std::vector<MarkerError> markers;
-  double mean_mm = 0.0, max_mm = 0.0;
-};
-
-// Whether a point in the projector frame falls inside the projector's image (Eq. 3).
-bool lit_by(const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
-  if (p.z() <= 0.0) return false;
-  const Eigen::Vector2d x = k.project_lit(p);
-  return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < k.width_px && x.y() < k.height_px;
-}
-
-// The projector as the twin's light follows it (the scene's: the truth) and as the session believes it
-// (a calibration's A_p and R_cp, T_cp when the tour is given one; else the truth): Eq. 2 and the
-// drawing use what the session believes.
-struct ProjectorModels {
-  config::ProjectorConfig truth, believed;
-  Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();  // believed R_cp, T_cp
-  Eigen::Matrix4d projector_from_target(const Eigen::Matrix4d& T_camera_target) const {
-    return alignment::projector_from_target(T_projector_camera, T_camera_target);  // Eq. 2
-  }
-};
-
-// The error at the target's markers. A marker the projector cannot light (outside its image, turned
-// away, or hidden by the target itself or something in front), or lights edge-on (seen_edge_on), has no
-// error to measure and is left out; mean and max are NaN when no marker is left (such frames are left
-// out of the visit's statistics).
-Errors marker_errors(const Twin& twin, std::size_t target, const ProjectorModels& projector,
-                     const Eigen::Matrix4d& T_world_projector, const Eigen::Matrix4d& T_camera_target_estimated) {
-  const Eigen::Matrix4d T_projector_target_estimated = projector.projector_from_target(T_camera_target_estimated);
-  const Eigen::Matrix4d T_projector_world = alignment::rigid_inverse(T_world_projector);
-  const auto scene = twin.true_scene(T_projector_world);
-  const TwinTarget& t = twin.targets()[target];
-  const Eigen::Matrix4d T_true = T_projector_world * t.T_world_target_true;
-  Errors e;
-  int visible = 0;
-  for (const auto& m : t.config.markers_m) {
-    const Eigen::Vector3d truth = (T_true * m.homogeneous()).head<3>();
-    if (!lit_by(projector.truth, truth)) continue;  // outside the projector's image: it cannot be lit
-    const auto first = cast_ray(scene, Eigen::Vector3d::Zero(), truth.normalized());
-    if (!first || (*first - truth).norm() > 0.002) continue;
-    if (seen_edge_on(scene, truth)) continue;  // a pose's error cannot be measured there
-    e.markers.push_back(measure_marker(projector.believed, projector.truth, T_projector_target_estimated, T_true, m, scene));
-    e.mean_mm += e.markers.back().error_mm;
-    e.max_mm = std::max(e.max_mm, e.markers.back().error_mm);
-    ++visible;
-  }
-  if (visible == 0)
-    e.mean_mm = e.max_mm = std::nan("");
-  else
-    e.mean_mm /= visible;
-  return e;
-}
-
-// What a stop's acquisition gave for one target: the estimate, its check against free space, whether it
-// is lit, and its wall time.
-struct Acquired {
-  alignment::AlignmentResult icp;
-  alignment::FreeSpaceCheck free_space;
-  bool projected = false;
-  double align_ms = 0.0;
-};
-
-// One acquisition at arrival. Odometry and localized modes: the whole acquisition once (the paper's
-// one alignment per stop; odometry projects whatever it gives). Tracking mode: the follower's first
-// step, the bounded start of its search, as the live engine's worker does it.
-Acquired acquire(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const alignment::DepthImage& depth,
-                 const Eigen::Matrix4d& T_init, const alignment::Footing& footing, const assets::Image* colour) {
-  const auto t0 = Clock::now();
-  Acquired r;
-  r.icp.T_scan_model = T_init;  // too little in view: nothing to align
-  r.icp.converged = false;
-  if (mode == TourMode::tracking) {
-    follower.set_initial_guess(T_init, footing);
-    const auto sample = follower.step(depth, colour);
-    if (follower.last_attempt()) r.icp = *follower.last_attempt();
-    if (sample && !sample->lost) r.icp.T_scan_model = sample->T_camera_target;  // colour may have moved it
-    r.icp.colour_shift_mm = follower.search_stats().colour_shift_mm;
-    r.icp.colour_agreement = follower.search_stats().colour_agreement;
-    if (sample && !sample->lost && !follower.last_attempt()) {  // the projective tracker found it from the guess
-      r.icp.T_scan_model = sample->T_camera_target;
-      r.icp.converged = true;
-      r.icp.inlier_ratio = sample->inlier_ratio;
-      r.icp.rmse_mm = sample->rmse_mm;
-    }
-    r.free_space = follower.last_check();
-    r.projected = sample && !sample->lost;
-  } else {
-    try {
-      // Ours leaves out the floor (known from the map and where the robot believes its camera is) and
-      // what lies outside the guess's silhouette, and takes only a pose that stands as surveyed; the
-      // paper's set-up aligns to everything near the guess.
-      r.icp = mode == TourMode::localized ? follower.acquire(depth, T_init, footing, follower.silhouette_grow_m(), colour)
-                                          : follower.aligner().align(alignment::depth_to_cloud(depth, twin.camera()), T_init);
-    } catch (const alignment::AlignmentError&) {
-    }
-    // Ours also checks the estimate against free space; the paper's set-up projects whatever ICP gives.
-    r.free_space = follower.verify(depth, r.icp.T_scan_model);
-    if (mode == TourMode::localized && !follower.passes(r.free_space)) r.icp.converged = false;
-    r.projected = mode == TourMode::odometry || r.icp.converged;
-  }
-  r.align_ms = ms_since(t0);
-  return r;
-}
 
 // A neighbour lit with the visited target (issue 11, item 5): what the projector draws for it, and the
 // error of its lit frames so far.
@@ -179,168 +74,6 @@ struct DwellContext {
   const TourOptions& options;
   std::vector<NeighbourLight>& neighbours;
 };
-
-// A tracker result on the simulated clock: usable by projector frames that start at or after ready_s.
-struct InFlight {
-  std::optional<alignment::PoseSample> sample;
-  double ready_s = 0.0;
-};
-
-// The tour's simulated clock as its camera and its trackers share it: how long the camera's last frame took
-// to render (wall time; a tracker starts on a frame that long after its exposure, the twin's rendering
-// standing in for the camera's readout), unless options.processing_ms fixes each frame's whole
-// processing time.
-struct SimClock {
-  double capture_ms = 0.0;
-  std::optional<double> processing_ms;
-};
-
-// One target's tracker worker on the tour's simulated clock: what Session::visit hands a lit target's
-// frames to in the tour, as `projbot run` hands them to alignment::TrackerWorker. The stop's first frame
-// is its acquisition (the mode's, acquire()). Later frames (tracking mode) are tracked by the follower,
-// the policy the engine's worker runs: a frame that comes while the tracker is still busy with an earlier
-// one is dropped (a worker always takes the newest), and a result is ready on the simulated clock when
-// its step ends: after the frame's capture, its measured wall time, or processing_ms for both together.
-class SimClockTracker final : public alignment::PoseTracker {
- public:
-  SimClockTracker(TourMode mode, alignment::TargetFollower& follower, const Twin& twin, const SimClock& clock)
-      : mode_(mode), follower_(follower), twin_(twin), clock_(clock) {}
-  void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const alignment::Footing& footing,
-                         std::shared_ptr<const assets::Image> colour) override;
-  std::optional<alignment::PoseSample> track(std::shared_ptr<const alignment::DepthImage> frame) override;
-  // The tour runs in lockstep: a frame handed over is tracked at once, its result kept for its ready time.
-  void submit(std::shared_ptr<const alignment::DepthImage> frame) override { track(std::move(frame)); }
-  // Whether it takes a frame that arrives at t_s (simulated clock).
-  bool free_at(double t_s) const { return free_s_ <= t_s; }
-  // The results ready by t_s, oldest first.
-  std::vector<alignment::PoseSample> ready_by(double t_s);
-  const Acquired& acquired() const { return acquired_; }  // the stop's acquisition
-  alignment::TargetFollower& follower() { return follower_; }
-  double track_ms() const { return track_ms_; }  // at this stop, after the acquisition
-  int tracked() const { return tracked_; }       // frames it took there
-
- private:
-  struct Start {
-    Eigen::Matrix4d T_camera_target;
-    alignment::Footing footing;
-    std::shared_ptr<const assets::Image> colour;
-  };
-  TourMode mode_;
-  alignment::TargetFollower& follower_;
-  const Twin& twin_;
-  const SimClock& clock_;
-  std::optional<Start> start_;  // set: the next frame acquires
-  Acquired acquired_;
-  std::deque<InFlight> in_flight_;
-  double free_s_ = 0.0;  // when its current step ends
-  double track_ms_ = 0.0;
-  int tracked_ = 0;
-};
-
-void SimClockTracker::set_initial_guess(const Eigen::Matrix4d& T_camera_target, const alignment::Footing& footing,
-                                        std::shared_ptr<const assets::Image> colour) {
-  start_ = Start{T_camera_target, footing, std::move(colour)};
-  acquired_ = Acquired{};
-  in_flight_.clear();
-  free_s_ = track_ms_ = 0.0;
-  tracked_ = 0;
-}
-
-std::optional<alignment::PoseSample> SimClockTracker::track(std::shared_ptr<const alignment::DepthImage> frame) {
-  if (start_) {
-    acquired_ = acquire(mode_, follower_, twin_, *frame, start_->T_camera_target, start_->footing, start_->colour.get());
-    start_.reset();
-    alignment::PoseSample s;
-    s.T_camera_target = s.motion.T = acquired_.icp.T_scan_model;
-    s.lost = !acquired_.projected;
-    return s;
-  }
-  const double t_k = frame->capture_time_s;
-  // Not rendered (nothing is tracked in this mode, or every tracker was busy), or this one is still busy
-  // when the next frame comes: dropped.
-  if (frame->width == 0 || free_s_ > t_k + 1.0 / kCameraHz) return std::nullopt;
-  const auto t0 = Clock::now();
-  InFlight f{follower_.step(*frame), 0.0};
-  const double step_ms = ms_since(t0);
-  track_ms_ += step_ms;
-  ++tracked_;
-  const double start_s = std::max(free_s_, t_k + (clock_.processing_ms ? 0.0 : 1e-3 * clock_.capture_ms));
-  f.ready_s = free_s_ = start_s + 1e-3 * clock_.processing_ms.value_or(step_ms);
-  in_flight_.push_back(f);
-  return f.sample;
-}
-
-std::vector<alignment::PoseSample> SimClockTracker::ready_by(double t_s) {
-  std::vector<alignment::PoseSample> out;
-  while (!in_flight_.empty() && in_flight_.front().ready_s <= t_s + 1e-9) {
-    if (in_flight_.front().sample) out.push_back(*in_flight_.front().sample);
-    in_flight_.pop_front();
-  }
-  return out;
-}
-
-// The twin's RGB-D camera on the tour's simulated clock, as Session::visit reads one. A stop's first
-// frame is the arrival's capture: depth, and the colour registered to it unless the mode is odometry
-// (the paper's set-up has none). Then, in tracking mode, a frame every 1/30 s, the visited target moved
-// by its motion script to the frame's instant first; it is rendered only when a lit target's tracker will
-// take it (one is free before the next frame comes), else its depth is empty. In the other modes nothing
-// is tracked while the robot dwells, and nothing is rendered.
-class TourCamera final : public alignment::RgbdCamera {
- public:
-  struct Stop {
-    std::size_t target = 0;  // index into Twin::targets()
-    int target_visit = 0;
-    Eigen::Matrix4d T_world_camera = Eigen::Matrix4d::Identity();  // true
-    std::uint32_t noise_seed = 0;                                  // the arrival's; frame k's is noise_seed + k
-    bool colour = true, tracking = true;
-    bool present = true;                 // the target was there at arrival
-    std::function<bool(double)> wanted;  // whether a lit target's tracker takes a frame arriving at t_s
-  };
-  TourCamera(Twin& twin, SimClock& clock) : twin_(twin), clock_(clock) {}
-  void at_stop(Stop stop) {
-    stop_ = std::move(stop);
-    frames_ = 0;
-    arrival_ = true;
-    gone_s_ = -1.0;
-  }
-  alignment::RgbdFrame next() override;
-  int frames() const { return frames_; }             // after the arrival's
-  double gone_s() const { return gone_s_; }          // capture time of the first frame without the target, -1: none
-  double arrival_ms() const { return arrival_ms_; }  // wall time of the arrival's depth
-
- private:
-  Twin& twin_;
-  SimClock& clock_;
-  Stop stop_;
-  int frames_ = 0;
-  bool arrival_ = true;
-  double gone_s_ = -1.0, arrival_ms_ = 0.0;
-};
-
-alignment::RgbdFrame TourCamera::next() {
-  alignment::RgbdFrame f;
-  if (arrival_) {
-    arrival_ = false;
-    const auto t0 = Clock::now();
-    f.depth = twin_.capture(stop_.T_world_camera, stop_.noise_seed);
-    arrival_ms_ = ms_since(t0);
-    if (stop_.colour) f.colour = twin_.capture_colour(stop_.T_world_camera, stop_.noise_seed);
-    return f;
-  }
-  if (!stop_.tracking) return f;  // nothing is tracked while the robot dwells: no frame is taken
-  const double t_k = ++frames_ / kCameraHz;
-  f.depth.capture_time_s = t_k;
-  TwinTarget& target = twin_.targets()[stop_.target];
-  target.T_world_target_true = twin_.scripted_pose(stop_.target, stop_.target_visit, t_k);
-  target.in_world = twin_.scripted_presence(stop_.target, stop_.target_visit, t_k);
-  if (!target.in_world && stop_.present && gone_s_ < 0.0) gone_s_ = t_k;
-  if (!stop_.wanted(t_k + 1.0 / kCameraHz)) return f;
-  const auto t0 = Clock::now();
-  f.depth = twin_.capture(stop_.T_world_camera, stop_.noise_seed + static_cast<std::uint32_t>(frames_));
-  f.depth.capture_time_s = t_k;  // the exposure, on the simulated clock
-  clock_.capture_ms = ms_since(t0);
-  return f;
-}
 
 // The error of one projector frame, against the target's true pose at the frame's display time.
 TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double display_s, bool shown,

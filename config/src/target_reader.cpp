@@ -1,0 +1,106 @@
+#include "target_reader.hpp"
+
+namespace projbot::config {
+namespace {
+
+// `content.timeline`: keys of a material's base colour factor over content time, times increasing.
+std::vector<TargetContent::Key> read_timeline(MapReader& m, const YAML::Node& list, const std::string& path) {
+  if (!list.IsSequence() || list.size() == 0)
+    m.fail(list, path, "expected a non-empty list of {at_s: S, base_color_factor: [r, g, b, a]}");
+  std::vector<TargetContent::Key> keys;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string where = path + "[" + std::to_string(k) + "]";
+    MapReader key(list[k], where, m.file());
+    TargetContent::Key out;
+    out.at_s = key.get<double>("at_s", 0.0, true);
+    if (!(out.at_s >= 0.0 && out.at_s <= 1e6)) key.fail(list[k]["at_s"], where + ".at_s", "must be 0..1e6 seconds");
+    if (!keys.empty() && !(out.at_s > keys.back().at_s))
+      key.fail(list[k]["at_s"], where + ".at_s", "must come after the key before it (times increase)");
+    const YAML::Node f = key.child("base_color_factor", true);
+    const auto v = key.numbers(f, where + ".base_color_factor", 4);
+    for (std::size_t i = 0; i < 4; ++i) {
+      if (!(v[i] >= 0.0 && v[i] <= 1.0)) key.fail(f, where + ".base_color_factor", "each of r, g, b, a must be 0..1");
+      out.base_color_factor[i] = v[i];
+    }
+    key.reject_unknown();
+    keys.push_back(out);
+  }
+  return keys;
+}
+
+}  // namespace
+
+// A target's `surface: {albedo: [r, g, b]}`: linear reflectance, each 0..1.
+TargetSurface read_surface(MapReader& t, const std::string& path) {
+  TargetSurface surface;
+  YAML::Node node = t.child("surface", false);
+  if (!node) return surface;
+  MapReader m(node, path, t.file());
+  if (m.has("texture"))
+    m.fail(node["texture"], m.key_path("texture"), "a reflectance texture is not supported yet: give surface.albedo: [r, g, b]");
+  const YAML::Node albedo = m.child("albedo", true);
+  surface.albedo = m.vector3(albedo, m.key_path("albedo"));
+  if (!((surface.albedo.array() >= 0.0).all() && (surface.albedo.array() <= 1.0).all()))
+    m.fail(albedo, m.key_path("albedo"), "each of r, g, b must be 0..1 (linear reflectance)");
+  m.reject_unknown();
+  return surface;
+}
+
+// A target's `content: {video: F, material: NAME_OR_INDEX, loop: B, start: arrival | tour | SECONDS, timeline: [...]}`.
+std::optional<TargetContent> read_content(MapReader& t, const std::string& path, const std::filesystem::path& base) {
+  YAML::Node node = t.child("content", false);
+  if (!node) return std::nullopt;
+  MapReader m(node, path, t.file());
+  TargetContent c;
+  if (m.has("video")) {
+    const auto video = m.get<std::string>("video", "");
+    if (video.empty()) m.fail(node["video"], m.key_path("video"), "must not be empty");
+    c.video = beside_scene(video, base);
+  }
+  if (YAML::Node tl = m.child("timeline", false)) c.timeline = read_timeline(m, tl, m.key_path("timeline"));
+  if (c.video.empty() && c.timeline.empty()) m.fail(node, path, "needs a video or a timeline (or both): nothing would move");
+  c.material = m.get<std::string>("material", "");
+  c.loop = m.get<bool>("loop", true);
+  if (YAML::Node st = m.child("start", false)) {
+    if (!st.IsScalar()) m.fail(st, m.key_path("start"), "expected arrival, tour or seconds after the tour began");
+    double at = 0.0;
+    if (st.Scalar() == "arrival") {
+      c.start = TargetContent::Start::kArrival;
+    } else if (st.Scalar() == "tour") {
+      c.start = TargetContent::Start::kTour;
+    } else if (YAML::convert<double>::decode(st, at) && at >= 0.0 && at <= 1e6) {
+      c.start = TargetContent::Start::kAt;
+      c.at_s = at;
+    } else {
+      m.fail(st, m.key_path("start"), "expected arrival, tour or 0..1e6 seconds after the tour began, not '" + st.Scalar() + "'");
+    }
+  }
+  m.reject_unknown();
+  return c;
+}
+
+TargetMotion read_motion(const YAML::Node& mo, const std::string& path, const std::string& file) {
+  MapReader m(mo, path, file);
+  TargetMotion motion;
+  motion.visit = m.get<int>("visit", motion.visit);
+  if (motion.visit < 1) m.fail(mo["visit"], m.key_path("visit"), "must be >= 1");
+  motion.start_s = m.get<double>("start_s", motion.start_s);
+  motion.duration_s = m.get<double>("duration_s", motion.duration_s);
+  if (motion.start_s < 0.0 || !(motion.duration_s > 0.0)) m.fail(mo, path, "need start_s >= 0 and duration_s > 0");
+  if (YAML::Node tr = m.child("translation", false)) motion.translation_m = m.vector3(tr, m.key_path("translation"));
+  if (YAML::Node rpy = m.child("rpy_deg", false)) motion.rpy_deg = m.vector3(rpy, m.key_path("rpy_deg"));
+  const std::string profile = m.get<std::string>("profile", "smooth");
+  if (profile == "constant")
+    motion.profile = MotionProfile::constant;
+  else if (profile == "accelerate")
+    motion.profile = MotionProfile::accelerate;
+  else if (profile != "smooth")
+    m.fail(mo["profile"], m.key_path("profile"), "must be smooth, constant or accelerate, not '" + profile + "'");
+  motion.stays = m.get<bool>("stays", false);
+  motion.removed = m.get<bool>("removed", false);
+  if (motion.removed && motion.stays) m.fail(mo, path, "a removed target cannot also stay: choose one");
+  m.reject_unknown();
+  return motion;
+}
+
+}  // namespace projbot::config
