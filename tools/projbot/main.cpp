@@ -39,9 +39,9 @@ const std::vector<const Command*>& commands() {
                                                &projbot::tools::kDevices,
                                                &projbot::tools::kSimBase,
                                                &projbot::tools::kRecord,
+                                               &projbot::tools::kCalibrateCapture,
                                                &projbot::tools::kCalibrateSimulate,
                                                &projbot::tools::kCalibrateSolve,
-                                               &projbot::tools::kCalibrateCapture,
                                                &projbot::tools::kCalibratePhotometric};
   return all;
 }
@@ -78,11 +78,81 @@ void print_help() {
          "  projbot bench render\n";
 }
 
+// A group of commands ("bench render", "calibrate solve", ...): the table's commands named "GROUP WHAT",
+// and what to say when WHAT is missing or unknown.
+struct Group {
+  const char* name;
+  const char* missing;
+  const char* unknown;
+};
+constexpr Group kGroups[] = {{"bench", "say what to benchmark", "no benchmark"}, {"calibrate", "say which step", "no step"}};
+
+// The command argv names (`name` gets it as typed, "align", "bench motion"; `first` the index of its first
+// option); null, said on stderr, when there is none.
+const Command* find_command(int argc, char** argv, std::string& name, int& first) {
+  name = argv[1];
+  first = 2;
+  for (const Group& g : kGroups) {
+    if (name != g.name) continue;
+    const std::string what = argc < 3 ? std::string() : argv[2], prefix = name + " ";
+    std::string known;  // the group's commands, from the table: "render | track | ..."
+    bool found = false;
+    for (const Command* c : commands())
+      if (c->name.rfind(prefix, 0) == 0) {
+        known += (known.empty() ? "" : " | ") + c->name.substr(prefix.size());
+        found = found || c->name.substr(prefix.size()) == what;
+      }
+    if (!found) {
+      std::cerr << "projbot " << name << ": " << (argc < 3 ? std::string(g.missing) : std::string(g.unknown) + " '" + what + "'")
+                << ": projbot " << name << " " << known << "\n";
+      return nullptr;
+    }
+    name = prefix + what;
+    first = 3;
+  }
+  for (const auto* c : commands())
+    if (c->name == name) return c;
+  std::cerr << "projbot: unknown command '" << name << "' (projbot --help lists them)\n";
+  return nullptr;
+}
+
+// Runs `cmd` on its options (argv from `first`); every exception ends here as one clear line.
+int run_command(const Command& cmd, int argc, char** argv, int first, const std::string& name) {
+  try {
+    const projbot::cli::Args args(cmd.options, argc, argv, first);
+    // Only `calibrate solve DIR`, `bench dataset DIR` and `bench sensor DIR` take an argument that is not an option.
+    const bool takes_folder = &cmd == &projbot::tools::kCalibrateSolve || &cmd == &projbot::tools::kBenchDataset ||
+                              &cmd == &projbot::tools::kBenchSensor;
+    if (args.positional().size() > (takes_folder ? 1U : 0U))
+      throw projbot::cli::UsageError("unexpected argument '" + args.positional().back() + "'");
+    // Every command's paths, before any work: inputs that are files, outputs that clash with nothing.
+    std::vector<projbot::config::NamedPath> folder;
+    if (takes_folder && !args.positional().empty()) folder.push_back({"the folder", args.positional().front(), true});
+    args.check_paths(folder);
+    return cmd.run(args);
+  } catch (const projbot::robot::SetupInterrupted& e) {  // SIGTERM while the twin was built: nothing made
+    return projbot::tools::nothing_written(std::string("while building the twin (") + e.what() + ")");
+  } catch (const std::bad_alloc&) {
+    std::cerr << "projbot " << name << ": out of memory: an input is larger than this machine can hold\n";
+    return 1;
+  } catch (const projbot::cli::UsageError& e) {
+    std::cerr << "projbot " << name << ": " << e.what() << " (see projbot " << name << " --help)\n";
+    return 2;
+  } catch (const std::exception& e) {  // ConfigError, AssetError, AlignmentError, EngineError: one clear line
+    // A third-party text that slipped through (a banner, a call stack): its first line that says something.
+    std::istringstream text(e.what());
+    std::string line, said;
+    while (said.empty() && std::getline(text, line))
+      if (line.find_first_not_of(" \t=") != std::string::npos) said = line;
+    std::cerr << "projbot " << name << ": " << said << '\n';
+    return 1;
+  }
+}
+
 }  // namespace
 
-// Runs the command argv names; its exit status.
-// Runs the command argv names; `name` gets it as typed ("align", "bench motion"), empty for --help
-// and --version.
+// Runs the command argv names; its exit status. `name` gets it as typed ("align", "bench motion"), empty
+// for --help and --version.
 static int dispatch(int argc, char** argv, std::string& name) {
   // Lavapipe allocates its per-frame binning memory anew each frame. By default glibc returns such large
   // blocks to the kernel on free and the next frame faults them in again, zeroed; keeping them in the
@@ -102,77 +172,15 @@ static int dispatch(int argc, char** argv, std::string& name) {
     std::cout << "projbot " << PROJBOT_VERSION << '\n';
     return 0;
   }
-  name = argv[1];
   int first = 2;
-  if (name == "bench") {  // "bench render", "bench track", ...: the benchmark of a subsystem
-    const std::string what = argc < 3 ? std::string() : argv[2];
-    std::string known;  // the benchmarks, from the command list: "render | track | ..."
-    bool found = false;
-    for (const Command* c : commands())
-      if (c->name.rfind("bench ", 0) == 0) {
-        known += (known.empty() ? "" : " | ") + c->name.substr(6);
-        found = found || c->name.substr(6) == what;
-      }
-    if (!found) {
-      std::cerr << "projbot bench: "
-                << (argc < 3 ? std::string("say what to benchmark") : "no benchmark '" + std::string(argv[2]) + "'")
-                << ": projbot bench " << known << "\n";
-      return 2;
-    }
-    name = std::string("bench ") + argv[2];
-    first = 3;
-  }
-  if (name == "calibrate") {  // "calibrate capture", "simulate", "solve": the projector-camera calibration's steps
-    const std::string what = argc < 3 ? std::string() : argv[2];
-    if (what != "capture" && what != "simulate" && what != "solve" && what != "photometric") {
-      std::cerr << "projbot calibrate: " << (argc < 3 ? std::string("say which step") : "no step '" + what + "'")
-                << ": projbot calibrate capture | simulate | solve | photometric\n";
-      return 2;
-    }
-    name = "calibrate " + what;
-    first = 3;
-  }
-  const Command* cmd = nullptr;
-  for (const auto* c : commands())
-    if (c->name == name) cmd = c;
-  if (cmd == nullptr) {
-    std::cerr << "projbot: unknown command '" << name << "' (projbot --help lists them)\n";
-    return 2;
-  }
+  const Command* cmd = find_command(argc, argv, name, first);
+  if (cmd == nullptr) return 2;
   for (int i = first; i < argc; ++i)
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
       std::cout << "Usage: " << cmd->usage << "\nOptions:\n" << projbot::cli::format_options(cmd->options);
       return 0;
     }
-  try {
-    const projbot::cli::Args args(cmd->options, argc, argv, first);
-    // Only `calibrate solve DIR`, `bench dataset DIR` and `bench sensor DIR` take an argument that is not an option.
-    const bool takes_folder =
-        cmd == &projbot::tools::kCalibrateSolve || cmd == &projbot::tools::kBenchDataset || cmd == &projbot::tools::kBenchSensor;
-    if (args.positional().size() > (takes_folder ? 1U : 0U))
-      throw projbot::cli::UsageError("unexpected argument '" + args.positional().back() + "'");
-    // Every command's paths, before any work: inputs that are files, outputs that clash with nothing.
-    std::vector<projbot::config::NamedPath> folder;
-    if (takes_folder && !args.positional().empty()) folder.push_back({"the folder", args.positional().front(), true});
-    args.check_paths(folder);
-    return cmd->run(args);
-  } catch (const projbot::robot::SetupInterrupted& e) {  // SIGTERM while the twin was built: nothing made
-    return projbot::tools::nothing_written(std::string("while building the twin (") + e.what() + ")");
-  } catch (const std::bad_alloc&) {
-    std::cerr << "projbot " << name << ": out of memory: an input is larger than this machine can hold\n";
-    return 1;
-  } catch (const projbot::cli::UsageError& e) {
-    std::cerr << "projbot " << name << ": " << e.what() << " (see projbot " << name << " --help)\n";
-    return 2;
-  } catch (const std::exception& e) {  // ConfigError, AssetError, AlignmentError, EngineError: one clear line
-    // A third-party text that slipped through (a banner, a call stack): its first line that says something.
-    std::istringstream text(e.what());
-    std::string line, said;
-    while (said.empty() && std::getline(text, line))
-      if (line.find_first_not_of(" \t=") != std::string::npos) said = line;
-    std::cerr << "projbot " << name << ": " << said << '\n';
-    return 1;
-  }
+  return run_command(*cmd, argc, argv, first, name);
 }
 
 int main(int argc, char** argv) {

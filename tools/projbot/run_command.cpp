@@ -298,6 +298,110 @@ void write_profile(const std::string& csv, const std::vector<session::LiveRow>& 
   config::write_file_atomically(csv, f.str());
   std::cout << "per-frame profile written to " << csv << '\n';
 }
+
+// The robot thread of a run: the session (drive()), publishing what the render thread draws; a failure is
+// kept for the render thread to report.
+class RobotThread {
+ public:
+  RobotThread(const config::Scene& scene, const RunOptions& o, SceneTrackers& trackers, hardware::Devices& devices,
+              const config::Recording* replay, PoseCheck* check)
+      : thread_([this, &scene, &o, &trackers, &devices, replay, check](std::stop_token cancel) {
+          try {
+            drive(scene, o, trackers, state_, handoffs_, cancel, devices, replay, check);
+          } catch (...) {
+            error_ = std::current_exception();
+          }
+          done_ = true;
+        }) {}
+  bool done() const { return done_; }
+  alignment::LatestValue<RobotState>& state() { return state_; }
+  const Handoffs& handoffs() const { return handoffs_; }  // the robot thread's until finish()
+  // After the frame loop: a device (or the twin) that failed while projecting blanks the projector at once,
+  // so nothing it last showed stays lit; then the thread is stopped and joined. The failure's message
+  // (empty: none); a failure that is not a std::exception is rethrown.
+  std::string finish(engine::Renderer& renderer, engine::RenderTarget& target, const config::ProjectorConfig& projector) {
+    std::string failure;
+    if (done_ && error_) {
+      renderer.draw_frame(target, projector, std::span<const engine::DrawItem>{});
+      try {
+        std::rethrow_exception(error_);
+      } catch (const std::exception& e) {
+        failure = e.what();
+      }
+    }
+    renderer.finish(target);
+    thread_.request_stop();
+    thread_.join();
+    if (error_ && failure.empty()) std::rethrow_exception(error_);
+    return failure;
+  }
+
+ private:
+  alignment::LatestValue<RobotState> state_;
+  Handoffs handoffs_;
+  std::exception_ptr error_;
+  std::atomic<bool> done_{false};
+  std::jthread thread_;  // last: starts once the above exist
+};
+
+// What the projector draws in a run: the scene's models uploaded, their compensation and content, and
+// the output (offscreen, or a window on the configured projector unless the command line says otherwise).
+struct RunOutput {
+  RunOutput(engine::Renderer& renderer, const cli::Args& args, const config::Scene& scene, const RunOptions& o, bool configured)
+      : items(upload_scene(renderer, scene, &models)),
+        plan(surfaces(models, scene), scene.room.ambient_lux, o.compensate),
+        content(renderer, scene, models, items),  // a bad video: one line, exit 1
+        target(open_output(renderer, args, scene, o.headless, configured)) {}
+  static std::vector<engine::CompensationPlan::Target> surfaces(const std::vector<assets::Model>& models,
+                                                                const config::Scene& scene) {
+    std::vector<engine::CompensationPlan::Target> out;
+    for (std::size_t i = 0; i < models.size(); ++i) out.push_back({&models[i], scene.targets[i].surface.albedo});
+    return out;
+  }
+  std::vector<assets::Model> models;
+  std::vector<engine::DrawItem> items;
+  engine::CompensationPlan plan;
+  engine::SceneContent content;
+  std::unique_ptr<engine::RenderTarget> target;
+};
+
+session::LiveLoopConfig loop_config(const config::Scene& scene, const RunOptions& o, bool replay) {
+  session::LiveLoopConfig c;
+  c.projection.T_projector_camera = scene.pan_tilt.T_projector_camera;
+  c.projection.refresh_hz = scene.projector.refresh_hz;
+  c.projection.input_lag_ms = scene.projector.input_lag_ms;
+  c.projection.predict = o.predict;
+  if (replay) c.projection.silent_camera_s = 0.0;  // a replay's frames play in lockstep
+  c.seconds = o.seconds;
+  c.paced_hz = o.headless ? 60.0 : 0.0;  // offscreen, no vsync: like a 60 Hz projector
+  return c;
+}
+
+// What the frame loop reads: the robot's state (into `seen`, which the meter measures against), the
+// workers' poses, the camera's hand-offs; the content's messages after each frame.
+session::LiveInputs live_inputs(const config::Scene& scene, RobotThread& robot, RobotState& seen, const SceneTrackers& trackers,
+                                engine::SceneContent& content) {
+  session::LiveInputs in;
+  in.stop = [&robot, &seen] {
+    robot.state().read(seen);
+    session::LiveStop stop{{}, seen.since_s, seen.visit};
+    for (const DrawnTarget& lit : seen.lit) stop.targets.push_back(lit.target);
+    return stop;
+  };
+  in.poses = [&trackers](int index, alignment::PoseSample& pose) {
+    return trackers.owned[static_cast<std::size_t>(index)]->latest(pose);
+  };
+  in.camera_last_s = [&robot] { return robot.handoffs().last_s.load(); };
+  in.keep_going = [&robot] { return !interrupted() && !robot.done(); };
+  in.meter = [&scene, &seen](const session::DrawnPose& drawn) { return marker_error(scene, seen, drawn); };
+  in.after_frame = [&content] {
+    for (const std::string& e : content.take_errors())  // the last good frame stays up; said once
+      std::cerr << "content: " << e << " (its last good frame stays)" << std::endl;
+    for (const std::string& e : content.reload_changed(config::steady_now_s()))  // a video changed on disk
+      std::cout << "content: " << e << std::endl;
+  };
+  return in;
+}
 }  // namespace
 
 const Command kRun{
@@ -373,86 +477,25 @@ const Command kRun{
       ro.windowing = !o.headless;
       engine::Renderer renderer(ro);
       std::cout << "device: " << renderer.device_info().name << std::endl;  // flushed: a log shows it has started
-      std::vector<assets::Model> models;
-      const auto items = upload_scene(renderer, scene, &models);
-      std::vector<engine::CompensationPlan::Target> surfaces;
-      for (std::size_t i = 0; i < models.size(); ++i) surfaces.push_back({&models[i], scene.targets[i].surface.albedo});
-      engine::CompensationPlan plan(std::move(surfaces), scene.room.ambient_lux, o.compensate);
-      engine::SceneContent content(renderer, scene, models, items);  // a bad video: one line, exit 1
-      const std::unique_ptr<engine::RenderTarget> target =
-          open_output(renderer, args, scene, o.headless, !args.flag("sim") && !recording);
-
-      session::LiveLoopConfig lc;
-      lc.projection.T_projector_camera = scene.pan_tilt.T_projector_camera;
-      lc.projection.refresh_hz = scene.projector.refresh_hz;
-      lc.projection.input_lag_ms = scene.projector.input_lag_ms;
-      lc.projection.predict = o.predict;
-      if (recording) lc.projection.silent_camera_s = 0.0;  // a replay's frames play in lockstep
-      lc.seconds = o.seconds;
-      lc.paced_hz = o.headless ? 60.0 : 0.0;  // offscreen, no vsync: like a 60 Hz projector
-      session::LiveLoop loop(renderer, scene.projector, items, lc);
-      loop.set_compensation(&plan);
-      loop.set_content(&content);
+      RunOutput out(renderer, args, scene, o, !args.flag("sim") && !recording);
+      const session::LiveLoopConfig lc = loop_config(scene, o, recording.has_value());
+      session::LiveLoop loop(renderer, scene.projector, out.items, lc);
+      loop.set_compensation(&out.plan);
+      loop.set_content(&out.content);
       // One tracker worker per target on the map.
       SceneTrackers trackers = make_trackers(scene, worker_config(o.predict, recording.has_value()));
-      const auto& workers = trackers.owned;
-
-      alignment::LatestValue<RobotState> state;
-      std::exception_ptr robot_error;
-      std::atomic<bool> robot_done{false};
-      Handoffs handoffs;  // the robot thread's until it is joined
-      std::jthread robot_thread([&](std::stop_token cancel) {
-        try {
-          drive(scene, o, trackers, state, handoffs, cancel, devices, recording ? &*recording : nullptr,
-                check ? &*check : nullptr);
-        } catch (...) {
-          robot_error = std::current_exception();
-        }
-        robot_done = true;
-      });
-
+      RobotThread robot_thread(scene, o, trackers, devices, recording ? &*recording : nullptr, check ? &*check : nullptr);
       RobotState robot;  // as the render thread last read it
-      session::LiveInputs in;
-      in.stop = [&] {
-        state.read(robot);
-        session::LiveStop stop{{}, robot.since_s, robot.visit};
-        for (const DrawnTarget& lit : robot.lit) stop.targets.push_back(lit.target);
-        return stop;
-      };
-      in.poses = [&](int index, alignment::PoseSample& pose) { return workers[static_cast<std::size_t>(index)]->latest(pose); };
-      in.camera_last_s = [&] { return handoffs.last_s.load(); };
-      in.keep_going = [&] { return !interrupted() && !robot_done; };
-      in.meter = [&](const session::DrawnPose& drawn) { return marker_error(scene, robot, drawn); };
-      in.after_frame = [&] {
-        for (const std::string& e : content.take_errors())  // the last good frame stays up; said once
-          std::cerr << "content: " << e << " (its last good frame stays)" << std::endl;
-        for (const std::string& e : content.reload_changed(config::steady_now_s()))  // a video changed on disk
-          std::cout << "content: " << e << std::endl;
-      };
       engine::FrameProfiler profiler;
-      const session::LiveFigures figures = loop.run(*target, in, profiler);
-
-      // A device (or the twin) failed while projecting: black at once, so nothing it last showed stays lit;
-      // what was measured until then is still printed and written, then the failure is reported.
-      std::string failure;
-      if (robot_done && robot_error) {
-        renderer.draw_frame(*target, scene.projector, std::span<const engine::DrawItem>{});
-        try {
-          std::rethrow_exception(robot_error);
-        } catch (const std::exception& e) {
-          failure = e.what();
-        }
-      }
-      renderer.finish(*target);
-      robot_thread.request_stop();
-      robot_thread.join();
-      if (robot_error && failure.empty()) std::rethrow_exception(robot_error);
-      for (const auto& w : workers)
+      const session::LiveFigures figures =
+          loop.run(*out.target, live_inputs(scene, robot_thread, robot, trackers, out.content), profiler);
+      const std::string failure = robot_thread.finish(renderer, *out.target, scene.projector);
+      for (const auto& w : trackers.owned)
         if (w && w->error()) std::rethrow_exception(w->error());
 
-      print_frames(std::cout, figures, profiler.summary(), loop.silent_frames(), lc.projection.silent_camera_s, content);
+      print_frames(std::cout, figures, profiler.summary(), loop.silent_frames(), lc.projection.silent_camera_s, out.content);
       std::size_t tracked = 0;
-      for (const auto& w : workers) tracked += w ? w->frames_processed() : 0;
+      for (const auto& w : trackers.owned) tracked += w ? w->frames_processed() : 0;
       if (recording) {
         print_replay(std::cout, *recording, robot.visit, tracked, *check);
       } else {
@@ -460,7 +503,7 @@ const Command kRun{
           std::cout << "error at display: not measured (the configured robot: no truth to measure against)\n";
         else
           print_display_errors(std::cout, figures);
-        print_robot(std::cout, robot, devices.camera != nullptr, handoffs, tracked);
+        print_robot(std::cout, robot, devices.camera != nullptr, robot_thread.handoffs(), tracked);
       }
       if (const auto csv = args.get("profile")) write_profile(*csv, figures.rows, scene);
       if (!failure.empty()) {
