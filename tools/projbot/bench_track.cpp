@@ -40,6 +40,47 @@ struct Stats {
   }
 };
 
+// The benchmark's frames: the Duck on a smooth path (up to 1 cm and 2 degrees per frame at 30 Hz) in
+// rendered Kinect v1 depth, and its true poses. Stops early (fewer frames) when interrupted.
+struct Sequence {
+  std::vector<Eigen::Matrix4d> truth;
+  std::vector<alignment::DepthImage> depth;
+};
+Sequence render_sequence(engine::Renderer& renderer, std::size_t model, const alignment::CameraIntrinsics& k, int frames,
+                         double distance) {
+  const config::ProjectorConfig pinhole(k, 0.1, 10.0);
+  auto camera = renderer.make_depth_camera(k.width_px, k.height_px);
+  Sequence s;
+  for (int f = 0; f < frames && !interrupted(); ++f) {
+    const double t = f / 30.0;
+    const Eigen::Matrix4d T =
+        config::pose_from_xyz_rpy({0.12 * std::sin(2.0 * t), 0.06 * std::sin(1.3 * t), distance + 0.1 * std::sin(0.9 * t)},
+                                  {180.0 + 15.0 * std::sin(1.1 * t), 20.0 * std::sin(0.8 * t), 40.0 * std::sin(1.5 * t)});
+    const std::vector<engine::DrawItem> items{{model, T}};
+    renderer.draw_frame(*camera, pinhole, items);
+    const engine::DepthMap map = camera->read_back_depth();
+    s.depth.push_back(
+        alignment::apply_kinect_v1_noise({map.width, map.height, map.z_m, t}, k, {}, static_cast<std::uint32_t>(f)));
+    s.truth.push_back(T);
+  }
+  return s;
+}
+
+// One method tracked frame to frame from the truth of frame 0: each step's time and error.
+Stats measure(const Sequence& sequence, const std::function<Eigen::Matrix4d(int, const Eigen::Matrix4d&)>& step) {
+  Stats s;
+  Eigen::Matrix4d estimate = sequence.truth[0];
+  for (std::size_t f = 1; f < sequence.truth.size() && !interrupted(); ++f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    estimate = step(static_cast<int>(f), estimate);
+    s.ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    const Eigen::Matrix4d err = alignment::rigid_inverse(sequence.truth[f]) * estimate;
+    s.err_mm.push_back(alignment::translation_norm_m(err) * 1000.0);
+    s.err_deg.push_back(alignment::rotation_angle_deg(err));
+  }
+  return s;
+}
+
 }  // namespace
 
 const Command kBenchTrack{
@@ -66,45 +107,17 @@ const Command kBenchTrack{
       const std::size_t id = renderer.add_model(duck);
       const alignment::ModelCloud model = alignment::model_cloud_from(duck, 50000);
       const alignment::CameraIntrinsics k = alignment::CameraIntrinsics::kinect_v1();
-      const config::ProjectorConfig pinhole(k, 0.1, 10.0);
-      auto camera = renderer.make_depth_camera(k.width_px, k.height_px);
 
       std::printf("rendering %d frames at %.1f m...\n", frames, distance);
       std::fflush(stdout);
-      std::vector<Eigen::Matrix4d> truth;
-      std::vector<alignment::DepthImage> depth;
       const auto stopped = [&](const std::string& what, int frame) {
         return benchmark_interrupted("while " + what + " (frame " + std::to_string(frame) + " of " + std::to_string(frames) +
                                      ")");
       };
       catch_interrupts();  // Ctrl-C: the methods measured are printed whole, the one under way is dropped; exit 130
-      for (int f = 0; f < frames; ++f) {
-        if (interrupted()) return stopped("rendering the depth sequence", f);
-        const double t = f / 30.0;  // a smooth path: up to 1 cm and 2 degrees per frame at 30 Hz
-        const Eigen::Matrix4d T =
-            config::pose_from_xyz_rpy({0.12 * std::sin(2.0 * t), 0.06 * std::sin(1.3 * t), distance + 0.1 * std::sin(0.9 * t)},
-                                      {180.0 + 15.0 * std::sin(1.1 * t), 20.0 * std::sin(0.8 * t), 40.0 * std::sin(1.5 * t)});
-        const std::vector<engine::DrawItem> items{{id, T}};
-        renderer.draw_frame(*camera, pinhole, items);
-        const engine::DepthMap map = camera->read_back_depth();
-        depth.push_back(
-            alignment::apply_kinect_v1_noise({map.width, map.height, map.z_m, t}, k, {}, static_cast<std::uint32_t>(f)));
-        truth.push_back(T);
-      }
-
-      const auto measure = [&](const std::function<Eigen::Matrix4d(int, const Eigen::Matrix4d&)>& step) {
-        Stats s;
-        Eigen::Matrix4d estimate = truth[0];
-        for (int f = 1; f < frames && !interrupted(); ++f) {
-          const auto t0 = std::chrono::steady_clock::now();
-          estimate = step(f, estimate);
-          s.ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-          const Eigen::Matrix4d err = alignment::rigid_inverse(truth[static_cast<std::size_t>(f)]) * estimate;
-          s.err_mm.push_back(alignment::translation_norm_m(err) * 1000.0);
-          s.err_deg.push_back(alignment::rotation_angle_deg(err));
-        }
-        return s;
-      };
+      const Sequence sequence = render_sequence(renderer, id, k, frames, distance);
+      if (interrupted()) return stopped("rendering the depth sequence", static_cast<int>(sequence.truth.size()));
+      const auto& depth = sequence.depth;
       std::printf("%-26s %7s %8s %8s %8s %8s %9s %9s %9s %6s\n", "method", "fps", "mean_ms", "p50_ms", "p95_ms", "max_ms",
                   "mean_mm", "max_mm", "max_deg", "iters");
       const alignment::ProjectiveTracker tracker(model, k);
@@ -114,19 +127,19 @@ const Command kBenchTrack{
         iterations += r.iterations;
         return r.T_camera_target;
       };
-      Stats ours = measure([&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker, f, prev); });
+      Stats ours = measure(sequence, [&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker, f, prev); });
       ours.iterations = std::exchange(iterations, 0.0);
       if (interrupted()) return stopped("measuring", static_cast<int>(ours.ms.size()) + 1);
       ours.print("projective (20k of 50k)");
       alignment::TrackerConfig all_points;
       all_points.model_points = {5000, 15000, 50000};
       const alignment::ProjectiveTracker tracker_all(model, k, all_points);
-      Stats ours_all = measure([&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker_all, f, prev); });
+      Stats ours_all = measure(sequence, [&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker_all, f, prev); });
       ours_all.iterations = iterations;
       if (interrupted()) return stopped("measuring", static_cast<int>(ours_all.ms.size()) + 1);
       ours_all.print("projective (all 50k)");
       const alignment::PclIcpBaseline pcl_icp(model);
-      const Stats base = measure([&](int f, const Eigen::Matrix4d& prev) {
+      const Stats base = measure(sequence, [&](int f, const Eigen::Matrix4d& prev) {
         return pcl_icp.track(alignment::depth_to_cloud(depth[static_cast<std::size_t>(f)], k), prev);
       });
       if (interrupted()) return stopped("measuring", static_cast<int>(base.ms.size()) + 1);
