@@ -13,9 +13,12 @@
 #include "progress.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/config/recording.hpp"
+#include "projbot/hardware/device_session.hpp"
 #include "projbot/hardware/devices.hpp"
 #include "projbot/robot/localization.hpp"
-#include "rigs.hpp"
+#include "projbot/session/replay.hpp"
+#include "projbot/session/trackers.hpp"
+#include "projbot/twin/twin_session.hpp"
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
@@ -91,7 +94,7 @@ class RecordObserver final : public session::StopObserver {
   Progress& progress_;
   config::RecordedStop current_;
   std::unique_ptr<alignment::FakenectDumpWriter> writer_;
-  PoseLog poses_;
+  session::PoseLog poses_;
   double t0_s_ = -1.0;
 };
 
@@ -159,14 +162,15 @@ const Command kRecord{
       rec.scene = fs::absolute(scene.source);
       rec.seed = seed;
       rec.dwell_s = dwell_s;
-      SceneTrackers trackers = make_trackers(scene, worker_config(true, true));
+      session::SceneTrackers trackers = session::make_trackers(scene, session::worker_config(true, true));
       // The robot: the configured base, pan-tilt and camera together, or the twin's (with the configured camera, if any).
-      std::unique_ptr<DeviceRig> device_rig;
-      std::unique_ptr<TwinRig> twin_rig;
+      std::unique_ptr<hardware::DeviceSession> device_rig;
+      std::unique_ptr<twin::TwinSession> twin_rig;
       if (robot)
-        device_rig = std::make_unique<DeviceRig>(scene, trackers.targets, devices);
+        device_rig = std::make_unique<hardware::DeviceSession>(scene, trackers.targets, devices);
       else
-        twin_rig = std::make_unique<TwinRig>(scene, trackers.targets, seed, devices.camera.get(), true);
+        twin_rig = std::make_unique<twin::TwinSession>(
+            scene, trackers.targets, seed, devices.camera.get(), [] { return interrupted(); }, true);
       session::Session& session = robot ? device_rig->session() : twin_rig->session();
       session::Dwell dwell = robot ? device_rig->dwell(dwell_s, true) : twin_rig->dwell(dwell_s, true);
       if (interrupted()) return nothing_written("while setting up");  // no folder made

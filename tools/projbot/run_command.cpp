@@ -23,12 +23,15 @@
 #include "projbot/engine/content.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
+#include "projbot/hardware/device_session.hpp"
 #include "projbot/hardware/devices.hpp"
 #include "projbot/session/live_loop.hpp"
+#include "projbot/session/replay.hpp"
 #include "projbot/session/session.hpp"
+#include "projbot/session/trackers.hpp"
 #include "projbot/twin/camera.hpp"
+#include "projbot/twin/twin_session.hpp"
 #include "projbot/twin/world.hpp"
-#include "rigs.hpp"
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
@@ -107,7 +110,7 @@ struct Handoffs {
 class RunObserver final : public session::StopObserver {
  public:
   RunObserver(const config::Scene& scene, alignment::LatestValue<RobotState>& state, Handoffs& handoffs, twin::Twin* twin,
-              PoseCheck* check)
+              session::PoseCheck* check)
       : scene_(scene), state_(state), handoffs_(handoffs), twin_(twin), check_(check) {}
   void driving(int visit) override { state_.publish({.lit = {}, .since_s = config::steady_now_s(), .visit = visit + 1}); }
   void lit(const session::Stop& stop, double since_s) override {
@@ -149,27 +152,27 @@ class RunObserver final : public session::StopObserver {
   alignment::LatestValue<RobotState>& state_;
   Handoffs& handoffs_;
   twin::Twin* twin_;
-  PoseCheck* check_;
+  session::PoseCheck* check_;
 };
 
 // The robot thread: the session at each stop of the tour (the twin's robot, the configured camera or the
 // twin's), or at each stop of a recording (`replay`, in lockstep, checked by `check`).
-void drive(const config::Scene& scene, const RunOptions& o, SceneTrackers& trackers, alignment::LatestValue<RobotState>& state,
-           Handoffs& handoffs, const std::stop_token& cancel, hardware::Devices& devices, const config::Recording* replay,
-           PoseCheck* check) {
+void drive(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers,
+           alignment::LatestValue<RobotState>& state, Handoffs& handoffs, const std::stop_token& cancel,
+           hardware::Devices& devices, const config::Recording* replay, session::PoseCheck* check) {
   const auto tour = [&](session::Session& session, const session::Dwell& dwell, twin::Twin* twin, int visits) {
     RunObserver observer(scene, state, handoffs, twin, check);
     for (int v = 0; v < visits && !cancel.stop_requested(); ++v) session.visit(v, trackers.workers, dwell, observer, cancel);
   };
   const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
   if (devices.base) {  // the configured robot: no twin
-    DeviceRig rig(scene, trackers.targets, devices);
+    hardware::DeviceSession rig(scene, trackers.targets, devices);
     tour(rig.session(), rig.dwell(o.dwell_s, false), nullptr, visits);
   } else if (replay) {
-    ReplayRig rig(scene, *replay, trackers.targets);
+    session::ReplaySession rig(scene, *replay, trackers.targets);
     tour(rig.session(), rig.dwell(), nullptr, static_cast<int>(replay->stops.size()));
   } else {
-    TwinRig rig(scene, trackers.targets, o.seed, devices.camera.get());
+    twin::TwinSession rig(scene, trackers.targets, o.seed, devices.camera.get(), [] { return interrupted(); });
     tour(rig.session(), rig.dwell(o.dwell_s, false), &rig.twin(), visits);
   }
   RobotState last;
@@ -277,7 +280,7 @@ void print_frames(std::ostream& out, const session::LiveFigures& f, const engine
 }
 
 void print_replay(std::ostream& out, const config::Recording& recording, int visits, std::size_t tracked,
-                  const PoseCheck& check) {
+                  const session::PoseCheck& check) {
   out << "replay of " << recording.folder().string() << ": " << visits << " of " << recording.stops.size() << " stops, "
       << tracked << " poses tracked in lockstep (each lit target's, every frame); against the recording's: " << check.compared
       << " compared, largest difference " << std::setprecision(4) << check.max_mm << " mm, " << check.max_deg << " deg; "
@@ -303,8 +306,8 @@ void write_profile(const std::string& csv, const std::vector<session::LiveRow>& 
 // kept for the render thread to report.
 class RobotThread {
  public:
-  RobotThread(const config::Scene& scene, const RunOptions& o, SceneTrackers& trackers, hardware::Devices& devices,
-              const config::Recording* replay, PoseCheck* check)
+  RobotThread(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers, hardware::Devices& devices,
+              const config::Recording* replay, session::PoseCheck* check)
       : thread_([this, &scene, &o, &trackers, &devices, replay, check](std::stop_token cancel) {
           try {
             drive(scene, o, trackers, state_, handoffs_, cancel, devices, replay, check);
@@ -379,8 +382,8 @@ session::LiveLoopConfig loop_config(const config::Scene& scene, const RunOptions
 
 // What the frame loop reads: the robot's state (into `seen`, which the meter measures against), the
 // workers' poses, the camera's hand-offs; the content's messages after each frame.
-session::LiveInputs live_inputs(const config::Scene& scene, RobotThread& robot, RobotState& seen, const SceneTrackers& trackers,
-                                engine::SceneContent& content) {
+session::LiveInputs live_inputs(const config::Scene& scene, RobotThread& robot, RobotState& seen,
+                                const session::SceneTrackers& trackers, engine::SceneContent& content) {
   session::LiveInputs in;
   in.stop = [&robot, &seen] {
     robot.state().read(seen);
@@ -467,7 +470,7 @@ const Command kRun{
       const config::Scene scene = config::load_scene(scene_path);
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
-      std::optional<PoseCheck> check;
+      std::optional<session::PoseCheck> check;
       if (recording) check.emplace(recording->folder() / "poses.csv");
       hardware::Devices devices =
           args.flag("sim") || recording ? hardware::Devices{} : open_configured(scene, args.flag("headless"));
@@ -483,7 +486,7 @@ const Command kRun{
       loop.set_compensation(&out.plan);
       loop.set_content(&out.content);
       // One tracker worker per target on the map.
-      SceneTrackers trackers = make_trackers(scene, worker_config(o.predict, recording.has_value()));
+      session::SceneTrackers trackers = session::make_trackers(scene, session::worker_config(o.predict, recording.has_value()));
       RobotThread robot_thread(scene, o, trackers, devices, recording ? &*recording : nullptr, check ? &*check : nullptr);
       RobotState robot;  // as the render thread last read it
       engine::FrameProfiler profiler;

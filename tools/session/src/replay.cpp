@@ -1,123 +1,46 @@
-#include "rigs.hpp"
+#include "projbot/session/replay.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
-#include <limits>
 #include <sstream>
 
-#include "interrupt.hpp"
 #include "projbot/alignment/equations.hpp"
-#include "projbot/assets/model.hpp"
 #include "projbot/config/rigid.hpp"
 
-namespace projbot::tools {
+namespace projbot::session {
 
-alignment::WorkerConfig worker_config(bool predict, bool lockstep) {
-  alignment::WorkerConfig c;
-  c.predict = predict;
-  if (lockstep) c.acquisition.attempt_budget_ms = std::numeric_limits<double>::infinity();
-  return c;
-}
+ReplaySession::ReplaySession(const config::Scene& scene, const config::Recording& recording, const std::vector<Target>& targets)
+    : recording_(recording), session_(std::make_unique<Session>(scene, targets, *this, *this)) {}
 
-SceneTrackers make_trackers(const config::Scene& scene, const alignment::WorkerConfig& config) {
-  SceneTrackers t;
-  const std::size_t n = scene.targets.size();
-  t.clouds.resize(n);
-  t.owned.resize(n);
-  t.workers.assign(n, nullptr);
-  const alignment::CameraIntrinsics& k = scene.depth_camera;
-  for (std::size_t i = 0; i < n; ++i) {
-    const config::TargetConfig& c = scene.targets[i];
-    if (!c.T_world_target && !c.T_map_target) continue;
-    auto model = assets::load_model(c.model);
-    assets::scale_and_recenter(model, c.scale, c.recenter);
-    t.clouds[i] = std::make_unique<alignment::ModelCloud>(alignment::model_cloud_from(model, 50000));
-    t.owned[i] = std::make_unique<alignment::TrackerWorker>(*t.clouds[i], k, config);
-    t.workers[i] = t.owned[i].get();
-    t.targets.push_back({static_cast<int>(i), t.clouds[i].get(), model.bounds().center()});
-  }
-  return t;
-}
-
-TwinRig::TwinRig(const config::Scene& scene, const std::vector<session::Target>& targets, std::uint64_t seed,
-                 alignment::RgbdCamera* configured, bool colour_every_frame)
-    : renderer_(engine::RendererOptions{}),
-      twin_(
-          scene,
-          [&] {
-            twin::TwinOptions o;
-            o.seed = seed;
-            o.stop_requested = [] { return interrupted(); };  // SIGTERM while the twin is built
-            return o;
-          }(),
-          renderer_),
-      twin_camera_(twin_, seed, colour_every_frame),
-      configured_(configured),
-      session_(scene, targets, twin_.robot(), twin_.pan_tilt()) {}
-
-session::Dwell TwinRig::dwell(double dwell_s, bool lockstep) {
-  session::Dwell d;
-  d.camera = [this](const session::Stop& stop, double since_s) -> alignment::RgbdCamera& {
-    const std::size_t i = twin_.target_index(twin_.scene().targets[static_cast<std::size_t>(stop.target)].name);
-    twin_camera_.at_stop(i, stop.target_visit, stop.visit, since_s);
-    return configured_ ? *configured_ : twin_camera_;
-  };
-  d.over = [dwell_s](const session::Stop&, int, double elapsed_s) { return elapsed_s >= dwell_s; };
-  d.lockstep = lockstep;
-  return d;
-}
-
-DeviceRig::DeviceRig(const config::Scene& scene, const std::vector<session::Target>& targets, hardware::Devices& devices)
-    : map_(devices.laser && scene.devices.laser
-               ? std::optional<robot::Localizer>(robot::Localizer::load(scene.devices.laser->map))
-               : std::nullopt),
-      navigator_(*devices.base, {scene.robot_start.x(), scene.robot_start.y(), scene.robot_start.z()}),
-      camera_(*devices.camera),
-      session_(scene, targets, navigator_, *devices.pan_tilt) {
-  if (devices.laser) navigator_.use_laser(*devices.laser, map_ ? &*map_ : nullptr);
-}
-
-session::Dwell DeviceRig::dwell(double dwell_s, bool lockstep) {
-  session::Dwell d;
-  d.camera = [this](const session::Stop&, double) -> alignment::RgbdCamera& { return camera_; };
-  d.over = [dwell_s](const session::Stop&, int, double elapsed_s) { return elapsed_s >= dwell_s; };
-  d.lockstep = lockstep;
-  return d;
-}
-
-ReplayRig::ReplayRig(const config::Scene& scene, const config::Recording& recording, const std::vector<session::Target>& targets)
-    : recording_(recording), session_(std::make_unique<session::Session>(scene, targets, *this, *this)) {}
-
-session::Dwell ReplayRig::dwell() {
-  session::Dwell d;
-  d.camera = [this](const session::Stop&, double) -> alignment::RgbdCamera& {
+Dwell ReplaySession::dwell() {
+  Dwell d;
+  d.camera = [this](const Stop&, double) -> alignment::RgbdCamera& {
     const config::RecordedStop& s = recording_.stops.at(static_cast<std::size_t>(stop_));
     camera_ = std::make_unique<alignment::FakenectDumpReader>(recording_.folder() / s.frames, true);
     if (camera_->frames() < s.frame_count)
-      throw session::SessionError(recording_.source.string() + ": stop " + std::to_string(stop_ + 1) + " lists " +
-                                  std::to_string(s.frame_count) + " frames but its dump " + s.frames + " holds " +
-                                  std::to_string(camera_->frames()));
+      throw SessionError(recording_.source.string() + ": stop " + std::to_string(stop_ + 1) + " lists " +
+                         std::to_string(s.frame_count) + " frames but its dump " + s.frames + " holds " +
+                         std::to_string(camera_->frames()));
     return *camera_;
   };
-  d.over = [this](const session::Stop&, int frames, double) {
+  d.over = [this](const Stop&, int frames, double) {
     return frames >= recording_.stops.at(static_cast<std::size_t>(stop_)).frame_count;
   };
   d.lockstep = true;
   return d;
 }
 
-robot::StopReport ReplayRig::drive_to(const robot::Pose2D& goal, int index) {
+robot::StopReport ReplaySession::drive_to(const robot::Pose2D& goal, int index) {
   if (index < 0 || index >= static_cast<int>(recording_.stops.size()))
-    throw session::SessionError(recording_.source.string() + ": the replay asked for stop " + std::to_string(index + 1) +
-                                " but the recording holds " + std::to_string(recording_.stops.size()));
+    throw SessionError(recording_.source.string() + ": the replay asked for stop " + std::to_string(index + 1) +
+                       " but the recording holds " + std::to_string(recording_.stops.size()));
   const config::RecordedStop& s = recording_.stops[static_cast<std::size_t>(index)];
   if (std::abs(goal.x_m - s.goal.x()) > 1e-9 || std::abs(goal.y_m - s.goal.y()) > 1e-9 ||
       std::abs(goal.theta_rad - s.goal.z()) > 1e-9)
-    throw session::SessionError(recording_.source.string() + ": stop " + std::to_string(index + 1) +
-                                " of the recording went to '" + s.target +
-                                "''s stop, but the scene's tour asks for another one here (a different scene or tour?)");
+    throw SessionError(recording_.source.string() + ": stop " + std::to_string(index + 1) + " of the recording went to '" +
+                       s.target + "''s stop, but the scene's tour asks for another one here (a different scene or tour?)");
   stop_ = index;
   robot::StopReport r;
   r.index = index;
@@ -128,21 +51,21 @@ robot::StopReport ReplayRig::drive_to(const robot::Pose2D& goal, int index) {
   return r;
 }
 
-robot::Pose2D ReplayRig::believed_pose() const {
+robot::Pose2D ReplaySession::believed_pose() const {
   if (stop_ < 0) return {};
   const Eigen::Vector3d& b = recording_.stops[static_cast<std::size_t>(stop_)].believed;
   return {b.x(), b.y(), b.z()};
 }
 
-robot::PanTiltStatus ReplayRig::move_to(const robot::PanTiltAngles&) { return {}; }
+robot::PanTiltStatus ReplaySession::move_to(const robot::PanTiltAngles&) { return {}; }
 
-robot::PanTiltStatus ReplayRig::position(robot::PanTiltAngles& out) {
+robot::PanTiltStatus ReplaySession::position(robot::PanTiltAngles& out) {
   const config::RecordedStop& s = recording_.stops.at(static_cast<std::size_t>(stop_));
   out = {s.pan_rad, s.tilt_rad};
   return {};
 }
 
-void PoseLog::add(const config::Scene& scene, const session::Stop& stop, int frame,
+void PoseLog::add(const config::Scene& scene, const Stop& stop, int frame,
                   const std::vector<std::optional<alignment::PoseSample>>& samples) {
   std::ostringstream row;
   row << std::setprecision(17);
@@ -215,7 +138,7 @@ int PoseCheck::unreached() const {
   return n;
 }
 
-void PoseCheck::compare(const config::Scene& scene, const session::Stop& stop, int frame,
+void PoseCheck::compare(const config::Scene& scene, const Stop& stop, int frame,
                         const std::vector<std::optional<alignment::PoseSample>>& samples) {
   for (std::size_t j = 0; j < samples.size() && j < stop.lit.size(); ++j) {
     const std::string& name = scene.targets[static_cast<std::size_t>(stop.lit[j].target)].name;
@@ -234,4 +157,4 @@ void PoseCheck::compare(const config::Scene& scene, const session::Stop& stop, i
   }
 }
 
-}  // namespace projbot::tools
+}  // namespace projbot::session

@@ -1,0 +1,137 @@
+// A session from a recording, at the library: poses.csv written by PoseLog and checked by PoseCheck (a
+// replay's poses against the recording's, and malformed files refused naming file and line), and the
+// recording's devices (ReplaySession) answering what was recorded or refusing a stop it does not hold.
+
+#include "projbot/session/replay.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+using namespace projbot;
+
+namespace {
+
+config::Scene two_targets() {
+  config::Scene scene;
+  scene.targets.resize(2);
+  scene.targets[0].name = "duck";
+  scene.targets[1].name = "box";
+  return scene;
+}
+
+session::Stop stop_lighting_both(int visit) {
+  session::Stop stop;
+  stop.visit = visit;
+  stop.target = 0;
+  stop.lit.resize(2);
+  stop.lit[0].target = 0;
+  stop.lit[1].target = 1;
+  return stop;
+}
+
+alignment::PoseSample pose_at(double x_m) {
+  alignment::PoseSample s;
+  s.T_camera_target(0, 3) = x_m;
+  s.T_camera_target(2, 3) = 1.0;
+  s.lost = false;
+  return s;
+}
+
+class ReplayTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("projbot_replay_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path write(const std::string& text) {
+    const auto path = dir_ / "poses.csv";
+    std::ofstream(path) << text;
+    return path;
+  }
+  // The message of the ConfigError that reading `text` as poses.csv throws.
+  std::string refusal(const std::string& text) {
+    try {
+      session::PoseCheck check(write(text));
+    } catch (const config::ConfigError& e) {
+      return e.what();
+    }
+    return "(accepted)";
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(ReplayTest, APoseLogReadBackComparesItsOwnPosesExactlyAndMeasuresADifference) {
+  const config::Scene scene = two_targets();
+  session::PoseLog log;
+  log.add(scene, stop_lighting_both(0), 1, {pose_at(0.1), std::nullopt});
+  log.add(scene, stop_lighting_both(0), 2, {pose_at(0.2), pose_at(-0.3)});
+  session::PoseCheck same(write(log.text()));
+  same.compare(scene, stop_lighting_both(0), 1, {pose_at(0.1), std::nullopt});
+  same.compare(scene, stop_lighting_both(0), 2, {pose_at(0.2), pose_at(-0.3)});
+  EXPECT_EQ(same.compared, 3);  // the box's missing pose of frame 1 agrees, but there is nothing to compare
+  EXPECT_EQ(same.mismatched, 0);
+  EXPECT_EQ(same.max_mm, 0.0);
+  EXPECT_EQ(same.unreached(), 0);
+
+  session::PoseCheck moved(write(log.text()));
+  moved.compare(scene, stop_lighting_both(0), 2, {pose_at(0.2015), std::nullopt});  // 1.5 mm off; the box lost
+  EXPECT_NEAR(moved.max_mm, 1.5, 1e-6);
+  EXPECT_EQ(moved.compared, 1);
+  EXPECT_EQ(moved.mismatched, 1);
+  EXPECT_EQ(moved.unreached(), 2);  // frame 1's two rows
+}
+
+TEST_F(ReplayTest, AMalformedPoseFileIsRefusedNamingItsLine) {
+  const std::string header = std::string(session::PoseLog::kHeader) + "\n";
+  const std::string row = "0,1,duck,1,0,1,0,0,0.1,0,1,0,0,0,0,1,1\n";
+  EXPECT_NE(refusal("visit,frame\n" + row).find("poses.csv:1: not the poses of a recording"), std::string::npos);
+  EXPECT_NE(refusal(header + "0,1,duck,1,0,1,0\n").find("poses.csv:2: expected visit, frame, target and 14 numbers"),
+            std::string::npos);
+  EXPECT_NE(refusal(header + "0,1,duck,1,0,nan,0,0,0.1,0,1,0,0,0,0,1,1\n").find(":2: a value is not a finite number"),
+            std::string::npos);
+  EXPECT_NE(refusal(header + row + row).find(":3: a second row for visit 0, frame 1, target duck"), std::string::npos);
+  EXPECT_NE(refusal(header + "0,1,duck,1,0,2,0,0,0.1,0,1,0,0,0,0,1,1\n").find(":2: pose"), std::string::npos);
+  EXPECT_EQ(refusal(header + row), "(accepted)");
+}
+
+TEST_F(ReplayTest, TheRecordingsDevicesAnswerWhatWasRecordedAndRefuseAStopItDoesNotHold) {
+  config::Recording recording;
+  recording.source = dir_ / "recording.yaml";
+  config::RecordedStop s;
+  s.target = "duck";
+  s.goal = {1.0, 2.0, 0.5};
+  s.believed = {1.01, 1.98, 0.49};
+  s.pan_rad = 0.2;
+  s.tilt_rad = -0.1;
+  s.drive_s = 7.5;
+  s.arrived = true;
+  recording.stops.push_back(s);
+  // The session it serves: the demo tour's scene, its targets with a stand-in model cloud.
+  const config::Scene scene = config::load_scene(std::filesystem::path(PROJBOT_ASSET_DIR) / "scenes" / "tour.yaml");
+  alignment::ModelCloud cloud;
+  std::vector<session::Target> targets;
+  for (int i = 0; i < static_cast<int>(scene.targets.size()); ++i) targets.push_back({i, &cloud, Eigen::Vector3d::Zero()});
+  session::ReplaySession replay(scene, recording, targets);
+  const robot::StopReport r = replay.drive_to({1.0, 2.0, 0.5}, 0);
+  EXPECT_TRUE(r.arrived);
+  EXPECT_DOUBLE_EQ(r.drive_seconds, 7.5);
+  EXPECT_DOUBLE_EQ(replay.believed_pose().x_m, 1.01);
+  robot::PanTiltAngles angles;
+  replay.position(angles);
+  EXPECT_DOUBLE_EQ(angles.pan_rad, 0.2);
+  EXPECT_DOUBLE_EQ(angles.tilt_rad, -0.1);
+  try {
+    replay.drive_to({1.0, 2.0, 0.5}, 1);
+    FAIL() << "a stop the recording does not hold was driven to";
+  } catch (const session::SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("asked for stop 2 but the recording holds 1"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(replay.drive_to({3.0, 2.0, 0.5}, 0), session::SessionError);  // another stop than recorded
+}
+
+}  // namespace

@@ -1,0 +1,37 @@
+#pragma once
+// The twin serving a projection session (`run --sim`, `record` in the twin): its robot and pan-tilt, and
+// its camera unless a configured one replaces it.
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "projbot/engine/renderer.hpp"
+#include "projbot/session/session.hpp"
+#include "projbot/twin/camera.hpp"
+#include "projbot/twin/world.hpp"
+
+namespace projbot::twin {
+
+/// The twin serving the session's robot (and camera, unless `configured`). Renders on the thread that
+/// builds it, which must be the one that drives it.
+class TwinSession {
+ public:
+  /// `stop_requested`, asked while the twin is built (its map survey), ends that with
+  /// robot::SetupInterrupted.
+  TwinSession(const config::Scene& scene, const std::vector<session::Target>& targets, std::uint64_t seed,
+              alignment::RgbdCamera* configured, std::function<bool()> stop_requested, bool colour_every_frame = false);
+  session::Session& session() { return session_; }
+  Twin& twin() { return twin_; }
+  /// The dwell: `dwell_s` at each stop, the camera the configured one or the twin's.
+  session::Dwell dwell(double dwell_s, bool lockstep);
+
+ private:
+  engine::Renderer renderer_;
+  Twin twin_;
+  TwinCamera twin_camera_;
+  alignment::RgbdCamera* configured_;
+  session::Session session_;
+};
+
+}  // namespace projbot::twin
