@@ -297,8 +297,8 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
       if (root.has("projector") && root.child("projector", false)[key])
         root.fail(node, "calibration",
                   std::string("projector.") + key + " is the calibration's photometry; leave it out of the scene");
-  static_cast<Pinhole&>(scene.projector) = c.projector;
-  scene.projector.distortion = c.distortion;
+  static_cast<Pinhole&>(scene.projector) = c.projector.pinhole;
+  scene.projector.distortion = c.projector.distortion;
   if (c.photometry) {
     const double lumens = scene.projector.photometry.brightness_lm;
     scene.projector.photometry = *c.photometry;
@@ -344,8 +344,7 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
   } catch (const ConfigError& e) {
     r.fail(c["projector"], "", e.what());
   }
-  out.projector = k;
-  out.distortion = k.distortion;
+  out.projector = {k, k.distortion};
   out.T_projector_camera = read_pose(r, "projector_from_camera", "projector_from_camera");
   if (!c["projector_from_camera"]) r.fail(c, "projector_from_camera", "missing required key");
   if (YAML::Node rms = r.child("reprojection_rms_px", false)) {  // what the calibration measured: informational here

@@ -7,10 +7,19 @@
 #include <array>
 #include <optional>
 
+#include "projbot/config/pinhole.hpp"
+
 namespace projbot::config {
 
 /// k1, k2, p1, p2, k3; all zero is a pinhole.
 using Distortion = std::array<double, 5>;
+
+/// A camera's or projector's lens as a calibration gives it: its pinhole and its distortion. The
+/// calibration's two lenses (camera and projector) and a calibration file's projector.
+struct Lens {
+  Pinhole pinhole;
+  Distortion distortion{};
+};
 
 /// Whether any coefficient is non-zero.
 bool has_distortion(const Distortion& k);

@@ -207,8 +207,7 @@ Scene load_scene(const std::filesystem::path& path);
 /// What a calibration file (`projbot calibrate solve`'s calib.yaml) gives: the projector's pinhole A_p
 /// and the camera-to-projector pose R_cp, T_cp (X_p = R_cp X_c + T_cp, Eq. 2).
 struct ProjectorCalibration {
-  Pinhole projector;
-  Distortion distortion{};  ///< the projector's lens, k1 k2 p1 p2 k3
+  Lens projector;  ///< A_p and its distortion, k1 k2 p1 p2 k3
   Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();
   /// `photometry:` (projbot calibrate photometric): its gammas, mixing and black level (brightness_lm when
   /// given) replace the scene's.

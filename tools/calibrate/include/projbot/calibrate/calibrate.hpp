@@ -46,11 +46,8 @@ struct Board {
   double height_m() const;
 };
 
-/// A pinhole with OpenCV's lens distortion (k1, k2, p1, p2, k3).
-struct Lens {
-  config::Pinhole pinhole;
-  std::array<double, 5> distortion{};
-};
+/// A pinhole with OpenCV's lens distortion (k1, k2, p1, p2, k3): config's one lens type.
+using config::Lens;
 
 /// How many images a pose of a projector this size takes: 2 per Gray-code bit of each axis, then white
 /// and black.
