@@ -113,7 +113,7 @@ DepthImage without_plane(const DepthImage& depth, const CameraIntrinsics& k, con
     for (int x = 0; x < depth.width; ++x) {
       float& z = out.depth_m[static_cast<std::size_t>(y) * depth.width + x];
       if (!(z > 0.0F)) continue;
-      const Eigen::Vector3d p((x - k.cx_px) * z / k.fx_px, (y - k.cy_px) * z / k.fy_px, z);
+      const Eigen::Vector3d p = k.back_project(x, y, z);
       if (plane.height_of(p) < margin_m) z = 0.0F;
     }
   return out;

@@ -233,7 +233,7 @@ ProjectiveTracker::Pass ProjectiveTracker::pass(const Level& lv, std::size_t cou
     if (!has_depth(zs)) continue;
     if (zs < x.z() - cfg_.occlusion_margin_m) continue;  // something in front of the model: occluded
     ++p.candidates;
-    const Eigen::Vector3d q((u - lv.k.cx_px) * zs / lv.k.fx_px, (v - lv.k.cy_px) * zs / lv.k.fy_px, zs);
+    const Eigen::Vector3d q = lv.k.back_project(u, v, zs);
     const Eigen::Vector3d d = x - q;
     if (d.squaredNorm() > reach * reach) continue;
     const double r = nrm.dot(d);  // point-to-plane, the plane of the model's exact normal

@@ -51,11 +51,11 @@ std::optional<Eigen::Vector2d> undistort(const Distortion& k, const Eigen::Vecto
 
 Eigen::Vector2d ProjectorConfig::project_lit(const Eigen::Vector3d& p) const {
   const Eigen::Vector2d d = distort(distortion, {p.x() / p.z(), p.y() / p.z()});
-  return {fx_px * d.x() + cx_px, fy_px * d.y() + cy_px};
+  return project({d.x(), d.y(), 1.0});
 }
 
 std::optional<Eigen::Vector3d> ProjectorConfig::panel_ray(double u, double v) const {
-  const auto x = undistort(distortion, {(u - cx_px) / fx_px, (v - cy_px) / fy_px});
+  const auto x = undistort(distortion, back_project(u, v, 1.0).head<2>());
   if (!x) return std::nullopt;
   return Eigen::Vector3d(x->x(), x->y(), 1.0);
 }
@@ -81,8 +81,8 @@ void validate_lens(const ProjectorConfig& p, const Fail& fail) {
       const auto where = " at panel pixel (" + pixel(u, p.width_px) + ", " + pixel(v, p.height_px) + ")";
       if (!ray || !(distort_jacobian(p.distortion, ray->head<2>()).determinant() > 0.0))
         fail("distortion folds the image over" + where + ": no lens the renderer can pre-distort for (check the calibration)");
-      const double iu = p.fx_px * ray->x() + p.cx_px, iv = p.fy_px * ray->y() + p.cy_px;
-      if (std::abs(iu - p.cx_px) > p.width_px || std::abs(iv - p.cy_px) > p.height_px)
+      const Eigen::Vector2d image = p.project(*ray);  // where the light goes, as the undistorted pinhole sees it
+      if (std::abs(image.x() - p.cx_px) > p.width_px || std::abs(image.y() - p.cy_px) > p.height_px)
         fail("distortion throws the light of the panel" + where +
              " more than an image's width or height from the centre: "
              "too strong to pre-distort for (check the calibration)");

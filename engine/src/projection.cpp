@@ -32,8 +32,8 @@ LensCanvas lens_canvas(const config::ProjectorConfig& p) {
     for (const auto& [u, v] : edges) {
       const auto ray = p.panel_ray(u, v);
       if (!ray) continue;  // validate_projector refuses such lenses; the canvas then only holds the panel
-      const double iu = p.fx_px * ray->x() + p.cx_px, iv = p.fy_px * ray->y() + p.cy_px;
-      u0 = std::min(u0, iu), u1 = std::max(u1, iu), v0 = std::min(v0, iv), v1 = std::max(v1, iv);
+      const Eigen::Vector2d image = p.project(*ray);
+      u0 = std::min(u0, image.x()), u1 = std::max(u1, image.x()), v0 = std::min(v0, image.y()), v1 = std::max(v1, image.y());
     }
   }
   LensCanvas c;
@@ -57,8 +57,9 @@ std::vector<float> lens_warp(const config::ProjectorConfig& p, const LensCanvas&
       const auto ray = p.panel_ray((x + 0.5) * sx - 0.5, (y + 0.5) * sy - 0.5);
       if (!ray) continue;
       const std::size_t i = 2 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x));
-      uv[i] = static_cast<float>((p.fx_px * ray->x() + p.cx_px + c.left_px + 0.5) / c.pinhole.width_px);
-      uv[i + 1] = static_cast<float>((p.fy_px * ray->y() + p.cy_px + c.top_px + 0.5) / c.pinhole.height_px);
+      const Eigen::Vector2d image = p.project(*ray);
+      uv[i] = static_cast<float>((image.x() + c.left_px + 0.5) / c.pinhole.width_px);
+      uv[i + 1] = static_cast<float>((image.y() + c.top_px + 0.5) / c.pinhole.height_px);
     }
   return uv;
 }

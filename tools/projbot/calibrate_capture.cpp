@@ -37,7 +37,8 @@ assets::Model pattern_quad(const config::ProjectorConfig& p, const cv::Mat& patt
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < 2; ++i) {
       assets::Vertex vx;
-      vx.position = {static_cast<float>((u[i] - p.cx_px) / p.fx_px), static_cast<float>((v[j] - p.cy_px) / p.fy_px), 1.0F};
+      const Eigen::Vector3d ray = p.back_project(u[i], v[j], 1.0);
+      vx.position = {static_cast<float>(ray.x()), static_cast<float>(ray.y()), 1.0F};
       vx.uv = {static_cast<float>(i), static_cast<float>(j)};
       q.vertices.push_back(vx);
     }

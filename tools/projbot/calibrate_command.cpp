@@ -126,7 +126,7 @@ double lens_difference_px(const calibrate::Lens& fit, const calibrate::Lens& tru
   double worst = 0.0;
   for (int j = 0; j <= 20; ++j)
     for (int i = 0; i <= 20; ++i) {
-      const Eigen::Vector2d x((k.width_px * i / 20.0 - k.cx_px) / k.fx_px, (k.height_px * j / 20.0 - k.cy_px) / k.fy_px);
+      const Eigen::Vector2d x = k.back_project(k.width_px * i / 20.0, k.height_px * j / 20.0, 1.0).head<2>();
       const Eigen::Vector2d d = config::distort(fit.distortion, x) - config::distort(truth.distortion, x);
       worst = std::max(worst, std::hypot(k.fx_px * d.x(), k.fy_px * d.y()));
     }

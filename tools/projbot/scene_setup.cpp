@@ -42,8 +42,7 @@ Eigen::Matrix4d framing_pose(const config::ProjectorConfig& p, double radius_m) 
   const double distance = radius_m / std::sin(half_fov * 0.8);
   Eigen::Matrix4d T = config::pose_from_xyz_rpy({0.0, 0.0, distance}, {180.0, 0.0, 0.0});
   // Aim at the principal point's ray for the image centre.
-  T(0, 3) = distance * ((p.width_px - 1) / 2.0 - p.cx_px) / p.fx_px;
-  T(1, 3) = distance * ((p.height_px - 1) / 2.0 - p.cy_px) / p.fy_px;
+  T.block<2, 1>(0, 3) = p.back_project((p.width_px - 1) / 2.0, (p.height_px - 1) / 2.0, distance).head<2>();
   return T;
 }
 
