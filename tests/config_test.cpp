@@ -460,15 +460,36 @@ TEST(IsolatedRead, EveryWayTheChildEndsIsNamed) {
 }
 
 // `calibration: calib.yaml` (issue 13's output) gives A_p and R_cp, T_cp in place of the scene's.
-TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
-  const auto dir = std::filesystem::temp_directory_path() / ("projbot_calib_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const auto write = [&](const std::string& name, const std::string& text) { std::ofstream(dir / name) << text; };
+class CalibrationFileTest : public ::testing::Test {
+ protected:
+  void TearDown() override { std::filesystem::remove_all(dir); }
+  void write(const std::string& name, const std::string& text) { std::ofstream(dir / name) << text; }
+  // The error loading a scene that names calib2.yaml holding `calib` gives; empty when it loads.
+  std::string error(const std::string& scene, const std::string& calib) {
+    write("calib2.yaml", calib);
+    write("scene2.yaml", scene + targets);
+    try {
+      projbot::config::load_scene(dir / "scene2.yaml");
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  }
+  const std::filesystem::path dir = [] {
+    const auto d = std::filesystem::temp_directory_path() / ("projbot_calib_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  const std::string targets = "targets:\n  - {name: a, model: a.glb, pose: {translation: [0, 0, 1.5]}}\n";
+  const std::string good_pose = "projector_from_camera: {translation: [0, 0, 0]}\n";
+  const std::string intrinsics = "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512, cy: 384}\n";
+};
+
+TEST_F(CalibrationFileTest, ItReplacesTheProjectorModel) {
   write("calib.yaml",
         "projector: {width: 1024, height: 768, fx: 1500.5, fy: 1499.5, cx: 511.2, cy: 383.9, distortion: [0, 0, 0, 0, 0]}\n"
         "projector_from_camera: {translation: [0.05, -0.1, 0.02], rpy_deg: [1, 2, 3]}\n"
         "reprojection_rms_px: {camera: 0.21, projector: 0.34}\n");
-  const std::string targets = "targets:\n  - {name: a, model: a.glb, pose: {translation: [0, 0, 1.5]}}\n";
   write("scene.yaml", "calibration: calib.yaml\nprojector: {near: 0.2, far: 6, refresh_hz: 120}\n" + targets);
   const auto s = projbot::config::load_scene(dir / "scene.yaml");
   EXPECT_EQ(s.projector.width_px, 1024);
@@ -478,20 +499,11 @@ TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
   EXPECT_DOUBLE_EQ(s.projector.refresh_hz, 120.0);
   EXPECT_NEAR(s.pan_tilt.T_projector_camera(0, 3), 0.05, 1e-12);
   EXPECT_NEAR(s.pan_tilt.T_projector_camera(1, 3), -0.1, 1e-12);
-  const auto error = [&](const std::string& scene, const std::string& calib) -> std::string {
-    write("calib2.yaml", calib);
-    write("scene2.yaml", scene + targets);
-    try {
-      projbot::config::load_scene(dir / "scene2.yaml");
-    } catch (const ConfigError& e) {
-      return e.what();
-    }
-    return "";
-  };
-  const std::string good_pose = "projector_from_camera: {translation: [0, 0, 0]}\n";
+}
+
+TEST_F(CalibrationFileTest, ItMayCarryThePhotometry) {
   // Issue 43: a calibration may carry `photometry:` (calibrate photometric's file, pasted in): its gamma and
   // black level replace the scene's, which may then not give them too; its mixing is checked.
-  const std::string intrinsics = "projector: {width: 1024, height: 768, fx: 1500, fy: 1500, cx: 512, cy: 384}\n";
   const std::string photometry =
       "photometry: {gamma: 2.31, gamma_rgb: [2.3, 2.31, 2.32], black_level: 0.001, mixing: [0.94, 0.05, 0.01, 0.04, 0.92, "
       "0.04, 0.01, 0.06, 0.93], camera_gamma: 2.2}\n";
@@ -511,6 +523,9 @@ TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
             std::string::npos);
   EXPECT_NE(error("calibration: calib2.yaml\n", intrinsics + good_pose + "photometry: {gamma: 9}\n").find("photometry.gamma"),
             std::string::npos);
+}
+
+TEST_F(CalibrationFileTest, ItCarriesTheLensAndIsRefusedNamingWhatIsWrong) {
   // The projector's lens comes with the calibration (the renderer pre-distorts by it); OpenCV's rational
   // terms k4..k6 are accepted only as zeros, and a lens that folds the image over is refused.
   EXPECT_EQ(error("calibration: calib2.yaml\n",
@@ -544,7 +559,6 @@ TEST(SceneTest, CalibrationFileReplacesTheProjectorModel) {
                 .find("scene2.yaml:1: calibration: projector.fx is the calibration's; leave it out of the scene"),
             std::string::npos);
   EXPECT_NE(error("calibration: none.yaml\n", "").find("scene2.yaml:1: calibration: cannot open"), std::string::npos);
-  std::filesystem::remove_all(dir);
 }
 
 // OpenCV's lens model: undistort inverts distort, and the Jacobian is distort's derivative.
