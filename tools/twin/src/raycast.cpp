@@ -29,28 +29,92 @@ MeshRaycaster::MeshRaycaster(const assets::Model& model) {
   for (std::size_t i = 0; i < a_.size(); ++i)
     for (const Eigen::Vector3d& c : {a_[i], Eigen::Vector3d(a_[i] + e1_[i]), Eigen::Vector3d(a_[i] + e2_[i])})
       radius_ = std::max(radius_, (c - centre_).norm());
+  order_.resize(a_.size());
+  for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+  if (!a_.empty()) build(0, static_cast<std::uint32_t>(a_.size()));
+}
+
+// The node over order_[first, first + count): a leaf of at most 8 triangles, else split at the median of
+// their centroids along the widest axis. Boxes are padded so that rounding never hides a hit on their faces.
+std::int32_t MeshRaycaster::build(std::uint32_t first, std::uint32_t count) {
+  const auto index = static_cast<std::int32_t>(nodes_.size());
+  nodes_.emplace_back();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  Eigen::Vector3d clo = lo, chi = hi;
+  for (std::uint32_t k = first; k < first + count; ++k) {
+    const std::uint32_t i = order_[k];
+    for (const Eigen::Vector3d& c : {a_[i], Eigen::Vector3d(a_[i] + e1_[i]), Eigen::Vector3d(a_[i] + e2_[i])})
+      lo = lo.cwiseMin(c), hi = hi.cwiseMax(c);
+    const Eigen::Vector3d centroid = a_[i] + (e1_[i] + e2_[i]) / 3.0;
+    clo = clo.cwiseMin(centroid), chi = chi.cwiseMax(centroid);
+  }
+  const double pad = 1e-6 * (1.0 + (hi - lo).maxCoeff());
+  nodes_[static_cast<std::size_t>(index)].lo = lo.array() - pad;
+  nodes_[static_cast<std::size_t>(index)].hi = hi.array() + pad;
+  if (count <= 8) {
+    nodes_[static_cast<std::size_t>(index)].first = first;
+    nodes_[static_cast<std::size_t>(index)].count = count;
+    return index;
+  }
+  int axis = 0;
+  (chi - clo).maxCoeff(&axis);
+  const auto centroid = [&](std::uint32_t i) { return (a_[i] + (e1_[i] + e2_[i]) / 3.0)[axis]; };
+  const auto begin = order_.begin() + first, mid = begin + count / 2, end = begin + count;
+  std::nth_element(begin, mid, end, [&](std::uint32_t x, std::uint32_t y) { return centroid(x) < centroid(y); });
+  const std::int32_t left = build(first, count / 2);
+  const std::int32_t right = build(first + count / 2, count - count / 2);
+  nodes_[static_cast<std::size_t>(index)].left = left;
+  nodes_[static_cast<std::size_t>(index)].right = right;
+  return index;
+}
+
+// Moeller-Trumbore: the distance along the ray to triangle i, front or back face.
+std::optional<double> MeshRaycaster::hit(std::size_t i, const Eigen::Vector3d& o, const Eigen::Vector3d& d) const {
+  const Eigen::Vector3d p = d.cross(e2_[i]);
+  const double det = e1_[i].dot(p);
+  if (std::abs(det) < 1e-15) return std::nullopt;
+  const double inv = 1.0 / det;
+  const Eigen::Vector3d s = o - a_[i];
+  const double u = s.dot(p) * inv;
+  if (u < 0.0 || u > 1.0) return std::nullopt;
+  const Eigen::Vector3d q = s.cross(e1_[i]);
+  const double v = d.dot(q) * inv;
+  if (v < 0.0 || u + v > 1.0) return std::nullopt;
+  const double t = e2_[i].dot(q) * inv;
+  if (!(t > 1e-9)) return std::nullopt;
+  return t;
 }
 
 std::optional<double> MeshRaycaster::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const {
   // Skip the mesh when the ray passes outside its bounding sphere.
   const Eigen::Vector3d oc = centre_ - o;
   const double along = oc.dot(d);
-  if ((oc - along * d).squaredNorm() > radius_ * radius_ || along < -radius_) return std::nullopt;
+  if (nodes_.empty() || (oc - along * d).squaredNorm() > radius_ * radius_ || along < -radius_) return std::nullopt;
+  const Eigen::Vector3d inv = d.cwiseInverse();  // +-inf along an axis the ray does not move on
   double best = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < a_.size(); ++i) {
-    // Moeller-Trumbore.
-    const Eigen::Vector3d p = d.cross(e2_[i]);
-    const double det = e1_[i].dot(p);
-    if (std::abs(det) < 1e-15) continue;
-    const double inv = 1.0 / det;
-    const Eigen::Vector3d s = o - a_[i];
-    const double u = s.dot(p) * inv;
-    if (u < 0.0 || u > 1.0) continue;
-    const Eigen::Vector3d q = s.cross(e1_[i]);
-    const double v = d.dot(q) * inv;
-    if (v < 0.0 || u + v > 1.0) continue;
-    const double t = e2_[i].dot(q) * inv;
-    if (t > 1e-9 && t < best) best = t;
+  std::array<std::int32_t, 64> stack{0};
+  std::size_t depth = 1;
+  while (depth > 0) {
+    const Node& n = nodes_[static_cast<std::size_t>(stack[--depth])];
+    // The slab test: where the ray is inside the box along every axis (nothing when it never is).
+    double enter = 0.0, leave = best;
+    for (int a = 0; a < 3 && enter <= leave; ++a) {
+      if (d[a] == 0.0) {
+        if (o[a] < n.lo[a] || o[a] > n.hi[a]) leave = -1.0;
+        continue;
+      }
+      const double t0 = (n.lo[a] - o[a]) * inv[a], t1 = (n.hi[a] - o[a]) * inv[a];
+      enter = std::max(enter, std::min(t0, t1));
+      leave = std::min(leave, std::max(t0, t1));
+    }
+    if (enter > leave) continue;
+    if (n.left < 0) {
+      for (std::uint32_t k = n.first; k < n.first + n.count; ++k)
+        if (const auto t = hit(order_[k], o, d); t && *t < best) best = *t;
+      continue;
+    }
+    stack[depth++] = n.left;
+    stack[depth++] = n.right;
   }
   if (!std::isfinite(best)) return std::nullopt;
   return best;
