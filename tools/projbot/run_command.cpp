@@ -30,6 +30,7 @@
 #include "projbot/session/session.hpp"
 #include "projbot/session/trackers.hpp"
 #include "projbot/twin/camera.hpp"
+#include "projbot/twin/display_error.hpp"
 #include "projbot/twin/twin_session.hpp"
 #include "projbot/twin/world.hpp"
 #include "scene_setup.hpp"
@@ -40,10 +41,9 @@ namespace {
 // What the render thread draws at a stop (session::LitTarget, as the render thread needs it): the visited
 // target or a neighbour expected in the projector's view there (issue 11, item 5), with the twin's truth.
 struct DrawnTarget {
-  int target = -1;  // scene index: its worker and draw item
-  // The twin's truth, so the render thread can measure each frame at its display time:
-  int target_visit = 0;                                        // this target's n-th visit (its motion script); 0: still
-  Eigen::Matrix4d T_world_home = Eigen::Matrix4d::Identity();  // where it stood when the stop began
+  int target = -1;       // scene index: its worker and draw item
+  int target_visit = 0;  // this target's n-th visit (its motion script); 0: still
+  std::size_t twin = 0;  // its index in the twin (when a twin serves the session)
 };
 
 // What the robot thread tells the render thread: which targets the robot is projecting onto (none while
@@ -53,12 +53,14 @@ struct RobotState {
   double since_s = 0.0;
   int visit = 0;
   bool done = false;
-  Eigen::Matrix4d T_camera_world = Eigen::Matrix4d::Identity();  // the camera's true pose at the stop (twin)
-  bool measured = false;  // the truth above is known (the twin's robot), so each frame's error is measured
+  // The twin's truth at the stop, so the render thread measures each frame at its display time; null
+  // where nothing serves a truth (a replay, the configured robot).
+  std::shared_ptr<const twin::StopMeter> meter{};
 };
 
-// The error of the frames drawn, against the twin's truth at each frame's display time: the mean
-// distance between the markers as drawn and where they truly are then (mm, object space).
+// The error of the frames drawn, against the twin's truth at each frame's display time: the mean distance
+// between where the projector's light lands and where the markers truly are then (mm; the tour's
+// definition, twin::marker_errors).
 void print_display_errors(std::ostream& out, const session::LiveFigures& f) {
   double still = 0.0, moving = 0.0;
   for (const double e : f.still_mm) still += e / static_cast<double>(f.still_mm.size());
@@ -73,21 +75,14 @@ void print_display_errors(std::ostream& out, const session::LiveFigures& f) {
 }
 
 // The mean marker error of a target drawn (at its display time and pose), against the twin's truth then;
-// NaN for a target without markers or a stop without a truth (a replay, the configured robot).
+// NaN where no marker can be measured or the stop has no truth (a replay, the configured robot).
 session::DisplayError marker_error(const config::Scene& scene, const RobotState& robot, const session::DrawnPose& drawn) {
   const auto lit =
       std::find_if(robot.lit.begin(), robot.lit.end(), [&](const DrawnTarget& l) { return l.target == drawn.target; });
-  if (!robot.measured || lit == robot.lit.end()) return {std::nan(""), false};
-  const config::TargetConfig& target = scene.targets[static_cast<std::size_t>(drawn.target)];
+  if (!robot.meter || lit == robot.lit.end()) return {std::nan(""), false};
   const double t = drawn.display_s - robot.since_s;
-  const config::TargetMotion* m = target.motion_on(lit->target_visit);
-  const bool moving = m && m->moving_at(t);
-  if (target.markers_m.empty()) return {std::nan(""), moving};
-  const Eigen::Matrix4d T_true = robot.T_camera_world * twin::scripted_pose(target, lit->T_world_home, lit->target_visit, t);
-  double sum = 0.0;
-  for (const auto& p : target.markers_m)
-    sum += ((drawn.T_camera_target * p.homogeneous()).head<3>() - (T_true * p.homogeneous()).head<3>()).norm();
-  return {1000.0 * sum / static_cast<double>(target.markers_m.size()), moving};
+  const config::TargetMotion* m = scene.targets[static_cast<std::size_t>(drawn.target)].motion_on(lit->target_visit);
+  return {robot.meter->measure(lit->twin, lit->target_visit, drawn.T_camera_target, t).mean_mm, m && m->moving_at(t)};
 }
 
 struct RunOptions {
@@ -126,11 +121,13 @@ class RunObserver final : public session::StopObserver {
     std::cout << std::endl;
     std::vector<DrawnTarget> lit;
     for (const session::LitTarget& l : stop.lit)
-      lit.push_back({l.target, l.target == stop.target ? stop.target_visit : 0,
-                     twin_ ? twin_->home(twin_index(l.target)) : Eigen::Matrix4d::Identity()});
-    const Eigen::Matrix4d T_camera_world =
-        twin_ ? alignment::rigid_inverse(twin_->true_head().T_world_camera.matrix()) : Eigen::Matrix4d::Identity();
-    state_.publish({lit, since_s, stop.visit + 1, false, T_camera_world, twin_ != nullptr});
+      lit.push_back({l.target, l.target == stop.target ? stop.target_visit : 0, twin_ ? twin_index(l.target) : 0});
+    std::shared_ptr<const twin::StopMeter> meter{};
+    if (twin_)
+      meter = std::make_shared<const twin::StopMeter>(
+          *twin_, twin::ProjectorModels{scene_.projector, scene_.projector, scene_.pan_tilt.T_projector_camera},
+          twin_->true_head().T_world_projector.matrix());
+    state_.publish({lit, since_s, stop.visit + 1, false, std::move(meter)});
   }
   void frame(const session::Stop& stop, int k, const alignment::RgbdFrame& f,
              const std::vector<std::optional<alignment::PoseSample>>& samples) override {
@@ -422,7 +419,8 @@ const Command kRun{
     "the initial guess (Eq. 1), the target's surveyed footing and the colour taken on arrival, and dwells\n"
     "while the camera streams depth. Per frame it records the pose's\n"
     "age at display (depth capture to the frame's expected display time), the frame time and, in the twin,\n"
-    "the error of the markers as drawn against where they truly are at that display time; it prints\n"
+    "the error at the markers at that display time (where the projector's light lands against where they\n"
+    "truly are, as the tour measures it: markers it cannot light or lights edge-on are left out); it prints\n"
     "percentiles at the end (the error while a target moves and while it stands still, mm).\n"
     "Devices come from the config's `devices:` section (projbot devices --help shows it): each one configured\n"
     "is opened and read once at start, and one that is absent stops the run with a message naming it.\n"

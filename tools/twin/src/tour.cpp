@@ -11,13 +11,13 @@
 #include <tuple>
 #include <utility>
 
-#include "marker_errors.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/image.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/photometry.hpp"
 #include "projbot/engine/projection.hpp"
+#include "projbot/twin/display_error.hpp"
 #include "projbot/twin/spectator.hpp"
 #include "projbot/twin/world.hpp"
 #include "sim_clock_devices.hpp"
@@ -89,7 +89,7 @@ TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double
   s.age_ms = 1000.0 * (display_s - drawn.capture_time_s);
   s.in_world = target.in_world;
   const Eigen::Matrix4d T_camera_target = predict ? alignment::predict_pose(drawn.motion, display_s) : drawn.T_camera_target;
-  const Errors e = marker_errors(c.twin, c.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
+  const MarkerErrors e = marker_errors(c.twin, c.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
   s.mean_mm = e.mean_mm;
   s.max_mm = e.max_mm;
   return s;
@@ -101,7 +101,7 @@ void measure_neighbour(const DwellContext& c, NeighbourLight& n, double display_
   if (!n.shown) return count_frame(n, std::nan(""));
   const Eigen::Matrix4d T_camera_target =
       c.options.predict ? alignment::predict_pose(n.drawn.motion, display_s) : n.drawn.T_camera_target;
-  const Errors e = marker_errors(c.twin, n.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
+  const MarkerErrors e = marker_errors(c.twin, n.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
   count_frame(n, e.mean_mm);
 }
 
@@ -161,7 +161,7 @@ NeighbourLight neighbour_light(const Twin& twin, const Acquired& a, std::size_t 
   r.projected = a.projected;
   r.align_ms = a.align_ms;
   std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth, t, n.T_camera_target_guess);
-  const Errors e = marker_errors(twin, target, models, truth.T_world_projector.matrix(), a.icp.T_scan_model);
+  const MarkerErrors e = marker_errors(twin, target, models, truth.T_world_projector.matrix(), a.icp.T_scan_model);
   r.mean_mm = e.mean_mm;
   r.max_mm = e.max_mm;
   count_frame(l, e.mean_mm);  // the arrival's frame
@@ -376,7 +376,7 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
   report.view = alignment::view_constraints(target.cloud, report.icp.T_scan_model, tour_.twin.camera());
   report.T_projector_target_estimated = tour_.models.projector_from_target(report.icp.T_scan_model);
   report.T_projector_target_true = alignment::rigid_inverse(T_world_projector) * target.T_world_target_true;
-  const Errors e = marker_errors(tour_.twin, target_index_, tour_.models, T_world_projector, report.icp.T_scan_model);
+  const MarkerErrors e = marker_errors(tour_.twin, target_index_, tour_.models, T_world_projector, report.icp.T_scan_model);
   report.markers = e.markers;
   report.mean_mm = e.mean_mm;
   report.max_mm = e.max_mm;

@@ -118,7 +118,7 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
   const std::string where = scene.source.empty() ? std::string("<scene>") : scene.source.string();
   if (scene.visits.empty()) throw TwinError(where + ": the twin needs a 'tour: {visits: [...]}' section");
   const assets::Model room = room_model(scene);
-  room_ray_ = std::make_unique<MeshRaycaster>(room);
+  room_ray_ = std::make_shared<MeshRaycaster>(room);
   room_id_ = renderer_.add_model(room);
   std::vector<config::Box2D> footprints;  // for the laser: what stands on the floor
   for (const auto& p : scene.props) {
@@ -129,7 +129,7 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     assets::Model model = assets::load_model(p.model);
     assets::scale_and_recenter(model, p.scale, p.recenter);
     footprints.push_back(footprint(world_bounds(model, p.T_world_prop)));
-    props_.push_back({std::make_unique<MeshRaycaster>(model), renderer_.add_model(model), p.T_world_prop});
+    props_.push_back({std::make_shared<MeshRaycaster>(model), renderer_.add_model(model), p.T_world_prop});
   }
   for (const auto& t : scene.targets) {
     if (!t.T_world_target) continue;
@@ -140,7 +140,7 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     tt.config = t;
     tt.model = assets::load_model(t.model);
     assets::scale_and_recenter(tt.model, t.scale, t.recenter);
-    tt.raycaster = std::make_unique<MeshRaycaster>(tt.model);
+    tt.raycaster = std::make_shared<MeshRaycaster>(tt.model);
     for (std::size_t k = 0; k < t.markers_m.size(); ++k) {
       const Eigen::Vector3d q = tt.raycaster->closest_point(t.markers_m[k]);
       const double d = (q - t.markers_m[k]).norm();
@@ -187,7 +187,7 @@ void Twin::place_support(TwinTarget& t, const std::string& where, std::vector<co
   const auto box = assets::make_box({-hx, -hy, 0.0}, {hx, hy, std::max(bounds.min().z(), 0.01)}, {0.7F, 0.7F, 0.7F, 1.0F});
   t.T_world_pedestal = Eigen::Matrix4d::Identity();
   t.T_world_pedestal.topRightCorner<2, 1>() = t.T_world_target_true.topRightCorner<2, 1>();
-  t.pedestal_raycaster = std::make_unique<MeshRaycaster>(box);
+  t.pedestal_raycaster = std::make_shared<MeshRaycaster>(box);
   t.pedestal_id = renderer_.add_model(box);
   const double x = t.T_world_pedestal(0, 3), y = t.T_world_pedestal(1, 3);
   footprints.push_back({x - hx, y - hy, x + hx, y + hy});
@@ -324,6 +324,16 @@ alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::
   alignment::DepthImage clean{map.width, map.height, map.z_m, 0.0};
   if (!options_.depth_noise) return clean;
   return alignment::apply_kinect_v1_noise(clean, camera_, options_.depth_model, noise_seed);
+}
+
+std::vector<std::shared_ptr<const MeshRaycaster>> Twin::meshes() const {
+  std::vector<std::shared_ptr<const MeshRaycaster>> out{room_ray_};
+  for (const auto& p : props_) out.push_back(p.raycaster);
+  for (const auto& t : targets_) {
+    out.push_back(t.raycaster);
+    if (t.pedestal_raycaster) out.push_back(t.pedestal_raycaster);
+  }
+  return out;
 }
 
 std::vector<PlacedMesh> Twin::true_scene(const Eigen::Matrix4d& T_frame_world) const {

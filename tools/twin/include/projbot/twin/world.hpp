@@ -45,7 +45,7 @@ struct TwinOptions {
 struct TwinTarget {
   config::TargetConfig config;
   assets::Model model;  ///< scaled and recentred, model frame
-  std::unique_ptr<MeshRaycaster> raycaster;
+  std::shared_ptr<MeshRaycaster> raycaster;
   alignment::ModelCloud cloud;          ///< 50k surface samples for ICP and tracking
   Eigen::Matrix4d T_world_target_true;  ///< where it stands now (moves with its motion script)
   /// In the world now: false for a target that is not there (`present: false`) or was carried away
@@ -54,7 +54,7 @@ struct TwinTarget {
   bool in_world = true;
   /// What it stands on (config.support): a box from the floor (a translation), none for the floor.
   Eigen::Matrix4d T_world_pedestal = Eigen::Matrix4d::Identity();
-  std::unique_ptr<MeshRaycaster> pedestal_raycaster;  ///< null when it stands on the floor
+  std::shared_ptr<MeshRaycaster> pedestal_raycaster;  ///< null when it stands on the floor
   std::size_t pedestal_id = 0;                        ///< renderer model id
 };
 
@@ -119,6 +119,8 @@ class Twin {
   config::ProjectorConfig camera_pinhole() const;
   /// The true surfaces placed in a frame (T_frame_world): for the projector's rays.
   std::vector<PlacedMesh> true_scene(const Eigen::Matrix4d& T_frame_world) const;
+  /// Every surface's ray caster (room, props, targets, pedestals): a holder keeps them beyond the twin.
+  std::vector<std::shared_ptr<const MeshRaycaster>> meshes() const;
 
   /// What a camera at T_world_camera sees: the room, props, supports and the targets in the world, each
   /// placed in the camera frame (for the renderer's draw_frame).
@@ -141,10 +143,10 @@ class Twin {
   std::vector<TwinTarget> targets_;
   std::vector<Eigen::Matrix4d> home_;        // where each target stands between visits
   std::set<std::size_t> gone_;               // targets carried away (motion.removed) on an earlier visit
-  std::unique_ptr<MeshRaycaster> room_ray_;  // floor, walls, obstacle blocks and box props
+  std::shared_ptr<MeshRaycaster> room_ray_;  // floor, walls, obstacle blocks and box props
   std::size_t room_id_ = 0;
   struct PlacedProp {
-    std::unique_ptr<MeshRaycaster> raycaster;
+    std::shared_ptr<MeshRaycaster> raycaster;
     std::size_t id = 0;  // renderer model id
     Eigen::Matrix4d T_world = Eigen::Matrix4d::Identity();
   };
