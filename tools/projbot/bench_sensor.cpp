@@ -24,8 +24,6 @@ namespace fs = std::filesystem;
 
 using bench::kLags;
 using bench::kRings;
-using Stats = bench::SensorStats;
-using Sensors = bench::SensorComparison;
 
 std::string share(long part, long whole) {
   char text[32];
@@ -40,26 +38,26 @@ std::string number(double v, const char* format) {
   return text;
 }
 
-using Cell = std::function<std::string(const Stats&)>;
+using Cell = std::function<std::string(const bench::SensorStats&)>;
 
-void print_row(const std::string& what, const Sensors& s, const Cell& cell) {
+void print_row(const std::string& what, const bench::SensorComparison& s, const Cell& cell) {
   std::cout << "| " << what << " | " << cell(s.real) << " | " << cell(s.twin) << " | " << cell(s.fitted) << " |\n";
 }
 
-std::string residuals(const Stats& s) {
+std::string residuals(const bench::SensorStats& s) {
   std::vector<double> a;
   for (const double r : s.residual_mm) a.push_back(std::abs(r));
   return number(engine::percentile(a, 0.5), "%.2f") + " / " + number(engine::percentile(a, 0.9), "%.2f") + " / " +
          number(engine::percentile(s.residual_mm, 0.5), "%+.2f");
 }
 
-double typical_noise(const Stats& t) {
+double typical_noise(const bench::SensorStats& t) {
   std::vector<double> size;
   for (const double r : t.noise_mm) size.push_back(std::abs(r));
   return engine::percentile(size, 0.5);
 }
 
-std::string noise(const Stats& t) {
+std::string noise(const bench::SensorStats& t) {
   std::vector<double> a, o;
   for (const double r : t.noise_mm) a.push_back(std::abs(r));
   for (const double r : t.offset_mm) o.push_back(std::abs(r));
@@ -69,7 +67,7 @@ std::string noise(const Stats& t) {
 
 // Robustly, from medians (the edges' outliers would rule a mean): for a normal field with correlation rho,
 // |a - b| has median sqrt(2 (1 - rho)) times that of |a|.
-std::string alike(const Stats& t) {
+std::string alike(const bench::SensorStats& t) {
   const double typical = typical_noise(t);
   std::string text;
   for (std::size_t l = 0; l < kLags.size(); ++l) {
@@ -79,13 +77,13 @@ std::string alike(const Stats& t) {
   return text;
 }
 
-std::string steps(const Stats& t) {
+std::string steps(const bench::SensorStats& t) {
   return number(engine::percentile(t.step_per_z2, 0.1) * 1000.0, "%.2f") + " / " +
          number(engine::percentile(t.step_per_z2, 0.5) * 1000.0, "%.2f");
 }
 
 // The fitted model's noise inside a surface is nearly all smooth: its size scales with the smooth coefficient.
-void print_needed_noise(const Sensors& s) {
+void print_needed_noise(const bench::SensorComparison& s) {
   const double real = typical_noise(s.real), fitted = typical_noise(s.fitted);
   if (!(real > 0.0) || !(fitted > 0.0)) return;
   const double coeff = alignment::KinectNoiseConfig::fitted().smooth_sigma_z_coeff;
@@ -95,7 +93,7 @@ void print_needed_noise(const Sensors& s) {
       real / fitted, coeff * real / fitted, coeff);
 }
 
-void print_sensors(const Sensors& s) {
+void print_sensors(const bench::SensorComparison& s) {
   std::cout << "\nThe real sensor and the twin's at the ground truth: " << s.instances << " instances in " << s.images
             << " images\n| | real | twin (published Kinect v1 model, the twin's) | twin (fitted to real frames) |\n"
             << "|---|---|---|---|\n";
@@ -104,17 +102,18 @@ void print_sensors(const Sensors& s) {
             noise);
   print_row("that noise's correlation with the pixel 1 / 3 / 8 px to the right", s, alike);
   print_row("missing inside (2 px from the edge and more)", s,
-            [](const Stats& t) { return share(t.interior_missing, t.interior); });
-  print_row("missing at the silhouette's edge (its outer 2 px)", s, [](const Stats& t) { return share(t.edge_missing, t.edge); });
+            [](const bench::SensorStats& t) { return share(t.interior_missing, t.interior); });
+  print_row("missing at the silhouette's edge (its outer 2 px)", s,
+            [](const bench::SensorStats& t) { return share(t.edge_missing, t.edge); });
   for (int d = 1; d <= kRings; ++d)
     print_row(std::to_string(d) + " px outside: missing / object's depth / between object and background", s,
-              [d](const Stats& t) {
+              [d](const bench::SensorStats& t) {
                 const auto i = static_cast<std::size_t>(d);
                 return share(t.ring_missing[i], t.ring[i]) + " / " + share(t.ring_object[i], t.ring[i]) + " / " +
                        share(t.ring_between[i], t.ring[i]);
               });
   print_row("missing 1-3 px outside, left of the object / right", s,
-            [](const Stats& t) { return share(t.left_missing, t.left) + " / " + share(t.right_missing, t.right); });
+            [](const bench::SensorStats& t) { return share(t.left_missing, t.left) + " / " + share(t.right_missing, t.right); });
   print_row("depth step between neighbours / z^2, p10 / median, mm per m^2", s, steps);
   print_needed_noise(s);
 }
@@ -131,7 +130,7 @@ int run_bench_sensor(const cli::Args& args) {
   int total = 0;
   for (const auto& scene : data.scenes) total += static_cast<int>(scene.images.size());
   Progress progress("image", std::min(total, max_images));
-  Sensors out;
+  bench::SensorComparison out;
   for (const auto& scene : data.scenes)
     for (const auto& image : scene.images) {
       if (interrupted() || out.images >= max_images) break;

@@ -5,11 +5,7 @@
 
 namespace projbot::twin {
 
-bool lit_by(const config::ProjectorConfig& k, const Eigen::Vector3d& p) {
-  if (p.z() <= 0.0) return false;
-  const Eigen::Vector2d x = k.project_lit(p);
-  return x.x() >= 0.0 && x.y() >= 0.0 && x.x() < k.width_px && x.y() < k.height_px;
-}
+bool lit_by(const config::ProjectorConfig& k, const Eigen::Vector3d& p) { return p.z() > 0.0 && k.contains(k.project_lit(p)); }
 
 MarkerErrors marker_errors(std::span<const PlacedMesh> scene, const Eigen::Matrix4d& T_projector_target_true,
                            const std::vector<Eigen::Vector3d>& markers_m, const ProjectorModels& projector,

@@ -180,7 +180,7 @@ MarkerError measure_marker(const config::ProjectorConfig& k, const config::Proje
   Eigen::Vector3d ray = drawn;
   if (drawn.z() > 0.0) {
     e.pixel = k.project_lit(drawn).array().round();
-    e.in_image = e.pixel.x() >= 0 && e.pixel.y() >= 0 && e.pixel.x() < k.width_px && e.pixel.y() < k.height_px;
+    e.in_image = k.contains(e.pixel);
     if (const auto r = light.panel_ray(e.pixel.x(), e.pixel.y()))
       ray = *r;
     else
