@@ -1,5 +1,6 @@
 #include "projbot/alignment/kinect_noise.hpp"
 
+#include <Eigen/Geometry>  // cross(): without it the product was only declared, and PCL's libraries happened to define it
 #include <algorithm>
 #include <array>
 #include <cmath>

@@ -35,6 +35,9 @@
 #include "projbot/config/paths.hpp"
 
 namespace projbot::robot {
+
+bool built_with_mrpt() { return true; }
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -249,47 +252,6 @@ void write_rawlog(const std::filesystem::path& path, const std::vector<RawlogSte
     frame.insert(detail::to_mrpt(step.scan));
     archive << frame;
   }
-}
-
-void write_trajectory(const std::filesystem::path& path, const std::vector<TrajectoryPoint>& trajectory) {
-  std::ostringstream out;
-  out << std::fixed;
-  for (const auto& p : trajectory)
-    out << std::setprecision(6) << p.timestamp_s << ' ' << std::setprecision(5) << p.pose.x_m << ' ' << p.pose.y_m << ' '
-        << p.pose.theta_rad << '\n';
-  config::write_file_atomically(path, out.str());
-}
-
-std::vector<TrajectoryPoint> read_trajectory(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw RobotError(path.string() + ": cannot open the trajectory file");
-  std::vector<TrajectoryPoint> out;
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t")] == '#') continue;
-    std::istringstream fields(line);
-    TrajectoryPoint p;
-    std::string extra;
-    if (!(fields >> p.timestamp_s >> p.pose.x_m >> p.pose.y_m >> p.pose.theta_rad) || (fields >> extra) ||
-        !std::isfinite(p.timestamp_s + p.pose.x_m + p.pose.y_m + p.pose.theta_rad))
-      throw RobotError(path.string() + ":" + std::to_string(number) + ": expected 'timestamp x y phi' (4 finite numbers)");
-    // Checked, not only typed: x = 1e308 or time running backwards was once compared as if it were right.
-    if (std::abs(p.pose.x_m) > 1e6 || std::abs(p.pose.y_m) > 1e6 || std::abs(p.pose.theta_rad) > 1e3)
-      throw RobotError(path.string() + ":" + std::to_string(number) +
-                       ": x and y must lie within 1000 km (|x|, |y| <= 1e6 m) and |phi| <= 1000 rad");
-    if (!out.empty() && !(p.timestamp_s > out.back().timestamp_s))
-      throw RobotError(path.string() + ":" + std::to_string(number) + ": timestamp " + std::to_string(p.timestamp_s) +
-                       " does not come after the line before's (" + std::to_string(out.back().timestamp_s) +
-                       "): timestamps must increase");
-    out.push_back(p);
-  }
-  if (out.empty()) throw RobotError(path.string() + ": no trajectory lines");
-  return out;
-}
-
-const std::set<std::string>& map_folder_files() {
-  static const std::set<std::string> files{"map.simplemap.gz", "grid.png", "grid.yaml"};
-  return files;
 }
 
 SlamResult build_map(const std::vector<RawlogStep>& steps, const std::optional<std::filesystem::path>& ini,

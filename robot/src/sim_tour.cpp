@@ -42,16 +42,21 @@ Localizer surveyed_localizer(const SimTourConfig& c, const OccupancyMap& map, st
 
 SimRobot::SimRobot(const SimTourConfig& config)
     : c_(config),
-      map_(OccupancyMap::from_room(config.room)),
       rng_(config.errors.seed * 7919 + 17),
-      localizer_(surveyed_localizer(c_, map_, rng_)),
       base_(config.start, config.errors),
       odometry_(base_.geometry(), config.start),
       controller_(config.controller, base_.geometry()) {
+  if (c_.source == PoseSource::localized && !built_with_mrpt())
+    throw RobotError(
+        "the simulated robot's laser localisation needs MRPT, which this portable build leaves out "
+        "(tools/bundle.sh): close the loop on odometry alone (tour --mode odometry) or use the full build");
+  if (built_with_mrpt()) map_.emplace(OccupancyMap::from_room(config.room));  // also checks the room
+  // The survey's scans draw on rng_; odometry mode draws nothing more from it, so leaving it out there changes nothing.
+  if (c_.source == PoseSource::localized) localizer_.emplace(surveyed_localizer(c_, *map_, rng_));
   odometry_.update(base_.read_encoders());
 }
 
-Pose2D SimRobot::believed_pose() const { return c_.source == PoseSource::localized ? localizer_.pose() : odometry_.pose(); }
+Pose2D SimRobot::believed_pose() const { return localizer_ ? localizer_->pose() : odometry_.pose(); }
 
 StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
   StopReport r;
@@ -60,11 +65,11 @@ StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
   controller_.reset();
   double ms_total = 0.0;
   const auto scan_and_correct = [&] {
-    LaserScan scan = map_.simulate_scan(base_.true_pose(), c_.laser, rng_);
+    LaserScan scan = map_->simulate_scan(base_.true_pose(), c_.laser, rng_);
     scan.timestamp_s = time_s_;
     if (on_scan_) on_scan_(scan, odometry_.pose());
     const auto t0 = std::chrono::steady_clock::now();
-    const LocalizationUpdate u = localizer_.correct(scan);
+    const LocalizationUpdate u = localizer_->correct(scan);
     ms_total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ++r.corrections;
     if (!u.accepted) ++r.rejected;
@@ -74,7 +79,7 @@ StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
     const Pose2D before = odometry_.pose();
     const Pose2D& after = odometry_.update(base_.read_encoders());
     if (c_.source == PoseSource::localized) {
-      localizer_.predict(between(before, after));
+      localizer_->predict(between(before, after));
       if (step % c_.localize_every == 0) scan_and_correct();
     }
     const BaseTwist cmd = controller_.update(believed_pose(), goal, c_.control_dt_s);

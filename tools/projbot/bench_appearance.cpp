@@ -126,6 +126,7 @@ const Command kBenchAppearance{
       const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
       Progress progress("visit", visits);
       o.on_visit = [&](const twin::VisitReport& v) { progress.step(v.visit); };
+      note_twin_on_odometry(std::cout);
       const twin::TourReport report = twin::run_tour(scene, o);
       print_table(report);
       print_albedo(report, scene);

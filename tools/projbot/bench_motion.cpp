@@ -90,6 +90,7 @@ const Command kBenchMotion{
       twin::TourReport runs[2];
       const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());
       Progress progress("visit", 2 * visits);
+      note_twin_on_odometry(std::cout);
       for (const bool predict : {false, true}) {
         o.predict = predict;
         std::cout << "prediction " << (predict ? "on" : "off") << ": " << std::flush;

@@ -16,7 +16,13 @@ struct Command {
   std::string usage;    ///< the top of `projbot NAME --help`
   std::vector<cli::OptionSpec> options;
   std::function<int(const cli::Args&)> run;  ///< returns the exit code
+  /// Non-empty: this build leaves the command out (the portable build, tools/bundle.sh), and why. Called, it
+  /// says so and exits kLeftOutExitCode.
+  std::string left_out{};
 };
+
+/// The exit status of a command this build leaves out (sysexits.h's EX_UNAVAILABLE).
+inline constexpr int kLeftOutExitCode = 69;
 
 extern const Command kRender;
 extern const Command kShow;

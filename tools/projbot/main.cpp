@@ -19,6 +19,12 @@ namespace {
 
 using projbot::tools::Command;
 
+#ifdef PROJBOT_PORTABLE
+constexpr const char* kBuild = " (portable build: without MRPT, OpenCV, FFmpeg and PCL's io; tools/bundle.sh)";
+#else
+constexpr const char* kBuild = "";
+#endif
+
 const std::vector<const Command*>& commands() {
   static const std::vector<const Command*> all{&projbot::tools::kRender,
                                                &projbot::tools::kShow,
@@ -55,7 +61,7 @@ void print_help() {
   for (const auto* c : commands()) {
     std::string name = "  " + c->name;
     name.resize(std::max<std::size_t>(25, name.size() + 2), ' ');  // the longest, "calibrate photometric", and two
-    std::cout << name << c->summary << '\n';
+    std::cout << name << (c->left_out.empty() ? c->summary : "(not in this build: " + c->left_out + ")") << '\n';
   }
   std::cout
       << "\nExamples:\n"
@@ -169,12 +175,16 @@ static int dispatch(int argc, char** argv, std::string& name) {
       std::cerr << "projbot: --version takes nothing after it, got '" << argv[2] << "'\n";
       return 2;
     }
-    std::cout << "projbot " << PROJBOT_VERSION << '\n';
+    std::cout << "projbot " << PROJBOT_VERSION << kBuild << '\n';
     return 0;
   }
   int first = 2;
   const Command* cmd = find_command(argc, argv, name, first);
   if (cmd == nullptr) return 2;
+  if (!cmd->left_out.empty()) {
+    std::cerr << "projbot " << name << ": not in this build: " << cmd->left_out << '\n';
+    return projbot::tools::kLeftOutExitCode;
+  }
   for (int i = first; i < argc; ++i)
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
       std::cout << "Usage: " << cmd->usage << "\nOptions:\n" << projbot::cli::format_options(cmd->options);

@@ -77,6 +77,13 @@ Pose2D parse_pose(const std::string& text, const std::string& what) {
   return {v[0], v[1], v[2]};
 }
 
+namespace {
+
+// What a build without MRPT (the portable one) says of the commands that need it.
+std::string mrpt_left_out() { return robot::built_with_mrpt() ? "" : "needs MRPT (maps, rawlogs, laser localisation)"; }
+
+}  // namespace
+
 const Command kSlam{
     "slam",
     "build the environment map from a laser rawlog (MRPT ICP-SLAM)",
@@ -153,7 +160,8 @@ const Command kSlam{
       std::cout << "  wrote " << *args.get("out-map") << "/{map.simplemap.gz,grid.png,grid.yaml} and "
                 << *args.get("out-trajectory") << '\n';
       return 0;
-    }};
+    },
+    mrpt_left_out()};
 
 const Command kLocalize{
     "localize",
@@ -206,7 +214,8 @@ const Command kLocalize{
         print_errors("odometry vs ground truth", compare(dead_reckoning(steps, start), *truth));
       }
       return 0;
-    }};
+    },
+    mrpt_left_out()};
 
 // One row of the simulated-tour table of bench localize.
 // Returns false, printing nothing, when the tour was interrupted.
@@ -293,6 +302,7 @@ const Command kBenchLocalize{
       print_errors("ICP-SLAM vs ground truth", compare(r.trajectory, truth));
       print_errors("odometry vs ground truth", compare(dead_reckoning(steps, r.trajectory.front().pose), truth));
       return 0;
-    }};
+    },
+    mrpt_left_out()};
 
 }  // namespace projbot::tools

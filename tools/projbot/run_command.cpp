@@ -476,6 +476,7 @@ const Command kRun{
       ro.windowing = !o.headless;
       engine::Renderer renderer(ro);
       std::cout << "device: " << renderer.device_info().name << std::endl;  // flushed: a log shows it has started
+      if (!devices.base && !recording) note_twin_on_odometry(std::cout);
       RunOutput out(renderer, args, scene, o, !args.flag("sim") && !recording);
       const session::LiveLoopConfig lc = loop_config(scene, o, recording.has_value());
       session::LiveLoop loop(renderer, scene.projector, out.items, lc);

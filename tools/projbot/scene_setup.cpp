@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "projbot/assets/model.hpp"
+#include "projbot/robot/localization.hpp"
 
 namespace projbot::tools {
 
@@ -29,6 +30,11 @@ std::vector<cli::OptionSpec> with_scene_options(std::vector<cli::OptionSpec> own
 std::filesystem::path asset_dir() {
   if (const char* env = std::getenv("PROJBOT_ASSETS"); env != nullptr && *env != '\0') return env;
   return PROJBOT_ASSET_DIR;
+}
+
+void note_twin_on_odometry(std::ostream& out) {
+  if (!robot::built_with_mrpt())
+    out << "note: this portable build has no MRPT: the twin's robot closes its loop on odometry alone\n";
 }
 
 double model_scale_option(const cli::Args& args, double fallback) {

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <filesystem>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ std::vector<cli::OptionSpec> with_scene_options(std::vector<cli::OptionSpec> own
 
 /// The folder holding the shipped demo assets (PROJBOT_ASSETS overrides the built-in path).
 std::filesystem::path asset_dir();
+
+/// In a portable build (no MRPT), a line saying the twin's robot drives on odometry alone; nothing otherwise.
+void note_twin_on_odometry(std::ostream& out);
 
 /// --model-scale (model units to metres), `fallback` when not given; a usage error outside [1e-6, 1e6].
 double model_scale_option(const cli::Args& args, double fallback);

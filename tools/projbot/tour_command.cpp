@@ -135,6 +135,7 @@ const Command kTour{
         std::cout << std::endl;
         progress.step(v.visit);
       };
+      if (o.mode != twin::TourMode::odometry) note_twin_on_odometry(std::cout);
       const twin::TourReport report = twin::run_tour(scene, o);
       std::cout << '\n';
       twin::print_table(report, std::cout);

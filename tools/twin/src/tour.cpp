@@ -555,7 +555,9 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   const auto wall0 = Clock::now();
   engine::Renderer renderer(engine::RendererOptions{});
   TwinOptions twin_options;
-  twin_options.pose_source = options.mode == TourMode::odometry ? robot::PoseSource::odometry : robot::PoseSource::localized;
+  // A portable build has no MRPT localisation: its localized and tracking tours close the loop on odometry.
+  twin_options.pose_source = options.mode == TourMode::odometry || !robot::built_with_mrpt() ? robot::PoseSource::odometry
+                                                                                             : robot::PoseSource::localized;
   twin_options.seed = options.seed;
   twin_options.depth_noise = options.depth_noise;
   if (options.fitted_depth) twin_options.depth_model = alignment::KinectNoiseConfig::fitted();

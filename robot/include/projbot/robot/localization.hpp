@@ -14,6 +14,11 @@
 
 namespace projbot::robot {
 
+/// Whether this build has MRPT (the occupancy grid and simulated laser, localisation, mapping, rawlogs, the
+/// real laser and pan-tilt drivers): false in the portable build (tools/bundle.sh), where each of those
+/// throws RobotError saying so.
+bool built_with_mrpt();
+
 /// One step of a rawlog: an odometry increment (in the previous base frame) and a scan.
 struct RawlogStep {
   double timestamp_s = 0.0;

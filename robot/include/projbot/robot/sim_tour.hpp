@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -39,7 +40,8 @@ struct SimTourConfig {
 };
 
 /// The simulated robot of a tour, one stop at a time: the room and its map, the drifting base, wheel
-/// odometry and the MRPT localiser. The twin drives it and asks where the robot believes it is.
+/// odometry and the MRPT localiser (localized mode; a portable build without MRPT closes the loop on
+/// odometry alone and refuses localized mode with RobotError). The twin drives it and asks where the robot believes it is.
 /// Deterministic for a given config. Not thread-safe: one owner thread.
 class SimRobot final : public Navigator {
  public:
@@ -51,7 +53,6 @@ class SimRobot final : public Navigator {
   Pose2D believed_pose() const override;
   Pose2D true_pose() const { return base_.true_pose(); }
   Pose2D odometry_pose() const { return odometry_.pose(); }
-  const OccupancyMap& map() const { return map_; }
   /// Called with every laser scan the robot takes (while driving and settling; localized mode) and the
   /// wheel odometry at that instant: what a recording keeps as its rawlog.
   void on_scan(std::function<void(const LaserScan&, const Pose2D& odometry)> listener) { on_scan_ = std::move(listener); }
@@ -59,9 +60,9 @@ class SimRobot final : public Navigator {
 
  private:
   SimTourConfig c_;
-  OccupancyMap map_;
+  std::optional<OccupancyMap> map_;  // the room's grid: the laser's world (none in a portable build)
   std::mt19937_64 rng_;
-  Localizer localizer_;
+  std::optional<Localizer> localizer_;  // localized mode only
   SimulatedBase base_;
   WheelOdometry odometry_;
   BaseController controller_;

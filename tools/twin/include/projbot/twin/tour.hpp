@@ -25,6 +25,7 @@ namespace projbot::twin {
 /// odometry: the paper's set-up (initial guess from wheel odometry, one plain ICP per stop).
 /// localized: MRPT localisation and our acquisition (ICP, restarts, FPFH re-initialisation, quality gate).
 /// tracking: localized, and the projective tracker follows the target while projecting.
+/// A portable build (no MRPT, tools/bundle.sh) drives localized and tracking tours on odometry alone.
 enum class TourMode { odometry, localized, tracking };
 const char* to_string(TourMode mode);
 

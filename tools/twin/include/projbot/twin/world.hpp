@@ -32,7 +32,8 @@ class TwinError : public std::runtime_error {
 };
 
 struct TwinOptions {
-  robot::PoseSource pose_source = robot::PoseSource::localized;
+  /// Laser localisation where the build has MRPT; odometry alone in the portable build (tools/bundle.sh).
+  robot::PoseSource pose_source = robot::built_with_mrpt() ? robot::PoseSource::localized : robot::PoseSource::odometry;
   std::uint64_t seed = 1;
   bool depth_noise = true;                   ///< Kinect v1 noise on captured depth...
   alignment::KinectNoiseConfig depth_model;  ///< ...this model of it (KinectNoiseConfig::fitted(): the real frames')
