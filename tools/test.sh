@@ -4,7 +4,7 @@
 # AddressSanitizer + UBSan (on every machine; valgrind's memcheck in the main suite is skipped where
 # valgrind cannot run the executable, see the README), run the whole test suite (GPU tests on lavapipe,
 # window tests under Xvfb), then every fuzz target for a short smoke run (its seeds include every
-# earlier finding).
+# earlier finding), then the portable bundle (tools/bundle-check.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # ccache keys without this checkout's absolute path, so a fresh clone (CI's) reuses earlier compiles.
@@ -21,4 +21,6 @@ ctest --preset ci || status=$?
 # ctest does not show a skipped test's output: say why each one was skipped.
 grep -h '^[a-z]*: SKIPPED:' build/ci/Testing/Temporary/LastTest.log 2>/dev/null || true
 bash tools/fuzz.sh all "${PROJBOT_FUZZ_SMOKE_SECONDS:-15}" || status=1
+# The portable bundle (issue 45): built, under 64 MiB, and run in a root with nothing but glibc and a driver.
+bash tools/bundle-check.sh || status=1
 exit "$status"
