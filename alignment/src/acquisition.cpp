@@ -10,6 +10,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/config/clock.hpp"
 
 namespace projbot::alignment {
 namespace {
@@ -69,7 +70,7 @@ std::optional<AlignmentResult> TargetFollower::projective_first(const DepthImage
   // 80 % within 3 mm and 0.5 degrees without this check, 90 % with it, 97 % always coarse to fine; a
   // firmer threshold, 0.05, sent the figure and duck the slow way too).
   if (!hold && !view_constraints(model_, r.T_scan_model, k_).weak.empty()) return std::nullopt;
-  r.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  r.time_ms = config::ms_since(t0);
   return r;
 }
 

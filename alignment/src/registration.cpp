@@ -29,6 +29,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/assets/model.hpp"
+#include "projbot/config/clock.hpp"
 #include "serial_kdtree.hpp"
 
 namespace projbot::alignment {
@@ -811,8 +812,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
   // any stage at the caller's deadline.
   const auto out_of_time = [&] {
     if (ThreadCpuClock::past(deadline)) return true;
-    return stage != SearchStage::full && stage != SearchStage::icp_only &&
-           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() > m.cfg.attempt_budget_ms;
+    return stage != SearchStage::full && stage != SearchStage::icp_only && config::ms_since(t0) > m.cfg.attempt_budget_ms;
   };
   AlignmentResult best;
   best.T_scan_model = T_init;
@@ -868,7 +868,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
         stage == SearchStage::full && !deadline ? std::numeric_limits<std::size_t>::max() : m.cfg.max_global_points;
     if (const auto T = m.reinitialise(scan, T_init, margin, cap, out_of_time)) attempt(*T, true);
   }
-  best.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  best.time_ms = config::ms_since(t0);
   return best;
 }
 

@@ -14,6 +14,7 @@
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
+#include "projbot/config/clock.hpp"
 
 namespace projbot::alignment {
 namespace {
@@ -310,7 +311,7 @@ TrackResult ProjectiveTracker::track(const DepthImage& depth, const Eigen::Matri
       q.inliers > 0 ? 1000.0 * std::sqrt(q.inlier_sq / static_cast<double>(q.inliers)) : std::numeric_limits<double>::infinity();
   out.accepted =
       q.used >= cfg_.min_correspondences && out.inlier_ratio >= cfg_.min_inlier_ratio && out.rmse_mm <= cfg_.max_rmse_mm;
-  out.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  out.time_ms = config::ms_since(t0);
   return out;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "projbot/alignment/equations.hpp"
+#include "projbot/config/clock.hpp"
 
 namespace projbot::alignment {
 namespace {
@@ -245,7 +246,7 @@ std::optional<PoseSample> TargetFollower::search(const DepthImage& frame, const 
   const SearchStage stage = aligner_.config().reinitialise ? kEscalation[search_attempts_ % 3] : SearchStage::local;
   const auto t0 = std::chrono::steady_clock::now();
   const auto elapsed = [&] {
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms = config::ms_since(t0);
     ++stats_.attempts;
     ++search_attempts_;
     stats_.last_attempt_ms = ms;

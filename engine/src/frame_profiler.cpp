@@ -6,15 +6,14 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "projbot/config/clock.hpp"
 #include "projbot/config/output_file.hpp"
 
 namespace projbot::engine {
 
 FrameProfiler::FrameProfiler() : t0_(std::chrono::steady_clock::now()) {}
 
-double FrameProfiler::now_ms() const {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count();
-}
+double FrameProfiler::now_ms() const { return config::ms_since(t0_); }
 
 void FrameProfiler::add(const FrameRecord& record) { records_.push_back(record); }
 

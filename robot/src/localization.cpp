@@ -30,6 +30,7 @@
 
 #include "icp_slam_ini.hpp"
 #include "mrpt_convert.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/config/isolated_read.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/config/paths.hpp"
@@ -41,7 +42,7 @@ bool built_with_mrpt() { return true; }
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+using config::ms_since;
 
 mrpt::obs::CActionCollection::Ptr odometry_action(const Pose2D& increment, double timestamp_s) {
   mrpt::obs::CActionRobotMovement2D move;

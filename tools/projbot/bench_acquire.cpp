@@ -11,6 +11,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/twin/world.hpp"
 #include "scene_setup.hpp"
@@ -84,8 +85,7 @@ Outcome ours(const alignment::TargetFollower& follower, const alignment::DepthIm
   } catch (const alignment::AlignmentError&) {  // too little left to align: blank
   }
   const bool lit = r.converged && follower.passes(follower.verify(depth, r.T_scan_model));
-  return judged(truth, r.T_scan_model, lit,
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  return judged(truth, r.T_scan_model, lit, config::ms_since(t0));
 }
 
 // PCL's own pipeline: crop around the guess, normals, point-to-plane ICP; lit whenever ICP converges.
@@ -98,8 +98,7 @@ Outcome pcl_pipeline(const alignment::Aligner& aligner, const twin::Twin& twin, 
     r = aligner.align(alignment::depth_to_cloud(depth, twin.camera()), guess, alignment::SearchStage::icp_only);
   } catch (const alignment::AlignmentError&) {
   }
-  return judged(truth, r.T_scan_model, r.converged,
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  return judged(truth, r.T_scan_model, r.converged, config::ms_since(t0));
 }
 
 const char* const kMethods[3] = {"ours", "PCL", "PCL, serial search"};

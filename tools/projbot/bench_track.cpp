@@ -13,6 +13,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/alignment/tracker.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
 #include "scene_setup.hpp"
@@ -73,7 +74,7 @@ Stats measure(const Sequence& sequence, const std::function<Eigen::Matrix4d(int,
   for (std::size_t f = 1; f < sequence.truth.size() && !interrupted(); ++f) {
     const auto t0 = std::chrono::steady_clock::now();
     estimate = step(static_cast<int>(f), estimate);
-    s.ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    s.ms.push_back(config::ms_since(t0));
     const Eigen::Matrix4d err = alignment::rigid_inverse(sequence.truth[f]) * estimate;
     s.err_mm.push_back(alignment::translation_norm_m(err) * 1000.0);
     s.err_deg.push_back(alignment::rotation_angle_deg(err));

@@ -9,6 +9,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/pose_error.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/config/output_file.hpp"
 
 namespace projbot::bench {
@@ -60,7 +61,7 @@ template <typename F>
 double timed_ms(F&& f) {
   const auto t0 = std::chrono::steady_clock::now();
   f();
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return config::ms_since(t0);
 }
 
 // The starts' error is known (the perturbation): an estimate beyond it is something else that fits

@@ -13,6 +13,7 @@
 
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/image.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/twin/tour.hpp"
 #include "projbot/twin/world.hpp"
 
@@ -20,10 +21,7 @@ namespace projbot::twin {
 
 constexpr double kCameraHz = 30.0;  ///< the twin's depth camera, on the simulated clock
 
-/// Wall milliseconds since t0.
-inline double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
+using config::ms_since;  // wall milliseconds of a step
 
 // What a stop's acquisition gave for one target: the estimate, its check against free space, whether it
 // is lit, and its wall time.
