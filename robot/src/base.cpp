@@ -48,4 +48,18 @@ BaseTwist BaseController::update(const Pose2D& estimate, const Pose2D& goal, dou
   return cmd;
 }
 
+bool drive_loop(BaseController& controller, DriveSteps& steps, const Pose2D& goal, double timeout_s) {
+  controller.reset();
+  for (long step = 0;; ++step) {
+    steps.sense(step);
+    const BaseTwist cmd = controller.update(steps.believed_pose(), goal, steps.step_s());
+    if (controller.arrived() || steps.elapsed_s() > timeout_s) break;
+    steps.command(cmd);
+  }
+  steps.halt();
+  const bool arrived = controller.arrived();
+  steps.settle();
+  return arrived;
+}
+
 }  // namespace projbot::robot

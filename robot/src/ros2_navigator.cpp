@@ -61,37 +61,60 @@ Odometry2D Ros2Navigator::fresh(double& last_change_s) {
   return o;
 }
 
+// A drive's steps on the wall clock at rate_hz: the newest odometry and a scan matched against the map
+// (with a laser) every control period.
+class Ros2Navigator::Steps final : public DriveSteps {
+ public:
+  explicit Steps(Ros2Navigator& navigator)
+      : n_(navigator),
+        period_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+            std::chrono::duration<double>(1.0 / navigator.rate_hz_))),
+        tick_(std::chrono::steady_clock::now()),
+        t0_(config::steady_now_s()),
+        last_change_(t0_),
+        last_step_(t0_) {}
+  void sense(long) override {
+    n_.fresh(last_change_);
+    n_.correct(last_change_, corrections);  // the laser's scan waits at most one of its periods (40 Hz: 25 ms)
+  }
+  Pose2D believed_pose() const override { return n_.believed_pose(); }
+  double step_s() override {
+    const double now = config::steady_now_s(), dt = now - last_step_;
+    last_step_ = now;
+    return dt;
+  }
+  double elapsed_s() const override { return config::steady_now_s() - t0_; }
+  void command(const BaseTwist& twist) override {
+    n_.base_.send(twist);
+    std::this_thread::sleep_until(tick_ += period_);
+  }
+  void halt() override { n_.base_.send({}); }
+  void settle() override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // let it stop, then read where it stands
+    n_.fresh(last_change_);
+    for (int i = 0; i < n_.settle_scans_ && n_.laser_; ++i) n_.correct(last_change_, corrections);  // the stop's best fix
+  }
+  Corrections corrections;
+
+ private:
+  Ros2Navigator& n_;
+  std::chrono::steady_clock::duration period_;
+  std::chrono::steady_clock::time_point tick_;
+  double t0_, last_change_, last_step_;
+};
+
 StopReport Ros2Navigator::drive_to(const Pose2D& goal, int index) {
   StopReport r;
   r.index = index;
   r.goal = goal;
-  controller_.reset();
-  const double t0 = config::steady_now_s();
-  double last_change = t0, last_step = t0;
-  Corrections c;
-  const auto period = std::chrono::duration<double>(1.0 / rate_hz_);
-  for (auto tick = std::chrono::steady_clock::now();;
-       tick += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period)) {
-    std::this_thread::sleep_until(tick);
-    fresh(last_change);
-    correct(last_change, c);  // the laser's scan waits at most one of its periods (40 Hz: 25 ms)
-    const double now = config::steady_now_s();
-    const BaseTwist cmd = controller_.update(believed_pose(), goal, now - last_step);
-    last_step = now;
-    if (controller_.arrived() || now - t0 > timeout_s_) break;
-    base_.send(cmd);
-  }
-  base_.send({});
-  r.arrived = controller_.arrived();
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // let it stop, then read where it stands
-  fresh(last_change);
-  for (int i = 0; i < settle_scans_ && laser_; ++i) correct(last_change, c);  // standing still: the stop's best fix
-  r.drive_seconds = config::steady_now_s() - t0;
+  Steps steps(*this);
+  r.arrived = drive_loop(controller_, steps, goal, timeout_s_);
+  r.drive_seconds = steps.elapsed_s();
   r.estimate = believed_pose();
   r.odometry = compose(T_map_odom_start_, last_.pose);
-  r.corrections = c.count;
-  r.rejected = c.rejected;
-  r.correct_ms_mean = c.count > 0 ? c.ms / c.count : 0.0;
+  r.corrections = steps.corrections.count;
+  r.rejected = steps.corrections.rejected;
+  r.correct_ms_mean = steps.corrections.count > 0 ? steps.corrections.ms / steps.corrections.count : 0.0;
   return r;
 }
 

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "projbot/config/clock.hpp"
+
 namespace projbot::robot {
 
 SimTourConfig default_sim_tour() {
@@ -58,45 +60,59 @@ SimRobot::SimRobot(const SimTourConfig& config)
 
 Pose2D SimRobot::believed_pose() const { return localizer_ ? localizer_->pose() : odometry_.pose(); }
 
+// A drive's steps on the simulated clock: wheel odometry every control period, localisation predicted
+// with it and corrected with every localize_every-th scan (localized mode).
+class SimRobot::Steps final : public DriveSteps {
+ public:
+  Steps(SimRobot& robot, StopReport& report) : r_(robot), report_(report), t_start_(robot.time_s_) {}
+  void sense(long step) override {
+    const Pose2D before = r_.odometry_.pose();
+    const Pose2D& after = r_.odometry_.update(r_.base_.read_encoders());
+    if (!r_.localizer_) return;
+    r_.localizer_->predict(between(before, after));
+    if (step % r_.c_.localize_every == 0) scan_and_correct();
+  }
+  Pose2D believed_pose() const override { return r_.believed_pose(); }
+  double step_s() override { return r_.c_.control_dt_s; }
+  double elapsed_s() const override { return r_.time_s_ - t_start_; }
+  void command(const BaseTwist& twist) override {
+    r_.base_.set_wheel_speeds(wheel_speeds_from_twist(twist, r_.base_.geometry()));
+    r_.base_.advance(r_.c_.control_dt_s);
+    r_.time_s_ += r_.c_.control_dt_s;
+  }
+  void halt() override { r_.base_.set_wheel_speeds({}); }
+  void settle() override {
+    if (!r_.localizer_) return;
+    for (int k = 0; k < r_.c_.controller.settle_scans; ++k) {  // at rest, one scan per laser period (the control period)
+      r_.time_s_ += r_.c_.control_dt_s;
+      scan_and_correct();
+    }
+  }
+  double correct_ms = 0.0;  ///< wall time of the corrections, together
+
+ private:
+  void scan_and_correct() {
+    LaserScan scan = r_.map_->simulate_scan(r_.base_.true_pose(), r_.c_.laser, r_.rng_);
+    scan.timestamp_s = r_.time_s_;
+    if (r_.on_scan_) r_.on_scan_(scan, r_.odometry_.pose());
+    const auto t0 = std::chrono::steady_clock::now();
+    const LocalizationUpdate u = r_.localizer_->correct(scan);
+    correct_ms += config::ms_since(t0);
+    ++report_.corrections;
+    if (!u.accepted) ++report_.rejected;
+  }
+  SimRobot& r_;
+  StopReport& report_;
+  double t_start_;
+};
+
 StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
   StopReport r;
   r.index = index;
   r.goal = goal;
-  controller_.reset();
-  double ms_total = 0.0;
-  const auto scan_and_correct = [&] {
-    LaserScan scan = map_->simulate_scan(base_.true_pose(), c_.laser, rng_);
-    scan.timestamp_s = time_s_;
-    if (on_scan_) on_scan_(scan, odometry_.pose());
-    const auto t0 = std::chrono::steady_clock::now();
-    const LocalizationUpdate u = localizer_->correct(scan);
-    ms_total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    ++r.corrections;
-    if (!u.accepted) ++r.rejected;
-  };
-  const double t_start = time_s_;
-  for (long step = 0;; ++step) {
-    const Pose2D before = odometry_.pose();
-    const Pose2D& after = odometry_.update(base_.read_encoders());
-    if (c_.source == PoseSource::localized) {
-      localizer_->predict(between(before, after));
-      if (step % c_.localize_every == 0) scan_and_correct();
-    }
-    const BaseTwist cmd = controller_.update(believed_pose(), goal, c_.control_dt_s);
-    if (controller_.arrived()) break;
-    if (time_s_ - t_start > c_.max_seconds_per_stop) break;
-    base_.set_wheel_speeds(wheel_speeds_from_twist(cmd, base_.geometry()));
-    base_.advance(c_.control_dt_s);
-    time_s_ += c_.control_dt_s;
-  }
-  base_.set_wheel_speeds({});
-  r.arrived = controller_.arrived();
-  if (c_.source == PoseSource::localized)
-    for (int k = 0; k < c_.controller.settle_scans; ++k) {  // at rest, one scan per laser period (the control period)
-      time_s_ += c_.control_dt_s;
-      scan_and_correct();
-    }
-  r.drive_seconds = time_s_ - t_start;
+  Steps steps(*this, r);
+  r.arrived = drive_loop(controller_, steps, goal, c_.max_seconds_per_stop);
+  r.drive_seconds = steps.elapsed_s();
   r.truth = base_.true_pose();
   r.odometry = odometry_.pose();
   r.estimate = believed_pose();
@@ -105,7 +121,7 @@ StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
   r.odometry_error_m = distance_m(r.odometry, r.truth);
   r.odometry_error_rad = heading_error_rad(r.odometry, r.truth);
   r.arrival_error_m = distance_m(r.truth, goal);
-  r.correct_ms_mean = r.corrections > 0 ? ms_total / r.corrections : 0.0;
+  r.correct_ms_mean = r.corrections > 0 ? steps.correct_ms / r.corrections : 0.0;
   return r;
 }
 

@@ -59,4 +59,28 @@ class BaseController {
   bool arrived_ = false;
 };
 
+/// What differs between robots at each step of a drive to a stop (the twin's simulated base on its
+/// simulated clock, a real base over ROS 2 on the wall clock); drive_loop() is the loop around them.
+class DriveSteps {
+ public:
+  virtual ~DriveSteps() = default;
+  /// Reads the odometry (and, when one is due at this step, a laser scan) into the believed pose.
+  virtual void sense(long step) = 0;
+  virtual Pose2D believed_pose() const = 0;
+  /// Seconds since the last control step (the controller's dt).
+  virtual double step_s() = 0;
+  /// Seconds since the drive began.
+  virtual double elapsed_s() const = 0;
+  /// Sends `twist` to the base and waits out the control period.
+  virtual void command(const BaseTwist& twist) = 0;
+  /// Stops the base.
+  virtual void halt() = 0;
+  /// At rest after the drive: the stop's last corrections (laser scans against the map).
+  virtual void settle() = 0;
+};
+
+/// The drive to a stop: sense, ask `controller`, command, until it says arrived or `timeout_s` has passed;
+/// then halt and settle. Returns whether it arrived.
+bool drive_loop(BaseController& controller, DriveSteps& steps, const Pose2D& goal, double timeout_s);
+
 }  // namespace projbot::robot

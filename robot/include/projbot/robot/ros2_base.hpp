@@ -84,6 +84,7 @@ class Ros2Navigator final : public Navigator {
     int count = 0, rejected = 0;
     double ms = 0.0;
   };
+  class Steps;  // a drive's steps, for drive_loop()
   Odometry2D fresh(double& last_change_s);
   /// One scan matched against the map (with the newest odometry); stops the base when the laser fails.
   void correct(double& last_change_s, Corrections& c);

@@ -59,6 +59,7 @@ class SimRobot final : public Navigator {
   double time_s() const { return time_s_; }
 
  private:
+  class Steps;  // a drive's steps, for drive_loop()
   SimTourConfig c_;
   std::optional<OccupancyMap> map_;  // the room's grid: the laser's world (none in a portable build)
   std::mt19937_64 rng_;
