@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "projbot/robot/base.hpp"
 #include "projbot/robot/pan_tilt.hpp"
@@ -152,6 +153,63 @@ TEST(BaseController, ReachesAGoalWithinLimitsAndTolerance) {
   EXPECT_LE(peak_speed, cfg.max_speed_m_s + 1e-9);
   EXPECT_LE(peak_accel, cfg.max_accel_m_s2 * std::sqrt(2.0) + 1e-6);  // per axis limit
   EXPECT_LT(steps * dt, 15.0);                                        // 2.2 m at 0.4 m/s with ramps: about 7 s
+}
+
+// drive_loop's steps on a simulated base that believes the truth, counting what the loop asked of them.
+class CountingSteps final : public DriveSteps {
+ public:
+  explicit CountingSteps(double dt) : base_({0, 0, 0}, projbot::config::OdometryDrift::none()), dt_(dt) {}
+  void sense(long step) override { sensed.push_back(step); }
+  Pose2D believed_pose() const override { return base_.true_pose(); }
+  double step_s() override { return dt_; }
+  double elapsed_s() const override { return t_; }
+  void command(const BaseTwist& twist) override {
+    ASSERT_EQ(halts, 0) << "commanded after the halt";
+    base_.set_wheel_speeds(wheel_speeds_from_twist(twist));
+    base_.advance(dt_);
+    t_ += dt_;
+    ++commands;
+  }
+  void halt() override {
+    base_.set_wheel_speeds({});
+    ++halts;
+  }
+  void settle() override {
+    EXPECT_EQ(halts, 1) << "settled before the halt";
+    ++settles;
+  }
+  const SimulatedBase& base() const { return base_; }
+  std::vector<long> sensed;
+  int commands = 0, halts = 0, settles = 0;
+
+ private:
+  SimulatedBase base_;
+  double dt_, t_ = 0.0;
+};
+
+TEST(DriveLoop, SensesEachStepStopsOnArrivalThenHaltsAndSettlesOnce) {
+  BaseController ctl;
+  CountingSteps steps(0.025);
+  const Pose2D goal{1.0, 0.5, deg(45)};
+  ASSERT_TRUE(drive_loop(ctl, steps, goal, 60.0));
+  EXPECT_LT(distance_m(steps.base().true_pose(), goal), ControllerConfig{}.position_tolerance_m);
+  EXPECT_EQ(steps.halts, 1);
+  EXPECT_EQ(steps.settles, 1);
+  // One sense per step, numbered from 0; every step but the arriving one commanded.
+  ASSERT_FALSE(steps.sensed.empty());
+  for (std::size_t i = 0; i < steps.sensed.size(); ++i) ASSERT_EQ(steps.sensed[i], static_cast<long>(i));
+  EXPECT_EQ(steps.commands + 1, static_cast<int>(steps.sensed.size()));
+  EXPECT_TRUE(steps.base().commanded() == WheelSpeeds{}) << "the base was left moving";
+}
+
+TEST(DriveLoop, GivesUpAtTheTimeoutNotArrivedAndStillHalts) {
+  BaseController ctl;
+  CountingSteps steps(0.025);
+  EXPECT_FALSE(drive_loop(ctl, steps, {5.0, 0.0, 0.0}, 1.0));  // 5 m cannot be driven in 1 s
+  EXPECT_NEAR(steps.commands * 0.025, 1.0, 0.03);
+  EXPECT_EQ(steps.halts, 1);
+  EXPECT_EQ(steps.settles, 1);
+  EXPECT_TRUE(steps.base().commanded() == WheelSpeeds{});
 }
 
 projbot::config::PanTiltConfig bare_rig() {
