@@ -45,7 +45,7 @@ std::string error_of(const std::function<void()>& f) {
 SimulationConfig twin_config(int poses) {
   SimulationConfig c;
   c.poses = poses;
-  c.camera.pinhole = projbot::config::Pinhole::kinect_v1();
+  static_cast<projbot::config::Pinhole&>(c.camera) = projbot::config::Pinhole::kinect_v1();
   c.camera.distortion = {0.10, -0.20, 0.0005, -0.0005, 0.0};
   c.projector = projbot::config::ProjectorConfig();
   c.T_projector_camera.block<3, 3>(0, 0) =
@@ -206,20 +206,20 @@ TEST(SimulateSolve, RecoversTheTruthOfTenPoses) {
   for (const ViewResult& v : s.views) EXPECT_TRUE(v.refused.empty()) << v.folder << ": " << v.refused;
   EXPECT_LE(s.projector_rms_px, 0.3);
   EXPECT_LE(s.camera_rms_px, 0.2);
-  const auto& p = s.projector.pinhole;
+  const projbot::config::Pinhole& p = s.projector;
   EXPECT_NEAR(p.fx_px / c.projector.fx_px, 1.0, 0.003);
   EXPECT_NEAR(p.fy_px / c.projector.fy_px, 1.0, 0.003);
   EXPECT_LT(std::hypot(p.cx_px - c.projector.cx_px, p.cy_px - c.projector.cy_px), 2.0);
-  const auto& k = s.camera.pinhole;
-  EXPECT_NEAR(k.fx_px / c.camera.pinhole.fx_px, 1.0, 0.003);
-  EXPECT_NEAR(k.fy_px / c.camera.pinhole.fy_px, 1.0, 0.003);
-  EXPECT_LT(std::hypot(k.cx_px - c.camera.pinhole.cx_px, k.cy_px - c.camera.pinhole.cy_px), 2.0);
+  const projbot::config::Pinhole& k = s.camera;
+  EXPECT_NEAR(k.fx_px / c.camera.fx_px, 1.0, 0.003);
+  EXPECT_NEAR(k.fy_px / c.camera.fy_px, 1.0, 0.003);
+  EXPECT_LT(std::hypot(k.cx_px - c.camera.cx_px, k.cy_px - c.camera.cy_px), 2.0);
   EXPECT_LT((s.T_projector_camera.block<3, 1>(0, 3) - c.T_projector_camera.block<3, 1>(0, 3)).norm(), 0.001);
   EXPECT_LT(angle_deg(s.T_projector_camera, c.T_projector_camera), 0.1);
   EXPECT_GT(s.projector_coverage, 0.3);
   // The truth the folder carries is what it was made with.
   const Calibration t = read_calibration(dir / "truth.yaml");
-  EXPECT_DOUBLE_EQ(t.projector.pinhole.fx_px, c.projector.fx_px);
+  EXPECT_DOUBLE_EQ(t.projector.fx_px, c.projector.fx_px);
   EXPECT_TRUE(t.T_projector_camera.isApprox(c.T_projector_camera, 1e-12));
   fs::remove_all(dir.parent_path());
 }

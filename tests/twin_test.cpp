@@ -794,7 +794,7 @@ TEST_F(ShopDuckStop, ColourIsRegisteredToDepthWithTheModelsTextureAndNoise) {
   ASSERT_EQ(colour.height, depth.height);
   EXPECT_EQ(twin.capture_colour(T_world_camera, 7).rgba, colour.rgba);  // seeded
   // The Duck alone, noiseless, in colour and depth.
-  const projbot::config::ProjectorConfig pinhole = twin.camera_pinhole();
+  const projbot::config::ProjectorConfig pinhole(twin.camera_pinhole());  // drawn through, as the twin does
   const std::vector<projbot::engine::DrawItem> duck_only{
       {twin.target_model_ids()[duck],
        projbot::alignment::rigid_inverse(T_world_camera) * twin.targets()[duck].T_world_target_true}};

@@ -49,12 +49,12 @@ std::optional<Eigen::Vector2d> undistort(const Distortion& k, const Eigen::Vecto
   return std::nullopt;
 }
 
-Eigen::Vector2d ProjectorConfig::project_lit(const Eigen::Vector3d& p) const {
+Eigen::Vector2d Camera::project_lit(const Eigen::Vector3d& p) const {
   const Eigen::Vector2d d = distort(distortion, {p.x() / p.z(), p.y() / p.z()});
   return project({d.x(), d.y(), 1.0});
 }
 
-std::optional<Eigen::Vector3d> ProjectorConfig::panel_ray(double u, double v) const {
+std::optional<Eigen::Vector3d> Camera::panel_ray(double u, double v) const {
   const auto x = undistort(distortion, back_project(u, v, 1.0).head<2>());
   if (!x) return std::nullopt;
   return Eigen::Vector3d(x->x(), x->y(), 1.0);

@@ -297,7 +297,7 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
       if (root.has("projector") && root.child("projector", false)[key])
         root.fail(node, "calibration",
                   std::string("projector.") + key + " is the calibration's photometry; leave it out of the scene");
-  static_cast<Pinhole&>(scene.projector) = c.projector.pinhole;
+  static_cast<Pinhole&>(scene.projector) = c.projector;
   scene.projector.distortion = c.projector.distortion;
   if (c.photometry) {
     const double lumens = scene.projector.photometry.brightness_lm;
@@ -344,7 +344,7 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
   } catch (const ConfigError& e) {
     r.fail(c["projector"], "", e.what());
   }
-  out.projector = {k, k.distortion};
+  out.projector = k;
   out.T_projector_camera = read_pose(r, "projector_from_camera", "projector_from_camera");
   if (!c["projector_from_camera"]) r.fail(c, "projector_from_camera", "missing required key");
   if (YAML::Node rms = r.child("reprojection_rms_px", false)) {  // what the calibration measured: informational here
@@ -506,7 +506,7 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
   scene.projector =
       read_pinhole(r, "projector", r.has("calibration") ? std::optional<ProjectorConfig>(ProjectorConfig{}) : std::nullopt);
   scene.pan_tilt = read_robot(r, scene);
-  scene.depth_camera = read_pinhole(r, "camera", Scene::kinect_v1_depth_camera());
+  scene.depth_camera = read_pinhole(r, "camera", ProjectorConfig(Scene::kinect_v1_depth_camera()));
   read_room(r, file, scene);
   if (root["robot"] && root["robot"].IsMap() && root["robot"]["start"]) {
     if (const std::string why = place_problem(scene.room, scene.robot_start.x(), scene.robot_start.y()); !why.empty())

@@ -146,7 +146,7 @@ namespace {
 
 // Points spread over a triangle (the middles of an m x m subdivision), m from its size in the camera's
 // image: about one point per 4 x 4 pixels, at most 256.
-std::vector<Eigen::Vector3d> spread_over(const Eigen::Vector3d (&x)[3], const config::ProjectorConfig& camera,
+std::vector<Eigen::Vector3d> spread_over(const Eigen::Vector3d (&x)[3], const config::Camera& camera,
                                          const Eigen::Matrix4d& T_camera_target) {
   Eigen::Vector2d px[3];
   for (int k = 0; k < 3; ++k) {
@@ -167,7 +167,7 @@ std::vector<Eigen::Vector3d> spread_over(const Eigen::Vector3d (&x)[3], const co
 
 }  // namespace
 
-std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::ProjectorConfig& camera,
+std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::Camera& camera,
                                               const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
                                               const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
                                               const assets::Image& under_grey, double grey) {

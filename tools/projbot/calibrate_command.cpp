@@ -36,9 +36,9 @@ calibrate::Board board_option(const cli::Args& args) {
   }
 }
 
-calibrate::Lens twin_colour_lens(const config::Scene& scene) {
-  calibrate::Lens l;
-  l.pinhole = scene.depth_camera;
+calibrate::Camera twin_colour_lens(const config::Scene& scene) {
+  calibrate::Camera l;
+  static_cast<config::Pinhole&>(l) = scene.depth_camera;
   l.distortion = {0.10, -0.20, 0.0005, -0.0005, 0.0};
   return l;
 }
@@ -79,7 +79,7 @@ int run_simulate(const cli::Args& args) {
     return interrupt_exit_code();
   }
   std::cout << "wrote " << written << " board poses (" << calibrate::images_per_pose(c.projector.width_px, c.projector.height_px)
-            << " images each, " << c.camera.pinhole.width_px << "x" << c.camera.pinhole.height_px << ") and the truth to " << *out
+            << " images each, " << c.camera.width_px << "x" << c.camera.height_px << ") and the truth to " << *out
             << "\nnext: projbot calibrate solve " << *out << " --out calib.yaml\n";
   if (written < c.poses) std::cout << "interrupted after " << written << " of " << c.poses << " poses\n";
   return interrupted() ? interrupt_exit_code() : 0;
@@ -103,8 +103,8 @@ void print_result(const calibrate::Calibration& c) {
     else
       std::cout << ", refused: " << v.refused << '\n';
   }
-  const auto& p = c.projector.pinhole;
-  const auto& k = c.camera.pinhole;
+  const config::Pinhole& p = c.projector;
+  const config::Pinhole& k = c.camera;
   std::cout << "projector " << p.width_px << "x" << p.height_px << ": fx " << p.fx_px << " fy " << p.fy_px << " cx " << p.cx_px
             << " cy " << p.cy_px;
   if (config::has_distortion(c.projector.distortion))
@@ -121,8 +121,8 @@ void print_result(const calibrate::Calibration& c) {
 }
 
 // How far apart two lenses put the same ray on the panel, at most over the image (in the truth's pixels).
-double lens_difference_px(const calibrate::Lens& fit, const calibrate::Lens& truth) {
-  const config::Pinhole& k = truth.pinhole;
+double lens_difference_px(const calibrate::Camera& fit, const calibrate::Camera& truth) {
+  const config::Pinhole& k = truth;
   double worst = 0.0;
   for (int j = 0; j <= 20; ++j)
     for (int i = 0; i <= 20; ++i) {
@@ -136,10 +136,10 @@ double lens_difference_px(const calibrate::Lens& fit, const calibrate::Lens& tru
 // The solve beside the truth a simulated capture carries.
 void print_truth(const calibrate::Calibration& c, const calibrate::Calibration& t) {
   const auto pct = [](double a, double b) { return 100.0 * std::abs(a - b) / b; };
-  const auto& p = c.projector.pinhole;
-  const auto& q = t.projector.pinhole;
-  const auto& k = c.camera.pinhole;
-  const auto& l = t.camera.pinhole;
+  const config::Pinhole& p = c.projector;
+  const config::Pinhole& q = t.projector;
+  const config::Pinhole& k = c.camera;
+  const config::Pinhole& l = t.camera;
   const Eigen::Matrix3d dR = c.T_projector_camera.block<3, 3>(0, 0) * t.T_projector_camera.block<3, 3>(0, 0).transpose();
   const double angle_deg = std::acos(std::clamp((dR.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
   const double dt_mm = 1000.0 * (c.T_projector_camera.block<3, 1>(0, 3) - t.T_projector_camera.block<3, 1>(0, 3)).norm();

@@ -106,10 +106,10 @@ const Command kTour{
       const auto scene = config::load_scene(scene_path);
       if (const auto calibration = args.get("calibration")) {
         o.calibration = config::load_calibration(*calibration);
-        if (o.calibration->projector.pinhole.width_px != scene.projector.width_px ||
-            o.calibration->projector.pinhole.height_px != scene.projector.height_px)
-          throw config::ConfigError(*calibration + ": a " + std::to_string(o.calibration->projector.pinhole.width_px) + "x" +
-                                    std::to_string(o.calibration->projector.pinhole.height_px) + " projector, the scene's is " +
+        if (o.calibration->projector.width_px != scene.projector.width_px ||
+            o.calibration->projector.height_px != scene.projector.height_px)
+          throw config::ConfigError(*calibration + ": a " + std::to_string(o.calibration->projector.width_px) + "x" +
+                                    std::to_string(o.calibration->projector.height_px) + " projector, the scene's is " +
                                     std::to_string(scene.projector.width_px) + "x" + std::to_string(scene.projector.height_px));
       }
       std::cout << "Tour of " << scene_path << " in " << mode << " mode" << kModeHints.at(mode)

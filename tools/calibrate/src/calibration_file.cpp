@@ -14,10 +14,10 @@
 namespace projbot::calibrate {
 namespace {
 
-std::string pinhole_fields(const Lens& l) {
+std::string pinhole_fields(const Camera& l) {
   std::ostringstream y;
   y.precision(17);
-  const config::Pinhole& p = l.pinhole;
+  const config::Pinhole& p = l;
   y << "width: " << p.width_px << ", height: " << p.height_px << ", fx: " << p.fx_px << ", fy: " << p.fy_px << ", cx: " << p.cx_px
     << ", cy: " << p.cy_px << ", distortion: [";
   for (std::size_t i = 0; i < l.distortion.size(); ++i) y << (i ? ", " : "") << l.distortion[i];
@@ -31,10 +31,10 @@ std::string quoted(const std::string& s) {
   return out + "\"";
 }
 
-Lens read_lens(const YAML::Node& n) {
-  Lens l;
-  l.pinhole = config::Pinhole{n["width"].as<int>(), n["height"].as<int>(), n["fx"].as<double>(),
-                              n["fy"].as<double>(), n["cx"].as<double>(),  n["cy"].as<double>()};
+Camera read_lens(const YAML::Node& n) {
+  Camera l;
+  static_cast<config::Pinhole&>(l) = config::Pinhole{n["width"].as<int>(), n["height"].as<int>(), n["fx"].as<double>(),
+                                                     n["fy"].as<double>(), n["cx"].as<double>(),  n["cy"].as<double>()};
   if (n["distortion"])
     for (std::size_t i = 0; i < n["distortion"].size() && i < 5; ++i) l.distortion[i] = n["distortion"][i].as<double>();
   return l;

@@ -25,16 +25,16 @@ constexpr int kSub = 4;  // samples per pixel along each axis: a pixel integrate
 cv::Matx33d camera_matrix(const config::Pinhole& p) { return {p.fx_px, 0, p.cx_px, 0, p.fy_px, p.cy_px, 0, 0, 1}; }
 
 // The undistorted viewing ray (x, y, 1) of each camera sample, kSub x kSub per pixel, row-major.
-std::vector<cv::Point2d> sample_rays(const Lens& camera) {
+std::vector<cv::Point2d> sample_rays(const Camera& camera) {
   std::vector<cv::Point2d> pixels;
-  const int w = camera.pinhole.width_px, h = camera.pinhole.height_px;
+  const int w = camera.width_px, h = camera.height_px;
   pixels.reserve(static_cast<std::size_t>(w * h * kSub * kSub));
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
       for (int sy = 0; sy < kSub; ++sy)
         for (int sx = 0; sx < kSub; ++sx) pixels.emplace_back(x + (sx + 0.5) / kSub - 0.5, y + (sy + 0.5) / kSub - 0.5);
   std::vector<cv::Point2d> rays;
-  cv::undistortPoints(pixels, rays, camera_matrix(camera.pinhole), cv::Mat(camera.distortion), cv::noArray(), cv::noArray(),
+  cv::undistortPoints(pixels, rays, camera_matrix(camera), cv::Mat(camera.distortion), cv::noArray(), cv::noArray(),
                       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 40, 1e-12));
   return rays;
 }
@@ -135,7 +135,7 @@ std::vector<Sample> trace(const SimulationConfig& c, const Geometry& g, const st
 
 // One camera image of one projected pattern: samples averaged per pixel, optical blur, noise, 8 bits.
 cv::Mat expose(const SimulationConfig& c, const std::vector<Sample>& samples, const cv::Mat& pattern, std::mt19937_64& rng) {
-  const int w = c.camera.pinhole.width_px, h = c.camera.pinhole.height_px;
+  const int w = c.camera.width_px, h = c.camera.height_px;
   cv::Mat radiance(h, w, CV_32F);
   const uchar* light = pattern.ptr<uchar>(0);
   const float ambient = static_cast<float>(c.ambient), direct = 1.0f - ambient;
@@ -186,10 +186,8 @@ bool pose_fits(const SimulationConfig& c, const Geometry& g, const Eigen::Matrix
       if (paper) {
         std::vector<cv::Point3d> in{{P.x(), P.y(), P.z()}};
         std::vector<cv::Point2d> out;
-        cv::projectPoints(in, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera_matrix(c.camera.pinhole),
-                          cv::Mat(c.camera.distortion), out);
-        if (out[0].x < 4 || out[0].y < 4 || out[0].x > c.camera.pinhole.width_px - 5 || out[0].y > c.camera.pinhole.height_px - 5)
-          return false;
+        cv::projectPoints(in, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera_matrix(c.camera), cv::Mat(c.camera.distortion), out);
+        if (out[0].x < 4 || out[0].y < 4 || out[0].x > c.camera.width_px - 5 || out[0].y > c.camera.height_px - 5) return false;
       } else {
         const Eigen::Vector3d Pp = (c.T_projector_camera * P.homogeneous()).head<3>();
         if (Pp.z() <= 0.2 || !c.projector.contains(c.projector.project_lit(Pp))) return false;
@@ -274,7 +272,7 @@ int simulate(const SimulationConfig& c, const std::filesystem::path& out, const 
   if (written == 0) return 0;  // stopped before the first pose: the writer removes its folder
   Calibration truth;
   truth.camera = c.camera;
-  truth.projector = Lens{c.projector, c.projector.distortion};
+  truth.projector = Camera{c.projector};
   truth.T_projector_camera = c.T_projector_camera;
   truth.T_camera_board.assign(poses.begin(), poses.begin() + written);
   writer.finish(manifest, truth);
@@ -311,7 +309,7 @@ class TwinRig final : public CaptureRig {
   std::optional<Calibration> truth() const override {
     Calibration t;
     t.camera = c_.camera;
-    t.projector = Lens{c_.projector, c_.projector.distortion};
+    t.projector = Camera{c_.projector};
     t.T_projector_camera = c_.T_projector_camera;
     t.T_camera_board = kept_;
     return t;

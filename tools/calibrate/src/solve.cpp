@@ -49,9 +49,9 @@ ViewResult measure_view(const CaptureManifest& m, const cv::Mat& lit, const std:
 
 namespace {
 
-Lens lens_from(const cv::Mat& K, const cv::Mat& D, cv::Size size) {
-  Lens l;
-  l.pinhole =
+Camera lens_from(const cv::Mat& K, const cv::Mat& D, cv::Size size) {
+  Camera l;
+  static_cast<config::Pinhole&>(l) =
       config::Pinhole{size.width, size.height, K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2), K.at<double>(1, 2)};
   for (int i = 0; i < 5 && i < static_cast<int>(D.total()); ++i) l.distortion[static_cast<std::size_t>(i)] = D.at<double>(i);
   return l;

@@ -54,8 +54,7 @@ config::ProjectorConfig spectator_eye() {
 SpectatorView::SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector)
     : SpectatorView(renderer, projector, spectator_eye()) {}
 
-SpectatorView::SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector,
-                             const config::ProjectorConfig& eye)
+SpectatorView::SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector, const config::Camera& eye)
     : renderer_(renderer), projector_(projector), pinhole_(eye) {
   colour_ = renderer_.make_offscreen(pinhole_.width_px, pinhole_.height_px);
   depth_ = renderer_.make_depth_camera(pinhole_.width_px, pinhole_.height_px);

@@ -172,7 +172,7 @@ NeighbourLight neighbour_light(const Twin& twin, const Acquired& a, std::size_t 
 ProjectorModels projector_models(const config::Scene& scene, const TourOptions& options) {
   ProjectorModels models{scene.projector, scene.projector, scene.pan_tilt.T_projector_camera};
   if (options.calibration) {
-    static_cast<config::Pinhole&>(models.believed) = options.calibration->projector.pinhole;
+    static_cast<config::Pinhole&>(models.believed) = options.calibration->projector;
     models.believed.distortion = options.calibration->projector.distortion;
     if (options.calibration->photometry) {  // its response and mixing; the lumens stay the scene's unless it gave them
       models.believed.photometry = *options.calibration->photometry;

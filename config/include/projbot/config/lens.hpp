@@ -14,13 +14,6 @@ namespace projbot::config {
 /// k1, k2, p1, p2, k3; all zero is a pinhole.
 using Distortion = std::array<double, 5>;
 
-/// A camera's or projector's lens as a calibration gives it: its pinhole and its distortion. The
-/// calibration's two lenses (camera and projector) and a calibration file's projector.
-struct Lens {
-  Pinhole pinhole;
-  Distortion distortion{};
-};
-
 /// Whether any coefficient is non-zero.
 bool has_distortion(const Distortion& k);
 
@@ -33,5 +26,26 @@ std::optional<Eigen::Vector2d> undistort(const Distortion& k, const Eigen::Vecto
 
 /// The Jacobian of distort() at x (its determinant <= 0 where the lens folds the image over).
 Eigen::Matrix2d distort_jacobian(const Distortion& k, const Eigen::Vector2d& x);
+
+/// The one camera type: a pinhole (A_p, Eq. 3), its lens's distortion and the depth range it draws. The
+/// projector's (ProjectorConfig adds its refresh, lag and photometry), the depth camera's (`camera:`, a
+/// pinhole: no distortion), the colour camera's and a calibration's two lenses (whose clip range is unused).
+struct Camera : Pinhole {
+  Camera() = default;
+  Camera(const Pinhole& pinhole, double near, double far, const Distortion& lens = {})
+      : Pinhole(pinhole), near_m(near), far_m(far), distortion(lens) {}
+  double near_m = 0.1;  ///< near clipping distance along z, metres (> 0)
+  double far_m = 20.0;  ///< far clipping distance along z, metres (> near_m)
+  /// k1, k2, p1, p2, k3 (`projector.distortion`, or a calibration's); zero for a pinhole. The renderer
+  /// pre-distorts the projector's image by it.
+  Distortion distortion{};
+
+  /// The image position where point p (z > 0) lands through the lens: A after the distortion. Equals
+  /// project(p) without distortion. (For a projector: the panel pixel whose light reaches p.)
+  Eigen::Vector2d project_lit(const Eigen::Vector3d& p) const;
+  /// The direction (x, y, 1) that image position (u, v) sees (a projector: sends its light out along): the
+  /// lens undone. Empty where the distortion cannot be inverted (validate_projector refuses such lenses).
+  std::optional<Eigen::Vector3d> panel_ray(double u, double v) const;
+};
 
 }  // namespace projbot::config

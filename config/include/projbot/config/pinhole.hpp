@@ -2,8 +2,8 @@
 // The one pinhole camera type (issue 12): the projector's intrinsics A_p, the depth camera's and the
 // colour camera's registered to it. OpenCV convention: x right, y down, z forward; a point (X, Y, Z) in
 // the camera frame lands at u = fx X/Z + cx, v = fy Y/Z + cy, and pixel (i, j) has its centre at u = i,
-// v = j (Eq. 3 of the paper, x = A_p X). The projector's lens distortion is ProjectorConfig's (scene.hpp);
-// the depth camera is a pinhole.
+// v = j (Eq. 3 of the paper, x = A_p X). A camera with its lens and clip range is config::Camera
+// (lens.hpp); the projector's (ProjectorConfig, scene.hpp) is one.
 
 #include <Eigen/Core>
 #include <cmath>

@@ -39,27 +39,16 @@ struct Photometry {
   Eigen::Matrix3d mixing = Eigen::Matrix3d::Identity();
 };
 
-/// The projector as a scene gives it (`projector:`), and a depth camera's pinhole with its clip range
-/// (`camera:`): the pinhole (A_p, Eq. 3) plus what drawing needs.
-struct ProjectorConfig : Pinhole {
-  ProjectorConfig() : Pinhole{1280, 800, 1400.0, 1400.0, 639.5, 399.5} {}
-  ProjectorConfig(const Pinhole& pinhole, double near, double far) : Pinhole(pinhole), near_m(near), far_m(far) {}
-  double near_m = 0.1;  ///< near clipping distance along z, metres (> 0)
-  double far_m = 20.0;  ///< far clipping distance along z, metres (> near_m)
-  // The projector only (`projector:`), for the time a frame reaches the object (issue 14):
+/// The projector as a scene gives it (`projector:`): its camera model (A_p, Eq. 3, the lens, the clip
+/// range) plus when its frames reach the object and how bright they are.
+struct ProjectorConfig : Camera {
+  ProjectorConfig() : Camera{Pinhole{1280, 800, 1400.0, 1400.0, 639.5, 399.5}, 0.1, 20.0} {}
+  ProjectorConfig(const Pinhole& pinhole, double near, double far) : Camera(pinhole, near, far) {}
+  explicit ProjectorConfig(const Camera& camera) : Camera(camera) {}
+  // For the time a frame reaches the object (issue 14):
   double refresh_hz = 60.0;   ///< frames per second it shows (1..1000)
   double input_lag_ms = 0.0;  ///< its own delay from a frame's arrival to light (0..1000 ms)
-  /// Its lens (`projector.distortion`, or a calibration's): k1, k2, p1, p2, k3. Zero for a pinhole and
-  /// for every depth camera. The renderer pre-distorts the projector's image by it.
-  Distortion distortion{};
-  Photometry photometry;  ///< the projector only: its brightness and response
-
-  /// The panel pixel whose light reaches projector-frame point p (z > 0): A_p after the lens. Equals
-  /// project(p) without distortion.
-  Eigen::Vector2d project_lit(const Eigen::Vector3d& p) const;
-  /// The direction (x, y, 1) of the light panel position (u, v) sends out: the lens undone. Empty where
-  /// the distortion cannot be inverted (validate_projector refuses such lenses over the image).
-  std::optional<Eigen::Vector3d> panel_ray(double u, double v) const;
+  Photometry photometry;      ///< its brightness and response
 };
 
 /// How a scripted move runs through its duration: `smooth` eases in and out (no jump in speed);
@@ -187,16 +176,16 @@ struct Scene {
   PanTiltConfig pan_tilt = default_pan_tilt();
 
   // The tour (optional sections):
-  Room room;                                                ///< `room:`
-  Eigen::Vector3d robot_start{1.0, 1.0, 0.0};               ///< `robot.start: [x, y, heading_deg]`
-  OdometryDrift drift = OdometryDrift::good_floor();        ///< `robot.drift:` (its seed is the run's)
-  ProjectorConfig depth_camera = kinect_v1_depth_camera();  ///< `camera:`, the RGB-D camera's depth intrinsics
-  std::vector<std::string> visits;                          ///< `tour.visits:` target names in order
-  std::vector<PropConfig> props;                            ///< `props:` the twin's static non-targets
-  DevicesConfig devices;                                    ///< `devices:` real devices (none: the twin)
+  Room room;                                          ///< `room:`
+  Eigen::Vector3d robot_start{1.0, 1.0, 0.0};         ///< `robot.start: [x, y, heading_deg]`
+  OdometryDrift drift = OdometryDrift::good_floor();  ///< `robot.drift:` (its seed is the run's)
+  Camera depth_camera = kinect_v1_depth_camera();     ///< `camera:`, the RGB-D camera's depth intrinsics
+  std::vector<std::string> visits;                    ///< `tour.visits:` target names in order
+  std::vector<PropConfig> props;                      ///< `props:` the twin's static non-targets
+  DevicesConfig devices;                              ///< `devices:` real devices (none: the twin)
 
   /// Kinect v1 depth: 640x480, fx = fy = 525 px, 0.5-4.5 m.
-  static ProjectorConfig kinect_v1_depth_camera() { return {Pinhole::kinect_v1(), 0.5, 4.5}; }
+  static Camera kinect_v1_depth_camera() { return {Pinhole::kinect_v1(), 0.5, 4.5}; }
   /// Index of the target named `name`, or -1.
   int target_index(std::string_view name) const;
 };
@@ -207,7 +196,7 @@ Scene load_scene(const std::filesystem::path& path);
 /// What a calibration file (`projbot calibrate solve`'s calib.yaml) gives: the projector's pinhole A_p
 /// and the camera-to-projector pose R_cp, T_cp (X_p = R_cp X_c + T_cp, Eq. 2).
 struct ProjectorCalibration {
-  Lens projector;  ///< A_p and its distortion, k1 k2 p1 p2 k3
+  Camera projector;  ///< A_p and its distortion, k1 k2 p1 p2 k3 (its clip range unused)
   Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();
   /// `photometry:` (projbot calibrate photometric): its gammas, mixing and black level (brightness_lm when
   /// given) replace the scene's.

@@ -77,7 +77,7 @@ double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vecto
 /// both, lit less than 60 degrees off its normal (about one per 4 x 4 camera pixels), give (grey - black)
 /// kReferenceLux / ((drive(grey) - drive(0)) white_lux) at their pixels (the room's light cancels); the
 /// median over them per channel. Empty when fewer than 20 points can be read unsaturated.
-std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::ProjectorConfig& camera,
+std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::Camera& camera,
                                               const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
                                               const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
                                               const assets::Image& under_grey, double grey);

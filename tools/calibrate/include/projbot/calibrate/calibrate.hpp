@@ -47,7 +47,7 @@ struct Board {
 };
 
 /// A pinhole with OpenCV's lens distortion (k1, k2, p1, p2, k3): config's one lens type.
-using config::Lens;
+using config::Camera;
 
 /// How many images a pose of a projector this size takes: 2 per Gray-code bit of each axis, then white
 /// and black.
@@ -72,7 +72,7 @@ struct SimulationConfig {
   std::vector<BoardPose> scripted;  ///< when given, the board is held at these (and `poses` is ignored)
   std::uint64_t seed = 1;
   Board board;
-  Lens camera;                                                       ///< the colour camera's truth (pinhole + distortion)
+  Camera camera;                                                     ///< the colour camera's truth (pinhole + distortion)
   config::ProjectorConfig projector;                                 ///< A_p's truth, with its lens
   Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();  ///< R_cp, T_cp's truth
   double ambient = 0.10;       ///< room light, as a fraction of the projector's white at 1 m
@@ -104,8 +104,8 @@ struct ViewResult {
 };
 
 struct Calibration {
-  Lens camera;
-  Lens projector;
+  Camera camera;
+  Camera projector;
   Eigen::Matrix4d T_projector_camera = Eigen::Matrix4d::Identity();  ///< X_p = R_cp X_c + T_cp (Eq. 2)
   double camera_rms_px = 0.0, projector_rms_px = 0.0;                ///< over all used views, after the joint fit
   double projector_coverage = 0.0;                                   ///< area of the corners' convex hull / the projector's image

@@ -57,7 +57,7 @@ class SpectatorView {
   SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector);
   /// The same light seen through another pinhole: the RGB-D camera's colour camera, as a radiometrically
   /// calibrated camera (sRGB, a white surface under engine::kReferenceLux reads 1).
-  SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector, const config::ProjectorConfig& eye);
+  SpectatorView(engine::Renderer& renderer, const config::ProjectorConfig& projector, const config::Camera& eye);
 
   /// The spectator's picture at T_world_spectator: each visible surface point's reflectance lit by the
   /// room's light (`room.ambient_lux`) plus the light of the projector's pixel that reaches it (Eq. 3 from

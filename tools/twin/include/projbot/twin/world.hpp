@@ -117,7 +117,7 @@ class Twin {
   assets::Image capture_colour(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed);
   static constexpr double kColourNoiseSigma = 2.5;
   /// The camera's pinhole as capture() and capture_colour() render it (clipped at 0.3 and 8 m).
-  config::ProjectorConfig camera_pinhole() const;
+  config::Camera camera_pinhole() const;
   /// The true surfaces placed in a frame (T_frame_world): for the projector's rays.
   std::vector<PlacedMesh> true_scene(const Eigen::Matrix4d& T_frame_world) const;
   /// Every surface's ray caster (room, props, targets, pedestals): a holder keeps them beyond the twin.
