@@ -555,9 +555,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   const auto wall0 = Clock::now();
   engine::Renderer renderer(engine::RendererOptions{});
   TwinOptions twin_options;
-  // A portable build has no MRPT localisation: its localized and tracking tours close the loop on odometry.
-  twin_options.pose_source = options.mode == TourMode::odometry || !robot::built_with_mrpt() ? robot::PoseSource::odometry
-                                                                                             : robot::PoseSource::localized;
+  // Otherwise TwinOptions' own: localised where the build has MRPT, odometry in a portable build.
+  if (options.mode == TourMode::odometry) twin_options.pose_source = robot::PoseSource::odometry;
   twin_options.seed = options.seed;
   twin_options.depth_noise = options.depth_noise;
   if (options.fitted_depth) twin_options.depth_model = alignment::KinectNoiseConfig::fitted();
