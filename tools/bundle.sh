@@ -56,19 +56,20 @@ strip --strip-unneeded "$work/projbot"
 echo "bundle: projbot $(mib "$before") MiB, stripped $(mib "$(size_of "$work/projbot")") MiB"
 
 # Its libraries: ldd's closure less the base; libstdc++ and libgcc_s as the fallback.
+deps=$(ldd "$work/projbot")
+if grep -q "not found" <<<"$deps"; then
+  grep "not found" <<<"$deps" >&2
+  echo "bundle: the executable needs libraries this machine does not have" >&2
+  exit 1
+fi
 base_re='^(linux-vdso\.so|ld-linux-x86-64\.so|libc\.so|libm\.so|libpthread\.so|libdl\.so|librt\.so|libresolv\.so|libutil\.so)'
-ldd "$work/projbot" | awk '$2 == "=>" && $3 ~ /^\// { print $1, $3 }' | while read -r soname path; do
+awk '$2 == "=>" && $3 ~ /^\// { print $1, $3 }' <<<"$deps" | while read -r soname path; do
   [[ "$soname" =~ $base_re ]] && continue
   case "$soname" in
     libstdc++.so.* | libgcc_s.so.*) cp -L "$path" "$work/lib/fallback/$soname" ;;
     *) cp -L "$path" "$work/lib/$soname" ;;
   esac
 done
-if ldd "$work/projbot" | grep -q "not found"; then
-  ldd "$work/projbot" | grep "not found" >&2
-  echo "bundle: the executable needs libraries this machine does not have" >&2
-  exit 1
-fi
 # The Vulkan loader: the engine opens it at run time (dlopen), so ldd does not list it.
 cp -L "$(ldconfig -p | awk '/libvulkan\.so\.1 .*x86-64/ { print $NF; exit }')" "$work/lib/libvulkan.so.1"
 # The Khronos validation layer, for `--validation` (packed with the libraries below).

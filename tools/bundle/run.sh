@@ -20,7 +20,7 @@ if [ -f "$here/lib/packed.tar.xz" ] && [ ! -f "$here/lib/.unpacked" ]; then
     xz -dc "$here/lib/packed.tar.xz" | tar -C "$tmp" -xf -
   else
     python3 -c 'import sys, tarfile; tarfile.open(sys.argv[1]).extractall(sys.argv[2])' "$here/lib/packed.tar.xz" "$tmp"
-  fi || { rm -rf "$tmp"; echo "run.sh: could not unpack $here/lib/packed.tar.xz (needs xz or python3)" >&2; exit 1; }
+  fi || { rm -rf "$tmp"; echo "run.sh: could not unpack $here/lib/packed.tar.xz (damaged in the copy? carry the bundle again; unpacking needs xz or python3)" >&2; exit 1; }
   mv "$tmp"/* "$here/lib/" && rmdir "$tmp" && : >"$here/lib/.unpacked"
 fi
 
