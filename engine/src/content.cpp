@@ -41,6 +41,17 @@ bool file_stamp(const std::filesystem::path& file, std::filesystem::file_time_ty
 
 }  // namespace
 
+std::vector<DrawItem> upload_scene(Renderer& renderer, const config::Scene& scene, std::vector<assets::Model>* models) {
+  std::vector<DrawItem> items;
+  for (const auto& target : scene.targets) {
+    auto model = assets::load_model(target.model);
+    assets::scale_and_recenter(model, target.scale, target.recenter);
+    items.push_back({renderer.add_model(model), target.T_projector_target});
+    if (models) models->push_back(std::move(model));
+  }
+  return items;
+}
+
 std::shared_ptr<assets::VideoPlayer> SceneContent::make_player(std::unique_ptr<assets::VideoDecoder> decoder, bool loop) {
   return std::make_shared<assets::VideoPlayer>(std::move(decoder), loop, 4,
                                                [this](std::size_t bytes) { return renderer_.frame_memory(bytes); });

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <mutex>
 #include <thread>
 
@@ -176,6 +177,31 @@ int UrgEmulator::scans_sent() const {
 std::vector<std::string> UrgEmulator::received() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->received;
+}
+
+RoomUrg::RoomUrg(const config::Room& room, std::filesystem::path link, const Pose2D& T_room_odometry)
+    : map_(OccupancyMap::from_room(room)),
+      unit_(std::vector<std::uint32_t>(UrgEmulator::kSteps, 0)),
+      link_(std::move(link)),
+      T_room_odometry_(T_room_odometry) {
+  std::error_code ec;
+  if (std::filesystem::is_symlink(link_, ec)) std::filesystem::remove(link_, ec);
+  std::filesystem::create_symlink(unit_.port(), link_, ec);
+  if (ec) throw RobotError(link_.string() + ": cannot link the laser's pseudo-terminal there: " + ec.message());
+  laser_.rays = UrgEmulator::kSteps;  // the UTM-30LX: 270 degrees in 0.25 degree steps
+}
+
+RoomUrg::~RoomUrg() {
+  std::error_code ec;
+  std::filesystem::remove(link_, ec);
+}
+
+void RoomUrg::stand_at(const Pose2D& pose) {
+  const LaserScan scan = map_.simulate_scan(compose(T_room_odometry_, pose), laser_, rng_);
+  std::vector<std::uint32_t> mm(scan.ranges_m.size(), 0);
+  for (std::size_t i = 0; i < mm.size(); ++i)
+    if (scan.valid[i]) mm[i] = static_cast<std::uint32_t>(std::lround(1000.0 * scan.ranges_m[i]));
+  unit_.set_ranges(std::move(mm));
 }
 
 }  // namespace projbot::robot

@@ -148,7 +148,7 @@ const Command kBenchContent{
       engine::Renderer renderer(ro);
       std::cout << "device: " << renderer.device_info().name << std::endl;
       std::vector<assets::Model> models;
-      const auto items = upload_scene(renderer, scene, &models);
+      const auto items = engine::upload_scene(renderer, scene, &models);
       engine::SceneContent content(renderer, scene, models, items);
       for (int i = 0; i < static_cast<int>(scene.targets.size()); ++i)
         if (content.has_video(i)) {

@@ -23,121 +23,13 @@
 namespace projbot::tools {
 namespace {
 
-// Serial devices a PTU-D46 or a Hokuyo / SICK laser appears as, with their stable by-id names.
-std::vector<std::string> serial_ports() {
-  std::vector<std::string> out;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator("/dev", ec)) {
-    const std::string name = entry.path().filename().string();
-    if (name.rfind("ttyUSB", 0) == 0 || name.rfind("ttyACM", 0) == 0) out.push_back(entry.path().string());
-  }
-  std::sort(out.begin(), out.end());
-  for (const auto& entry : std::filesystem::directory_iterator("/dev/serial/by-id", ec)) {
-    const auto target = std::filesystem::canonical(entry.path(), ec);
-    for (auto& port : out)
-      if (!ec && target.string() == port) port += " (" + entry.path().string() + ")";
-  }
-  return out;
+// The scene's room and its box props: what a laser at this height sees.
+config::Room laser_room(const config::Scene& scene) {
+  config::Room r = scene.room;
+  for (const auto& p : scene.props)
+    if (p.is_box()) r.obstacles.push_back(p.box_footprint());
+  return r;
 }
-
-void list_found(std::ostream& out, int dds_domain) {
-  out << "RGB-D cameras (OpenNI2: PrimeSense, Xtion): ";
-  try {
-    const auto found = alignment::openni2_devices();
-    if (found.empty()) out << "none found";
-    for (std::size_t i = 0; i < found.size(); ++i)
-      out << (i ? "; " : "") << found[i].vendor << " " << found[i].name << " (uri: " << found[i].uri << ")";
-  } catch (const std::exception& e) {
-    out << "cannot look: " << e.what();
-  }
-  out << "\nKinect v1 (libfreenect): ";
-  try {
-    const int n = alignment::FreenectSource::count_devices();
-    out << (n == 0 ? std::string("none found") : std::to_string(n) + " found (index 0.." + std::to_string(n - 1) + ")");
-  } catch (const std::exception& e) {
-    out << "cannot look: " << e.what();
-  }
-  const auto ports = serial_ports();
-  out << "\nserial ports (pan-tilt unit, laser): " << (ports.empty() ? "none found" : "");
-  for (std::size_t i = 0; i < ports.size(); ++i) out << (i ? ", " : "") << ports[i];
-  out << "\nmonitors (the projector is one): ";
-  try {
-    const auto monitors = engine::connected_monitors();
-    if (monitors.empty()) out << "none connected";
-    for (std::size_t i = 0; i < monitors.size(); ++i)
-      out << (i ? "; " : "") << i << ": " << monitors[i].name << " " << monitors[i].width_px << "x" << monitors[i].height_px
-          << (monitors[i].refresh_hz > 0 ? " at " + std::to_string(monitors[i].refresh_hz) + " Hz"
-                                         : std::string(", refresh unknown"));
-  } catch (const std::exception& e) {
-    out << e.what();
-  }
-  out << "\nROS 2 / DDS on domain " << dds_domain << ": ";
-  try {
-    const auto seen = robot::survey_dds(dds_domain, 1.0);
-    out << seen.participants << " other participant" << (seen.participants == 1 ? "" : "s") << " heard in 1 s";
-    const auto list = [&](const char* what, const auto& topics) {
-      if (topics.empty()) return;
-      out << "; " << what << ": ";
-      for (std::size_t i = 0; i < topics.size(); ++i)
-        out << (i ? ", " : "") << topics[i].first << " (" << topics[i].second << ")";
-    };
-    list("published", seen.published);
-    list("subscribed", seen.subscribed);
-  } catch (const std::exception& e) {
-    out << "cannot look: " << e.what();
-  }
-  out << "\n";
-}
-
-// sim-base's laser: a Hokuyo UTM-30LX on a pseudo-terminal linked at `link`, its scans ray-traced in the
-// scene's room from where the base truly stands (T_room_odometry composed with the server's pose, which
-// starts at robot.start). The link is removed when it is done.
-class SimBaseLaser {
- public:
-  SimBaseLaser(const config::Scene& scene, std::filesystem::path link, const robot::Pose2D& T_room_odometry)
-      : map_(robot::OccupancyMap::from_room(room(scene))),
-        unit_(std::vector<std::uint32_t>(robot::UrgEmulator::kSteps, 0)),
-        link_(std::move(link)),
-        T_room_odometry_(T_room_odometry) {
-    std::error_code ec;
-    if (std::filesystem::is_symlink(link_, ec)) std::filesystem::remove(link_, ec);
-    std::filesystem::create_symlink(unit_.port(), link_, ec);
-    if (ec)
-      throw cli::UsageError("--laser " + link_.string() + ": cannot link the laser's pseudo-terminal there: " + ec.message());
-    laser_.rays = robot::UrgEmulator::kSteps;  // the UTM-30LX: 270 degrees in 0.25 degree steps
-  }
-  ~SimBaseLaser() {
-    std::error_code ec;
-    std::filesystem::remove(link_, ec);
-  }
-  SimBaseLaser(const SimBaseLaser&) = delete;
-  SimBaseLaser& operator=(const SimBaseLaser&) = delete;
-
-  // The scans from now on: from the base at `pose` (the server's frame).
-  void stand_at(const robot::Pose2D& pose) {
-    const robot::LaserScan scan = map_.simulate_scan(robot::compose(T_room_odometry_, pose), laser_, rng_);
-    std::vector<std::uint32_t> mm(scan.ranges_m.size(), 0);
-    for (std::size_t i = 0; i < mm.size(); ++i)
-      if (scan.valid[i]) mm[i] = static_cast<std::uint32_t>(std::lround(1000.0 * scan.ranges_m[i]));
-    unit_.set_ranges(std::move(mm));
-  }
-  int scans_sent() const { return unit_.scans_sent(); }
-
- private:
-  // The scene's room and its box props: what a laser at this height sees.
-  static config::Room room(const config::Scene& scene) {
-    config::Room r = scene.room;
-    for (const auto& p : scene.props)
-      if (p.is_box()) r.obstacles.push_back(p.box_footprint());
-    return r;
-  }
-  robot::OccupancyMap map_;
-  robot::UrgEmulator unit_;
-  std::filesystem::path link_;
-  robot::Pose2D T_room_odometry_;
-  robot::LaserConfig laser_;
-  std::mt19937_64 rng_{7};
-};
 
 int serve_sim_base(const cli::Args& args) {
   catch_interrupts();
@@ -155,10 +47,14 @@ int serve_sim_base(const cli::Args& args) {
   const int rate = args.get_int("rate", 50, 1, 1000);
   const robot::Pose2D true_start = args.get("true-start") ? parse_pose(*args.get("true-start"), "--true-start") : start;
   const robot::Pose2D T_room_odometry = robot::compose(true_start, robot::inverse(start));  // where the base was set down
-  std::unique_ptr<SimBaseLaser> laser;
+  std::unique_ptr<robot::RoomUrg> laser;
   if (const auto link = args.get("laser")) {
     if (!scene) throw cli::UsageError("--laser needs --config: the laser's scans are ray-traced in its room");
-    laser = std::make_unique<SimBaseLaser>(*scene, *link, T_room_odometry);
+    try {
+      laser = std::make_unique<robot::RoomUrg>(laser_room(*scene), *link, T_room_odometry);
+    } catch (const robot::RobotError& e) {
+      throw cli::UsageError(std::string("--laser ") + e.what());
+    }
   }
   robot::Ros2BaseServer server(base, start);
   std::cout << "serving the twin's youBot on DDS domain " << base.domain << ": rt/" << base.cmd_vel << " in, rt/" << base.odom
@@ -213,7 +109,7 @@ const Command kDevices{"devices",
                            scene = config::load_scene(*path);  // a bad file fails before the listing
                          int domain = scene && scene->devices.base ? scene->devices.base->domain : 0;
                          domain = args.get_int("domain", domain, 0, 232);
-                         list_found(std::cout, domain);
+                         hardware::list_found(std::cout, domain);
                          if (!scene) return 0;
                          std::cout << "\nconfigured in " << scene->source.string() << ":\n";
                          if (!scene->devices.any()) {

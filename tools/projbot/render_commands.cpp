@@ -85,7 +85,7 @@ const Command kRender{
       const double content_time = args.get_double("content-time", 0.0);
       if (!(content_time >= 0.0 && content_time <= 1e6)) throw cli::UsageError("--content-time must be 0..1e6 seconds");
       std::vector<assets::Model> models;
-      auto items = upload_scene(renderer, scene, &models);
+      auto items = engine::upload_scene(renderer, scene, &models);
       engine::SceneContent content(renderer, scene, models, items);
       content_at(content, items, content_time);
       auto target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
@@ -128,7 +128,7 @@ const Command kShow{
       engine::Renderer renderer(renderer_options(args, true));
       std::cout << "device: " << renderer.device_info().name << '\n';
       std::vector<assets::Model> models;
-      const auto items = upload_scene(renderer, scene, &models);
+      const auto items = engine::upload_scene(renderer, scene, &models);
       engine::SceneContent content(renderer, scene, models, items);  // the targets' videos, previewed
       auto window = open_window(renderer, w, scene.projector);
       engine::FrameProfiler profiler;

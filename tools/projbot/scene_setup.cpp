@@ -122,18 +122,6 @@ config::Scene scene_from_args(const cli::Args& args) {
   return scene;
 }
 
-std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene,
-                                           std::vector<assets::Model>* models) {
-  std::vector<engine::DrawItem> items;
-  for (const auto& target : scene.targets) {
-    auto model = assets::load_model(target.model);
-    assets::scale_and_recenter(model, target.scale, target.recenter);
-    items.push_back({renderer.add_model(model), target.T_projector_target});
-    if (models) models->push_back(std::move(model));
-  }
-  return items;
-}
-
 bool on_off(const cli::Args& args, const std::string& name, bool fallback) {
   const auto value = args.get(name);
   if (!value) return fallback;

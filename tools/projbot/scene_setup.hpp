@@ -11,6 +11,7 @@
 
 #include "cli.hpp"
 #include "projbot/config/scene.hpp"
+#include "projbot/engine/content.hpp"
 #include "projbot/engine/renderer.hpp"
 
 namespace projbot::tools {
@@ -38,10 +39,6 @@ Eigen::Matrix4d framing_pose(const config::ProjectorConfig& projector, double ra
 /// An `--NAME on|off` option: `fallback` when not given; anything else is a usage error naming it.
 bool on_off(const cli::Args& args, const std::string& name, bool fallback);
 
-/// Loads, scales and recentres each target's model and uploads it; returns one DrawItem per target (and
-/// the models into `models` when given, in the same order).
-std::vector<engine::DrawItem> upload_scene(engine::Renderer& renderer, const config::Scene& scene,
-                                           std::vector<assets::Model>* models = nullptr);
 /// fifo, mailbox or immediate. Throws cli::UsageError listing them for anything else.
 engine::PresentMode present_mode(const std::string& name);
 

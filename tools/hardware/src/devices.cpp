@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -167,6 +168,97 @@ Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<De
   Devices devices = open_devices(wanted, checks, true);
   robot = configured_robot(wanted);  // after opening: an absent device is named before a missing one
   return devices;
+}
+
+Devices open_run_devices(const config::Scene& scene, bool headless, std::ostream& log) {
+  config::DevicesConfig wanted = scene.devices;
+  if (headless && wanted.projector) {  // drawn offscreen: no monitor to check
+    log << "devices.projector is not used with --headless" << std::endl;
+    wanted.projector.reset();
+  }
+  if (!wanted.any()) {
+    if (!scene.devices.any())
+      log << "no devices configured in " << scene.source.filename().string()
+          << " (a `devices:` section; projbot devices lists what this machine has): running against the digital twin (--sim)"
+          << std::endl;
+    return {};
+  }
+  std::vector<DeviceCheck> checks;
+  bool robot = false;
+  Devices devices = open_session_devices(wanted, checks, robot);  // an absent device, part of a robot or a laser: refused
+  for (const auto& c : checks) log << "opened " << c.config << ": " << c.detail << '\n';
+  if (robot)
+    log << "the configured base, pan-tilt and camera serve the session"
+        << (wanted.laser ? ", the base localised on the laser against " + wanted.laser->map.string() : std::string())
+        << ": no twin (nothing is measured against a truth)" << std::endl;
+  else
+    log << "the twin serves the robot" << (scene.devices.camera ? "" : " and the camera") << std::endl;
+  return devices;
+}
+
+std::vector<std::string> serial_ports() {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/dev", ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("ttyUSB", 0) == 0 || name.rfind("ttyACM", 0) == 0) out.push_back(entry.path().string());
+  }
+  std::sort(out.begin(), out.end());
+  for (const auto& entry : std::filesystem::directory_iterator("/dev/serial/by-id", ec)) {
+    const auto target = std::filesystem::canonical(entry.path(), ec);
+    for (auto& port : out)
+      if (!ec && target.string() == port) port += " (" + entry.path().string() + ")";
+  }
+  return out;
+}
+
+void list_found(std::ostream& out, int dds_domain) {
+  out << "RGB-D cameras (OpenNI2: PrimeSense, Xtion): ";
+  try {
+    const auto found = alignment::openni2_devices();
+    if (found.empty()) out << "none found";
+    for (std::size_t i = 0; i < found.size(); ++i)
+      out << (i ? "; " : "") << found[i].vendor << " " << found[i].name << " (uri: " << found[i].uri << ")";
+  } catch (const std::exception& e) {
+    out << "cannot look: " << e.what();
+  }
+  out << "\nKinect v1 (libfreenect): ";
+  try {
+    const int n = alignment::FreenectSource::count_devices();
+    out << (n == 0 ? std::string("none found") : std::to_string(n) + " found (index 0.." + std::to_string(n - 1) + ")");
+  } catch (const std::exception& e) {
+    out << "cannot look: " << e.what();
+  }
+  const auto ports = serial_ports();
+  out << "\nserial ports (pan-tilt unit, laser): " << (ports.empty() ? "none found" : "");
+  for (std::size_t i = 0; i < ports.size(); ++i) out << (i ? ", " : "") << ports[i];
+  out << "\nmonitors (the projector is one): ";
+  try {
+    const auto monitors = engine::connected_monitors();
+    if (monitors.empty()) out << "none connected";
+    for (std::size_t i = 0; i < monitors.size(); ++i)
+      out << (i ? "; " : "") << i << ": " << monitors[i].name << " " << monitors[i].width_px << "x" << monitors[i].height_px
+          << (monitors[i].refresh_hz > 0 ? " at " + std::to_string(monitors[i].refresh_hz) + " Hz"
+                                         : std::string(", refresh unknown"));
+  } catch (const std::exception& e) {
+    out << e.what();
+  }
+  out << "\nROS 2 / DDS on domain " << dds_domain << ": ";
+  try {
+    const auto seen = robot::survey_dds(dds_domain, 1.0);
+    out << seen.participants << " other participant" << (seen.participants == 1 ? "" : "s") << " heard in 1 s";
+    const auto list = [&](const char* what, const auto& topics) {
+      if (topics.empty()) return;
+      out << "; " << what << ": ";
+      for (std::size_t i = 0; i < topics.size(); ++i)
+        out << (i ? ", " : "") << topics[i].first << " (" << topics[i].second << ")";
+    };
+    list("published", seen.published);
+    list("subscribed", seen.subscribed);
+  } catch (const std::exception& e) {
+    out << "cannot look: " << e.what();
+  }
+  out << "\n";
 }
 
 }  // namespace projbot::hardware

@@ -20,6 +20,11 @@
 
 namespace projbot::engine {
 
+/// Loads, scales and recentres each target's model and uploads it: one DrawItem per target, at its
+/// T_projector_target (and the models into `models` when given, in the same order). Throws
+/// assets::AssetError naming a model that cannot be read.
+std::vector<DrawItem> upload_scene(Renderer& renderer, const config::Scene& scene, std::vector<assets::Model>* models = nullptr);
+
 /// The material of `model` that a target's `content.material` names: a material's name or its index; empty:
 /// the first textured material (0 where none is). Throws assets::AssetError naming the model and what it has.
 int content_material(const assets::Model& model, const std::string& spec);

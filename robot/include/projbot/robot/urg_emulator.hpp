@@ -3,9 +3,15 @@
 // with MRPT's CHokuyoURG driver) without the hardware.
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
+
+#include "projbot/config/scene.hpp"
+#include "projbot/robot/laser.hpp"
+#include "projbot/robot/pose2d.hpp"
 
 namespace projbot::robot {
 
@@ -37,6 +43,29 @@ class UrgEmulator {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+/// The twin's laser for a base served on DDS (`projbot sim-base --laser`): a UTM-30LX (UrgEmulator) whose
+/// pseudo-terminal is linked at `link`, its scans ray-traced in `room` from where the base truly stands
+/// (`T_room_odometry` composed with the pose it is told). The link is removed when it is destroyed.
+class RoomUrg {
+ public:
+  /// Throws RobotError naming `link` when it cannot be made.
+  RoomUrg(const config::Room& room, std::filesystem::path link, const Pose2D& T_room_odometry);
+  ~RoomUrg();
+  RoomUrg(const RoomUrg&) = delete;
+  RoomUrg& operator=(const RoomUrg&) = delete;
+  /// The scans from now on: from the base at `pose` (its odometry's frame).
+  void stand_at(const Pose2D& pose);
+  int scans_sent() const { return unit_.scans_sent(); }
+
+ private:
+  OccupancyMap map_;
+  UrgEmulator unit_;
+  std::filesystem::path link_;
+  Pose2D T_room_odometry_;
+  LaserConfig laser_;
+  std::mt19937_64 rng_{7};
 };
 
 }  // namespace projbot::robot

@@ -4,6 +4,7 @@
 // names it.
 
 #include <memory>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "projbot/alignment/openni2_source.hpp"
 #include "projbot/alignment/rgbd_camera.hpp"
 #include "projbot/config/devices.hpp"
+#include "projbot/config/scene.hpp"
 #include "projbot/robot/mrpt_laser.hpp"
 #include "projbot/robot/ptu_d46.hpp"
 #include "projbot/robot/ros2_base.hpp"
@@ -57,5 +59,19 @@ bool configured_robot(const config::DevicesConfig& devices);
 /// false (record's mapping run).
 Devices open_session_devices(const config::DevicesConfig& wanted, std::vector<DeviceCheck>& checks, bool& robot,
                              bool laser_needs_map = true);
+
+/// Serial devices a PTU-D46 or a Hokuyo / SICK laser appears as (ttyUSB*, ttyACM*), each with its
+/// stable /dev/serial/by-id name beside it where there is one.
+std::vector<std::string> serial_ports();
+
+/// What this machine offers, one line per kind (`projbot devices`): the RGB-D cameras OpenNI2 and
+/// libfreenect see, the serial ports, the monitors, and the DDS participants heard on `dds_domain` in 1 s.
+/// A kind that cannot be looked at says why on its line.
+void list_found(std::ostream& out, int dds_domain);
+
+/// `run`'s devices: the scene's (less the projector with `headless`: drawn offscreen), opened as
+/// open_session_devices opens them, with what each read and who serves the robot said on `log`. None
+/// configured: no device, and `log` says the twin runs.
+Devices open_run_devices(const config::Scene& scene, bool headless, std::ostream& log);
 
 }  // namespace projbot::hardware

@@ -1,0 +1,262 @@
+#include "projbot/live/live_run.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <iomanip>
+#include <thread>
+
+#include "projbot/alignment/latest_value.hpp"
+#include "projbot/config/clock.hpp"
+#include "projbot/engine/content.hpp"
+#include "projbot/live/rig.hpp"
+#include "projbot/session/trackers.hpp"
+#include "projbot/twin/display_error.hpp"
+
+namespace projbot::live {
+namespace {
+
+// What the render thread draws at a stop: the visited target or a neighbour expected in the projector's
+// view there, with its index in the twin.
+struct DrawnTarget {
+  int target = -1;       // scene index: its worker and draw item
+  int target_visit = 0;  // this target's n-th visit (its motion script); 0: still
+  std::size_t twin = 0;  // its index in the twin (when a twin serves the session)
+};
+
+// What the robot thread tells the render thread: which targets the robot is projecting onto (none while
+// it drives; the visited one first) and since when; poses captured before that belong to an earlier stop.
+struct RobotState {
+  std::vector<DrawnTarget> lit;
+  double since_s = 0.0;
+  int visit = 0;
+  bool done = false;
+  // The twin's truth at the stop, so the render thread measures each frame at its display time; null
+  // where nothing serves a truth (a replay, the configured robot).
+  std::shared_ptr<const twin::StopMeter> meter{};
+};
+
+// The mean marker error of a target drawn (at its display time and pose), against the twin's truth then;
+// NaN where no marker can be measured or the stop has no truth.
+session::DisplayError marker_error(const config::Scene& scene, const RobotState& robot, const session::DrawnPose& drawn) {
+  const auto lit =
+      std::find_if(robot.lit.begin(), robot.lit.end(), [&](const DrawnTarget& l) { return l.target == drawn.target; });
+  if (!robot.meter || lit == robot.lit.end()) return {std::nan(""), false};
+  const double t = drawn.display_s - robot.since_s;
+  const config::TargetMotion* m = scene.targets[static_cast<std::size_t>(drawn.target)].motion_on(lit->target_visit);
+  return {robot.meter->measure(lit->twin, lit->target_visit, drawn.T_camera_target, t).mean_mm, m && m->moving_at(t)};
+}
+
+// The camera's hand-offs to the workers (RunResult's), and the newest (steady clock) for the render thread.
+struct Handoffs {
+  std::vector<double> from_capture_ms, in_session_ms;
+  std::atomic<double> last_s{0.0};
+};
+
+// What the robot thread tells the render thread at each step of the session, with the twin's truth when
+// the twin serves the robot; in a replay, each lockstep frame's poses are also checked against the recording's.
+class RunObserver final : public session::StopObserver {
+ public:
+  RunObserver(const config::Scene& scene, alignment::LatestValue<RobotState>& state, Handoffs& handoffs, twin::Twin* twin,
+              session::PoseCheck* check, std::ostream& log)
+      : scene_(scene), state_(state), handoffs_(handoffs), twin_(twin), check_(check), log_(log) {}
+  void driving(int visit) override { state_.publish({.lit = {}, .since_s = config::steady_now_s(), .visit = visit + 1}); }
+  void lit(const session::Stop& stop, double since_s) override {
+    say_lit(stop);
+    std::vector<DrawnTarget> lit;
+    for (const session::LitTarget& l : stop.lit)
+      lit.push_back({l.target, l.target == stop.target ? stop.target_visit : 0, twin_ ? twin_index(l.target) : 0});
+    std::shared_ptr<const twin::StopMeter> meter{};
+    if (twin_)
+      meter = std::make_shared<const twin::StopMeter>(
+          *twin_, twin::ProjectorModels{scene_.projector, scene_.projector, scene_.pan_tilt.T_projector_camera},
+          twin_->true_head().T_world_projector.matrix());
+    state_.publish({lit, since_s, stop.visit + 1, false, std::move(meter)});
+  }
+  void frame(const session::Stop& stop, int k, const alignment::RgbdFrame& f,
+             const std::vector<std::optional<alignment::PoseSample>>& samples) override {
+    if (samples.empty()) {  // live: at the hand-off
+      const double now = config::steady_now_s();
+      handoffs_.from_capture_ms.push_back(1000.0 * (now - f.depth.capture_time_s));
+      handoffs_.in_session_ms.push_back(1000.0 * (now - f.delivered_s));
+      handoffs_.last_s = now;
+    }
+    if (check_) check_->compare(scene_, stop, k, samples);
+  }
+  void left(const session::Stop& stop) override {
+    if (twin_) twin_->end_visit(twin_index(stop.target), stop.target_visit);  // back home, or left where it was moved
+  }
+
+ private:
+  void say_lit(const session::Stop& stop) {
+    log_ << "visit " << stop.visit + 1 << ": " << scene_.targets[static_cast<std::size_t>(stop.target)].name << ", drove "
+         << std::fixed << std::setprecision(1) << stop.drive.drive_seconds << " s" << (stop.drive.arrived ? "" : " (not arrived)")
+         << ", believed at x " << std::setprecision(3) << stop.drive.estimate.x_m << " m, y " << stop.drive.estimate.y_m
+         << " m, heading " << std::setprecision(1) << stop.drive.estimate.theta_rad * 180.0 / M_PI << " deg; lit "
+         << stop.lit.size() << " target(s)";
+    if (stop.drive.corrections > 0)  // localised on a laser: how far odometry alone had drifted from that
+      log_ << "; " << stop.drive.corrections << " laser scans matched (" << stop.drive.rejected << " rejected), odometry alone "
+           << std::setprecision(0) << 1000.0 * robot::distance_m(stop.drive.estimate, stop.drive.odometry) << " mm away";
+    log_ << std::endl;
+  }
+  std::size_t twin_index(int target) const { return twin_->target_index(scene_.targets[static_cast<std::size_t>(target)].name); }
+  const config::Scene& scene_;
+  alignment::LatestValue<RobotState>& state_;
+  Handoffs& handoffs_;
+  twin::Twin* twin_;
+  session::PoseCheck* check_;
+  std::ostream& log_;
+};
+
+// The robot thread of a run: the session at each stop (the rig built on this thread: the twin renders on
+// it), publishing what the render thread draws; a failure is kept for the render thread to report.
+class RobotThread {
+ public:
+  RobotThread(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers, const RunSources& sources)
+      : thread_([this, &scene, &o, &trackers, &sources](std::stop_token cancel) {
+          try {
+            drive(scene, o, trackers, sources, cancel);
+          } catch (...) {
+            error_ = std::current_exception();
+          }
+          done_ = true;
+        }) {}
+  bool done() const { return done_; }
+  alignment::LatestValue<RobotState>& state() { return state_; }
+  Handoffs& handoffs() { return handoffs_; }  // the robot thread's until finish()
+  // After the frame loop: a device (or the twin) that failed while projecting blanks the projector at once,
+  // so nothing it last showed stays lit; then the thread is stopped and joined. The failure's message
+  // (empty: none); a failure that is not a std::exception is rethrown.
+  std::string finish(engine::Renderer& renderer, engine::RenderTarget& target, const config::ProjectorConfig& projector);
+
+ private:
+  void drive(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers, const RunSources& sources,
+             const std::stop_token& cancel);
+  alignment::LatestValue<RobotState> state_;
+  Handoffs handoffs_;
+  std::exception_ptr error_;
+  std::atomic<bool> done_{false};
+  std::jthread thread_;  // last: starts once the above exist
+};
+
+void RobotThread::drive(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers,
+                        const RunSources& sources, const std::stop_token& cancel) {
+  Rig rig(scene, trackers.targets, *sources.devices, sources.replay, {.seed = o.seed, .interrupted = sources.interrupted});
+  RunObserver observer(scene, state_, handoffs_, rig.twin(), sources.check, *sources.log);
+  const int visits = rig.visits(o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size()));
+  const session::Dwell dwell = rig.dwell(o.dwell_s);
+  for (int v = 0; v < visits && !cancel.stop_requested(); ++v) rig.session().visit(v, trackers.workers, dwell, observer, cancel);
+  RobotState last;
+  state_.read(last);
+  state_.publish({.lit = {}, .since_s = config::steady_now_s(), .visit = last.visit, .done = true});
+}
+
+std::string RobotThread::finish(engine::Renderer& renderer, engine::RenderTarget& target,
+                                const config::ProjectorConfig& projector) {
+  std::string failure;
+  if (done_ && error_) {
+    renderer.draw_frame(target, projector, std::span<const engine::DrawItem>{});
+    try {
+      std::rethrow_exception(error_);
+    } catch (const std::exception& e) {
+      failure = e.what();
+    }
+  }
+  renderer.finish(target);
+  thread_.request_stop();
+  thread_.join();
+  if (error_ && failure.empty()) std::rethrow_exception(error_);
+  return failure;
+}
+
+// What the projector draws: the scene's models uploaded, their compensation and content, and the output.
+struct Output {
+  Output(engine::Renderer& renderer, const config::Scene& scene, const RunOptions& o, const RunSources& sources)
+      : items(engine::upload_scene(renderer, scene, &models)),
+        plan(surfaces(models, scene), scene.room.ambient_lux, o.compensate),
+        content(renderer, scene, models, items),  // a bad video: thrown, naming it
+        target(sources.open_output(renderer)) {}
+  static std::vector<engine::CompensationPlan::Target> surfaces(const std::vector<assets::Model>& models,
+                                                                const config::Scene& scene) {
+    std::vector<engine::CompensationPlan::Target> out;
+    for (std::size_t i = 0; i < models.size(); ++i) out.push_back({&models[i], scene.targets[i].surface.albedo});
+    return out;
+  }
+  std::vector<assets::Model> models;
+  std::vector<engine::DrawItem> items;
+  engine::CompensationPlan plan;
+  engine::SceneContent content;
+  std::unique_ptr<engine::RenderTarget> target;
+};
+
+session::LiveLoopConfig loop_config(const config::Scene& scene, const RunOptions& o, bool replay) {
+  session::LiveLoopConfig c;
+  c.projection.T_projector_camera = scene.pan_tilt.T_projector_camera;
+  c.projection.refresh_hz = scene.projector.refresh_hz;
+  c.projection.input_lag_ms = scene.projector.input_lag_ms;
+  c.projection.predict = o.predict;
+  if (replay) c.projection.silent_camera_s = 0.0;  // a replay's frames play in lockstep
+  c.seconds = o.seconds;
+  c.paced_hz = o.headless ? 60.0 : 0.0;  // offscreen, no vsync: like a 60 Hz projector
+  return c;
+}
+
+// What the frame loop reads: the robot's state (into `seen`, which the meter measures against), the
+// workers' poses, the camera's hand-offs; the content's messages after each frame.
+session::LiveInputs live_inputs(const config::Scene& scene, RobotThread& robot, RobotState& seen,
+                                const session::SceneTrackers& trackers, engine::SceneContent& content,
+                                const RunSources& sources) {
+  session::LiveInputs in;
+  in.stop = [&robot, &seen] {
+    robot.state().read(seen);
+    session::LiveStop stop{{}, seen.since_s, seen.visit};
+    for (const DrawnTarget& lit : seen.lit) stop.targets.push_back(lit.target);
+    return stop;
+  };
+  in.poses = [&trackers](int index, alignment::PoseSample& pose) {
+    return trackers.owned[static_cast<std::size_t>(index)]->latest(pose);
+  };
+  in.camera_last_s = [&robot] { return robot.handoffs().last_s.load(); };
+  in.keep_going = [&robot, &sources] { return !(sources.interrupted && sources.interrupted()) && !robot.done(); };
+  in.meter = [&scene, &seen](const session::DrawnPose& drawn) { return marker_error(scene, seen, drawn); };
+  in.after_frame = [&content, &sources] {
+    for (const std::string& e : content.take_errors())  // the last good frame stays up; said once
+      *sources.errors << "content: " << e << " (its last good frame stays)" << std::endl;
+    for (const std::string& e : content.reload_changed(config::steady_now_s()))  // a video changed on disk
+      *sources.log << "content: " << e << std::endl;
+  };
+  return in;
+}
+
+}  // namespace
+
+RunResult run(engine::Renderer& renderer, const config::Scene& scene, const RunOptions& options, const RunSources& sources) {
+  Output out(renderer, scene, options, sources);
+  const session::LiveLoopConfig lc = loop_config(scene, options, sources.replay != nullptr);
+  session::LiveLoop loop(renderer, scene.projector, out.items, lc);
+  loop.set_compensation(&out.plan);
+  loop.set_content(&out.content);
+  // One tracker worker per target on the map.
+  session::SceneTrackers trackers =
+      session::make_trackers(scene, session::worker_config(options.predict, sources.replay != nullptr));
+  RobotThread robot(scene, options, trackers, sources);
+  RobotState seen;  // as the render thread last read it
+  engine::FrameProfiler profiler;
+  RunResult r;
+  r.figures = loop.run(*out.target, live_inputs(scene, robot, seen, trackers, out.content, sources), profiler);
+  r.failure = robot.finish(renderer, *out.target, scene.projector);
+  for (const auto& w : trackers.owned)
+    if (w && w->error()) std::rethrow_exception(w->error());
+  r.summary = profiler.summary();
+  r.silent_frames = loop.silent_frames();
+  r.silent_camera_s = lc.projection.silent_camera_s;
+  r.visits = seen.visit;
+  r.handoff_from_capture_ms = std::move(robot.handoffs().from_capture_ms);
+  r.handoff_in_session_ms = std::move(robot.handoffs().in_session_ms);
+  for (const auto& w : trackers.owned) r.tracked += w ? w->frames_processed() : 0;
+  r.content = out.content.summary();
+  r.measured = !sources.devices->base && !sources.replay;  // the twin served it
+  return r;
+}
+
+}  // namespace projbot::live

@@ -1,0 +1,162 @@
+#include "projbot/live/recorder.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+#include "projbot/alignment/freenect_source.hpp"
+#include "projbot/config/output_file.hpp"
+#include "projbot/hardware/devices.hpp"
+#include "projbot/live/rig.hpp"
+#include "projbot/robot/localization.hpp"
+#include "projbot/session/replay.hpp"
+#include "projbot/session/trackers.hpp"
+
+namespace projbot::live {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The camera's frames as a fakenect dump holds them (depth through the Kinect's 11-bit disparity), so the
+// trackers see here what a replay of the dump will see.
+class QuantisedCamera final : public alignment::RgbdCamera {
+ public:
+  alignment::RgbdCamera* inner = nullptr;
+  alignment::RgbdFrame next() override {
+    alignment::RgbdFrame f = inner->next();
+    if (f.colour.rgba.empty())
+      throw hardware::DeviceError("the camera delivers no colour, and a fakenect dump holds depth and colour together");
+    f.depth = alignment::kinect_quantised(std::move(f.depth));
+    return f;
+  }
+};
+
+// Writes each stop as it ends: its dump (frame by frame), then recording.yaml and poses.csv rewritten,
+// so a recording cut short holds every stop that was left.
+class RecordObserver final : public session::StopObserver {
+ public:
+  RecordObserver(const config::Scene& scene, config::Recording& recording, const fs::path& out, const RecordHooks& hooks)
+      : scene_(scene), rec_(recording), out_(out), hooks_(hooks) {}
+  void lit(const session::Stop& stop, double) override {
+    char name[32];
+    std::snprintf(name, sizeof name, "stop%02d", stop.visit + 1);
+    current_ = config::RecordedStop{};
+    current_.visit = stop.visit;
+    current_.target = scene_.targets[static_cast<std::size_t>(stop.target)].name;
+    current_.goal = {stop.drive.goal.x_m, stop.drive.goal.y_m, stop.drive.goal.theta_rad};
+    current_.believed = {stop.drive.estimate.x_m, stop.drive.estimate.y_m, stop.drive.estimate.theta_rad};
+    current_.pan_rad = stop.angles.pan_rad;
+    current_.tilt_rad = stop.angles.tilt_rad;
+    current_.drive_s = stop.drive.drive_seconds;
+    current_.arrived = stop.drive.arrived;
+    current_.frames = name;
+    writer_ = std::make_unique<alignment::FakenectDumpWriter>(out_ / name);
+  }
+  void frame(const session::Stop& stop, int k, const alignment::RgbdFrame& f,
+             const std::vector<std::optional<alignment::PoseSample>>& samples) override {
+    if (t0_s_ < 0.0) t0_s_ = f.depth.capture_time_s;
+    writer_->add({&f.depth, &f.colour, f.depth.capture_time_s - t0_s_});
+    poses_.add(scene_, stop, k, samples);
+    current_.frame_count = k + 1;
+    ++frames;
+    if (hooks_.frame) hooks_.frame(frames);
+  }
+  void left(const session::Stop&) override {
+    rec_.stops.push_back(current_);
+    save();
+    *hooks_.log << "stop " << rec_.stops.size() << ": " << current_.target << ", " << current_.frame_count << " frames recorded"
+                << std::endl;
+  }
+  // A laser scan with the odometry then, as a rawlog step (its odometry the increment since the last).
+  void scan(const robot::LaserScan& scan, const robot::Pose2D& odometry) {
+    robot::RawlogStep step;
+    step.timestamp_s = scan.timestamp_s;
+    if (last_odometry_) step.odometry_increment = robot::between(*last_odometry_, odometry);
+    step.scan = scan;
+    scans_.push_back(std::move(step));
+    last_odometry_ = odometry;
+  }
+  void save() const {
+    if (!scans_.empty()) {  // written whole, then renamed: a reader never sees half a rawlog
+      robot::write_rawlog(out_ / "laser.rawlog.tmp", scans_);
+      fs::rename(out_ / "laser.rawlog.tmp", out_ / "laser.rawlog");
+      rec_.laser = "laser.rawlog";
+    }
+    config::write_file_atomically(out_ / "poses.csv", poses_.text());
+    config::write_file_atomically(out_ / "recording.yaml", config::recording_yaml(rec_));
+  }
+  int frames = 0;
+
+ private:
+  const config::Scene& scene_;
+  config::Recording& rec_;
+  fs::path out_;
+  const RecordHooks& hooks_;
+  config::RecordedStop current_;
+  std::unique_ptr<alignment::FakenectDumpWriter> writer_;
+  session::PoseLog poses_;
+  std::vector<robot::RawlogStep> scans_;  // the robot's laser and odometry so far
+  std::optional<robot::Pose2D> last_odometry_;
+  double t0_s_ = -1.0;
+};
+
+// The scene's devices for a recording (none with `sim`); the camera's name goes into the recording.
+hardware::Devices open_devices(const config::Scene& scene, bool sim, config::Recording& rec) {
+  rec.camera = "the twin's camera";
+  if (sim) return {};
+  config::DevicesConfig wanted = scene.devices;
+  wanted.projector.reset();  // nothing is projected while recording
+  std::vector<hardware::DeviceCheck> checks;
+  bool robot = false;
+  hardware::Devices devices =
+      hardware::open_session_devices(wanted, checks, robot, false);  // a laser without a map: a mapping run
+  for (const auto& c : checks)
+    if (c.role == "camera") rec.camera = c.config;
+  return devices;
+}
+
+// The rig's dwell with the camera quantised as the dump holds it and every stop ended by an interrupt.
+session::Dwell recording_dwell(Rig& rig, double dwell_s, QuantisedCamera& quantised, const RecordHooks& hooks) {
+  session::Dwell dwell = rig.dwell(dwell_s);
+  dwell.camera = [&quantised, camera = dwell.camera](const session::Stop& stop, double since_s) -> alignment::RgbdCamera& {
+    quantised.inner = &camera(stop, since_s);
+    return quantised;
+  };
+  dwell.over = [&hooks, over = dwell.over](const session::Stop& stop, int frames, double elapsed_s) {
+    return (hooks.interrupted && hooks.interrupted()) || over(stop, frames, elapsed_s);
+  };
+  return dwell;
+}
+
+}  // namespace
+
+Recorded record(const config::Scene& scene, const RecordOptions& o, const fs::path& out, const RecordHooks& hooks) {
+  const auto interrupted = [&hooks] { return hooks.interrupted && hooks.interrupted(); };
+  Recorded result;
+  config::Recording& rec = result.recording;
+  hardware::Devices devices = open_devices(scene, o.sim, rec);
+  rec.scene = fs::absolute(scene.source);
+  rec.seed = o.seed;
+  rec.dwell_s = o.dwell_s;
+  session::SceneTrackers trackers = session::make_trackers(scene, session::worker_config(true, true));
+  // The robot: the configured base, pan-tilt and camera together, or the twin's (with the configured camera, if any).
+  Rig rig(scene, trackers.targets, devices, nullptr, {.seed = o.seed, .recording = true, .interrupted = interrupted});
+  QuantisedCamera quantised;
+  const session::Dwell dwell = recording_dwell(rig, o.dwell_s, quantised, hooks);
+  if (interrupted()) return result;  // no folder made
+  std::error_code ec;
+  fs::create_directories(out, ec);  // only now: a set-up that fails or is stopped leaves no folder behind
+  if (ec) throw config::ConfigError(out.string() + ": cannot create: " + ec.message());
+  result.started = true;
+  RecordObserver observer(scene, rec, out, hooks);
+  rig.on_scan([&observer](const robot::LaserScan& scan, const robot::Pose2D& odometry) { observer.scan(scan, odometry); });
+  const std::stop_source never;
+  for (int v = 0; v < o.visits && !interrupted(); ++v)
+    rig.session().visit(v, trackers.workers, dwell, observer, never.get_token());
+  rec.interrupted = interrupted();
+  observer.save();
+  result.frames = observer.frames;
+  return result;
+}
+
+}  // namespace projbot::live

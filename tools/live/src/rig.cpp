@@ -1,0 +1,41 @@
+#include "projbot/live/rig.hpp"
+
+namespace projbot::live {
+
+Rig::Rig(const config::Scene& scene, const std::vector<session::Target>& targets, hardware::Devices& devices,
+         const config::Recording* replay, RigOptions options)
+    : options_(std::move(options)), replay_(replay) {
+  if (!options_.interrupted) options_.interrupted = [] { return false; };
+  if (devices.base)
+    devices_ = std::make_unique<hardware::DeviceSession>(scene, targets, devices);
+  else if (replay)
+    replay_session_ = std::make_unique<session::ReplaySession>(scene, *replay, targets);
+  else
+    twin_ = std::make_unique<twin::TwinSession>(scene, targets, options_.seed, devices.camera.get(), options_.interrupted,
+                                                options_.recording);
+}
+
+Rig::~Rig() = default;
+
+session::Session& Rig::session() {
+  if (devices_) return devices_->session();
+  if (replay_session_) return replay_session_->session();
+  return twin_->session();
+}
+
+session::Dwell Rig::dwell(double dwell_s) {
+  if (devices_) return devices_->dwell(dwell_s, options_.recording);
+  if (replay_session_) return replay_session_->dwell();
+  return twin_->dwell(dwell_s, options_.recording);
+}
+
+twin::Twin* Rig::twin() { return twin_ ? &twin_->twin() : nullptr; }
+
+int Rig::visits(int asked) const { return replay_ ? static_cast<int>(replay_->stops.size()) : asked; }
+
+void Rig::on_scan(ScanListener listener) {
+  if (devices_) devices_->navigator().on_scan(std::move(listener));
+  if (twin_) twin_->twin().robot().on_scan(std::move(listener));
+}
+
+}  // namespace projbot::live
