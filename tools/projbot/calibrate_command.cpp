@@ -7,12 +7,12 @@
 #include <iostream>
 #include <sstream>
 
-#include "calibrate_capture.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "progress.hpp"
 #include "projbot/calibrate/calibrate.hpp"
 #include "projbot/calibrate/capture.hpp"
+#include "projbot/calibrate/pattern_screen.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/hardware/devices.hpp"
 #include "scene_setup.hpp"
@@ -22,8 +22,6 @@ namespace {
 
 constexpr const char* kDefaultBoard = "charuco:10x7:0.06:0.045:DICT_4X4_50";
 
-// The twin's colour camera lens: the Kinect v1 depth camera's pinhole (colour registered to it) with a
-// moderate barrel distortion of a webcam-class lens, so the solve has one to find.
 // --board (default kDefaultBoard); a bad one is a usage error naming the option.
 calibrate::Board board_option(const cli::Args& args) {
   const std::string spec = args.get_or("board", kDefaultBoard);
@@ -34,13 +32,6 @@ calibrate::Board board_option(const cli::Args& args) {
     if (const std::string head = "board '" + spec + "': "; why.rfind(head, 0) == 0) why = why.substr(head.size());
     throw cli::UsageError("--board '" + spec + "': " + why);
   }
-}
-
-calibrate::Camera twin_colour_lens(const config::Scene& scene) {
-  calibrate::Camera l;
-  static_cast<config::Pinhole&>(l) = scene.depth_camera;
-  l.distortion = {0.10, -0.20, 0.0005, -0.0005, 0.0};
-  return l;
 }
 
 // The twin's session from the command line: poses (spread or scripted), board, seed and noise, with the
@@ -55,7 +46,7 @@ calibrate::SimulationConfig simulation_config(const cli::Args& args, const confi
   }
   c.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
   c.board = board_option(args);
-  c.camera = twin_colour_lens(scene);
+  c.camera = calibrate::twin_colour_camera(scene.depth_camera);
   c.projector = scene.projector;
   c.T_projector_camera = scene.pan_tilt.T_projector_camera;
   c.noise_sigma = args.get_double("noise", c.noise_sigma);
@@ -120,38 +111,17 @@ void print_result(const calibrate::Calibration& c) {
   for (const auto& w : c.warnings) std::cout << "warning: " << w << '\n';
 }
 
-// How far apart two lenses put the same ray on the panel, at most over the image (in the truth's pixels).
-double lens_difference_px(const calibrate::Camera& fit, const calibrate::Camera& truth) {
-  const config::Pinhole& k = truth;
-  double worst = 0.0;
-  for (int j = 0; j <= 20; ++j)
-    for (int i = 0; i <= 20; ++i) {
-      const Eigen::Vector2d x = k.back_project(k.width_px * i / 20.0, k.height_px * j / 20.0, 1.0).head<2>();
-      const Eigen::Vector2d d = config::distort(fit.distortion, x) - config::distort(truth.distortion, x);
-      worst = std::max(worst, std::hypot(k.fx_px * d.x(), k.fy_px * d.y()));
-    }
-  return worst;
-}
-
 // The solve beside the truth a simulated capture carries.
 void print_truth(const calibrate::Calibration& c, const calibrate::Calibration& t) {
-  const auto pct = [](double a, double b) { return 100.0 * std::abs(a - b) / b; };
-  const config::Pinhole& p = c.projector;
-  const config::Pinhole& q = t.projector;
-  const config::Pinhole& k = c.camera;
-  const config::Pinhole& l = t.camera;
-  const Eigen::Matrix3d dR = c.T_projector_camera.block<3, 3>(0, 0) * t.T_projector_camera.block<3, 3>(0, 0).transpose();
-  const double angle_deg = std::acos(std::clamp((dR.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
-  const double dt_mm = 1000.0 * (c.T_projector_camera.block<3, 1>(0, 3) - t.T_projector_camera.block<3, 1>(0, 3)).norm();
-  std::cout << std::fixed << std::setprecision(3) << "against the truth:\n  projector fx " << pct(p.fx_px, q.fx_px) << " %, fy "
-            << pct(p.fy_px, q.fy_px) << " %, principal point " << std::hypot(p.cx_px - q.cx_px, p.cy_px - q.cy_px)
-            << " px\n  camera fx " << pct(k.fx_px, l.fx_px) << " %, fy " << pct(k.fy_px, l.fy_px) << " %, principal point "
-            << std::hypot(k.cx_px - l.cx_px, k.cy_px - l.cy_px) << " px\n  T_cp " << dt_mm << " mm, R_cp " << angle_deg
-            << " deg\n";
-  if (config::has_distortion(c.projector.distortion) || config::has_distortion(t.projector.distortion))
+  const calibrate::TruthComparison d = calibrate::compare(c, t);
+  std::cout << std::fixed << std::setprecision(3) << "against the truth:\n  projector fx " << d.projector_fx_pct << " %, fy "
+            << d.projector_fy_pct << " %, principal point " << d.projector_principal_px << " px\n  camera fx " << d.camera_fx_pct
+            << " %, fy " << d.camera_fy_pct << " %, principal point " << d.camera_principal_px << " px\n  T_cp "
+            << d.translation_mm << " mm, R_cp " << d.rotation_deg << " deg\n";
+  if (d.projector_lens)
     std::cout << "  projector lens k1 " << c.projector.distortion[0] << " (truth " << t.projector.distortion[0] << "), k2 "
               << c.projector.distortion[1] << " (truth " << t.projector.distortion[1] << "): the two lenses place a ray "
-              << lens_difference_px(c.projector, t.projector) << " px apart at most over the image\n";
+              << d.projector_lens_px << " px apart at most over the image\n";
 }
 
 int run_solve(const cli::Args& args) {
@@ -199,7 +169,7 @@ calibrate::CaptureSummary capture_on_devices(const cli::Args& args, const config
   engine::RendererOptions ro;  // after the monitors were checked: that check starts and stops GLFW
   ro.windowing = true;
   engine::Renderer renderer(ro);
-  PatternScreen screen(renderer, scene.projector);
+  calibrate::PatternScreen screen(renderer, scene.projector);
   engine::WindowOptions wo = window_options(args, scene.projector, "projbot calibrate capture");
   if (scene.devices.projector) {
     wo.fullscreen = args.flag("fullscreen") || scene.devices.projector->fullscreen;
@@ -208,7 +178,8 @@ calibrate::CaptureSummary capture_on_devices(const cli::Args& args, const config
   auto window = open_window(renderer, wo, scene.projector);
   const double settle_ms = args.get_double("settle-ms", 150.0);
   if (!(settle_ms >= 0.0 && settle_ms <= 5000.0)) throw cli::UsageError("--settle-ms must be 0..5000");
-  auto rig = make_device_rig(screen, renderer, *window, *devices.camera, settle_ms, scene.projector.input_lag_ms);
+  auto rig = calibrate::make_device_rig(screen, renderer, *window, *devices.camera, settle_ms, scene.projector.input_lag_ms,
+                                        std::cin, std::cout);
   return calibrate::capture(
       *rig, o, out, [](const std::string& line) { std::cout << line << std::endl; }, interrupted);
 }
@@ -233,18 +204,11 @@ int run_capture(const cli::Args& args) {
   calibrate::CaptureSummary s;
   if (sim) {
     engine::Renderer renderer(engine::RendererOptions{});
-    PatternScreen screen(renderer, scene.projector);
+    calibrate::PatternScreen screen(renderer, scene.projector);
     const calibrate::SimulationConfig c = simulation_config(args, scene);
     o.poses = c.poses;
     // The twin takes what the engine drew, checked pixel for pixel against the pattern it was given.
-    auto rig = calibrate::make_twin_rig(c, [&](std::size_t index, const cv::Mat& pattern) {
-      cv::Mat shown = screen.render(index);
-      const int differ = cv::countNonZero(shown != pattern);
-      if (differ != 0)
-        throw calibrate::CalibrationError("the engine drew pattern " + std::to_string(index) + " with " + std::to_string(differ) +
-                                          " pixels unlike the pattern's");
-      return shown;
-    });
+    auto rig = calibrate::make_twin_rig(c, calibrate::engine_display(screen));
     s = calibrate::capture(
         *rig, o, *out, [](const std::string& line) { std::cout << line << std::endl; }, interrupted);
   } else {

@@ -1,15 +1,14 @@
-#include "calibrate_capture.hpp"
+#include "projbot/calibrate/pattern_screen.hpp"
 
 #include <chrono>
 #include <cmath>
-#include <iostream>
 #include <string>
 #include <thread>
 
 #include "projbot/calibrate/procam.hpp"
 #include "projbot/config/clock.hpp"
 
-namespace projbot::tools {
+namespace projbot::calibrate {
 namespace {
 
 // A quad at 1 m whose corners are the projector image's outer pixel edges, its texture the pattern.
@@ -58,25 +57,27 @@ cv::Mat grey_of(const assets::Image& colour) {
   return out;
 }
 
-class DeviceRig final : public calibrate::CaptureRig {
+class DeviceRig final : public CaptureRig {
  public:
   DeviceRig(PatternScreen& screen, engine::Renderer& renderer, engine::RenderTarget& window, alignment::RgbdCamera& camera,
-            double settle_ms, double lag_ms)
+            double settle_ms, double lag_ms, std::istream& answers, std::ostream& prompt)
       : screen_(screen),
         renderer_(renderer),
         window_(window),
         camera_(camera),
         settle_s_(settle_ms / 1000.0),
-        lag_s_(lag_ms / 1000.0) {}
+        lag_s_(lag_ms / 1000.0),
+        answers_(answers),
+        prompt_(prompt) {}
 
   bool ready(int pose, int poses) override {
     show(screen_.white_index());
-    std::cout << "pose " << pose << " of " << poses
-              << ": hold the board in the projector's white light, wholly in the camera's view, and press Enter (q and "
-                 "Enter: finish with the poses kept)"
-              << std::endl;
+    prompt_ << "pose " << pose << " of " << poses
+            << ": hold the board in the projector's white light, wholly in the camera's view, and press Enter (q and "
+               "Enter: finish with the poses kept)"
+            << std::endl;
     std::string line;
-    if (!std::getline(std::cin, line)) return false;
+    if (!std::getline(answers_, line)) return false;
     return line != "q" && line != "Q";
   }
 
@@ -87,10 +88,10 @@ class DeviceRig final : public calibrate::CaptureRig {
     for (int tries = 0; tries < 100; ++tries) {  // frames taken before the light changed are dropped
       alignment::RgbdFrame f = camera_.next();
       if (f.colour.rgba.empty())
-        throw calibrate::CalibrationError("the configured camera delivers no colour image; calibrate capture needs one");
+        throw CalibrationError("the configured camera delivers no colour image; calibrate capture needs one");
       if (f.depth.capture_time_s >= shown + lag_s_) return grey_of(f.colour);
     }
-    throw calibrate::CalibrationError(
+    throw CalibrationError(
         "the camera delivered 100 frames all taken before the pattern was shown: are its "
         "timestamps on the host's steady clock?");
   }
@@ -107,6 +108,8 @@ class DeviceRig final : public calibrate::CaptureRig {
   engine::RenderTarget& window_;
   alignment::RgbdCamera& camera_;
   double settle_s_, lag_s_;
+  std::istream& answers_;
+  std::ostream& prompt_;
 };
 
 }  // namespace
@@ -116,7 +119,7 @@ PatternScreen::PatternScreen(engine::Renderer& renderer, const config::Projector
   pinhole_.distortion = {};
   pinhole_.near_m = 0.1;
   pinhole_.far_m = 10.0;
-  for (const cv::Mat& pattern : calibrate::gray_code_images(projector.width_px, projector.height_px))
+  for (const cv::Mat& pattern : gray_code_images(projector.width_px, projector.height_px))
     models_.push_back(renderer_.add_model(pattern_quad(pinhole_, pattern)));
 }
 
@@ -135,10 +138,21 @@ cv::Mat PatternScreen::render(std::size_t index) {
   return out;
 }
 
-std::unique_ptr<calibrate::CaptureRig> make_device_rig(PatternScreen& screen, engine::Renderer& renderer,
-                                                       engine::RenderTarget& window, alignment::RgbdCamera& camera,
-                                                       double settle_ms, double input_lag_ms) {
-  return std::make_unique<DeviceRig>(screen, renderer, window, camera, settle_ms, input_lag_ms);
+PatternDisplay engine_display(PatternScreen& screen) {
+  return [&screen](std::size_t index, const cv::Mat& pattern) {
+    cv::Mat shown = screen.render(index);
+    const int differ = cv::countNonZero(shown != pattern);
+    if (differ != 0)
+      throw CalibrationError("the engine drew pattern " + std::to_string(index) + " with " + std::to_string(differ) +
+                             " pixels unlike the pattern's");
+    return shown;
+  };
 }
 
-}  // namespace projbot::tools
+std::unique_ptr<CaptureRig> make_device_rig(PatternScreen& screen, engine::Renderer& renderer, engine::RenderTarget& window,
+                                            alignment::RgbdCamera& camera, double settle_ms, double input_lag_ms,
+                                            std::istream& answers, std::ostream& prompt) {
+  return std::make_unique<DeviceRig>(screen, renderer, window, camera, settle_ms, input_lag_ms, answers, prompt);
+}
+
+}  // namespace projbot::calibrate

@@ -333,4 +333,11 @@ std::unique_ptr<CaptureRig> make_twin_rig(const SimulationConfig& config, Patter
   return std::make_unique<TwinRig>(config, std::move(display));
 }
 
+Camera twin_colour_camera(const config::Camera& depth_camera) {
+  Camera c;
+  static_cast<config::Pinhole&>(c) = depth_camera;
+  c.distortion = {0.10, -0.20, 0.0005, -0.0005, 0.0};
+  return c;
+}
+
 }  // namespace projbot::calibrate

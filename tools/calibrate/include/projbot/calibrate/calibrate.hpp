@@ -80,6 +80,10 @@ struct SimulationConfig {
   double noise_sigma = 1.5;    ///< sensor noise, grey levels (of 255)
 };
 
+/// The twin's colour camera: the depth camera's pinhole (colour registered to it) with a webcam-class
+/// barrel distortion, so that a solve has one to find.
+Camera twin_colour_camera(const config::Camera& depth_camera);
+
 /// Writes a capture folder (capture.yaml, pose_NN/NN.png, truth.yaml with the values it was made
 /// with); returns the poses written. `progress(pose)` is called after each pose; when `stop()` says so
 /// the poses finished so far are written as the capture (none: nothing is). Throws CalibrationError.
@@ -116,6 +120,17 @@ struct Calibration {
   /// A simulated capture's truth only: each pose's board in the camera frame (OpenCV's board frame).
   std::vector<Eigen::Matrix4d> T_camera_board;
 };
+
+/// A solve against the truth a simulated capture carries: focal lengths in % of the truth's, principal
+/// points in pixels, T_cp in mm, R_cp in degrees.
+struct TruthComparison {
+  double projector_fx_pct = 0.0, projector_fy_pct = 0.0, projector_principal_px = 0.0;
+  double camera_fx_pct = 0.0, camera_fy_pct = 0.0, camera_principal_px = 0.0;
+  double translation_mm = 0.0, rotation_deg = 0.0;
+  bool projector_lens = false;     ///< either has a projector distortion
+  double projector_lens_px = 0.0;  ///< then: how far apart the two lenses put one ray, at most over the image
+};
+TruthComparison compare(const Calibration& solved, const Calibration& truth);
 
 /// Decodes, finds corners, maps them to the projector and calibrates. Throws CalibrationError for a
 /// folder that cannot be read or has too few usable views. `progress(view)` after each view.

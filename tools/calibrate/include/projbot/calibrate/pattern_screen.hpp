@@ -2,14 +2,16 @@
 // `calibrate capture`'s rigs on the engine: the patterns drawn by the renderer (offscreen for the twin,
 // full screen on the projector for the real devices) and the configured colour camera.
 
+#include <istream>
 #include <memory>
+#include <ostream>
 
 #include "projbot/alignment/rgbd_camera.hpp"
 #include "projbot/calibrate/capture.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
 
-namespace projbot::tools {
+namespace projbot::calibrate {
 
 /// The Gray-code patterns uploaded once, each a quad that fills the projector's image texel for pixel
 /// (nearest sampling, no lens: a pattern's pixels are the panel's own).
@@ -30,11 +32,15 @@ class PatternScreen {
   std::unique_ptr<engine::RenderTarget> offscreen_;
 };
 
+/// What the twin's rig is lit by (make_twin_rig's `display`): each pattern as `screen` draws it,
+/// checked pixel for pixel against the pattern (a CalibrationError naming the pattern where they differ).
+PatternDisplay engine_display(PatternScreen& screen);
+
 /// The real rig: `screen` drawn into `window` (the projector, full screen), `camera`'s colour images
 /// taken `settle_ms` plus the projector's input lag after each pattern is presented; ready() asks the
-/// person on the terminal to hold the board and press Enter (q: finish).
-std::unique_ptr<calibrate::CaptureRig> make_device_rig(PatternScreen& screen, engine::Renderer& renderer,
-                                                       engine::RenderTarget& window, alignment::RgbdCamera& camera,
-                                                       double settle_ms, double input_lag_ms);
+/// person at `prompt` to hold the board and press Enter on `answers` (q: finish).
+std::unique_ptr<CaptureRig> make_device_rig(PatternScreen& screen, engine::Renderer& renderer, engine::RenderTarget& window,
+                                            alignment::RgbdCamera& camera, double settle_ms, double input_lag_ms,
+                                            std::istream& answers, std::ostream& prompt);
 
-}  // namespace projbot::tools
+}  // namespace projbot::calibrate
