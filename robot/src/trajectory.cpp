@@ -1,8 +1,11 @@
-// Trajectories on disk (`timestamp x y phi` lines) and the names of a map folder's files: plain text and
-// names, no MRPT, so that a build without MRPT (tools/bundle.sh) keeps them.
+// Trajectories on disk (`timestamp x y phi` lines), compared and dead-reckoned, a rawlog localised step by
+// step, and the names of a map folder's files: no MRPT here, so that a build without MRPT (tools/bundle.sh)
+// keeps them (the localiser itself says there that it is left out).
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <numbers>
 #include <sstream>
 
 #include "projbot/config/output_file.hpp"
@@ -49,6 +52,47 @@ std::vector<TrajectoryPoint> read_trajectory(const std::filesystem::path& path) 
 const std::set<std::string>& map_folder_files() {
   static const std::set<std::string> files{"map.simplemap.gz", "grid.png", "grid.yaml"};
   return files;
+}
+
+TrajectoryErrors trajectory_errors(const std::vector<TrajectoryPoint>& est, const std::vector<TrajectoryPoint>& truth) {
+  TrajectoryErrors s;
+  if (truth.empty()) return s;
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < est.size(); ++i) {
+    while (j + 1 < truth.size() && truth[j + 1].timestamp_s <= est[i].timestamp_s + 1e-3) ++j;
+    const bool by_time = std::abs(truth[j].timestamp_s - est[i].timestamp_s) < 1e-3;
+    const TrajectoryPoint* t = by_time ? &truth[j] : (i < truth.size() ? &truth[i] : nullptr);
+    if (t == nullptr) continue;
+    const double e = distance_m(est[i].pose, t->pose), a = heading_error_rad(est[i].pose, t->pose) * 180.0 / std::numbers::pi;
+    s.mean_m += e, s.mean_deg += a, s.max_m = std::max(s.max_m, e), s.max_deg = std::max(s.max_deg, a), ++s.n;
+  }
+  if (s.n > 0) s.mean_m /= static_cast<double>(s.n), s.mean_deg /= static_cast<double>(s.n);
+  return s;
+}
+
+std::vector<TrajectoryPoint> dead_reckoning(const std::vector<RawlogStep>& steps, const Pose2D& start) {
+  std::vector<TrajectoryPoint> out;
+  Pose2D p = start;
+  for (const auto& s : steps) {
+    if (s.odometry_increment) p = compose(p, *s.odometry_increment);
+    out.push_back({s.timestamp_s, p});
+  }
+  return out;
+}
+
+RawlogLocalization localize_rawlog(Localizer& localizer, const std::vector<RawlogStep>& steps, const Pose2D& start,
+                                   const std::function<bool(int done)>& keep_going) {
+  RawlogLocalization r;
+  localizer.reset(start);
+  for (const auto& s : steps) {
+    if (s.odometry_increment) localizer.predict(*s.odometry_increment);
+    const auto u = localizer.correct(s.scan);
+    r.accepted += u.accepted;
+    r.correct_ms += u.time_ms;
+    r.trajectory.push_back({s.timestamp_s, localizer.pose()});
+    if (keep_going && !keep_going(static_cast<int>(r.trajectory.size()))) break;
+  }
+  return r;
 }
 
 }  // namespace projbot::robot

@@ -28,39 +28,7 @@ namespace fs = std::filesystem;
 using robot::Pose2D;
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
-struct ErrorStats {
-  double mean_m = 0, max_m = 0, mean_deg = 0, max_deg = 0;
-  std::size_t n = 0;
-};
-
-// Pose errors of an estimated trajectory against ground truth, matched by timestamp (nearest,
-// within 1 ms), or by index when the timestamps do not match at all.
-ErrorStats compare(const std::vector<robot::TrajectoryPoint>& est, const std::vector<robot::TrajectoryPoint>& truth) {
-  ErrorStats s;
-  std::size_t j = 0;
-  for (std::size_t i = 0; i < est.size(); ++i) {
-    while (j + 1 < truth.size() && truth[j + 1].timestamp_s <= est[i].timestamp_s + 1e-3) ++j;
-    const bool by_time = std::abs(truth[j].timestamp_s - est[i].timestamp_s) < 1e-3;
-    const robot::TrajectoryPoint* t = by_time ? &truth[j] : (i < truth.size() ? &truth[i] : nullptr);
-    if (t == nullptr) continue;
-    const double e = robot::distance_m(est[i].pose, t->pose), a = robot::heading_error_rad(est[i].pose, t->pose) * kDeg;
-    s.mean_m += e, s.mean_deg += a, s.max_m = std::max(s.max_m, e), s.max_deg = std::max(s.max_deg, a), ++s.n;
-  }
-  if (s.n > 0) s.mean_m /= static_cast<double>(s.n), s.mean_deg /= static_cast<double>(s.n);
-  return s;
-}
-
-std::vector<robot::TrajectoryPoint> dead_reckoning(const std::vector<robot::RawlogStep>& steps, const Pose2D& start) {
-  std::vector<robot::TrajectoryPoint> out;
-  Pose2D p = start;
-  for (const auto& s : steps) {
-    if (s.odometry_increment) p = robot::compose(p, *s.odometry_increment);
-    out.push_back({s.timestamp_s, p});
-  }
-  return out;
-}
-
-void print_errors(const std::string& what, const ErrorStats& s) {
+void print_errors(const std::string& what, const robot::TrajectoryErrors& s) {
   std::cout << std::fixed << std::setprecision(2) << "  " << what << ": mean " << s.mean_m * 100 << " cm / " << s.mean_deg
             << " deg, max " << s.max_m * 100 << " cm / " << s.max_deg << " deg over " << s.n << " poses\n";
 }
@@ -146,10 +114,10 @@ const Command kSlam{
       std::cout << std::fixed << std::setprecision(2) << "ICP-SLAM: " << steps.size() << " scans, " << r.keyframes
                 << " keyframes, " << r.seconds << " s (" << r.seconds * 1000 / static_cast<double>(steps.size())
                 << " ms per scan)\n";
-      const auto odometry = dead_reckoning(steps, r.trajectory.front().pose);
+      const auto odometry = robot::dead_reckoning(steps, r.trajectory.front().pose);
       if (truth) {
-        print_errors("ICP-SLAM vs ground truth", compare(r.trajectory, *truth));
-        print_errors("odometry vs ground truth", compare(odometry, *truth));
+        print_errors("ICP-SLAM vs ground truth", robot::trajectory_errors(r.trajectory, *truth));
+        print_errors("odometry vs ground truth", robot::trajectory_errors(odometry, *truth));
       } else {
         const auto gap = [](const std::vector<robot::TrajectoryPoint>& t) {
           return robot::distance_m(t.front().pose, t.back().pose);
@@ -186,20 +154,12 @@ const Command kLocalize{
       if (interrupted()) return nothing_written("while reading the map and the rawlog");
       std::cout << "localising " << steps.size() << " scans (Ctrl-C stops and keeps the trajectory of the scans done)..."
                 << std::endl;
-      loc.reset(start);
       Progress progress("scan", static_cast<int>(steps.size()));
-      std::vector<robot::TrajectoryPoint> out;
-      int accepted = 0;
-      double ms = 0;
-      for (const auto& s : steps) {
-        if (interrupted()) break;
-        if (s.odometry_increment) loc.predict(*s.odometry_increment);
-        const auto u = loc.correct(s.scan);
-        accepted += u.accepted;
-        ms += u.time_ms;
-        out.push_back({s.timestamp_s, loc.pose()});
-        progress.step(static_cast<int>(out.size()));
-      }
+      const robot::RawlogLocalization r = robot::localize_rawlog(loc, steps, start, [&progress](int done) {
+        progress.step(done);
+        return !interrupted();
+      });
+      const std::vector<robot::TrajectoryPoint>& out = r.trajectory;
       if (out.empty()) return nothing_written("before the first scan");
       robot::write_trajectory(*args.get("out-trajectory"), out);
       if (interrupted()) {
@@ -208,10 +168,11 @@ const Command kLocalize{
         return interrupt_exit_code();
       }
       std::cout << std::fixed << std::setprecision(2) << "localised " << steps.size() << " scans against " << loc.map_points()
-                << " map points: " << accepted << " accepted, " << ms / static_cast<double>(steps.size()) << " ms per scan\n";
+                << " map points: " << r.accepted << " accepted, " << r.correct_ms / static_cast<double>(steps.size())
+                << " ms per scan\n";
       if (truth) {
-        print_errors("localisation vs ground truth", compare(out, *truth));
-        print_errors("odometry vs ground truth", compare(dead_reckoning(steps, start), *truth));
+        print_errors("localisation vs ground truth", robot::trajectory_errors(out, *truth));
+        print_errors("odometry vs ground truth", robot::trajectory_errors(robot::dead_reckoning(steps, start), *truth));
       }
       return 0;
     },
@@ -299,8 +260,9 @@ const Command kBenchLocalize{
       if (r.interrupted) return benchmark_interrupted("during ICP-SLAM");
       std::cout << "\nICP-SLAM on " << rawlog.filename() << " (" << steps.size() << " scans, " << r.keyframes << " keyframes, "
                 << r.seconds * 1000 / static_cast<double>(steps.size()) << " ms per scan):\n";
-      print_errors("ICP-SLAM vs ground truth", compare(r.trajectory, truth));
-      print_errors("odometry vs ground truth", compare(dead_reckoning(steps, r.trajectory.front().pose), truth));
+      print_errors("ICP-SLAM vs ground truth", robot::trajectory_errors(r.trajectory, truth));
+      print_errors("odometry vs ground truth",
+                   robot::trajectory_errors(robot::dead_reckoning(steps, r.trajectory.front().pose), truth));
       return 0;
     },
     mrpt_left_out()};

@@ -41,6 +41,17 @@ void write_trajectory(const std::filesystem::path& path, const std::vector<Traje
 /// Reads `timestamp x y phi` lines; throws RobotError naming file:line on anything else.
 std::vector<TrajectoryPoint> read_trajectory(const std::filesystem::path& path);
 
+/// How far an estimated trajectory lies from the truth: position (m) and heading (degrees), mean and
+/// largest, over the estimates matched to a true pose by timestamp (nearest, within 1 ms), or by index
+/// when the timestamps do not match at all.
+struct TrajectoryErrors {
+  double mean_m = 0.0, max_m = 0.0, mean_deg = 0.0, max_deg = 0.0;
+  std::size_t n = 0;  ///< poses compared
+};
+TrajectoryErrors trajectory_errors(const std::vector<TrajectoryPoint>& estimate, const std::vector<TrajectoryPoint>& truth);
+/// Odometry alone: each step's increment composed onto `start`, one point per step.
+std::vector<TrajectoryPoint> dead_reckoning(const std::vector<RawlogStep>& steps, const Pose2D& start);
+
 /// Result of a mapping run.
 struct SlamResult {
   std::vector<TrajectoryPoint> trajectory;  ///< the corrected pose after every step
@@ -117,5 +128,17 @@ class Localizer {
   explicit Localizer(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
+
+/// A rawlog localised against the map: the pose after every step, the scans ICP accepted, and the time
+/// spent correcting (ms, in all).
+struct RawlogLocalization {
+  std::vector<TrajectoryPoint> trajectory;
+  int accepted = 0;
+  double correct_ms = 0.0;
+};
+/// Starts `localizer` at `start`, then for each step lets odometry predict and the scan correct.
+/// `keep_going(done)` is asked after each step; false stops there (the steps done are kept).
+RawlogLocalization localize_rawlog(Localizer& localizer, const std::vector<RawlogStep>& steps, const Pose2D& start,
+                                   const std::function<bool(int done)>& keep_going = {});
 
 }  // namespace projbot::robot
