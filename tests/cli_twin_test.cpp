@@ -1,0 +1,209 @@
+// The twin's commands through the executable: tours, bench appearance, bench motion, bench acquire and
+// run, with the figures they print.
+
+#include "cli_fixture.hpp"
+
+using namespace cli_fixture;
+
+// bench appearance (issue 43): the shop's figure, compensation off and on, scored and reported; the
+// compensated picture within the issue's colour goals, the one as stored far off them.
+TEST_F(CliTest, BenchAppearanceScoresCompensationOffAndOn) {
+  const fs::path report = dir_ / "appearance.json";
+  const CliRun r =
+      run_projbot("bench appearance --visits 1 --frames " + (dir_ / "frames").string() + " --report " + report.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("| 1 | figure | no |"), std::string::npos) << r.output;
+  std::ifstream in(report);
+  const auto json = nlohmann::json::parse(in);
+  ASSERT_EQ(json.at("visits").size(), 2U) << json.dump(1);
+  const auto& off = json.at("visits")[0];
+  const auto& on = json.at("visits")[1];
+  EXPECT_EQ(off.at("compensation"), "off");
+  EXPECT_EQ(on.at("compensation"), "on");
+  EXPECT_EQ(on.at("target"), "figure");
+  EXPECT_FALSE(on.at("moving").get<bool>());
+  EXPECT_LE(on.at("de2000_median").get<double>(), 5.0) << on.dump();
+  EXPECT_LE(on.at("de2000_p95").get<double>(), 12.0) << on.dump();
+  EXPECT_GE(on.at("ssim").get<double>(), 0.85) << on.dump();
+  EXPECT_GE(on.at("psnr_db").get<double>(), off.at("psnr_db").get<double>() + 10.0) << off.dump() << on.dump();
+  EXPECT_GT(off.at("de2000_median").get<double>(), 10.0) << off.dump();
+  EXPECT_GT(on.at("ms_per_frame").get<double>(), 0.0);
+  EXPECT_TRUE(fs::exists(dir_ / "frames" / "visit01_figure_spectator_off.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "frames" / "visit01_figure_spectator_on.png"));
+}
+
+// bench appearance --reflectance measured (issue 43): the figure's beige measured at its stop from the
+// colour camera under the projector's black and grey, within 3 % of the scene's (the twin's truth).
+TEST_F(CliTest, BenchAppearanceMeasuresTheFiguresReflectance) {
+  const CliRun r = run_projbot("bench appearance --visits 1 --dwell 0.2 --reflectance measured");
+  ASSERT_EQ(r.code, 0) << r.output;
+  double m[3] = {0, 0, 0}, t[3] = {0, 0, 0};
+  const std::size_t at = r.output.find("visit 1 figure: reflectance measured ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + at, "visit 1 figure: reflectance measured %lf %lf %lf, the scene's %lf %lf %lf", &m[0],
+                        &m[1], &m[2], &t[0], &t[1], &t[2]),
+            6)
+      << r.output;
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(m[ch], t[ch], 0.03 * t[ch]) << "channel " << ch << "\n" << r.output;
+  EXPECT_DOUBLE_EQ(t[0], 0.72);  // the shop's beige
+}
+
+// tour --compensation (issue 43, default on): the shop's figure is beige, so the compensated frame sends
+// it more blue than red to show its grey content grey; off, the content goes out as stored.
+TEST_F(CliTest, TourCompensatesTheFiguresBeigeUnlessTurnedOff) {
+  const auto blue_over_red = [&](const std::string& extra, const fs::path& frames) {
+    const CliRun r = run_projbot("tour --visits 1 --mode localized --frames " + frames.string() + extra);
+    EXPECT_EQ(r.code, 0) << r.output;
+    const auto image = projbot::assets::read_image(frames / "visit01_figure.png");
+    double red = 0.0, blue = 0.0;
+    for (std::size_t i = 0; i < image.rgba.size(); i += 4)
+      if (image.rgba[i] + image.rgba[i + 1] + image.rgba[i + 2] > 60) red += image.rgba[i], blue += image.rgba[i + 2];
+    return red > 0.0 ? blue / red : 0.0;
+  };
+  EXPECT_GT(blue_over_red("", dir_ / "on"), 1.15);  // beige reflects red 0.72, blue 0.44
+  EXPECT_NEAR(blue_over_red(" --compensation off", dir_ / "off"), 1.0, 0.1);
+}
+
+// Two targets side by side: at the duck's stop the box is lit in the same projector frames, on the
+// right of the duck (the box stands 0.6 m east of it).
+TEST_F(CliTest, TourLightsANeighbourInTheSameFrame) {
+  const CliRun r = run_projbot("tour --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/display.yaml --visits 1" +
+                               " --dwell 0.5 --report " + (dir_ / "r.json").string() + " --frames " + (dir_ / "frames").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("; neighbour box lit in 31/31 frames"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| 1 | duck | box |"), std::string::npos) << r.output;  // the neighbours table
+  std::ifstream in(dir_ / "r.json");
+  std::ostringstream json;
+  json << in.rdbuf();
+  EXPECT_NE(json.str().find("\"neighbours\": [\n        {"), std::string::npos) << json.str().substr(0, 400);
+  // The projector frame carries both: the yellow duck left of the middle, the box's white and blue right.
+  const auto image = projbot::assets::read_image(dir_ / "frames" / "visit01_duck.png");
+  std::size_t left = 0, right = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const auto* p = image.pixel(x, y);
+      if (p[0] + p[1] + p[2] < 60) continue;
+      (x < image.width * 3 / 4 ? left : right) += 1;
+    }
+  EXPECT_GT(left, 20000U);
+  EXPECT_GT(right, 20000U);
+}
+
+TEST_F(CliTest, TourPrintsTheTableAndWritesReportAndFrames) {
+  const CliRun r = run_projbot("tour --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml --mode localized" +
+                               " --visits 1 --report " + (dir_ / "r.json").string() + " --frames " + (dir_ / "frames").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("| visit | duck | paper target 1 |"), std::string::npos) << r.output;
+  std::ifstream in(dir_ / "r.json");
+  std::ostringstream json;
+  json << in.rdbuf();
+  for (const char* key : {"\"T_projector_target_true\"", "\"T_projector_target_estimated\"", "\"error_mm\"", "\"model_m\"",
+                          "\"inlier_ratio\"", "\"fx\"", "\"timings_ms\""})
+    EXPECT_NE(json.str().find(key), std::string::npos) << key;
+  // The projector frame shows the Duck: a good share of lit pixels, the rest black.
+  const auto image = projbot::assets::read_image(dir_ / "frames" / "visit01_duck.png");
+  ASSERT_EQ(image.width, 1280);
+  std::size_t lit = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) lit += image.pixel(x, y)[0] + image.pixel(x, y)[1] > 40 ? 1 : 0;
+  const double share = static_cast<double>(lit) / (image.width * image.height);
+  EXPECT_GT(share, 0.01);
+  EXPECT_LT(share, 0.5);
+  // Beside it, the RGB-D camera's colour view at 640 x 480: the yellow Duck in the middle of a lit room.
+  const auto camera = projbot::assets::read_image(dir_ / "frames" / "visit01_duck_camera.png");
+  ASSERT_EQ(camera.width, 640);
+  ASSERT_EQ(camera.height, 480);
+  std::size_t yellow = 0, dark = 0;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const auto* p = camera.pixel(x, y);
+      yellow += p[0] > 180 && p[1] > 150 && p[2] < 90 ? 1 : 0;
+      dark += p[0] + p[1] + p[2] < 30 ? 1 : 0;
+    }
+  EXPECT_GT(static_cast<double>(yellow) / (640 * 480), 0.02);
+  EXPECT_LT(static_cast<double>(dark) / (640 * 480), 0.05);  // walls and floor everywhere else
+  // And a visitor's view of the room with the projector's light on it.
+  const auto spectator = projbot::assets::read_image(dir_ / "frames" / "visit01_duck_spectator.png");
+  EXPECT_EQ(spectator.width, 960);
+  EXPECT_EQ(spectator.height, 720);
+}
+
+namespace {
+
+// The figures in one table cell "a / b / c", as numbers.
+std::vector<double> numbers_in(const std::string& cell) {
+  std::vector<double> out;
+  std::istringstream in(cell);
+  std::string item;
+  while (std::getline(in, item, '/')) out.push_back(std::stod(item));
+  return out;
+}
+
+}  // namespace
+
+// bench motion through the executable: both runs, side by side, and prediction better on the box
+// carried at 0.5 m/s (visit 2 of the shipped motion scene). Each pose ready 20 ms after its capture, as
+// in the twin's own test: with this machine's measured times the figures moved with the load (p95 12.5 mm
+// once, with CI beside it).
+TEST_F(CliTest, BenchMotionComparesPredictionOffAndOn) {
+  const CliRun r = run_projbot("bench motion --visits 2 --dwell 2 --processing-ms 20");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("prediction off: 1 2 visits done"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("prediction on: 1 2 visits done"), std::string::npos) << r.output;
+  const auto row = r.output.find("| 2 | box | moved | ");
+  ASSERT_NE(row, std::string::npos) << r.output;
+  std::vector<std::string> cells;
+  std::istringstream line(r.output.substr(row, r.output.find('\n', row) - row));
+  std::string cell;
+  while (std::getline(line, cell, '|')) cells.push_back(cell);
+  ASSERT_GE(cells.size(), 6U) << r.output;
+  const auto off = numbers_in(cells[4]), on = numbers_in(cells[5]);
+  ASSERT_EQ(off.size(), 3U);
+  ASSERT_EQ(on.size(), 3U);
+  EXPECT_GT(off[0], 8.0);  // 0.5 m/s and a pose about 50 ms old at display: about 25 mm behind
+  EXPECT_LT(on[0], 5.0);   // the issue's goal for the mean while moving
+  EXPECT_LT(on[1], 10.0);  // and for its 95th percentile
+  EXPECT_NE(r.output.find("projector 60 Hz, input lag 0 ms; camera 30 Hz"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("a pose ready 20.0 ms after its capture (fixed)"), std::string::npos) << r.output;
+  EXPECT_EQ(run_projbot("bench motion --dwell 0").code, 2);
+  EXPECT_EQ(run_projbot("bench motion --processing-ms -1").code, 2);
+}
+
+// run lights the neighbour in view with the visited target (assets/scenes/display.yaml: the box beside
+// the duck), each from its own tracker worker.
+TEST_F(CliTest, RunLightsANeighbourInTheSameFrames) {
+  const CliRun r =
+      run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) + "/scenes/display.yaml --visits 1 --dwell 2");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string key = " frames lit a neighbour too";
+  const auto at = r.output.find(key);
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const auto from = r.output.rfind("; ", at);
+  ASSERT_NE(from, std::string::npos);
+  EXPECT_GT(std::stoi(r.output.substr(from + 2)), 60) << r.output;    // of about 120 frames in the 2 s dwell
+  EXPECT_LT(number_after(r.output, "still mean "), 2.5) << r.output;  // both targets' frames
+}
+
+// run in the shop: each worker starts a stop with the target's footing and the colour taken on arrival,
+// as the tour does; the face-on box slid 2.9 mm along its face on depth alone (all frames: 1.1 mm).
+TEST_F(CliTest, RunPlacesTheShopTargetsWithFootingAndColour) {
+  const CliRun r =
+      run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) + "/scenes/shop.yaml --visits 3 --dwell 2");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto still = r.output.find("still mean ");
+  EXPECT_LT(number_after(r.output, "still mean "), 0.8) << r.output;         // measured 0.4
+  EXPECT_GT(number_after(r.output, " mm over ", still), 200.0) << r.output;  // of about 360 frames: all three lit
+}
+
+// bench acquire through the executable, one trial per target on the demo tour: a row per target, kind
+// of guess and method, and the duck acquired from a 5 cm / 10 degree guess without a false accept.
+TEST_F(CliTest, BenchAcquireReportsEveryTargetAndMethod) {
+  const CliRun r = run_projbot("bench acquire --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml --trials 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* row : {"| duck | 5 cm, 10 deg | ours | 1 |", "| duck | 5 cm, 10 deg | PCL | 1 |",
+                          "| duck | 30 cm, 40 deg | ours | 1 |", "| box | 30 cm, 40 deg | PCL | 1 |"})
+    EXPECT_NE(r.output.find(row), std::string::npos) << row << '\n' << r.output;
+  EXPECT_NE(r.output.find("| duck | 5 cm, 10 deg | ours | 1 | 100.0 % | 0 (0) | 0 |"), std::string::npos) << r.output;
+  EXPECT_EQ(run_projbot("bench acquire --guess-error 5").code, 2);
+  EXPECT_EQ(run_projbot("bench acquire --trials 0").code, 2);
+}
