@@ -10,6 +10,7 @@
 #include "projbot/alignment/depth.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/registration.hpp"
+#include "projbot/alignment/scan_alignment.hpp"
 #include "projbot/config/scene.hpp"
 
 namespace fs = std::filesystem;
@@ -246,4 +247,26 @@ TEST_F(BunnyTest, BadScansAreErrors) {
   bad(0, 3) = std::nan("");
   EXPECT_THROW(aligner_->align(scan_, bad), AlignmentError);
   EXPECT_THROW(Aligner(ModelCloud{}), AlignmentError);
+}
+
+// A scan from a file: a depth image's camera must fit it (the Kinect's defaults only a 640x480 image; given
+// intrinsics must put the principal point inside), and the image is back-projected through it.
+TEST(LoadScan, ADepthImagesCameraMustFitIt) {
+  const fs::path png = fs::path(PROJBOT_SOURCE_DIR) / "tests" / "fuzz" / "corpus" / "depth_png" / "gray16_4x3.png";
+  try {
+    load_scan(png, 1000.0, std::nullopt);
+    ADD_FAILURE() << "a 4x3 image taken with the Kinect's 640x480 intrinsics";
+  } catch (const AlignmentError& e) {
+    EXPECT_NE(std::string(e.what()).find("640x480"), std::string::npos) << e.what();
+  }
+  CameraIntrinsics k{4, 3, 5.0, 5.0, 10.0, 1.0};
+  EXPECT_THROW(load_scan(png, 1000.0, k), AlignmentError);  // cx 10 outside a 4 pixel wide image
+  k.cx_px = 1.5;
+  const Scan scan = load_scan(png, 1000.0, k);
+  ASSERT_TRUE(scan.depth.has_value());
+  EXPECT_EQ(scan.k.width_px, 4);
+  EXPECT_EQ(scan.cloud.points.size(), 12U);
+  EXPECT_TRUE(is_cloud_file("a.PLY"));
+  EXPECT_TRUE(is_depth_image_file("a.TIFF"));
+  EXPECT_FALSE(is_depth_image_file("a.jpg"));
 }

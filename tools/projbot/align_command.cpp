@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "projbot/alignment/depth.hpp"
 #include "projbot/alignment/registration.hpp"
+#include "projbot/alignment/scan_alignment.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/config/rigid.hpp"
@@ -18,56 +19,30 @@
 namespace projbot::tools {
 namespace {
 
-std::string lower_extension(const std::filesystem::path& p) {
-  std::string ext = p.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
-// The scan as a cloud, and for a depth image the image and its camera too (for the free-space check).
-struct Scan {
-  alignment::PointCloud cloud;
-  std::optional<alignment::DepthImage> depth;
-  alignment::CameraIntrinsics k;
-};
-
-Scan load_scan(const cli::Args& args) {
+// --scan, with --intrinsics and --depth-scale for a depth image: a usage error for what they cannot apply to.
+alignment::Scan load_scan(const cli::Args& args) {
   const std::filesystem::path scan = *args.get("scan");
-  const std::string ext = lower_extension(scan);
-  if (ext == ".pcd" || ext == ".ply") {
+  if (alignment::is_cloud_file(scan)) {
     if (args.get("intrinsics") || args.get("depth-scale"))
-      throw cli::UsageError("--intrinsics and --depth-scale apply to depth images, not to " + ext + " clouds");
-    return {alignment::read_cloud(scan), std::nullopt, {}};
+      throw cli::UsageError("--intrinsics and --depth-scale apply to depth images, not to " + scan.extension().string() +
+                            " clouds");
+    return alignment::load_scan(scan, 1.0, std::nullopt);
   }
-  if (ext != ".png" && ext != ".tif" && ext != ".tiff")
+  if (!alignment::is_depth_image_file(scan))
     throw cli::UsageError("--scan must be a .pcd or .ply cloud or a 16-bit .png / .tiff depth image, got '" + scan.string() +
                           "'");
   const double scale = args.get_double("depth-scale", 1000.0);
   if (!(scale > 0.0)) throw cli::UsageError("--depth-scale must be > 0 depth units per metre");
-  const alignment::DepthImage depth =
-      ext == ".png" ? alignment::read_depth_png(scan, scale) : alignment::read_depth_tiff(scan, 1.0 / scale);
-  alignment::CameraIntrinsics k = alignment::CameraIntrinsics::kinect_v1();
+  std::optional<alignment::CameraIntrinsics> k;
   if (const auto text = args.get("intrinsics")) {
     const auto v = config::parse_number_list(*text, 4, "--intrinsics");
     if (!(v[0] > 0.0) || !(v[1] > 0.0)) throw cli::UsageError("--intrinsics: fx and fy must be > 0");
-    k.fx_px = v[0], k.fy_px = v[1], k.cx_px = v[2], k.cy_px = v[3];
+    k = alignment::CameraIntrinsics::kinect_v1();
+    k->fx_px = v[0], k->fy_px = v[1], k->cx_px = v[2], k->cy_px = v[3];
   } else {
     std::cerr << "projbot align: no --intrinsics, using the Kinect v1 defaults (fx = fy = 525, cx = 319.5, cy = 239.5)\n";
   }
-  // Intrinsics belong to one image size: a depth image of another size would back-project to a wrong,
-  // plausible-looking cloud.
-  const std::string size = std::to_string(depth.width) + "x" + std::to_string(depth.height);
-  if (!args.get("intrinsics") && (depth.width != 640 || depth.height != 480))
-    throw alignment::AlignmentError(scan.string() + ": the depth image is " + size +
-                                    " pixels, the Kinect v1 default intrinsics are for 640x480: give --intrinsics "
-                                    "fx,fy,cx,cy of the camera that took it");
-  if (!(k.cx_px > 0 && k.cx_px < depth.width && k.cy_px > 0 && k.cy_px < depth.height))
-    throw alignment::AlignmentError(scan.string() + ": the depth image is " + size +
-                                    " pixels, but --intrinsics put its principal point outside it (cx, cy = " +
-                                    std::to_string(k.cx_px) + ", " + std::to_string(k.cy_px) + ")");
-  k.width_px = depth.width;
-  k.height_px = depth.height;
-  return {alignment::depth_to_cloud(depth, k), depth, k};
+  return alignment::load_scan(scan, scale, k);
 }
 
 nlohmann::json free_space_json(const std::optional<alignment::FreeSpaceCheck>& c, double limit) {
@@ -149,36 +124,17 @@ const Command kAlign{
       const double model_scale = model_scale_option(args, 1.0);
       const alignment::ModelCloud model = alignment::load_model_cloud(*args.get("model"), 50000, model_scale);
       const alignment::GuessError error = guess_error(args);
-      const Scan loaded = load_scan(args);
+      const alignment::Scan loaded = load_scan(args);
       const alignment::PointCloud& scan = loaded.cloud;
       if (const std::size_t valid = scan.finite_count(); valid < cfg.min_points)
         throw alignment::AlignmentError(*args.get("scan") + ": " + std::to_string(valid) + " valid points; at least " +
                                         std::to_string(cfg.min_points) + " are needed");
-      alignment::AlignmentResult r;
-      std::optional<alignment::FreeSpaceCheck> free_space;
-      const double limit = alignment::WorkerConfig{}.max_behind_ratio;
-      if (loaded.depth) {
-        // A depth image: the acquisition the tour, the tracker and bench dataset run (the support under the
-        // guess found in the frame and left out, the depth cropped to the guess's silhouette grown by how
-        // far its error reaches, ICP, the gate), then the free-space check: where the camera looks through
-        // the model at the estimate, it is in the wrong place, however well it fits.
-        alignment::WorkerConfig worker;
-        worker.acquisition = cfg;
-        const alignment::TargetFollower follower(model, loaded.k, worker);
-        try {
-          r = follower.acquire(*loaded.depth, T_init, error);
-        } catch (const alignment::AlignmentError& e) {  // too little depth near the guess: nothing to align, refused
-          std::cerr << "projbot align: " << e.what() << "\n";
-          r.T_scan_model = T_init;
-        }
-        free_space = follower.verify(*loaded.depth, r.T_scan_model);
-      } else {
-        // A cloud's frame is unknown: its z is no range, and the depth camera's noise at a range says nothing.
-        cfg.depth_sigma_coeff = 0.0;
-        cfg.scan_from_origin = false;  // nor is its origin where it was seen from
-        r = alignment::Aligner(model, cfg).align(scan, T_init);
-      }
-      const bool accepted = r.converged && (!free_space || free_space->passes(limit));
+      const alignment::ScanAlignment a = alignment::align_scan(model, loaded, T_init, error, cfg);
+      if (!a.refused.empty()) std::cerr << "projbot align: " << a.refused << "\n";
+      const alignment::AlignmentResult& r = a.result;
+      const std::optional<alignment::FreeSpaceCheck>& free_space = a.free_space;
+      const double limit = a.max_behind_ratio;
+      const bool accepted = a.accepted;
       if (args.flag("json")) {
         nlohmann::json T = nlohmann::json::array();
         for (int i = 0; i < 4; ++i)

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "projbot/assets/model.hpp"
+#include "projbot/bench/frames.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
 #include "scene_setup.hpp"
@@ -20,16 +21,6 @@ struct BenchModel {
   std::string name;
   assets::Model model;
 };
-
-config::ProjectorConfig projector_for(int w, int h) {
-  config::ProjectorConfig p;
-  p.width_px = w;
-  p.height_px = h;
-  p.fx_px = p.fy_px = 1.1 * w;  // about a 48 degree horizontal field, a typical projector
-  p.cx_px = (w - 1) / 2.0;
-  p.cy_px = (h - 1) / 2.0;
-  return p;
-}
 
 std::vector<std::pair<int, int>> parse_sizes(const std::string& text) {
   std::vector<std::pair<int, int>> out;
@@ -59,7 +50,7 @@ std::vector<std::optional<config::Distortion>> lenses_to_measure(const std::opti
     throw cli::UsageError("--lens must be K1,K2 (two radial terms, e.g. -0.12,0.05), not '" + *text + "'");
   lenses.push_back(config::Distortion{k1, k2, 0.0, 0.0, 0.0});
   for (const auto& [w, h] : sizes) {
-    auto p = projector_for(w, h);
+    auto p = bench::typical_projector(w, h);
     p.distortion = *lenses.back();
     try {
       config::validate_projector(p, "--lens " + *text + " at " + std::to_string(w) + "x" + std::to_string(h));
@@ -68,34 +59,6 @@ std::vector<std::optional<config::Distortion>> lenses_to_measure(const std::opti
     }
   }
   return lenses;
-}
-
-// One run: 20 warm-up frames, then `frames` measured ones (fewer when interrupted).
-engine::FrameSummary measure(engine::Renderer& renderer, const config::ProjectorConfig& projector,
-                             const std::vector<engine::DrawItem>& items, bool windowed, int frames) {
-  std::unique_ptr<engine::RenderTarget> target;
-  if (windowed) {
-    engine::WindowOptions wo;
-    wo.width_px = projector.width_px;
-    wo.height_px = projector.height_px;
-    wo.title = "projbot bench";
-    wo.present_mode = engine::PresentMode::kImmediate;
-    target = renderer.make_window(wo);
-  } else {
-    target = renderer.make_offscreen(projector.width_px, projector.height_px);
-  }
-  for (int i = 0; i < 20 && !interrupted(); ++i) {
-    target->poll_close();
-    renderer.draw_frame(*target, projector, items);
-  }
-  renderer.finish(*target);
-  engine::FrameProfiler profiler;
-  for (int i = 0; i < frames && !interrupted(); ++i) {
-    target->poll_close();
-    renderer.draw_frame(*target, projector, items, &profiler);
-  }
-  renderer.finish(*target);
-  return profiler.summary();
 }
 
 }  // namespace
@@ -154,11 +117,12 @@ const Command kBenchRender{
           for (const auto& lens : lenses)
             for (const engine::Compensation& comp : compensations)
               for (const bool windowed : {false, true}) {
-                auto projector = projector_for(w, h);
+                auto projector = bench::typical_projector(w, h);
                 if (lens) projector.distortion = *lens;
                 const std::vector<engine::DrawItem> items{{id, framing_pose(projector, radius), comp}};
                 if ((windowed && !want_window) || (!windowed && !want_offscreen)) continue;
-                const engine::FrameSummary s = measure(renderer, projector, items, windowed, frames);
+                const engine::FrameSummary s =
+                    bench::measure_render(renderer, projector, items, windowed, frames, [] { return !interrupted(); });
                 if (interrupted())
                   return benchmark_interrupted("after " + std::to_string(s.frames) + " of " + std::to_string(frames) +
                                                " frames of this run (not reported)");

@@ -12,7 +12,7 @@
 
 #include "commands.hpp"
 #include "interrupt.hpp"
-#include "projbot/config/clock.hpp"
+#include "projbot/bench/frames.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/engine/content.hpp"
 #include "scene_setup.hpp"
@@ -20,72 +20,9 @@
 namespace projbot::tools {
 namespace {
 
-double rss_mb() {
-  std::ifstream status("/proc/self/status");
-  for (std::string line; std::getline(status, line);)
-    if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;  // kB
-  return std::nan("");
-}
-
-struct ContentRun {
-  std::size_t frames = 0;
-  std::vector<double> offset_ms;  // per target-frame: content time less the shown frame's presentation time
-  double in_step_ms_max = 0.0;    // the largest spread of that offset between targets within one frame
-  double within_one_frame = 0.0;  // share of target-frames whose offset is under one video frame
-  std::size_t waits = 0, repeated = 0, skipped = 0, shown = 0;
-  double rss_start_mb = 0.0, rss_end_mb = 0.0, seconds = 0.0;
-  bool interrupted = false;
-};
-
-// Draws every target at its scene pose for `seconds`, paced like a projector at its refresh (an offscreen
-// target has no vsync), each target's content sampled at the frame's display time (one period ahead).
-ContentRun run_content(engine::Renderer& renderer, engine::RenderTarget& target, const config::Scene& scene,
-                       const std::vector<engine::DrawItem>& items, engine::SceneContent& content, double seconds,
-                       engine::FrameProfiler& profiler) {
-  ContentRun run;
-  run.rss_start_mb = rss_mb();
-  const double period_s = 1.0 / scene.projector.refresh_hz;
-  const double t0 = config::steady_now_s();
-  auto next = std::chrono::steady_clock::now();
-  std::size_t within = 0;
-  while (!interrupted() && config::steady_now_s() - t0 < seconds) {
-    pace_frame(next, std::chrono::microseconds(static_cast<std::int64_t>(1e6 * period_s)));
-    const auto read = [&](std::vector<engine::DrawItem>& out) {
-      out.assign(items.begin(), items.end());
-      const double display_s = config::steady_now_s() + period_s;
-      double lo = INFINITY, hi = -INFINITY;
-      for (int i = 0; i < static_cast<int>(items.size()); ++i) {
-        if (!content.has(i)) continue;
-        const auto s = content.apply(i, display_s - content.start_s(i, t0, t0), out[static_cast<std::size_t>(i)]);
-        if (std::isnan(s.pts_s)) continue;  // no video, or none decoded yet
-        const double offset = 1000.0 * (s.content_s - s.pts_s);
-        run.offset_ms.push_back(offset);
-        within += offset < 1000.0 / content.player(i).info().fps ? 1 : 0;
-        lo = std::min(lo, offset);
-        hi = std::max(hi, offset);
-      }
-      if (hi >= lo) run.in_step_ms_max = std::max(run.in_step_ms_max, hi - lo);
-    };
-    if (renderer.draw_frame(target, scene.projector, read, &profiler)) ++run.frames;
-  }
-  renderer.finish(target);
-  run.seconds = config::steady_now_s() - t0;
-  run.interrupted = interrupted();
-  for (const assets::VideoPlayer* video : content.videos()) {
-    const auto st = video->stats();
-    run.waits += st.waits;
-    run.repeated += st.repeated;
-    run.skipped += st.skipped;
-    run.shown += st.shown;
-  }
-  run.within_one_frame = run.offset_ms.empty() ? 0.0 : static_cast<double>(within) / static_cast<double>(run.offset_ms.size());
-  run.rss_end_mb = rss_mb();
-  return run;
-}
-
 nlohmann::json finite(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
-void write_report(const std::filesystem::path& file, const ContentRun& r, const engine::FrameSummary& frames) {
+void write_report(const std::filesystem::path& file, const bench::ContentRun& r, const engine::FrameSummary& frames) {
   const nlohmann::json out = {{"frames", r.frames},
                               {"renderer_waits", r.waits},
                               {"content_offset_ms_p50", finite(engine::percentile(r.offset_ms, 0.5))},
@@ -103,7 +40,7 @@ void write_report(const std::filesystem::path& file, const ContentRun& r, const 
   config::write_file_atomically(file, out.dump(1) + "\n");
 }
 
-void print(const ContentRun& r, const engine::FrameSummary& frames) {
+void print(const bench::ContentRun& r, const engine::FrameSummary& frames) {
   std::printf("%zu frames in %.1f s (%s)\n", r.frames, r.seconds, engine::format_summary(frames).c_str());
   std::printf(
       "content time less the shown frame's time: p50 %.1f ms, p99 %.1f ms; within one video frame on %.1f %% of "
@@ -159,7 +96,8 @@ const Command kBenchContent{
       auto target = renderer.make_offscreen(scene.projector.width_px, scene.projector.height_px);
       catch_interrupts();
       engine::FrameProfiler profiler;
-      const ContentRun run = run_content(renderer, *target, scene, items, content, seconds, profiler);
+      const bench::ContentRun run =
+          bench::run_content(renderer, *target, scene, items, content, seconds, profiler, [] { return !interrupted(); });
       const engine::FrameSummary frames = profiler.summary();
       print(run, frames);
       if (const auto out = args.get("out")) assets::write_png(*out, target->read_back());

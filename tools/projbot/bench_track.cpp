@@ -11,8 +11,8 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "projbot/alignment/equations.hpp"
-#include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/alignment/tracker.hpp"
+#include "projbot/bench/track.hpp"
 #include "projbot/config/clock.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/renderer.hpp"
@@ -21,65 +21,21 @@
 namespace projbot::tools {
 namespace {
 
-struct Stats {
-  std::vector<double> ms, err_mm, err_deg;
-  double iterations = 0.0;  // Gauss-Newton iterations per frame, all levels (the projective tracker's)
-  void print(const char* name) const {
-    double mean = 0, mean_mm = 0, max_mm = 0, max_deg = 0;
-    for (std::size_t i = 0; i < ms.size(); ++i) {
-      mean += ms[i] / static_cast<double>(ms.size());
-      mean_mm += err_mm[i] / static_cast<double>(ms.size());
-      max_mm = std::max(max_mm, err_mm[i]);
-      max_deg = std::max(max_deg, err_deg[i]);
-    }
-    std::printf("%-26s %7.1f %8.2f %8.2f %8.2f %8.2f %9.3f %9.3f %9.3f", name, 1000.0 / mean, mean, engine::percentile(ms, 0.5),
-                engine::percentile(ms, 0.95), *std::max_element(ms.begin(), ms.end()), mean_mm, max_mm, max_deg);
-    if (iterations > 0.0)
-      std::printf(" %6.1f\n", iterations / static_cast<double>(ms.size()));
-    else
-      std::printf(" %6s\n", "-");
+void print_row(const char* name, const bench::TrackStats& stats) {
+  const auto& ms = stats.ms;
+  double mean = 0, mean_mm = 0, max_mm = 0, max_deg = 0;
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    mean += ms[i] / static_cast<double>(ms.size());
+    mean_mm += stats.err_mm[i] / static_cast<double>(ms.size());
+    max_mm = std::max(max_mm, stats.err_mm[i]);
+    max_deg = std::max(max_deg, stats.err_deg[i]);
   }
-};
-
-// The benchmark's frames: the Duck on a smooth path (up to 1 cm and 2 degrees per frame at 30 Hz) in
-// rendered Kinect v1 depth, and its true poses. Stops early (fewer frames) when interrupted.
-struct Sequence {
-  std::vector<Eigen::Matrix4d> truth;
-  std::vector<alignment::DepthImage> depth;
-};
-Sequence render_sequence(engine::Renderer& renderer, std::size_t model, const alignment::CameraIntrinsics& k, int frames,
-                         double distance) {
-  const config::ProjectorConfig pinhole(k, 0.1, 10.0);
-  auto camera = renderer.make_depth_camera(k.width_px, k.height_px);
-  Sequence s;
-  for (int f = 0; f < frames && !interrupted(); ++f) {
-    const double t = f / 30.0;
-    const Eigen::Matrix4d T =
-        config::pose_from_xyz_rpy({0.12 * std::sin(2.0 * t), 0.06 * std::sin(1.3 * t), distance + 0.1 * std::sin(0.9 * t)},
-                                  {180.0 + 15.0 * std::sin(1.1 * t), 20.0 * std::sin(0.8 * t), 40.0 * std::sin(1.5 * t)});
-    const std::vector<engine::DrawItem> items{{model, T}};
-    renderer.draw_frame(*camera, pinhole, items);
-    const engine::DepthMap map = camera->read_back_depth();
-    s.depth.push_back(
-        alignment::apply_kinect_v1_noise({map.width, map.height, map.z_m, t}, k, {}, static_cast<std::uint32_t>(f)));
-    s.truth.push_back(T);
-  }
-  return s;
-}
-
-// One method tracked frame to frame from the truth of frame 0: each step's time and error.
-Stats measure(const Sequence& sequence, const std::function<Eigen::Matrix4d(int, const Eigen::Matrix4d&)>& step) {
-  Stats s;
-  Eigen::Matrix4d estimate = sequence.truth[0];
-  for (std::size_t f = 1; f < sequence.truth.size() && !interrupted(); ++f) {
-    const auto t0 = std::chrono::steady_clock::now();
-    estimate = step(static_cast<int>(f), estimate);
-    s.ms.push_back(config::ms_since(t0));
-    const Eigen::Matrix4d err = alignment::rigid_inverse(sequence.truth[f]) * estimate;
-    s.err_mm.push_back(alignment::translation_norm_m(err) * 1000.0);
-    s.err_deg.push_back(alignment::rotation_angle_deg(err));
-  }
-  return s;
+  std::printf("%-26s %7.1f %8.2f %8.2f %8.2f %8.2f %9.3f %9.3f %9.3f", name, 1000.0 / mean, mean, engine::percentile(ms, 0.5),
+              engine::percentile(ms, 0.95), *std::max_element(ms.begin(), ms.end()), mean_mm, max_mm, max_deg);
+  if (stats.iterations_per_frame > 0.0)
+    std::printf(" %6.1f\n", stats.iterations_per_frame);
+  else
+    std::printf(" %6s\n", "-");
 }
 
 }  // namespace
@@ -116,7 +72,8 @@ const Command kBenchTrack{
                                      ")");
       };
       catch_interrupts();  // Ctrl-C: the methods measured are printed whole, the one under way is dropped; exit 130
-      const Sequence sequence = render_sequence(renderer, id, k, frames, distance);
+      const auto keep_going = [] { return !interrupted(); };
+      const bench::TrackSequence sequence = bench::render_track_sequence(renderer, id, k, frames, distance, keep_going);
       if (interrupted()) return stopped("rendering the depth sequence", static_cast<int>(sequence.truth.size()));
       const auto& depth = sequence.depth;
       std::printf("%-26s %7s %8s %8s %8s %8s %9s %9s %9s %6s\n", "method", "fps", "mean_ms", "p50_ms", "p95_ms", "max_ms",
@@ -128,23 +85,28 @@ const Command kBenchTrack{
         iterations += r.iterations;
         return r.T_camera_target;
       };
-      Stats ours = measure(sequence, [&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker, f, prev); });
-      ours.iterations = std::exchange(iterations, 0.0);
+      bench::TrackStats ours = bench::measure_tracking(
+          sequence, [&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker, f, prev); }, keep_going);
+      ours.iterations_per_frame = std::exchange(iterations, 0.0) / static_cast<double>(ours.ms.size());
       if (interrupted()) return stopped("measuring", static_cast<int>(ours.ms.size()) + 1);
-      ours.print("projective (20k of 50k)");
+      print_row("projective (20k of 50k)", ours);
       alignment::TrackerConfig all_points;
       all_points.model_points = {5000, 15000, 50000};
       const alignment::ProjectiveTracker tracker_all(model, k, all_points);
-      Stats ours_all = measure(sequence, [&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker_all, f, prev); });
-      ours_all.iterations = iterations;
+      bench::TrackStats ours_all = bench::measure_tracking(
+          sequence, [&](int f, const Eigen::Matrix4d& prev) { return tracked(tracker_all, f, prev); }, keep_going);
+      ours_all.iterations_per_frame = iterations / static_cast<double>(ours_all.ms.size());
       if (interrupted()) return stopped("measuring", static_cast<int>(ours_all.ms.size()) + 1);
-      ours_all.print("projective (all 50k)");
+      print_row("projective (all 50k)", ours_all);
       const alignment::PclIcpBaseline pcl_icp(model);
-      const Stats base = measure(sequence, [&](int f, const Eigen::Matrix4d& prev) {
-        return pcl_icp.track(alignment::depth_to_cloud(depth[static_cast<std::size_t>(f)], k), prev);
-      });
+      const bench::TrackStats base = bench::measure_tracking(
+          sequence,
+          [&](int f, const Eigen::Matrix4d& prev) {
+            return pcl_icp.track(alignment::depth_to_cloud(depth[static_cast<std::size_t>(f)], k), prev);
+          },
+          keep_going);
       if (interrupted()) return stopped("measuring", static_cast<int>(base.ms.size()) + 1);
-      base.print("pcl IterativeClosestPoint");
+      print_row("pcl IterativeClosestPoint", base);
       const auto mean = [](const std::vector<double>& v) {
         return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
       };

@@ -130,12 +130,6 @@ bool on_off(const cli::Args& args, const std::string& name, bool fallback) {
   throw cli::UsageError("--" + name + " must be on or off, not '" + *value + "'");
 }
 
-void pace_frame(std::chrono::steady_clock::time_point& next, std::chrono::microseconds period) {
-  next += period;
-  std::this_thread::sleep_until(next);
-  if (std::chrono::steady_clock::now() > next + std::chrono::milliseconds(50)) next = std::chrono::steady_clock::now();
-}
-
 engine::PresentMode present_mode(const std::string& name) {
   if (name == "fifo") return engine::PresentMode::kFifo;
   if (name == "mailbox") return engine::PresentMode::kMailbox;

@@ -42,9 +42,6 @@ bool on_off(const cli::Args& args, const std::string& name, bool fallback);
 /// fifo, mailbox or immediate. Throws cli::UsageError listing them for anything else.
 engine::PresentMode present_mode(const std::string& name);
 
-/// Paces an offscreen target (no vsync) like a projector: sleeps until `next` moved on by one `period`, and
-/// starts the cadence afresh after a frame more than 50 ms late.
-void pace_frame(std::chrono::steady_clock::time_point& next, std::chrono::microseconds period);
 /// The projector window from --fullscreen, --monitor and --present-mode (fifo, mailbox or immediate), the
 /// projector's size when windowed. Throws cli::UsageError.
 engine::WindowOptions window_options(const cli::Args& args, const config::ProjectorConfig& projector, std::string title);

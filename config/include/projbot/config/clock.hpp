@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <thread>
 
 namespace projbot::config {
 
@@ -14,6 +15,14 @@ inline double steady_now_s() {
 /// Milliseconds since `t0` on the steady clock: how long a step took.
 inline double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Paces a target without vsync (offscreen) like a projector: sleeps until `next` moved on by one `period`,
+/// and starts the cadence afresh after a frame more than 50 ms late.
+inline void pace_frame(std::chrono::steady_clock::time_point& next, std::chrono::microseconds period) {
+  next += period;
+  std::this_thread::sleep_until(next);
+  if (std::chrono::steady_clock::now() > next + std::chrono::milliseconds(50)) next = std::chrono::steady_clock::now();
 }
 
 }  // namespace projbot::config
