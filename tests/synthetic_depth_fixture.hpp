@@ -26,7 +26,7 @@ namespace synthetic_depth {
 
 inline const fs::path kDuck = fs::path(PROJBOT_SHARED_DATA) / "gltf" / "Duck" / "glTF-Binary" / "Duck.glb";
 
-inline projbot::config::ProjectorConfig as_pinhole(const CameraIntrinsics& k) { return {k, 0.1, 10.0}; }
+inline projbot::config::Camera as_pinhole(const CameraIntrinsics& k) { return {k, 0.1, 10.0}; }
 
 inline Eigen::Matrix4d perturb(const Eigen::Matrix4d& T, double angle_deg, double shift_m, std::mt19937& rng) {
   std::normal_distribution<double> g;

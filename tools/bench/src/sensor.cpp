@@ -214,7 +214,7 @@ std::vector<float> SensorBench::render(const alignment::BopImage& image,
   }
   std::vector<engine::DrawItem> items;
   for (const auto* inst : which) items.push_back({ids_.at(inst->obj_id), inst->T_camera_model});
-  renderer_.draw_frame(*target_, config::ProjectorConfig(image.k, 0.1, 10.0), items);
+  renderer_.draw_frame(*target_, config::Camera(image.k, 0.1, 10.0), items);
   return target_->read_back_depth().z_m;
 }
 

@@ -12,7 +12,7 @@ namespace projbot::bench {
 
 TrackSequence render_track_sequence(engine::Renderer& renderer, std::size_t model, const alignment::CameraIntrinsics& k,
                                     int frames, double distance, const std::function<bool()>& keep_going) {
-  const config::ProjectorConfig pinhole(k, 0.1, 10.0);
+  const config::Camera pinhole(k, 0.1, 10.0);
   auto camera = renderer.make_depth_camera(k.width_px, k.height_px);
   TrackSequence s;
   for (int f = 0; f < frames && keep_going(); ++f) {

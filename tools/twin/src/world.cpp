@@ -306,7 +306,7 @@ config::Camera Twin::camera_pinhole() const {
 
 assets::Image Twin::capture_colour(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
   if (!colour_target_) colour_target_ = renderer_.make_offscreen(camera_.width_px, camera_.height_px);
-  renderer_.draw_frame(*colour_target_, config::ProjectorConfig(camera_pinhole()), draw_items(T_world_camera));
+  renderer_.draw_frame(*colour_target_, camera_pinhole(), draw_items(T_world_camera));
   assets::Image image = colour_target_->read_back();
   if (!options_.depth_noise) return image;
   std::mt19937 rng(noise_seed ^ 0x9e3779b9U);
@@ -319,7 +319,7 @@ assets::Image Twin::capture_colour(const Eigen::Matrix4d& T_world_camera, std::u
 }
 
 alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {
-  renderer_.draw_frame(*depth_target_, config::ProjectorConfig(camera_pinhole()), draw_items(T_world_camera));
+  renderer_.draw_frame(*depth_target_, camera_pinhole(), draw_items(T_world_camera));
   const engine::DepthMap map = depth_target_->read_back_depth();
   alignment::DepthImage clean{map.width, map.height, map.z_m, 0.0};
   if (!options_.depth_noise) return clean;

@@ -156,21 +156,25 @@ class Renderer {
 
   /// An offscreen RGBA8 target of the given size.
   std::unique_ptr<RenderTarget> make_offscreen(int width_px, int height_px);
-  /// A depth camera of the given size: draw_frame() through the camera (its config::Camera as a
-  /// ProjectorConfig: the photometry is not used for depth) and T_camera_target poses renders the depth of
-  /// every surface, whatever its material.
+  /// A depth camera of the given size: draw_frame() through the camera (its config::Camera) and T_camera_target poses renders the
+  /// depth of every surface, whatever its material.
   std::unique_ptr<RenderTarget> make_depth_camera(int width_px, int height_px);
   /// A window with a swapchain. Needs RendererOptions::windowing.
   std::unique_ptr<RenderTarget> make_window(const WindowOptions& options);
 
   /// Draws one frame: black background, depth-tested, unlit textured models placed by their poses and
   /// projected through `projector` (whose size is stretched onto the target; its photometry sets the
-  /// white gain, so a camera's colour view passes ProjectorConfig(camera)). Returns false if the frame
-  /// was skipped (window minimised or swapchain rebuilt). Records timing into `profiler` if given.
+  /// white gain). Returns false if the frame was skipped (window minimised or swapchain rebuilt). Records
+  /// timing into `profiler` if given.
   bool draw_frame(RenderTarget& target, const config::ProjectorConfig& projector, const PoseReader& read_poses,
                   FrameProfiler* profiler = nullptr);
   bool draw_frame(RenderTarget& target, const config::ProjectorConfig& projector, std::span<const DrawItem> items,
                   FrameProfiler* profiler = nullptr);
+  /// The same through a camera (a depth or colour camera's view: no projector photometry, white as stored).
+  bool draw_frame(RenderTarget& target, const config::Camera& camera, std::span<const DrawItem> items,
+                  FrameProfiler* profiler = nullptr) {
+    return draw_frame(target, config::ProjectorConfig(camera), items, profiler);
+  }
 
   /// Waits for every frame submitted to `target` and hands their pending timings to their profilers.
   void finish(RenderTarget& target);
