@@ -226,4 +226,20 @@ DdsSurvey survey_dds(int domain, double listen_s) {
   return survey;
 }
 
+int serve(Ros2BaseServer& server, int rate_hz, double seconds, const std::function<bool()>& keep_going,
+          const std::function<void()>& each_step) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double dt = 1.0 / rate_hz;
+  int steps = 0;
+  for (; keep_going(); ++steps) {
+    const double t = steps * dt;
+    if (seconds > 0.0 && t >= seconds) break;
+    std::this_thread::sleep_until(
+        t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(t)));
+    server.step(t, dt);
+    if (each_step) each_step();
+  }
+  return steps;
+}
+
 }  // namespace projbot::robot

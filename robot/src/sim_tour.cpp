@@ -133,4 +133,19 @@ std::vector<StopReport> run_sim_tour(const SimTourConfig& c, const std::function
   return reports;
 }
 
+SimTourErrors tour_errors(const std::vector<StopReport>& reports) {
+  SimTourErrors e;
+  if (reports.empty()) return e;
+  for (const auto& r : reports) {
+    e.mean_m += r.error_m, e.max_m = std::max(e.max_m, r.error_m);
+    e.mean_rad += r.error_rad, e.max_rad = std::max(e.max_rad, r.error_rad);
+    e.correct_ms += r.correct_ms_mean;
+  }
+  const double k = static_cast<double>(reports.size());
+  e.mean_m /= k, e.mean_rad /= k, e.correct_ms /= k;
+  e.last_odometry_m = reports.back().odometry_error_m;
+  e.last_odometry_rad = reports.back().odometry_error_rad;
+  return e;
+}
+
 }  // namespace projbot::robot

@@ -15,15 +15,11 @@ namespace projbot::tools {
 namespace {
 
 void print_against_truth(const calibrate::PhotometricResult& r, const calibrate::PhotometricSim& sim) {
-  const config::Photometry& truth = sim.projector.photometry;
-  double worst_gamma = 0.0;
-  for (std::size_t j = 0; j < 3; ++j)
-    worst_gamma = std::max(worst_gamma, std::abs(r.projector.gamma_rgb[j] / truth.gamma_rgb[j] - 1.0));
-  const double worst_mix = (r.projector.mixing - truth.mixing).cwiseAbs().maxCoeff();
+  const calibrate::PhotometricDifference d = calibrate::compare(r, sim);
   std::printf(
       "against the twin's truth: gamma within %.2f %% (worst channel), mixing within %.4f (worst entry), "
       "camera gamma %.3f (truth %.3f)\n",
-      100.0 * worst_gamma, worst_mix, r.camera_gamma, sim.camera_gamma);
+      100.0 * d.gamma_share, d.mixing, r.camera_gamma, sim.camera_gamma);
 }
 
 int run_photometric(const cli::Args& args) {

@@ -61,17 +61,11 @@ int serve_sim_base(const cli::Args& args) {
             << " out at " << rate << " Hz";
   if (laser) std::cout << "; its laser (Hokuyo UTM-30LX, SCIP 2.0) on " << *args.get("laser");
   std::cout << " (Ctrl-C stops)" << std::endl;
-  const auto t0 = std::chrono::steady_clock::now();
-  const double dt = 1.0 / rate;
-  int steps = 0;
-  for (; !interrupted(); ++steps) {
-    const double t = steps * dt;
-    if (seconds > 0.0 && t >= seconds) break;
-    std::this_thread::sleep_until(
-        t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(t)));
-    server.step(t, dt);
-    if (laser) laser->stand_at(server.true_pose());
-  }
+  const int steps = robot::serve(
+      server, rate, seconds, [] { return !interrupted(); },
+      [&] {
+        if (laser) laser->stand_at(server.true_pose());
+      });
   const auto& p = server.odometry_pose();
   const robot::Pose2D truth = robot::compose(T_room_odometry, server.true_pose());
   std::cout << "served " << steps << " odometry messages, " << server.commands_received() << " commands received; odometry at x "

@@ -187,19 +187,13 @@ bool print_sim_tour_row(int n, robot::PoseSource source, int seed) {
   cfg.errors.seed = static_cast<std::uint64_t>(seed);
   const auto reports = robot::run_sim_tour(cfg, [] { return interrupted(); });
   if (interrupted()) return false;
-  double mean_m = 0, max_m = 0, mean_r = 0, max_r = 0, ms = 0;
   // The error of what the robot believes: with odometry alone that is the odometry's drift.
-  for (const auto& r : reports) {
-    mean_m += r.error_m, max_m = std::max(max_m, r.error_m);
-    mean_r += r.error_rad, max_r = std::max(max_r, r.error_rad);
-    ms += r.correct_ms_mean;
-  }
-  const double k = static_cast<double>(reports.size());
-  std::cout << std::fixed << std::setprecision(2) << "| " << n << " | "
-            << (source == robot::PoseSource::localized ? "MRPT localisation" : "odometry alone") << " | " << mean_m / k * 100
-            << " | " << max_m * 100 << " | " << mean_r / k * kDeg << " | " << max_r * kDeg << " | "
-            << reports.back().odometry_error_m * 100 << " / " << reports.back().odometry_error_rad * kDeg << " | "
-            << (source == robot::PoseSource::localized ? ms / k : 0.0) << " |" << std::endl;
+  const robot::SimTourErrors e = robot::tour_errors(reports);
+  const bool localized = source == robot::PoseSource::localized;
+  std::cout << std::fixed << std::setprecision(2) << "| " << n << " | " << (localized ? "MRPT localisation" : "odometry alone")
+            << " | " << e.mean_m * 100 << " | " << e.max_m * 100 << " | " << e.mean_rad * kDeg << " | " << e.max_rad * kDeg
+            << " | " << e.last_odometry_m * 100 << " / " << e.last_odometry_rad * kDeg << " | "
+            << (localized ? e.correct_ms : 0.0) << " |" << std::endl;
   return true;
 }
 

@@ -1,5 +1,6 @@
 #include "projbot/calibrate/photometric.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <sstream>
@@ -131,6 +132,15 @@ void write_photometric(const PhotometricResult& r, const std::filesystem::path& 
   for (int i = 0; i < 9; ++i) y << (i ? ", " : "") << p.mixing(i / 3, i % 3);
   y << "]\n  camera_gamma: " << r.camera_gamma << "\n";
   config::write_file_atomically(path, y.str());
+}
+
+PhotometricDifference compare(const PhotometricResult& r, const PhotometricSim& sim) {
+  const config::Photometry& truth = sim.projector.photometry;
+  PhotometricDifference d;
+  for (std::size_t j = 0; j < 3; ++j)
+    d.gamma_share = std::max(d.gamma_share, std::abs(r.projector.gamma_rgb[j] / truth.gamma_rgb[j] - 1.0));
+  d.mixing = (r.projector.mixing - truth.mixing).cwiseAbs().maxCoeff();
+  return d;
 }
 
 }  // namespace projbot::calibrate

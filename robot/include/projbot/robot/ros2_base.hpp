@@ -123,6 +123,12 @@ class Ros2BaseServer {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Runs `server` at `rate_hz` on the steady clock (each step at its own time) until `seconds` have
+/// passed (0: no limit) or `keep_going` says no; `each_step` is called after every step (a laser standing
+/// where the base now truly is). Returns the steps run.
+int serve(Ros2BaseServer& server, int rate_hz, double seconds, const std::function<bool()>& keep_going,
+          const std::function<void()>& each_step = {});
+
 /// What DDS shows on a domain after listening a while: the other participants, and the topics they
 /// publish and subscribe (name and type as on the wire: "rt/odom", "nav_msgs::msg::dds_::Odometry_").
 struct DdsSurvey {

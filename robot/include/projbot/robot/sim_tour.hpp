@@ -75,6 +75,14 @@ class SimRobot final : public Navigator {
 /// each stop, ends the tour there (Ctrl-C): the reports of the stops reached.
 std::vector<StopReport> run_sim_tour(const SimTourConfig& config, const std::function<bool()>& stop_requested = {});
 
+/// A tour's errors at its stops: what the robot believed against the truth (m, rad; mean and largest),
+/// the mean localisation update time (ms), and wheel odometry's drift at the last stop.
+struct SimTourErrors {
+  double mean_m = 0.0, max_m = 0.0, mean_rad = 0.0, max_rad = 0.0, correct_ms = 0.0;
+  double last_odometry_m = 0.0, last_odometry_rad = 0.0;
+};
+SimTourErrors tour_errors(const std::vector<StopReport>& reports);
+
 /// The built-in demo room (8 x 6 m with furniture) and a ring of stops in it.
 SimTourConfig default_sim_tour();
 

@@ -50,6 +50,12 @@ struct PhotometricSim {
   std::uint64_t seed = 1;
 };
 std::unique_ptr<PhotometricRig> make_twin_photometric_rig(const PhotometricSim& sim);
+/// A result against the twin's truth: the worst channel's gamma off by this share (0.01: 1 %), and the
+/// largest mixing entry off by this much.
+struct PhotometricDifference {
+  double gamma_share = 0.0, mixing = 0.0;
+};
+PhotometricDifference compare(const PhotometricResult& result, const PhotometricSim& truth);
 /// The crosstalk of a typical DLP's colour wheel, the twin's truth: a few percent of each channel's light
 /// in its neighbours.
 Eigen::Matrix3d typical_mixing();
