@@ -68,4 +68,12 @@ TEST(LiveRun, ARunEndsAfterItsSeconds) {
   EXPECT_LE(r.visits, 1);
 }
 
+// What run requires is refused by name, before anything is drawn.
+TEST(LiveRun, MissingSourcesAreRefused) {
+  const auto scene = projbot::config::load_scene(std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml");
+  projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
+  projbot::live::RunSources none;
+  EXPECT_THROW(projbot::live::run(renderer, scene, {}, none), std::invalid_argument);
+}
+
 }  // namespace

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <iomanip>
+#include <stdexcept>
 #include <thread>
 
 #include "projbot/alignment/latest_value.hpp"
@@ -231,6 +232,8 @@ session::LiveInputs live_inputs(const config::Scene& scene, RobotThread& robot, 
 }  // namespace
 
 RunResult run(engine::Renderer& renderer, const config::Scene& scene, const RunOptions& options, const RunSources& sources) {
+  if (!sources.devices || !sources.open_output || !sources.log || !sources.errors)
+    throw std::invalid_argument("live::run needs devices, open_output, log and errors in its RunSources");
   Output out(renderer, scene, options, sources);
   const session::LiveLoopConfig lc = loop_config(scene, options, sources.replay != nullptr);
   session::LiveLoop loop(renderer, scene.projector, out.items, lc);

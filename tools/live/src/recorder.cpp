@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <stdexcept>
 
 #include "projbot/alignment/freenect_source.hpp"
 #include "projbot/config/output_file.hpp"
@@ -131,6 +132,7 @@ session::Dwell recording_dwell(Rig& rig, double dwell_s, QuantisedCamera& quanti
 }  // namespace
 
 Recorded record(const config::Scene& scene, const RecordOptions& o, const fs::path& out, const RecordHooks& hooks) {
+  if (!hooks.log) throw std::invalid_argument("live::record needs a log in its RecordHooks");
   const auto interrupted = [&hooks] { return hooks.interrupted && hooks.interrupted(); };
   Recorded result;
   config::Recording& rec = result.recording;

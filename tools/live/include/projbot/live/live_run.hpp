@@ -62,7 +62,8 @@ struct RunResult {
 /// Runs the tour (`options.visits` visits, or the recording's stops) while drawing into the output, until
 /// the tour ends, `options.seconds` pass, the output is closed or `interrupted` says so. A failure of a
 /// device or the twin while projecting blanks the projector and is returned; a tracker worker's failure,
-/// or one before the loop starts (a bad model or video), is thrown.
+/// or one before the loop starts (a bad model or video), is thrown; std::invalid_argument when `sources`
+/// lacks what it requires.
 RunResult run(engine::Renderer& renderer, const config::Scene& scene, const RunOptions& options, const RunSources& sources);
 
 }  // namespace projbot::live
