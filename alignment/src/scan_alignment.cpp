@@ -1,16 +1,13 @@
 #include "projbot/alignment/scan_alignment.hpp"
 
-#include <cctype>
 #include <string>
+
+#include "file_kind.hpp"
 
 namespace projbot::alignment {
 namespace {
 
-std::string lower_extension(const std::filesystem::path& p) {
-  std::string ext = p.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
+using detail::lower_extension;
 
 // The camera of a depth image: `k` (its size the image's), or the Kinect v1's for a 640x480 one.
 CameraIntrinsics camera_of(const std::filesystem::path& path, const DepthImage& depth, const std::optional<CameraIntrinsics>& k) {

@@ -2,6 +2,7 @@
 // decoded Gray code, then OpenCV's calibrateCamera for each device and stereoCalibrate for R_cp, T_cp.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -165,6 +166,44 @@ Calibration solve(const std::filesystem::path& dir, const SolveOptions& o,
   c.projector_coverage = coverage(used.projector, projector_size);
   add_warnings(c, static_cast<int>(used.projector.size()), static_cast<int>(c.views.size()));
   return c;
+}
+
+namespace {
+
+// How far apart two lenses put the same ray on the panel, at most over the image (in the truth's pixels).
+double lens_difference_px(const Camera& fit, const Camera& truth) {
+  const config::Pinhole& k = truth;
+  double worst = 0.0;
+  for (int j = 0; j <= 20; ++j)
+    for (int i = 0; i <= 20; ++i) {
+      const Eigen::Vector2d x = k.back_project(k.width_px * i / 20.0, k.height_px * j / 20.0, 1.0).head<2>();
+      const Eigen::Vector2d d = config::distort(fit.distortion, x) - config::distort(truth.distortion, x);
+      worst = std::max(worst, std::hypot(k.fx_px * d.x(), k.fy_px * d.y()));
+    }
+  return worst;
+}
+
+}  // namespace
+
+TruthComparison compare(const Calibration& c, const Calibration& t) {
+  const auto pct = [](double a, double b) { return 100.0 * std::abs(a - b) / b; };
+  const config::Pinhole& p = c.projector;
+  const config::Pinhole& q = t.projector;
+  const config::Pinhole& k = c.camera;
+  const config::Pinhole& l = t.camera;
+  TruthComparison r;
+  r.projector_fx_pct = pct(p.fx_px, q.fx_px);
+  r.projector_fy_pct = pct(p.fy_px, q.fy_px);
+  r.projector_principal_px = std::hypot(p.cx_px - q.cx_px, p.cy_px - q.cy_px);
+  r.camera_fx_pct = pct(k.fx_px, l.fx_px);
+  r.camera_fy_pct = pct(k.fy_px, l.fy_px);
+  r.camera_principal_px = std::hypot(k.cx_px - l.cx_px, k.cy_px - l.cy_px);
+  const Eigen::Matrix3d dR = c.T_projector_camera.block<3, 3>(0, 0) * t.T_projector_camera.block<3, 3>(0, 0).transpose();
+  r.rotation_deg = std::acos(std::clamp((dR.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
+  r.translation_mm = 1000.0 * (c.T_projector_camera.block<3, 1>(0, 3) - t.T_projector_camera.block<3, 1>(0, 3)).norm();
+  r.projector_lens = config::has_distortion(c.projector.distortion) || config::has_distortion(t.projector.distortion);
+  if (r.projector_lens) r.projector_lens_px = lens_difference_px(c.projector, t.projector);
+  return r;
 }
 
 }  // namespace projbot::calibrate
