@@ -89,6 +89,32 @@ TEST_F(CliTest, TourLightsANeighbourInTheSameFrame) {
   EXPECT_GT(right, 20000U);
 }
 
+// tour --processing-ms: each pose is ready a fixed time after its capture, so the timeline does not depend
+// on the machine's load: two runs give the same frames, lit and measured alike, and each drawn pose's age
+// at display is that time plus the wait for a projector frame and one refresh (the arrival's pose, taken
+// at the stop's start, is 2 refreshes old when its first frame is lit).
+TEST_F(CliTest, TourWithAFixedProcessingTimeRepeatsItsTimeline) {
+  const auto timeline = [this](const std::string& name) {
+    const fs::path report = dir_ / name;
+    const CliRun r = run_projbot("tour --scene " + std::string(PROJBOT_ASSET_DIR) +
+                                 "/scenes/display.yaml --visits 1 --dwell 0.5 --processing-ms 20 --report " + report.string());
+    EXPECT_EQ(r.code, 0) << r.output;
+    std::ifstream in(report);
+    const auto json = nlohmann::json::parse(in);
+    EXPECT_EQ(json.at("processing_ms").get<double>(), 20.0);
+    return json.at("visits").at(0).at("timeline");
+  };
+  const auto first = timeline("a.json"), second = timeline("b.json");
+  ASSERT_EQ(first.size(), 30U);  // 0.5 s at 60 Hz
+  EXPECT_EQ(first, second);
+  for (const auto& frame : first) {
+    ASSERT_TRUE(frame.at("shown").get<bool>()) << frame.dump();
+    const double age_ms = frame.at("pose_age_ms").get<double>();
+    EXPECT_GE(age_ms, 1000.0 / 30.0 - 1e-6) << frame.dump();                         // 2 refreshes: the arrival's
+    EXPECT_LE(age_ms, 20.0 + 1000.0 / 60.0 + 1000.0 / 30.0 + 1e-6) << frame.dump();  // ready, then a camera frame
+  }
+}
+
 TEST_F(CliTest, TourPrintsTheTableAndWritesReportAndFrames) {
   const CliRun r = run_projbot("tour --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml --mode localized" +
                                " --visits 1 --report " + (dir_ / "r.json").string() + " --frames " + (dir_ / "frames").string());

@@ -36,7 +36,7 @@ const Command kTour{
     "drive the stops in the digital twin and measure the projection error (the paper's Table 1)",
     "projbot tour [--scene S.yaml] [--visits N] [--seed K] [--mode odometry|localized|tracking] [--report R.json]\n"
     "             [--frames DIR] [--dwell S] [--no-noise] [--no-predict]\n"
-    "             [--depth-model kinect|fitted]\n\n"
+    "             [--depth-model kinect|fitted] [--processing-ms MS]\n\n"
     "Runs the tour of the scene's `tour.visits` in the digital twin (simulated youBot with wheel drift, laser,\n"
     "MRPT localisation, pan-tilt, Kinect v1 depth camera, projector). At each stop the robot aims at the\n"
     "middle of the target as surveyed, captures depth, takes the initial guess from its pose (Eq. 1), refines it by\n"
@@ -72,6 +72,9 @@ const Command kTour{
      {"no-noise", "", "depth without the Kinect v1 noise model"},
      {"depth-model", "M", "the twin's depth camera: kinect (the published model, default) or fitted (to real frames)"},
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"},
+     {"processing-ms", "MS",
+      "a pose is ready this long after its capture (default: as measured on this machine); fixed, the report does not "
+      "depend on the machine's load"},
      {"compensation", "on|off",
       "radiometric compensation of each target's surface and the room's light (default on; off: the content as stored)"},
      {"calibration", "FILE",
@@ -100,6 +103,10 @@ const Command kTour{
       if (depth_model != "fitted" && depth_model != "kinect")
         throw cli::UsageError("--depth-model must be kinect or fitted, not '" + depth_model + "'");
       o.predict = !args.flag("no-predict");
+      if (args.get("processing-ms")) {
+        o.processing_ms = args.get_double("processing-ms", 0.0);
+        if (!(*o.processing_ms >= 0.0 && *o.processing_ms <= 1000.0)) throw cli::UsageError("--processing-ms must be 0..1000");
+      }
       o.compensation = on_off(args, "compensation", true);
       const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
       args.check_clashes({{"the default scene", scene_path, false}});

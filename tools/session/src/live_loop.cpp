@@ -35,7 +35,7 @@ void LiveLoop::compose(const LiveStop& stop, const LiveInputs& in, std::vector<e
   drawn = frames_.compose(now_s, {stop.targets, stop.since_s, in.camera_last_s()}, in.poses);
   const auto content_s = [&](int target, double display_s) { return display_s - content_->start_s(target, t0_s_, stop.since_s); };
   if (content_) {
-    const double display_s = now_s + frames_.period_s() + 1e-3 * cfg_.projection.input_lag_ms;
+    const double display_s = frames_.display_time_s(now_s);
     for (const int target : stop.targets)
       if (content_->has_video(target) &&
           std::none_of(drawn.begin(), drawn.end(), [&](const DrawnPose& d) { return d.target == target; }))

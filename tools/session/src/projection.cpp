@@ -23,7 +23,7 @@ double PresentCadence::period_s(double configured_s) const {
 
 std::vector<DrawnPose> ProjectionFrames::compose(double now_s, const LitNow& lit, const PoseSource& poses) {
   std::vector<DrawnPose> drawn;
-  const double display_s = now_s + period_s() + 1e-3 * cfg_.input_lag_ms;
+  const double display_s = display_time_s(now_s);
   if (cfg_.silent_camera_s > 0.0 && !lit.targets.empty() && now_s - lit.last_frame_s > cfg_.silent_camera_s) {
     ++silent_;                // the camera has gone quiet: blank rather than show what it saw last...
     stale_before_s_ = now_s;  // ...and, once it is back, only what it sees from then on

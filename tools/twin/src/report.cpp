@@ -259,6 +259,7 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
       {"predict", report.predict},
       {"depth_model", report.depth_model},
       {"seed", report.seed},
+      {"processing_ms", report.processing_ms ? nlohmann::json(*report.processing_ms) : nlohmann::json(nullptr)},
       {"projector",
        {{"width", k.width_px}, {"height", k.height_px}, {"fx", k.fx_px}, {"fy", k.fy_px}, {"cx", k.cx_px}, {"cy", k.cy_px}}},
       {"paper_table1_mm", {{"target1", kPaperMm[0]}, {"target2", kPaperMm[1]}}},

@@ -17,6 +17,7 @@
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/photometry.hpp"
 #include "projbot/engine/projection.hpp"
+#include "projbot/session/projection.hpp"
 #include "projbot/twin/display_error.hpp"
 #include "projbot/twin/spectator.hpp"
 #include "projbot/twin/world.hpp"
@@ -75,33 +76,41 @@ struct DwellContext {
   std::vector<NeighbourLight>& neighbours;
 };
 
-// The error of one projector frame, against the target's true pose at the frame's display time.
-TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double display_s, bool shown,
-                             const alignment::PoseSample& drawn, bool predict) {
+// Where a frame puts the target's light: at the pose it draws, or in a blank frame where the last pose lit
+// would have put it at the display time (camera frame).
+Eigen::Matrix4d light_pose(const session::DrawnPose* drawn, const alignment::PoseSample& last_lit, double display_s,
+                           bool predict) {
+  if (drawn) return drawn->T_camera_target;
+  return predict ? alignment::predict_pose(last_lit.motion, display_s) : last_lit.T_camera_target;
+}
+
+// The error of one projector frame, against the target's true pose at the frame's display time: of the
+// pose drawn (`drawn`), or for a blank frame of where the last pose lit (`last_lit`) would have put the light.
+TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double display_s, const session::DrawnPose* drawn,
+                             const alignment::PoseSample& last_lit) {
   TwinTarget& target = c.twin.targets()[c.target];
   target.T_world_target_true = c.twin.scripted_pose(c.target, r.target_visit, display_s);
   target.in_world = c.twin.scripted_presence(c.target, r.target_visit, display_s);
   const config::TargetMotion* motion = target.config.motion_on(r.target_visit);
   TimelineSample s;
   s.t_s = display_s;
-  s.shown = shown;
+  s.shown = drawn != nullptr;
   s.moving = motion && motion->moving_at(display_s);
-  s.age_ms = 1000.0 * (display_s - drawn.capture_time_s);
+  s.age_ms = 1000.0 * (display_s - (drawn ? drawn->capture_s : last_lit.capture_time_s));
   s.in_world = target.in_world;
-  const Eigen::Matrix4d T_camera_target = predict ? alignment::predict_pose(drawn.motion, display_s) : drawn.T_camera_target;
+  const Eigen::Matrix4d T_camera_target = light_pose(drawn, last_lit, display_s, c.options.predict);
   const MarkerErrors e = marker_errors(c.twin, c.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
   s.mean_mm = e.mean_mm;
   s.max_mm = e.max_mm;
   return s;
 }
 
-// A neighbour's projector frame: counted, and its error measured at display time when it is lit
+// A neighbour's projector frame: counted, and the error of the pose drawn measured when it is lit
 // (neighbours stand still: their motion scripts run on their own visits).
-void measure_neighbour(const DwellContext& c, NeighbourLight& n, double display_s) {
-  if (!n.shown) return count_frame(n, std::nan(""));
-  const Eigen::Matrix4d T_camera_target =
-      c.options.predict ? alignment::predict_pose(n.drawn.motion, display_s) : n.drawn.T_camera_target;
-  const MarkerErrors e = marker_errors(c.twin, n.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
+void measure_neighbour(const DwellContext& c, NeighbourLight& n, const session::DrawnPose* drawn) {
+  n.shown = drawn != nullptr;
+  if (!drawn) return count_frame(n, std::nan(""));
+  const MarkerErrors e = marker_errors(c.twin, n.target, c.models, c.truth.T_world_projector.matrix(), drawn->T_camera_target);
   count_frame(n, e.mean_mm);
 }
 
@@ -263,9 +272,11 @@ Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Tw
 // One visit of the tour as the session runs it (session::Session::visit, in lockstep). On the stop's
 // first frame: the acquisitions' errors (the visited target's and each neighbour's) and, with --frames,
 // the pictures. Then, while the robot dwells (tracking mode, or a target that moves), projection on the
-// simulated clock: the projector at its refresh rate drawing the newest result ready when its frame
-// starts, predicted to the frame's display time (one refresh later, plus the projector's input lag), each
-// frame's error measured against the target's true pose at its display time.
+// simulated clock: the projector at its refresh rate; each frame decides what it draws as `run`'s live
+// loop does (session::ProjectionFrames: each lit target's newest result ready when the frame starts,
+// blanked when lost, else predicted to the frame's display time and moved to the projector by Eq. 2), and
+// its error is measured against the target's true pose at its display time. The frames are measured, not
+// drawn (drawn only for --frames and appearance).
 class TourStop final : public session::StopObserver {
  public:
   TourStop(Tour& tour, int visit) : tour_(tour), visit_(visit) {}
@@ -289,6 +300,8 @@ class TourStop final : public session::StopObserver {
   void measure_reflectance();
   assets::Image spectator_picture(const assets::Image& projector);
   void write_pictures(const assets::Image& colour);
+  void start_projection();
+  void take_results(double start_s);
   void project(double start_s);
   void end_dwell();
 
@@ -303,9 +316,12 @@ class TourStop final : public session::StopObserver {
   // The dwell.
   bool dwelling_ = false;
   int frames_ = 0, next_ = 1;  // projector frames: in all, and the next to measure (1-based)
-  double period_s_ = 0.0, display_delay_s_ = 0.0;
-  alignment::PoseSample drawn_;  // the newest result: at first the arrival's estimate
-  bool shown_ = false;
+  double period_s_ = 0.0;
+  std::optional<session::ProjectionFrames> projection_;  // what each frame draws, as in `run`
+  session::LitNow lit_now_;                              // to it: the lit targets by their place in lit_
+  std::vector<alignment::PoseSample> newest_;            // each lit target's newest result: at first its arrival's
+  alignment::PoseSample drawn_;                          // the visited target's newest result not lost
+  bool shown_ = false;                                   // the visited target is lit in the newest frame
   double wall_to_light_ms_ = 0.0, seen_track_ms_ = 0.0;
   double motion_end_s_ = 0.0;
   double back_under_ = -1.0;  // when the error went back under the goal for good, -1 while it is not
@@ -387,14 +403,35 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
   if (tour_.options.appearance) measure_appearance(false, report.projected, report.T_projector_target_estimated);
 
   dwell_.emplace(DwellContext{tour_.twin, target_index_, tour_.models, truth_, tour_.options, lights_});
-  period_s_ = 1.0 / tour_.models.truth.refresh_hz;
-  display_delay_s_ = period_s_ + 1e-3 * tour_.models.truth.input_lag_ms;
-  drawn_.T_camera_target = drawn_.motion.T = report.icp.T_scan_model;
-  shown_ = report.projected;
+  start_projection();
   wall_to_light_ms_ = report.align_ms;
   const config::TargetMotion* motion = target.config.motion_on(report.target_visit);
   motion_end_s_ = motion ? motion->end_s() : 0.0;
   frames_ = static_cast<int>(std::lround(tour_.options.dwell_s * tour_.models.truth.refresh_hz));
+}
+
+// The dwell's projection from the arrival's estimates: the projector's frames as the twin's projector
+// paces them (its refresh and input lag), Eq. 2 with the believed R_cp, T_cp; the camera is not watched for
+// silence (the tour runs in lockstep with it).
+void TourStop::start_projection() {
+  session::ProjectionConfig config;
+  config.T_projector_camera = tour_.models.T_projector_camera;
+  config.refresh_hz = tour_.models.truth.refresh_hz;
+  config.input_lag_ms = tour_.models.truth.input_lag_ms;
+  config.predict = tour_.options.predict;
+  config.silent_camera_s = 0.0;
+  projection_.emplace(config);
+  period_s_ = 1.0 / config.refresh_hz;
+  for (std::size_t k = 0; k < lit_.size(); ++k) {
+    lit_now_.targets.push_back(static_cast<int>(k));
+    alignment::PoseSample arrival;
+    const Acquired& a = tour_.trackers[lit_[k]].acquired();
+    arrival.T_camera_target = arrival.motion.T = a.icp.T_scan_model;
+    arrival.lost = !a.projected;
+    newest_.push_back(arrival);
+  }
+  drawn_ = newest_.front();
+  shown_ = report.projected;
 }
 
 // The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else
@@ -467,30 +504,41 @@ void TourStop::write_pictures(const assets::Image& colour) {
   assets::write_png(frame_path(tour_.options, report, "_spectator"), spectator_picture(image));
 }
 
-// One projector frame of the dwell, starting at start_s: the newest results ready by then drawn
-// (tracking mode), and the frame's error measured at its display time.
+// The results each lit target's tracker has ready by start_s (tracking mode): the newest of each is what
+// the frame starting then may draw.
+void TourStop::take_results(double start_s) {
+  for (std::size_t k = 0; k < lit_.size(); ++k)
+    for (const auto& sample : tour_.trackers[lit_[k]].ready_by(start_s)) {
+      newest_[k] = sample;
+      if (!sample.lost) (k == 0 ? drawn_ : lights_[k - 1].drawn) = sample;
+    }
+  const double track_ms = tour_.trackers[target_index_].track_ms();  // the visited target's frames tracked since the last
+  if (report.first_light_s < 0.0) wall_to_light_ms_ += track_ms - seen_track_ms_;
+  seen_track_ms_ = track_ms;
+}
+
+// One projector frame of the dwell, starting at start_s: what it draws decided as in `run`, and its error
+// measured at its display time.
 void TourStop::project(double start_s) {
   const DwellContext& c = *dwell_;
-  if (tour_.options.mode == TourMode::tracking) {
-    for (std::size_t k = 0; k < lit_.size(); ++k)
-      for (const auto& sample : tour_.trackers[lit_[k]].ready_by(start_s)) {
-        bool& shown = k == 0 ? shown_ : lights_[k - 1].shown;
-        shown = !sample.lost;
-        if (shown) (k == 0 ? drawn_ : lights_[k - 1].drawn) = sample;
-      }
-    const double track_ms = tour_.trackers[target_index_].track_ms();  // the visited target's frames tracked since the last
-    if (report.first_light_s < 0.0) wall_to_light_ms_ += track_ms - seen_track_ms_;
-    seen_track_ms_ = track_ms;
-  }
-  const TimelineSample s = measure_frame(c, report, start_s + display_delay_s_, shown_, drawn_, tour_.options.predict);
+  if (tour_.options.mode == TourMode::tracking) take_results(start_s);
+  projection_->frame_started(start_s);
+  const auto newest = [this](int k, alignment::PoseSample& out) { return (out = newest_[static_cast<std::size_t>(k)]), true; };
+  const std::vector<session::DrawnPose> drawn = projection_->compose(start_s, lit_now_, newest);
+  const auto drawn_of = [&drawn](int k) {
+    const auto it = std::find_if(drawn.begin(), drawn.end(), [k](const session::DrawnPose& d) { return d.target == k; });
+    return it == drawn.end() ? nullptr : &*it;
+  };
+  const session::DrawnPose* visited = drawn_of(0);
+  shown_ = visited != nullptr;
+  const TimelineSample s = measure_frame(c, report, projection_->display_time_s(start_s), visited, drawn_);
   const config::TargetMotion* motion = tour_.twin.targets()[target_index_].config.motion_on(report.target_visit);
   if (tour_.options.appearance && s.moving && !moving_measured_ && s.t_s >= motion->start_s + motion->duration_s / 2) {
     moving_measured_ = true;
-    const Eigen::Matrix4d T_camera_target =
-        tour_.options.predict ? alignment::predict_pose(drawn_.motion, s.t_s) : drawn_.T_camera_target;
+    const Eigen::Matrix4d T_camera_target = light_pose(visited, drawn_, s.t_s, tour_.options.predict);
     measure_appearance(true, shown_, tour_.models.projector_from_target(T_camera_target));
   }
-  for (NeighbourLight& n : lights_) measure_neighbour(c, n, start_s + display_delay_s_);
+  for (std::size_t k = 1; k < lit_.size(); ++k) measure_neighbour(c, lights_[k - 1], drawn_of(static_cast<int>(k)));
   report.timeline.push_back(s);
   report.lit_frames += shown_ ? 1 : 0;
   if (shown_ && report.first_light_s < 0.0) {
@@ -572,6 +620,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   report.mode = options.mode;
   report.seed = options.seed;
   report.predict = options.predict;
+  report.processing_ms = options.processing_ms;
   report.depth_model = !options.depth_noise ? "none" : options.fitted_depth ? "fitted" : "kinect";
   report.projector = scene.projector;
   const int visits = options.visits > 0 ? options.visits : static_cast<int>(scene.visits.size());

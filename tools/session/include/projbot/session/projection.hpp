@@ -3,7 +3,7 @@
 // lit target at its newest accepted pose, moved on to the frame's display time by its measured motion,
 // through Eq. 2 into the projector's frame; a target not found yet, lost, or seen only before the stop
 // began is blanked on its own, and every target while the camera is silent. Times are seconds on one
-// steady clock (config::steady_now_s in `run`; any clock in a test).
+// steady clock (config::steady_now_s in `run`, the simulated clock in the twin's tour; any clock in a test).
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -68,6 +68,9 @@ class ProjectionFrames {
   /// Frames blanked because the camera was silent.
   std::size_t silent_frames() const { return silent_; }
   double period_s() const { return cadence_.period_s(1.0 / cfg_.refresh_hz); }
+  /// When the frame whose poses are read at now_s is expected to be lit: one measured frame period plus
+  /// the projector's input lag later.
+  double display_time_s(double now_s) const { return now_s + period_s() + 1e-3 * cfg_.input_lag_ms; }
 
  private:
   ProjectionConfig cfg_;

@@ -158,8 +158,9 @@ struct VisitReport {
 struct TourReport {
   TourMode mode = TourMode::localized;
   std::uint64_t seed = 1;
-  bool predict = true;                 ///< TourOptions::predict
-  std::string depth_model = "kinect";  ///< the twin's depth camera: "kinect" (published), "fitted" or "none"
+  bool predict = true;                  ///< TourOptions::predict
+  std::optional<double> processing_ms;  ///< TourOptions::processing_ms: unset, as measured on the machine
+  std::string depth_model = "kinect";   ///< the twin's depth camera: "kinect" (published), "fitted" or "none"
   config::ProjectorConfig projector;
   std::vector<VisitReport> visits;  ///< the finished visits
   double wall_s = 0.0;
