@@ -9,6 +9,9 @@ layout(location = 1) in vec4 in_color;
 layout(location = 2) in vec3 in_q;
 
 layout(set = 0, binding = 0) uniform sampler2D base_color_texture;
+// The target's physical surface over the same UVs (Renderer::set_surface): linear reflectance, which
+// compensation divides by besides compensate.rgb's per-channel albedo; white unless the scene gives one.
+layout(set = 0, binding = 1) uniform sampler2D surface_texture;
 
 // The projector's response, per frame (renderer.cpp's FrameUniform).
 layout(set = 1, binding = 0) uniform Frame {
@@ -47,7 +50,8 @@ float white_lux() {
 // The input that adds what the surface lacks: the lux needed less the room's, as a share of full white
 // here, unmixed into the channels' drives, through the inverse response.
 vec3 compensated(vec3 c, float white) {
-  vec3 needed = draw.compensate.rgb * srgb_to_linear(c) - draw.compensate.a;
+  vec3 rho = max(textureLod(surface_texture, in_uv, 0.0).rgb, vec3(1e-3));  // no mipmaps: no derivatives needed
+  vec3 needed = draw.compensate.rgb * srgb_to_linear(c) / rho - draw.compensate.a;
   vec3 light = white > 0.0 ? needed / white : mix(vec3(0.0), vec3(2.0), greaterThan(needed, vec3(0.0)));
   vec3 d = vec3(dot(frame.unmix[0].xyz, light), dot(frame.unmix[1].xyz, light), dot(frame.unmix[2].xyz, light));
   float black = frame.response.w;

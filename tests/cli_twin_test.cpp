@@ -64,6 +64,57 @@ TEST_F(CliTest, TourCompensatesTheFiguresBeigeUnlessTurnedOff) {
   EXPECT_NEAR(blue_over_red(" --compensation off", dir_ / "off"), 1.0, 0.1);
 }
 
+// surface.texture (issue 43): the shop's duck printed with red bands over its UVs (the scene's yellow
+// between them). As stored, the bands show through the content; compensated against the print, the visitor
+// sees the content within the issue's colour goals. A print that is not there, or not a picture, is one
+// line naming it.
+TEST_F(CliTest, BenchAppearanceCompensatesAPrintedSurface) {
+  projbot::assets::Image print;
+  print.width = print.height = 64;
+  for (int y = 0; y < print.height; ++y)
+    for (int x = 0; x < print.width; ++x) {
+      const bool band = (y / 8) % 2 == 0;
+      print.rgba.insert(print.rgba.end(), {std::uint8_t(band ? 218 : 229), std::uint8_t(band ? 108 : 206),
+                                           std::uint8_t(band ? 89 : 80), std::uint8_t(255)});
+    }
+  projbot::assets::write_png(dir_ / "print.png", print);
+  std::ifstream in(std::string(PROJBOT_ASSET_DIR) + "/scenes/shop.yaml");
+  std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto replace = [&yaml](const std::string& from, const std::string& to) {
+    const auto at = yaml.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    yaml.replace(at, from.size(), to);
+  };
+  for (std::size_t at = 0; (at = yaml.find("../models/", at)) != std::string::npos;)
+    yaml.replace(at, 10, std::string(PROJBOT_ASSET_DIR) + "/models/");
+  replace("surface: {albedo: [0.78, 0.62, 0.08]}", "surface: {texture: print.png}");
+  replace("visits: [figure, duck, box,", "visits: [duck]  #");
+  std::ofstream(dir_ / "printed.yaml") << yaml;
+  const CliRun r =
+      run_projbot("bench appearance --scene " + (dir_ / "printed.yaml").string() + " --report " + (dir_ / "r.json").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream report(dir_ / "r.json");
+  const auto json = nlohmann::json::parse(report);
+  ASSERT_EQ(json.at("visits").size(), 2U) << json.dump(1);
+  const auto& off = json.at("visits")[0];
+  const auto& on = json.at("visits")[1];
+  EXPECT_EQ(on.at("compensation"), "on");
+  EXPECT_LE(on.at("de2000_median").get<double>(), 5.0) << on.dump();
+  EXPECT_LE(on.at("de2000_p95").get<double>(), 12.0) << on.dump();
+  EXPECT_GE(on.at("ssim").get<double>(), 0.85) << on.dump();
+  EXPECT_GE(on.at("psnr_db").get<double>(), off.at("psnr_db").get<double>() + 10.0) << off.dump() << on.dump();
+  EXPECT_GT(off.at("de2000_median").get<double>(), 20.0) << off.dump();
+  // The print missing, then not a picture.
+  fs::remove(dir_ / "print.png");
+  CliRun bad = run_projbot("bench appearance --scene " + (dir_ / "printed.yaml").string());
+  EXPECT_EQ(bad.code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("print.png"), std::string::npos) << bad.output;
+  std::ofstream(dir_ / "print.png") << "not a picture";
+  bad = run_projbot("bench appearance --scene " + (dir_ / "printed.yaml").string());
+  EXPECT_EQ(bad.code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("print.png"), std::string::npos) << bad.output;
+}
+
 // Two targets side by side: at the duck's stop the box is lit in the same projector frames, on the
 // right of the duck (the box stands 0.6 m east of it).
 TEST_F(CliTest, TourLightsANeighbourInTheSameFrame) {

@@ -75,6 +75,14 @@ TEST(SceneTest, ParsesEveryField) {
   EXPECT_TRUE(lit.projector.photometry.mixing.isIdentity());
   EXPECT_DOUBLE_EQ(lit.room.ambient_lux, 150.0);
   EXPECT_DOUBLE_EQ(lit.targets[0].surface.albedo.z(), 0.4);
+  EXPECT_TRUE(lit.targets[0].surface.texture.empty());
+  // A printed surface: its picture beside the scene, albedo 1 (the picture carries it).
+  const auto printed = parse_scene(
+      "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2}\n"
+      "targets:\n  - {name: a, model: a.glb, pose: {translation: [0, 0, 1]}, surface: {texture: prints/a.png}}\n",
+      "/scenes/s.yaml");
+  EXPECT_EQ(printed.targets[0].surface.texture, std::filesystem::path("/scenes/prints/a.png"));
+  EXPECT_EQ(printed.targets[0].surface.albedo, Eigen::Vector3d::Ones());
 }
 
 TEST(SceneTest, TargetContent) {
@@ -205,9 +213,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"albedo_missing",
                 kProj + "targets:\n  - name: a\n    model: a.glb\n    surface: {}\n",
                 {"targets[0].surface.albedo", "missing"}},
-        BadCase{"surface_texture_not_yet",
-                kProj + "targets:\n  - name: a\n    model: a.glb\n    surface: {texture: a.png}\n",
-                {"targets[0].surface.texture", "not supported yet"}},
+        BadCase{"surface_texture_and_albedo",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    surface: {texture: a.png, albedo: [1, 1, 1]}\n",
+                {"targets[0].surface.albedo", "not both"}},
+        BadCase{"surface_texture_empty",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    surface: {texture: \"\"}\n",
+                {"targets[0].surface.texture", "must not be empty"}},
         BadCase{"content_without_video",
                 kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {loop: false}\n",
                 {"targets[0].content", "needs a video or a timeline"}},

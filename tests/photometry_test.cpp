@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
+#include <memory>
 
 #include "projbot/engine/renderer.hpp"
 
@@ -108,48 +110,66 @@ TEST(Photometry, TheGainClipsTheShareAskedFor) {
   EXPECT_EQ(engine::choose_gain({{Eigen::Vector3d::Ones(), 1e5, 1.0}}, albedo, 0.0), 1.0);
 }
 
-// mesh.frag's compensation against compensated_input: a flat patch of one colour, tilted 40 degrees
-// and off the axis, each pixel's input from the ray's point on the plane.
+// A flat 0.6 m square patch of one colour (sRGB `content`), its UVs 0..1 across it, tilted 40 degrees and
+// off the axis of a 320 x 200 projector with crosstalk and a gamma per channel (the shader's set 1).
+struct Patch {
+  explicit Patch(const Eigen::Vector3d& content) {
+    quad.source = "quad";
+    projbot::assets::Primitive prim;
+    for (const auto& [x, y] : {std::pair{-0.3F, -0.3F}, {0.3F, -0.3F}, {0.3F, 0.3F}, {-0.3F, 0.3F}}) {
+      projbot::assets::Vertex v;
+      v.position = {x, y, 0.0F};
+      v.normal = {0.0F, 0.0F, -1.0F};
+      v.uv = {x / 0.6F + 0.5F, y / 0.6F + 0.5F};
+      prim.vertices.push_back(v);
+    }
+    prim.indices = {0, 1, 2, 0, 2, 3};
+    quad.primitives.push_back(prim);
+    projbot::assets::Material material;
+    material.base_color_factor = {static_cast<float>(content[0]), static_cast<float>(content[1]), static_cast<float>(content[2]),
+                                  1.0F};
+    material.double_sided = true;
+    quad.materials.push_back(material);
+    projector = mixed_projector();
+    projector.width_px = 320, projector.height_px = 200, projector.fx_px = projector.fy_px = 350.0;
+    projector.cx_px = 150.3, projector.cy_px = 104.1;
+    T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    T.topRightCorner<3, 1>() = Eigen::Vector3d(0.15, -0.05, 2.0);
+  }
+  Eigen::Vector3d normal() const { return T.topLeftCorner<3, 3>() * Eigen::Vector3d::UnitZ(); }
+  // Pixel (u, v)'s ray on the patch's plane: the point, projector frame.
+  Eigen::Vector3d point(int u, int v) const {
+    const Eigen::Vector3d ray((u - projector.cx_px) / projector.fx_px, (v - projector.cy_px) / projector.fy_px, 1.0);
+    const Eigen::Vector3d p0 = T.topRightCorner<3, 1>();
+    return ray * (normal().dot(p0) / normal().dot(ray));
+  }
+  // That point on the patch (model frame; inside where |x|, |y| < 0.3).
+  Eigen::Vector3d local(const Eigen::Vector3d& q) const {
+    return T.topLeftCorner<3, 3>().transpose() * (q - T.topRightCorner<3, 1>().eval());
+  }
+  projbot::assets::Model quad;
+  ProjectorConfig projector;
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+};
+
+// mesh.frag's compensation against compensated_input: a flat patch of one colour, tilted and off the
+// axis, each pixel's input from the ray's point on the plane.
 TEST(Photometry, TheShaderMatchesItsCpuReference) {
   engine::Renderer renderer{engine::RendererOptions{}};
-  projbot::assets::Model quad;
-  quad.source = "quad";
-  projbot::assets::Primitive prim;
-  for (const auto& [x, y] : {std::pair{-0.3F, -0.3F}, {0.3F, -0.3F}, {0.3F, 0.3F}, {-0.3F, 0.3F}}) {
-    projbot::assets::Vertex v;
-    v.position = {x, y, 0.0F};
-    v.normal = {0.0F, 0.0F, -1.0F};
-    prim.vertices.push_back(v);
-  }
-  prim.indices = {0, 1, 2, 0, 2, 3};
-  quad.primitives.push_back(prim);
-  projbot::assets::Material material;
   const Eigen::Vector3d content(0.85, 0.55, 0.35);  // sRGB
-  material.base_color_factor = {0.85F, 0.55F, 0.35F, 1.0F};
-  material.double_sided = true;
-  quad.materials.push_back(material);
-  const std::size_t id = renderer.add_model(quad);
-  ProjectorConfig projector = mixed_projector();  // crosstalk and a gamma per channel: the shader's set 1
-  projector.width_px = 320, projector.height_px = 200, projector.fx_px = projector.fy_px = 350.0;
-  projector.cx_px = 150.3, projector.cy_px = 104.1;
-  auto target = renderer.make_offscreen(projector.width_px, projector.height_px);
-  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  T.topRightCorner<3, 1>() = Eigen::Vector3d(0.15, -0.05, 2.0);
+  const Patch patch(content);
+  const std::size_t id = renderer.add_model(patch.quad);
+  auto target = renderer.make_offscreen(patch.projector.width_px, patch.projector.height_px);
   const engine::Compensation comp = engine::compensation({0.7, 0.6, 0.5}, 20.0, 0.35);
-  const std::vector<engine::DrawItem> items{{id, T, comp}};
-  renderer.draw_frame(*target, projector, items);
+  renderer.draw_frame(*target, patch.projector, std::vector<engine::DrawItem>{{id, patch.T, comp}});
   const auto image = target->read_back();
-  const Eigen::Vector3d n = T.topLeftCorner<3, 3>() * Eigen::Vector3d::UnitZ(), p0 = T.topRightCorner<3, 1>();
   std::size_t compared = 0;
   double worst = 0.0;
-  for (int v = 0; v < projector.height_px; ++v)
-    for (int u = 0; u < projector.width_px; ++u) {
-      const Eigen::Vector3d ray((u - projector.cx_px) / projector.fx_px, (v - projector.cy_px) / projector.fy_px, 1.0);
-      const Eigen::Vector3d q = ray * (n.dot(p0) / n.dot(ray));
-      const Eigen::Vector3d local = T.topLeftCorner<3, 3>().transpose() * (q - p0);
+  for (int v = 0; v < patch.projector.height_px; ++v)
+    for (int u = 0; u < patch.projector.width_px; ++u) {
+      const Eigen::Vector3d q = patch.point(u, v), local = patch.local(q);
       if (std::abs(local.x()) > 0.29 || std::abs(local.y()) > 0.29) continue;  // off the patch or on its edge
-      const Eigen::Vector3d want = engine::compensated_input(projector, comp, content, q, n);
+      const Eigen::Vector3d want = engine::compensated_input(patch.projector, comp, content, q, patch.normal());
       const std::uint8_t* px = image.pixel(u, v);
       for (int i = 0; i < 3; ++i) worst = std::max(worst, std::abs(px[i] - 255.0 * want[i]));
       ++compared;
@@ -157,12 +177,73 @@ TEST(Photometry, TheShaderMatchesItsCpuReference) {
   EXPECT_GT(compared, 8000U);
   EXPECT_LT(worst, 1.5) << "levels of 255";  // float in the shader, rounding to 8 bits
   // Without compensation the content is sent as stored.
-  renderer.draw_frame(*target, projector, std::vector<engine::DrawItem>{{id, T}});
+  renderer.draw_frame(*target, patch.projector, std::vector<engine::DrawItem>{{id, patch.T}});
   const auto plain = target->read_back();
   const std::uint8_t* mid = plain.pixel(160, 100);
   EXPECT_EQ(mid[0], 217);
   EXPECT_EQ(mid[1], 140);
   EXPECT_EQ(mid[2], 89);
+}
+
+// surface.texture: a patch printed in two colours (its left half reddish, its right half blue-grey, sRGB
+// bytes over its UVs) compensated with an albedo of 1 and the print bound as its surface: each half's
+// input is the CPU reference's for a one-colour surface of that half's reflectance, and the gain choice
+// reads the print as such a surface would be read.
+TEST(Photometry, TheShaderDividesByTheSurfaceTexture) {
+  engine::Renderer renderer{engine::RendererOptions{}};
+  const Eigen::Vector3d content(0.85, 0.55, 0.35);
+  const Patch patch(content);
+  const std::size_t id = renderer.add_model(patch.quad);
+  projbot::assets::Image print;
+  print.width = 64, print.height = 4;
+  const std::array<std::uint8_t, 3> left{230, 120, 90}, right{110, 140, 200};
+  for (int y = 0; y < print.height; ++y)
+    for (int x = 0; x < print.width; ++x) {
+      const auto& c = x < 32 ? left : right;
+      print.rgba.insert(print.rgba.end(), {c[0], c[1], c[2], 255});
+    }
+  ASSERT_EQ(print.rgba.size(), 64U * 4U * 4U);
+  renderer.set_surface(id, print);
+  const auto rho = [](const std::array<std::uint8_t, 3>& c) {
+    return Eigen::Vector3d(engine::srgb_to_linear(c[0] / 255.0), engine::srgb_to_linear(c[1] / 255.0),
+                           engine::srgb_to_linear(c[2] / 255.0));
+  };
+  auto target = renderer.make_offscreen(patch.projector.width_px, patch.projector.height_px);
+  const engine::Compensation comp = engine::compensation(Eigen::Vector3d::Ones(), 20.0, 0.35);
+  renderer.draw_frame(*target, patch.projector, std::vector<engine::DrawItem>{{id, patch.T, comp}});
+  const auto image = target->read_back();
+  std::size_t compared[2] = {0, 0};
+  double worst = 0.0;
+  for (int v = 0; v < patch.projector.height_px; ++v)
+    for (int u = 0; u < patch.projector.width_px; ++u) {
+      const Eigen::Vector3d q = patch.point(u, v), local = patch.local(q);
+      // On the patch, clear of its edges and of the seam between the halves (texels blend there).
+      if (std::abs(local.x()) > 0.28 || std::abs(local.y()) > 0.28 || std::abs(local.x()) < 0.02) continue;
+      const bool on_left = local.x() < 0.0;
+      const engine::Compensation half = engine::compensation(rho(on_left ? left : right), 20.0, 0.35);
+      const Eigen::Vector3d want = engine::compensated_input(patch.projector, half, content, q, patch.normal());
+      const std::uint8_t* px = image.pixel(u, v);
+      for (int i = 0; i < 3; ++i) worst = std::max(worst, std::abs(px[i] - 255.0 * want[i]));
+      ++compared[on_left ? 0 : 1];
+    }
+  EXPECT_GT(compared[0], 3000U);
+  EXPECT_GT(compared[1], 3000U);
+  EXPECT_LT(worst, 1.5) << "levels of 255";
+  // The gain: a print of one colour reads as that colour's albedo.
+  projbot::assets::Image plain = print;
+  for (std::size_t i = 0; i < plain.rgba.size(); i += 4) std::copy(right.begin(), right.end(), plain.rgba.begin() + i);
+  const auto samples = engine::surface_samples(patch.quad, patch.projector, patch.T, &plain);
+  ASSERT_FALSE(samples.empty());
+  EXPECT_NEAR(engine::choose_gain(samples, Eigen::Vector3d::Ones(), 20.0),
+              engine::choose_gain(engine::surface_samples(patch.quad, patch.projector, patch.T), rho(right), 20.0),
+              1e-6);  // the texel is read in single precision
+  // A plan keeps a printed surface: one colour measured over it is not taken.
+  auto shared = std::make_shared<const projbot::assets::Image>(plain);
+  engine::CompensationPlan plan({{&patch.quad, Eigen::Vector3d::Ones(), shared}}, 20.0, true);
+  const engine::Compensation first = plan.at(0, 1, patch.projector, patch.T);
+  plan.add_measured_albedo(0, Eigen::Vector3d(0.2, 0.2, 0.2));
+  EXPECT_EQ(plan.albedo(0), Eigen::Vector3d::Ones());
+  EXPECT_EQ(plan.at(0, 1, patch.projector, patch.T).scale_lux, first.scale_lux);
 }
 
 }  // namespace
@@ -172,7 +253,7 @@ namespace {
 // The plan keeps a target's gain through a visit, whatever the pose does, and chooses it again in the next.
 TEST(Photometry, ThePlanKeepsTheGainThroughAVisit) {
   projbot::assets::Model quad = projbot::assets::make_box({-0.2, -0.2, -0.01}, {0.2, 0.2, 0.01}, {1.0F, 1.0F, 1.0F, 1.0F});
-  engine::CompensationPlan plan({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5)}}, 20.0, true);
+  engine::CompensationPlan plan({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5), nullptr}}, 20.0, true);
   Eigen::Matrix4d near = Eigen::Matrix4d::Identity(), far = Eigen::Matrix4d::Identity();
   near(2, 3) = 1.0;
   far(2, 3) = 3.0;  // nine times less light: a smaller gain
@@ -189,7 +270,7 @@ TEST(Photometry, ThePlanKeepsTheGainThroughAVisit) {
   EXPECT_TRUE(plan.albedo(0).isApprox(Eigen::Vector3d(0.65, 0.45, 0.25), 1e-12)) << plan.albedo(0).transpose();
   const engine::Compensation refined = plan.at(0, 2, kProjector, far);  // its gain chosen again for the new albedo
   EXPECT_FLOAT_EQ(refined.scale_lux[0], static_cast<float>(plan.gain(0) * engine::kReferenceLux / 0.65));
-  engine::CompensationPlan off({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5)}}, 20.0, false);
+  engine::CompensationPlan off({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5), nullptr}}, 20.0, false);
   EXPECT_FALSE(off.at(0, 1, kProjector, near).on);
 }
 

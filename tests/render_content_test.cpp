@@ -160,6 +160,40 @@ projbot::config::TargetContent video_content(const fs::path& clip) {
 
 }  // namespace
 
+// surface.texture is read for a model that has texture coordinates to lay it on; one line names what is wrong.
+TEST(SurfaceTexture, NeedsTheFileAndTheModelsTextureCoordinates) {
+  Model m = projbot::assets::make_box({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}, {1.0F, 1.0F, 1.0F, 1.0F});
+  projbot::config::TargetConfig target;
+  target.name = "box";
+  target.model = "box.glb";
+  EXPECT_EQ(projbot::engine::load_surface_texture(target, m), nullptr);  // one colour: nothing to read
+  const fs::path dir = fs::temp_directory_path() / ("projbot_surface_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  target.surface.texture = dir / "print.png";
+  const auto message = [&] {
+    try {
+      projbot::engine::load_surface_texture(target, m);
+    } catch (const projbot::assets::AssetError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no throw");
+  };
+  for (auto& p : m.primitives)
+    for (auto& v : p.vertices) v.uv = {0.0F, 0.0F};
+  projbot::assets::Image print;
+  print.width = print.height = 2;
+  print.rgba.assign(16, 200);
+  projbot::assets::write_png(target.surface.texture, print);
+  EXPECT_NE(message().find("box.glb has none"), std::string::npos) << message();
+  m.primitives[0].vertices[1].uv = {1.0F, 0.0F};
+  const auto read = projbot::engine::load_surface_texture(target, m);
+  ASSERT_NE(read, nullptr);
+  EXPECT_EQ(read->width, 2);
+  fs::remove(target.surface.texture);
+  EXPECT_NE(message().find("print.png"), std::string::npos) << message();
+  fs::remove_all(dir);
+}
+
 TEST(SceneContentMaterial, ByNameIndexOrFirstTextured) {
   Model m;
   m.source = "m.glb";

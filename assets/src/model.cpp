@@ -20,6 +20,14 @@ double wrapped(double x, Wrap w) {
 
 }  // namespace
 
+Eigen::Vector3f texel_colour(const Image& image, double u, double v, Wrap wrap_s, Wrap wrap_t) {
+  if (image.width <= 0 || image.height <= 0) return Eigen::Vector3f::Ones();
+  const int x = std::min(image.width - 1, static_cast<int>(wrapped(u, wrap_s) * image.width));
+  const int y = std::min(image.height - 1, static_cast<int>(wrapped(v, wrap_t) * image.height));
+  const std::uint8_t* px = image.pixel(x, y);
+  return Eigen::Vector3f(px[0], px[1], px[2]) / 255.0F;
+}
+
 Eigen::Vector3f surface_colour(const Model& model, int material, double u, double v, const Eigen::Vector3f& vc) {
   if (model.materials.empty()) return vc;
   const Material& m = model.materials[static_cast<std::size_t>(std::max(material, 0)) % model.materials.size()];
@@ -28,10 +36,7 @@ Eigen::Vector3f surface_colour(const Model& model, int material, double u, doubl
   if (m.base_color_image < 0 || static_cast<std::size_t>(m.base_color_image) >= model.images.size()) return c;
   const Image& img = model.images[static_cast<std::size_t>(m.base_color_image)];
   if (img.width <= 0 || img.height <= 0) return c;
-  const int x = std::min(img.width - 1, static_cast<int>(wrapped(u, m.sampler.wrap_s) * img.width));
-  const int y = std::min(img.height - 1, static_cast<int>(wrapped(v, m.sampler.wrap_t) * img.height));
-  const std::uint8_t* px = img.pixel(x, y);
-  return c.cwiseProduct(Eigen::Vector3f(px[0], px[1], px[2]) / 255.0F);
+  return c.cwiseProduct(texel_colour(img, u, v, m.sampler.wrap_s, m.sampler.wrap_t));
 }
 
 std::size_t Model::triangle_count() const {

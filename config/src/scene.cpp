@@ -423,7 +423,7 @@ TargetConfig read_target(const YAML::Node& node, const std::string& path, const 
   read_model_ref(t, node, path, base, target.model, target.scale, target.recenter);
   target.present = t.get<bool>("present", true);
   target.support = read_support(t, path + ".support");
-  target.surface = read_surface(t, path + ".surface");
+  target.surface = read_surface(t, path + ".surface", base);
   target.content = read_content(t, path + ".content", base);
   target.T_projector_target = read_pose(t, path + ".pose");
   if (t.has("world_pose")) target.T_world_target = read_pose(t, path + ".world_pose", "world_pose");

@@ -30,14 +30,22 @@ std::vector<TargetContent::Key> read_timeline(MapReader& m, const YAML::Node& li
 
 }  // namespace
 
-// A target's `surface: {albedo: [r, g, b]}`: linear reflectance, each 0..1.
-TargetSurface read_surface(MapReader& t, const std::string& path) {
+// A target's `surface: {albedo: [r, g, b]}` (linear reflectance, each 0..1) or `surface: {texture: F}`
+// (a picture of it over the model's UVs, beside the scene; read where it is used).
+TargetSurface read_surface(MapReader& t, const std::string& path, const std::filesystem::path& base) {
   TargetSurface surface;
   YAML::Node node = t.child("surface", false);
   if (!node) return surface;
   MapReader m(node, path, t.file());
-  if (m.has("texture"))
-    m.fail(node["texture"], m.key_path("texture"), "a reflectance texture is not supported yet: give surface.albedo: [r, g, b]");
+  if (m.has("texture")) {
+    if (m.has("albedo")) m.fail(node["albedo"], m.key_path("albedo"), "give surface.albedo or surface.texture, not both");
+    const auto texture = m.get<std::string>("texture", "");
+    if (texture.empty()) m.fail(node["texture"], m.key_path("texture"), "must not be empty");
+    surface.texture = beside_scene(texture, base);
+    surface.albedo = Eigen::Vector3d::Ones();  // the texture carries it
+    m.reject_unknown();
+    return surface;
+  }
   const YAML::Node albedo = m.child("albedo", true);
   surface.albedo = m.vector3(albedo, m.key_path("albedo"));
   if (!((surface.albedo.array() >= 0.0).all() && (surface.albedo.array() <= 1.0).all()))

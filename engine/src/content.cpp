@@ -7,7 +7,33 @@
 #include <cmath>
 #include <optional>
 
+#include "projbot/assets/image.hpp"
+
 namespace projbot::engine {
+
+std::shared_ptr<const assets::Image> load_surface_texture(const config::TargetConfig& target, const assets::Model& model) {
+  if (target.surface.texture.empty()) return nullptr;
+  const bool has_uvs = std::any_of(model.primitives.begin(), model.primitives.end(), [](const assets::Primitive& p) {
+    return std::any_of(p.vertices.begin(), p.vertices.end(),
+                       [](const assets::Vertex& v) { return v.uv[0] != 0.0F || v.uv[1] != 0.0F; });
+  });
+  if (!has_uvs)
+    throw assets::AssetError(target.surface.texture.string() + ": target '" + target.name + "'s surface texture needs texture " +
+                             "coordinates, and its model " + target.model.string() + " has none");
+  return std::make_shared<const assets::Image>(assets::read_image(target.surface.texture));
+}
+
+std::vector<CompensationPlan::Target> upload_surfaces(Renderer& renderer, const config::Scene& scene,
+                                                      const std::vector<assets::Model>& models,
+                                                      const std::vector<DrawItem>& items) {
+  std::vector<CompensationPlan::Target> out;
+  for (std::size_t i = 0; i < models.size() && i < items.size() && i < scene.targets.size(); ++i) {
+    CompensationPlan::Target t{&models[i], scene.targets[i].surface.albedo, load_surface_texture(scene.targets[i], models[i])};
+    if (t.surface) renderer.set_surface(items[i].model, *t.surface);
+    out.push_back(std::move(t));
+  }
+  return out;
+}
 
 int content_material(const assets::Model& model, const std::string& spec) {
   const auto n = static_cast<int>(model.materials.size());

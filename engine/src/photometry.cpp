@@ -79,10 +79,16 @@ Eigen::Vector3d vertex_content(const assets::Model& model, int material, const a
       .cast<double>();
 }
 
+// A vertex's surface reflectance, linear, from the surface texture at its UV.
+Eigen::Vector3d surface_reflectance(const assets::Image& surface, const assets::Vertex& v) {
+  const Eigen::Vector3f c = assets::texel_colour(surface, v.uv[0], v.uv[1]);
+  return {srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2])};
+}
+
 }  // namespace
 
 std::vector<SurfaceSample> surface_samples(const assets::Model& model, const config::ProjectorConfig& p,
-                                           const Eigen::Matrix4d& T_projector_target) {
+                                           const Eigen::Matrix4d& T_projector_target, const assets::Image* surface) {
   std::vector<SurfaceSample> out;
   const Eigen::Matrix3d R = T_projector_target.topLeftCorner<3, 3>();
   const Eigen::Vector3d t = T_projector_target.topRightCorner<3, 1>();
@@ -100,10 +106,13 @@ std::vector<SurfaceSample> surface_samples(const assets::Model& model, const con
       const Eigen::Vector2d x = p.project(q);
       if (x.x() < -0.5 || x.y() < -0.5 || x.x() > p.width_px - 0.5 || x.y() > p.height_px - 0.5) continue;
       SurfaceSample s;
+      if (surface) s.reflectance.setZero();
       s.content =
           (vertex_content(model, prim.material, prim.vertices[a]) + vertex_content(model, prim.material, prim.vertices[b]) +
            vertex_content(model, prim.material, prim.vertices[c])) /
           3.0;
+      if (surface)
+        for (const std::uint32_t k : {a, b, c}) s.reflectance += surface_reflectance(*surface, prim.vertices[k]) / 3.0;
       s.white_lux = white_lux(p, q, n);
       s.weight = std::abs(n.dot(q)) / (2.0 * q.norm() * q.squaredNorm());  // its solid angle: the projector's pixels on it
       if (s.weight > 0.0) out.push_back(s);
@@ -122,7 +131,8 @@ double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vecto
   double total = 0.0;
   for (const SurfaceSample& s : samples) {
     Eigen::Vector3d u;
-    for (int i = 0; i < 3; ++i) u[i] = kReferenceLux * srgb_to_linear(s.content[i]) / std::max(albedo[i], 1e-3);
+    for (int i = 0; i < 3; ++i)
+      u[i] = kReferenceLux * srgb_to_linear(s.content[i]) / std::max(albedo[i] * s.reflectance[i], 1e-3);
     const Eigen::Vector3d per_drive = unmix * u;
     double k = 1e9;
     for (int j = 0; j < 3; ++j)
@@ -216,6 +226,7 @@ std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const 
 
 void CompensationPlan::add_measured_albedo(std::size_t target, const Eigen::Vector3d& albedo) {
   Chosen& c = chosen_.at(target);
+  if (targets_.at(target).surface) return;  // its texture stays
   Eigen::Vector3d& mean = targets_.at(target).albedo;
   mean = c.measurements == 0 ? albedo : Eigen::Vector3d((mean * c.measurements + albedo) / (c.measurements + 1));
   ++c.measurements;
@@ -231,8 +242,8 @@ Compensation CompensationPlan::at(std::size_t target, long visit, const config::
   const Target& t = targets_.at(target);
   Chosen& c = chosen_.at(target);
   if (!c.made || c.visit != visit) {
-    c.gain = t.model ? choose_gain(surface_samples(*t.model, projector, T_projector_target), t.albedo, ambient_lux_, 0.02,
-                                   projector.photometry.mixing)
+    c.gain = t.model ? choose_gain(surface_samples(*t.model, projector, T_projector_target, t.surface.get()), t.albedo,
+                                   ambient_lux_, 0.02, projector.photometry.mixing)
                      : 1.0;
     c.visit = visit;
     c.made = true;

@@ -266,6 +266,7 @@ Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl
 Renderer::~Renderer() = default;
 const DeviceInfo& Renderer::device_info() const { return impl_->gpu->info; }
 std::size_t Renderer::add_model(const assets::Model& model) { return impl_->add_model(model); }
+void Renderer::set_surface(std::size_t model, const assets::Image& reflectance) { impl_->set_surface(model, reflectance); }
 std::size_t Renderer::add_streamed_texture(std::size_t model, int material, int width_px, int height_px) {
   return impl_->add_streamed_texture(model, material, width_px, height_px);
 }

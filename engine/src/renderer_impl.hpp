@@ -112,7 +112,8 @@ struct GpuModel {
   std::vector<detail::Image> textures;
   std::vector<vk::raii::Sampler> samplers;
   vk::raii::DescriptorPool pool{nullptr};
-  std::vector<vk::raii::DescriptorSet> sets;  // one per material
+  std::vector<vk::raii::DescriptorSet> sets;  // one per material: binding 0 its base colour, 1 the surface
+  detail::Image surface;                      // Renderer::set_surface's, sRGB; none: `white` is bound
 };
 
 // A texture rewritten while it is drawn (a video on a material): the image the material samples, and one
@@ -157,7 +158,8 @@ struct Renderer::Impl {
   vk::raii::Sampler warp_sampler{nullptr};                 // nearest: the warp map is read texel for texel
   vk::raii::DescriptorSetLayout lens_set_layout{nullptr};  // the canvas and the warp map
   std::map<vk::Format, vk::raii::Pipeline> lens_pipelines;
-  detail::Image white;  // bound where a material has no texture
+  detail::Image white;                         // bound where a material has no texture, and as a surface's reflectance until set
+  vk::raii::Sampler surface_sampler{nullptr};  // a surface's reflectance: linear, repeating
   std::vector<GpuModel> models;
   std::vector<StreamedTexture> streamed;
   std::vector<DrawItem> items;
@@ -187,6 +189,9 @@ struct Renderer::Impl {
   detail::LensCanvasImages& ensure_canvas(detail::TargetBackend& t, const config::ProjectorConfig& p);
 
   std::size_t add_model(const assets::Model& model);
+  void set_surface(std::size_t model, const assets::Image& reflectance);
+  // Binds `view` as each of model g's materials' surface (binding 1).
+  void bind_surface(GpuModel& g, vk::ImageView view);
 
   // Model `model`'s uploaded copy, checked to have material `material`.
   GpuModel& model_with_material(std::size_t model, int material);

@@ -18,8 +18,11 @@ namespace projbot::engine {
 using namespace detail;
 
 Renderer::Impl::Impl(const RendererOptions& options) : gpu(std::make_shared<Gpu>(options)) {
-  vk::DescriptorSetLayoutBinding binding(0, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment);
-  set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, binding));
+  const vk::DescriptorSetLayoutBinding bindings[] = {
+      // a material's base colour, its target's surface
+      {0, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment},
+      {1, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment}};
+  set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, bindings));
   vk::PushConstantRange push(vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, sizeof(DrawConstants));
   vk::DescriptorSetLayoutBinding frame_binding(0, vk::DescriptorType::eUniformBuffer, 1, vk::ShaderStageFlagBits::eFragment);
   frame_set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, frame_binding));
@@ -48,6 +51,10 @@ Renderer::Impl::Impl(const RendererOptions& options) : gpu(std::make_shared<Gpu>
   w.width = w.height = 1;
   w.rgba = {255, 255, 255, 255};
   white = upload_texture(w);
+  surface_sampler =
+      vk::raii::Sampler(gpu->device, vk::SamplerCreateInfo({}, vk::Filter::eLinear, vk::Filter::eLinear,
+                                                           vk::SamplerMipmapMode::eNearest, vk::SamplerAddressMode::eRepeat,
+                                                           vk::SamplerAddressMode::eRepeat, vk::SamplerAddressMode::eRepeat));
 }
 
 Renderer::Impl::~Impl() {
@@ -171,7 +178,7 @@ std::size_t Renderer::Impl::add_model(const assets::Model& model) {
   g.materials = model.materials;
 
   const auto n = static_cast<std::uint32_t>(model.materials.size());
-  vk::DescriptorPoolSize size(vk::DescriptorType::eCombinedImageSampler, n);
+  vk::DescriptorPoolSize size(vk::DescriptorType::eCombinedImageSampler, 2 * n);
   g.pool = vk::raii::DescriptorPool(gpu->device,
                                     vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, n, size));
   std::vector<vk::DescriptorSetLayout> layouts(n, *set_layout);
@@ -191,8 +198,30 @@ std::size_t Renderer::Impl::add_model(const assets::Model& model) {
         vk::WriteDescriptorSet(*sets[i], 0, 0, vk::DescriptorType::eCombinedImageSampler, image_info), {});
   }
   for (auto& s : sets) g.sets.push_back(std::move(s));
+  bind_surface(g, *white.view);
   models.push_back(std::move(g));
   return models.size() - 1;
+}
+
+void Renderer::Impl::bind_surface(GpuModel& g, vk::ImageView view) {
+  const vk::DescriptorImageInfo info(*surface_sampler, view, vk::ImageLayout::eShaderReadOnlyOptimal);
+  for (const auto& set : g.sets)
+    gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*set, 1, 0, vk::DescriptorType::eCombinedImageSampler, info), {});
+}
+
+void Renderer::Impl::set_surface(std::size_t model, const assets::Image& reflectance) {
+  if (model >= models.size()) throw EngineError("a surface for model " + std::to_string(model) + ", not uploaded");
+  if (reflectance.width <= 0 || reflectance.height <= 0 || reflectance.width > 16384 || reflectance.height > 16384 ||
+      reflectance.rgba.size() != static_cast<std::size_t>(reflectance.width) * reflectance.height * 4)
+    throw EngineError("a surface texture of " + std::to_string(reflectance.width) + "x" + std::to_string(reflectance.height) +
+                      " px that is not RGBA8 of that size");
+  GpuModel& g = models[model];
+  gpu->device.waitIdle();  // the model's descriptor sets may be in a frame in flight
+  // sRGB: the sampler reads linear reflectance, which compensation divides by.
+  g.surface =
+      upload_image(vk::Extent2D(static_cast<std::uint32_t>(reflectance.width), static_cast<std::uint32_t>(reflectance.height)),
+                   vk::Format::eR8G8B8A8Srgb, reflectance.rgba.data(), reflectance.rgba.size());
+  bind_surface(g, *g.surface.view);
 }
 
 GpuModel& Renderer::Impl::model_with_material(std::size_t model, int material) {

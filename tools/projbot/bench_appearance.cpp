@@ -40,8 +40,13 @@ void print_table(const twin::TourReport& report) {
 void print_albedo(const twin::TourReport& report, const config::Scene& scene) {
   for (const auto& v : report.visits) {
     if (!v.measured_albedo) continue;
-    const Eigen::Vector3d& truth = scene.targets[static_cast<std::size_t>(scene.target_index(v.target))].surface.albedo;
-    const Eigen::Vector3d& m = *v.measured_albedo;
+    const config::TargetSurface& surface = scene.targets[static_cast<std::size_t>(scene.target_index(v.target))].surface;
+    const Eigen::Vector3d &truth = surface.albedo, &m = *v.measured_albedo;
+    if (!surface.texture.empty()) {  // one colour measured over a print is not the print
+      std::printf("visit %d %s: reflectance measured %.3f %.3f %.3f over its printed surface (%s, kept)\n", v.visit,
+                  v.target.c_str(), m.x(), m.y(), m.z(), surface.texture.filename().c_str());
+      continue;
+    }
     std::printf("visit %d %s: reflectance measured %.3f %.3f %.3f, the scene's %.3f %.3f %.3f (worst channel %+.1f %%)\n",
                 v.visit, v.target.c_str(), m.x(), m.y(), m.z(), truth.x(), truth.y(), truth.z(),
                 100.0 * (m.cwiseQuotient(truth) - Eigen::Vector3d::Ones()).cwiseAbs().maxCoeff());

@@ -174,15 +174,9 @@ std::string RobotThread::finish(engine::Renderer& renderer, engine::RenderTarget
 struct Output {
   Output(engine::Renderer& renderer, const config::Scene& scene, const RunOptions& o, const RunSources& sources)
       : items(engine::upload_scene(renderer, scene, &models)),
-        plan(surfaces(models, scene), scene.room.ambient_lux, o.compensate),
+        plan(engine::upload_surfaces(renderer, scene, models, items), scene.room.ambient_lux, o.compensate),
         content(renderer, scene, models, items),  // a bad video: thrown, naming it
         target(sources.open_output(renderer)) {}
-  static std::vector<engine::CompensationPlan::Target> surfaces(const std::vector<assets::Model>& models,
-                                                                const config::Scene& scene) {
-    std::vector<engine::CompensationPlan::Target> out;
-    for (std::size_t i = 0; i < models.size(); ++i) out.push_back({&models[i], scene.targets[i].surface.albedo});
-    return out;
-  }
   std::vector<assets::Model> models;
   std::vector<engine::DrawItem> items;
   engine::CompensationPlan plan;

@@ -218,7 +218,7 @@ alignment::WorkerConfig follower_config(const TourOptions& options) {
 // Each target's content and the surface the scene gives it, as the session knows them.
 std::vector<engine::CompensationPlan::Target> compensation_targets(const Twin& twin) {
   std::vector<engine::CompensationPlan::Target> out;
-  for (const TwinTarget& t : twin.targets()) out.push_back({&t.model, t.config.surface.albedo});
+  for (const TwinTarget& t : twin.targets()) out.push_back({&t.model, t.config.surface.albedo, t.surface_texture});
   return out;
 }
 

@@ -9,6 +9,7 @@
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
+#include "projbot/engine/content.hpp"
 #include "projbot/engine/photometry.hpp"
 #include "projbot/engine/projection.hpp"
 
@@ -54,13 +55,16 @@ assets::Model room_model(const config::Scene& scene) {
   return room;
 }
 
-// The target's physical surface: its mesh, every material a flat colour, its albedo as sRGB (the twin's
-// colours are sRGB, as the room's are; SpectatorView decodes them to reflectance).
-assets::Model surface_model(const assets::Model& model, const Eigen::Vector3d& albedo) {
+// The target's physical surface: its mesh, every material a flat colour, its albedo as sRGB, or its
+// surface texture over the model's UVs (the twin's colours are sRGB, as the room's are; SpectatorView
+// decodes them to reflectance).
+assets::Model surface_model(const assets::Model& model, const Eigen::Vector3d& albedo, const assets::Image* texture) {
   assets::Model surface = model;
   surface.images.clear();
+  if (texture) surface.images.push_back(*texture);
   for (assets::Material& m : surface.materials) {
-    m.base_color_image = -1;
+    m.base_color_image = texture ? 0 : -1;
+    m.sampler = assets::Sampler{};  // repeating, linear
     for (int i = 0; i < 3; ++i)
       m.base_color_factor[static_cast<std::size_t>(i)] = static_cast<float>(engine::linear_to_srgb(albedo[i]));
   }
@@ -155,8 +159,10 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     tt.cloud = alignment::model_cloud_from(tt.model, 50000);
     tt.T_world_target_true = *t.T_world_target;
     place_support(tt, where, footprints);
+    tt.surface_texture = engine::load_surface_texture(t, tt.model);
     target_ids_.push_back(renderer_.add_model(tt.model));
-    surface_ids_.push_back(renderer_.add_model(surface_model(tt.model, t.surface.albedo)));
+    if (tt.surface_texture) renderer_.set_surface(target_ids_.back(), *tt.surface_texture);  // what compensation divides by
+    surface_ids_.push_back(renderer_.add_model(surface_model(tt.model, t.surface.albedo, tt.surface_texture.get())));
     facet_ids_.push_back(renderer_.add_model(facet_normal_model(tt.model)));
     tt.in_world = t.present;
     home_.push_back(tt.T_world_target_true);

@@ -81,6 +81,10 @@ Model load_model(const std::filesystem::path& path);
 /// Scales the model frame uniformly, then (if recenter) moves the origin to the surface centroid.
 void scale_and_recenter(Model& model, double scale, bool recenter);
 
+/// The texel of `image` at texture coordinate (u, v), nearest, wrapped as given: RGB 0..1 as stored (white
+/// for an empty image).
+Eigen::Vector3f texel_colour(const Image& image, double u, double v, Wrap wrap_s = Wrap::kRepeat, Wrap wrap_t = Wrap::kRepeat);
+
 /// The colour material `material` shows at texture coordinate (u, v) with vertex colour `vc`: texture
 /// (nearest texel, the sampler's wrap) x base colour factor x vertex colour, RGB 0..1 as stored (what the
 /// unlit renderer draws).

@@ -86,9 +86,13 @@ struct TargetSupport {
 };
 
 /// What a target's physical surface reflects (`surface:`, issue 43): the twin's visitor sees it lit, and
-/// the renderer divides it out when it compensates. Linear reflectance per channel, 0..1.
+/// the renderer divides it out when it compensates. Linear reflectance per channel, 0..1: one colour, or
+/// a picture of the surface in the model's texture coordinates.
 struct TargetSurface {
   Eigen::Vector3d albedo{0.75, 0.75, 0.75};  ///< `surface: {albedo: [r, g, b]}`; default a light grey
+  /// `surface: {texture: file.png}` (beside the scene file): its colour under white light, sRGB, over the
+  /// model's UVs (those of its base colour texture); empty: `albedo` everywhere.
+  std::filesystem::path texture;
 };
 
 /// Content that moves on a target (`content:`, issue 44): a video in place of one material's base colour

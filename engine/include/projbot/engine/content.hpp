@@ -3,7 +3,7 @@
 // content time of each frame's display time and streamed into the target's material. Every target's content
 // runs on the display clock of the frame being drawn, so targets lit in one frame stay in step and a
 // dropped frame skips content rather than slowing it. Render thread only (the players decode on their own
-// threads).
+// threads). Also what a scene's targets are uploaded with: their models and their surfaces.
 
 #include <cstddef>
 #include <filesystem>
@@ -16,6 +16,7 @@
 #include "projbot/assets/model.hpp"
 #include "projbot/assets/video.hpp"
 #include "projbot/config/scene.hpp"
+#include "projbot/engine/photometry.hpp"
 #include "projbot/engine/renderer.hpp"
 
 namespace projbot::engine {
@@ -24,6 +25,18 @@ namespace projbot::engine {
 /// T_projector_target (and the models into `models` when given, in the same order). Throws
 /// assets::AssetError naming a model that cannot be read.
 std::vector<DrawItem> upload_scene(Renderer& renderer, const config::Scene& scene, std::vector<assets::Model>* models = nullptr);
+
+/// A target's `surface.texture` read for its model (loaded as upload_scene loads it); null when the
+/// surface is one colour. Throws assets::AssetError naming the file when it cannot be read, or when the
+/// model has no texture coordinates to lay it on.
+std::shared_ptr<const assets::Image> load_surface_texture(const config::TargetConfig& target, const assets::Model& model);
+
+/// Each target's surface for compensation (issue 43): its albedo, or its surface texture (albedo 1),
+/// bound to its uploaded model (Renderer::set_surface). `models` and `items` as upload_scene gives them.
+/// Throws as load_surface_texture.
+std::vector<CompensationPlan::Target> upload_surfaces(Renderer& renderer, const config::Scene& scene,
+                                                      const std::vector<assets::Model>& models,
+                                                      const std::vector<DrawItem>& items);
 
 /// The material of `model` that a target's `content.material` names: a material's name or its index; empty:
 /// the first textured material (0 where none is). Throws assets::AssetError naming the model and what it has.

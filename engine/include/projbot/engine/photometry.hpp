@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -57,16 +58,18 @@ Eigen::Vector3d compensated_input(const config::ProjectorConfig& projector, cons
 struct SurfaceSample {
   Eigen::Vector3d content = Eigen::Vector3d::Ones();
   double white_lux = 0.0;
-  double weight = 1.0;  ///< its share of the projector's pixels: the solid angle it fills, sr
+  double weight = 1.0;                                    ///< its share of the projector's pixels: the solid angle it fills, sr
+  Eigen::Vector3d reflectance = Eigen::Vector3d::Ones();  ///< the surface texture's there (linear); 1 without one
 };
 /// The target's triangles that face the projector at T_projector_target, their middle inside its image:
-/// each one's content (material, texture at its corners' UVs, vertex colours; averaged) and full white's
-/// lux at its middle, weighted by the projector pixels it covers (so that grazing slivers count little).
+/// each one's content (material, texture at its corners' UVs, vertex colours; averaged), its surface
+/// texture's reflectance likewise (`surface`, sRGB over the same UVs, repeating; null: none) and full
+/// white's lux at its middle, weighted by the projector pixels it covers (so that grazing slivers count little).
 std::vector<SurfaceSample> surface_samples(const assets::Model& model, const config::ProjectorConfig& projector,
-                                           const Eigen::Matrix4d& T_projector_target);
+                                           const Eigen::Matrix4d& T_projector_target, const assets::Image* surface = nullptr);
 /// The target's gain k: the largest that leaves at most `clip_share` of `samples`' weight asking a channel
-/// for more than full white (albedo, ambient as above), at most 1 (the content under the reference light); 1 when
-/// nothing asks. Chosen once per visit, so frames do not flicker.
+/// for more than full white (albedo times each sample's reflectance, ambient as above), at most 1 (the
+/// content under the reference light); 1 when nothing asks. Chosen once per visit, so frames do not flicker.
 double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vector3d& albedo, double ambient_lux,
                    double clip_share = 0.02, const Eigen::Matrix3d& mixing = Eigen::Matrix3d::Identity());
 
@@ -91,6 +94,9 @@ class CompensationPlan {
   struct Target {
     const assets::Model* model = nullptr;  ///< its content; must outlive the plan
     Eigen::Vector3d albedo = Eigen::Vector3d::Constant(0.75);
+    /// Its surface texture (`surface.texture`, bound to its model by Renderer::set_surface), with an
+    /// albedo of 1: the gain choice reads it; null: `albedo` everywhere.
+    std::shared_ptr<const assets::Image> surface;
   };
   CompensationPlan(std::vector<Target> targets, double ambient_lux, bool on);
   /// Target `target`'s compensation in visit `visit` (any number that changes between visits), drawn at
@@ -98,7 +104,8 @@ class CompensationPlan {
   Compensation at(std::size_t target, long visit, const config::ProjectorConfig& projector,
                   const Eigen::Matrix4d& T_projector_target);
   /// A target's reflectance measured at a stop (measure_albedo): the mean of its measurements so far
-  /// replaces the scene's from now on (refined over visits); its gain is chosen again.
+  /// replaces the scene's from now on (refined over visits); its gain is chosen again. A target whose
+  /// surface is a texture keeps it (one colour measured over it would blur its print).
   void add_measured_albedo(std::size_t target, const Eigen::Vector3d& albedo);
   const Eigen::Vector3d& albedo(std::size_t target) const { return targets_.at(target).albedo; }
   /// The gain chosen for `target` in its latest visit; 1 before any.

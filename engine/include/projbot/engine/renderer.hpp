@@ -133,6 +133,11 @@ class Renderer {
 
   /// Uploads a model's meshes and textures; returns its id for DrawItem::model.
   std::size_t add_model(const assets::Model& model);
+  /// The physical surface of model `model`'s target (issue 43, `surface.texture`): its reflectance over the
+  /// model's UVs (RGBA8, sRGB-coded), which compensation divides the content by, per fragment, besides the
+  /// Compensation's per-channel scale (give the target an albedo of 1 there). Until set, every model's is
+  /// white. Waits for the frames in flight. Throws EngineError for a model that is not there or an empty image.
+  void set_surface(std::size_t model, const assets::Image& reflectance);
   /// A texture whose texels change while it is drawn (a video on a material, issue 44): made black at
   /// width x height px, it becomes material `material`'s base colour texture of model `model` (the material's
   /// sampler, base colour factor and the vertex colours still apply). Waits for the frames in flight.

@@ -46,6 +46,8 @@ struct TwinOptions {
 struct TwinTarget {
   config::TargetConfig config;
   assets::Model model;  ///< scaled and recentred, model frame
+  /// Its surface as a picture over the model's UVs (`surface.texture`); null: config.surface.albedo.
+  std::shared_ptr<const assets::Image> surface_texture;
   std::shared_ptr<MeshRaycaster> raycaster;
   alignment::ModelCloud cloud;          ///< 50k surface samples for ICP and tracking
   Eigen::Matrix4d T_world_target_true;  ///< where it stands now (moves with its motion script)
