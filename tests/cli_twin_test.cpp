@@ -250,14 +250,16 @@ TEST_F(CliTest, BenchMotionComparesPredictionOffAndOn) {
 // the duck), each from its own tracker worker.
 TEST_F(CliTest, RunLightsANeighbourInTheSameFrames) {
   const CliRun r =
-      run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) + "/scenes/display.yaml --visits 1 --dwell 2");
+      run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) + "/scenes/display.yaml --visits 1 --dwell 3");
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string key = " frames lit a neighbour too";
   const auto at = r.output.find(key);
   ASSERT_NE(at, std::string::npos) << r.output;
   const auto from = r.output.rfind("; ", at);
   ASSERT_NE(from, std::string::npos);
-  EXPECT_GT(std::stoi(r.output.substr(from + 2)), 60) << r.output;    // of about 120 frames in the 2 s dwell
+  // Of about 180 frames in the 3 s dwell, those after both acquisitions (wall time: 66-102 of 120 in a 2 s
+  // dwell, fewer with a build running beside it).
+  EXPECT_GT(std::stoi(r.output.substr(from + 2)), 60) << r.output;
   EXPECT_LT(number_after(r.output, "still mean "), 2.5) << r.output;  // both targets' frames
 }
 
