@@ -114,7 +114,7 @@ std::vector<Hostile> clash_cases() {
               "bench appearance --reflectance guessed",
               "",
               2,
-              {"--reflectance must be scene or measured, not 'guessed'"}},
+              {"--reflectance must be scene, measured or mapped, not 'guessed'"}},
       Hostile{"bench_appearance_dwell_zero", "bench appearance --dwell 0", "", 2, {"--dwell must be 0.1..600 seconds"}},
       Hostile{"bench_appearance_gamma_nan",
               "bench appearance --scene {dir}/bad.yaml",

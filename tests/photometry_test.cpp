@@ -302,4 +302,40 @@ TEST(Photometry, MeasuringReflectanceNeedsPicturesItCanRead) {
   EXPECT_EQ(*none, Eigen::Vector3d::Zero());
 }
 
+// A reflectance map (--reflectance mapped): points of a print, its left half one colour and its right
+// half another, measured only over the lower half of the UVs (one point in three an outlier, as points at
+// a silhouette are). Measured texels are their points' median; the upper half grows from the nearest
+// measured texels in texture space; too few points give no map.
+TEST(Photometry, AReflectanceMapKeepsEachTexelsMedianAndGrowsIntoTheRest) {
+  const Eigen::Vector3d left(0.6, 0.2, 0.1), right(0.1, 0.3, 0.7);
+  std::vector<engine::ReflectancePoint> points;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x)
+      for (int k = 0; k < 3; ++k) {
+        engine::ReflectancePoint p;
+        p.uv = Eigen::Vector2d((x + 0.5) / 16.0, (y + 0.5) / 16.0);
+        p.rho = (x < 8 ? left : right) * (k == 2 ? 3.0 : 1.0);
+        p.valid = {true, true, true};
+        points.push_back(p);
+      }
+  engine::ReflectanceMap map(16, 16);
+  map.add(std::vector<engine::ReflectancePoint>(points.begin(), points.begin() + 18));
+  EXPECT_FALSE(map.image());  // 18 points: fewer than 20
+  map.add(std::vector<engine::ReflectancePoint>(points.begin() + 18, points.end()));
+  const std::optional<projbot::assets::Image> image = map.image();
+  ASSERT_TRUE(image);
+  ASSERT_EQ(image->width, 16);
+  ASSERT_EQ(image->height, 16);
+  const auto rho = [&](int x, int y) {
+    const std::uint8_t* px = image->pixel(x, y);
+    return Eigen::Vector3d(engine::srgb_to_linear(px[0] / 255.0), engine::srgb_to_linear(px[1] / 255.0),
+                           engine::srgb_to_linear(px[2] / 255.0));
+  };
+  for (const int y : {0, 7, 8, 12, 15})  // measured, then grown (each column from the rows above and below)
+    for (const int x : {0, 3, 7, 8, 12, 15}) {
+      const Eigen::Vector3d want = x < 8 ? left : right;
+      EXPECT_LT((rho(x, y) - want).cwiseAbs().maxCoeff(), 0.01) << x << ", " << y << ": " << rho(x, y).transpose();
+    }
+}
+
 }  // namespace

@@ -154,9 +154,9 @@ double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vecto
 
 namespace {
 
-// Points spread over a triangle (the middles of an m x m subdivision), m from its size in the camera's
-// image: about one point per 4 x 4 pixels, at most 256.
-std::vector<Eigen::Vector3d> spread_over(const Eigen::Vector3d (&x)[3], const config::Camera& camera,
+// Points spread over a triangle (the middles of an m x m subdivision) as barycentric weights of its second
+// and third corner, m from its size in the camera's image: about one point per 4 x 4 pixels, at most 256.
+std::vector<Eigen::Vector2d> spread_over(const Eigen::Vector3d (&x)[3], const config::Camera& camera,
                                          const Eigen::Matrix4d& T_camera_target) {
   Eigen::Vector2d px[3];
   for (int k = 0; k < 3; ++k) {
@@ -166,38 +166,38 @@ std::vector<Eigen::Vector3d> spread_over(const Eigen::Vector3d (&x)[3], const co
   const Eigen::Vector2d a = px[1] - px[0], b = px[2] - px[0];
   const double area_px = 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
   const int m = std::clamp(static_cast<int>(std::ceil(std::sqrt(area_px / 8.0))), 1, 16);
-  std::vector<Eigen::Vector3d> out;
+  std::vector<Eigen::Vector2d> out;
   for (int i = 0; i < m; ++i)
-    for (int j = 0; i + j < m; ++j) {
-      const double u = (i + 1.0 / 3.0) / m, v = (j + 1.0 / 3.0) / m;
-      out.push_back(x[0] + u * (x[1] - x[0]) + v * (x[2] - x[0]));
-    }
+    for (int j = 0; i + j < m; ++j) out.emplace_back((i + 1.0 / 3.0) / m, (j + 1.0 / 3.0) / m);
   return out;
 }
 
 }  // namespace
 
-std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::Camera& camera,
-                                              const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
-                                              const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
-                                              const assets::Image& under_grey, double grey) {
+std::vector<ReflectancePoint> reflectance_points(const assets::Model& model, const config::Camera& camera,
+                                                 const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
+                                                 const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
+                                                 const assets::Image& under_grey, double grey) {
+  std::vector<ReflectancePoint> out;
   if (under_black.width != camera.width_px || under_black.height != camera.height_px || under_grey.width != camera.width_px ||
       under_grey.height != camera.height_px || !(grey > 0.0 && grey <= 1.0))
-    return std::nullopt;
+    return out;
   const Eigen::Vector3d added =
       light(projector.photometry, Eigen::Vector3d::Constant(grey)) - light(projector.photometry, Eigen::Vector3d::Zero());
-  std::array<std::vector<double>, 3> ratios;
   const Eigen::Matrix3d Rc = T_camera_target.topLeftCorner<3, 3>(), Rp = T_projector_target.topLeftCorner<3, 3>();
   for (const assets::Primitive& prim : model.primitives)
     for (std::size_t f = 0; f + 2 < prim.indices.size(); f += 3) {
       Eigen::Vector3d x[3];
+      Eigen::Vector2d uv[3];
       for (int k = 0; k < 3; ++k) {
-        const auto& p = prim.vertices.at(prim.indices[f + static_cast<std::size_t>(k)]).position;
-        x[k] = Eigen::Vector3d(p[0], p[1], p[2]);
+        const assets::Vertex& vertex = prim.vertices.at(prim.indices[f + static_cast<std::size_t>(k)]);
+        x[k] = Eigen::Vector3d(vertex.position[0], vertex.position[1], vertex.position[2]);
+        uv[k] = Eigen::Vector2d(vertex.uv[0], vertex.uv[1]);
       }
       const Eigen::Vector3d n = (x[1] - x[0]).cross(x[2] - x[0]).normalized();
       const Eigen::Vector3d nc = Rc * n, np = Rp * n;
-      for (const Eigen::Vector3d& point : spread_over(x, camera, T_camera_target)) {
+      for (const Eigen::Vector2d& w : spread_over(x, camera, T_camera_target)) {
+        const Eigen::Vector3d point = x[0] + w.x() * (x[1] - x[0]) + w.y() * (x[2] - x[0]);
         const Eigen::Vector3d qc = Rc * point + T_camera_target.topRightCorner<3, 1>();
         const Eigen::Vector3d qp = Rp * point + T_projector_target.topRightCorner<3, 1>();
         if (!n.allFinite() || !(qc.z() > 0.1) || !(qp.z() > 0.1) || nc.dot(qc) >= 0.0) break;  // hidden from the camera
@@ -208,20 +208,127 @@ std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const 
         const Eigen::Vector3d lux = white_lux(projector, qp, np) * added;
         const std::uint8_t* b = under_black.pixel(static_cast<int>(u), static_cast<int>(v));
         const std::uint8_t* g = under_grey.pixel(static_cast<int>(u), static_cast<int>(v));
+        ReflectancePoint r;
+        r.uv = uv[0] + w.x() * (uv[1] - uv[0]) + w.y() * (uv[2] - uv[0]);
         for (int ch = 0; ch < 3; ++ch) {
           const double lifted = srgb_to_linear(g[ch] / 255.0) - srgb_to_linear(b[ch] / 255.0);
-          if (g[ch] < 250) ratios[static_cast<std::size_t>(ch)].push_back(lifted * kReferenceLux / lux[ch]);  // not saturated
+          r.rho[ch] = lifted * kReferenceLux / lux[ch];
+          r.valid[static_cast<std::size_t>(ch)] = g[ch] < 250;  // not saturated
         }
+        out.push_back(r);
       }
     }
-  Eigen::Vector3d albedo;
+  return out;
+}
+
+namespace {
+
+// The median of each channel's valid values; empty when a channel has fewer than `least`.
+std::optional<Eigen::Vector3d> channel_medians(const std::vector<ReflectancePoint>& points, std::size_t least) {
+  Eigen::Vector3d median;
   for (int ch = 0; ch < 3; ++ch) {
-    std::vector<double>& r = ratios[static_cast<std::size_t>(ch)];
-    if (r.size() < 20) return std::nullopt;
+    std::vector<double> r;
+    for (const ReflectancePoint& p : points)
+      if (p.valid[static_cast<std::size_t>(ch)]) r.push_back(p.rho[ch]);
+    if (r.size() < least || r.empty()) return std::nullopt;
     std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
-    albedo[ch] = std::clamp(r[r.size() / 2], 0.0, 1.0);
+    median[ch] = std::clamp(r[r.size() / 2], 0.0, 1.0);
   }
-  return albedo;
+  return median;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::Camera& camera,
+                                              const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
+                                              const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
+                                              const assets::Image& under_grey, double grey) {
+  return median_albedo(
+      reflectance_points(model, camera, T_camera_target, projector, T_projector_target, under_black, under_grey, grey));
+}
+
+std::optional<Eigen::Vector3d> median_albedo(const std::vector<ReflectancePoint>& points) { return channel_medians(points, 20); }
+
+ReflectanceMap::ReflectanceMap(int width, int height) : width_(width), height_(height) {}
+
+void ReflectanceMap::add(const std::vector<ReflectancePoint>& points) {
+  for (const ReflectancePoint& p : points)
+    if (p.uv.allFinite() && p.rho.allFinite()) all_.push_back(p);
+}
+
+namespace {
+
+// Each texel's median of the points that fell in it, per channel (repeating UVs, as the renderer samples
+// a surface); known: whether it had any.
+void texel_medians(const std::vector<ReflectancePoint>& points, int width, int height, std::vector<Eigen::Vector3d>& rho,
+                   std::vector<Eigen::Vector3i>& known) {
+  const auto texel = [](double t, int n) { return std::clamp(static_cast<int>((t - std::floor(t)) * n), 0, n - 1); };
+  std::vector<std::array<std::vector<double>, 3>> in(static_cast<std::size_t>(width) * height);
+  for (const ReflectancePoint& p : points) {
+    auto& values = in[static_cast<std::size_t>(texel(p.uv.y(), height)) * width + texel(p.uv.x(), width)];
+    for (int ch = 0; ch < 3; ++ch)
+      if (p.valid[static_cast<std::size_t>(ch)]) values[static_cast<std::size_t>(ch)].push_back(p.rho[ch]);
+  }
+  rho.assign(in.size(), Eigen::Vector3d::Zero());
+  known.assign(in.size(), Eigen::Vector3i::Zero());
+  for (std::size_t i = 0; i < in.size(); ++i)
+    for (int ch = 0; ch < 3; ++ch) {
+      std::vector<double>& v = in[i][static_cast<std::size_t>(ch)];
+      if (v.empty()) continue;
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+      rho[i][ch] = v[v.size() / 2];
+      known[i][ch] = 1;
+    }
+}
+
+// Grows the known texels into the unknown ones a ring at a time (the mean of their known 4-neighbours,
+// wrapping as the UVs repeat), so that a texel takes its nearest measurements in texture space.
+void grow_known(int width, int height, std::vector<Eigen::Vector3d>& rho, std::vector<Eigen::Vector3i>& known) {
+  for (int ring = 0; ring < width + height; ++ring) {
+    std::vector<Eigen::Vector3d> next = rho;
+    std::vector<Eigen::Vector3i> grown = known;
+    bool changed = false;
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const auto at = [&](int xx, int yy) {
+          return static_cast<std::size_t>((yy + height) % height) * width + static_cast<std::size_t>((xx + width) % width);
+        };
+        const std::size_t i = at(x, y), around[4] = {at(x + 1, y), at(x - 1, y), at(x, y + 1), at(x, y - 1)};
+        for (int ch = 0; ch < 3; ++ch) {
+          if (known[i][ch]) continue;
+          double sum = 0.0;
+          int n = 0;
+          for (const std::size_t j : around)
+            if (known[j][ch]) sum += rho[j][ch], ++n;
+          if (n > 0) next[i][ch] = sum / n, grown[i][ch] = 1, changed = true;
+        }
+      }
+    rho.swap(next);
+    known.swap(grown);
+    if (!changed) return;
+  }
+}
+
+}  // namespace
+
+std::optional<assets::Image> ReflectanceMap::image() const {
+  const std::optional<Eigen::Vector3d> fill = median_albedo(all_);  // where no measurement reaches
+  if (!fill) return std::nullopt;
+  std::vector<Eigen::Vector3d> rho;
+  std::vector<Eigen::Vector3i> known;
+  texel_medians(all_, width_, height_, rho, known);
+  grow_known(width_, height_, rho, known);
+  assets::Image out;
+  out.width = width_, out.height = height_;
+  out.rgba.reserve(rho.size() * 4);
+  for (std::size_t i = 0; i < rho.size(); ++i) {
+    for (int ch = 0; ch < 3; ++ch) {
+      const double r = known[i][ch] ? std::clamp(rho[i][ch], 0.0, 1.0) : (*fill)[ch];
+      out.rgba.push_back(static_cast<std::uint8_t>(std::lround(255.0 * linear_to_srgb(r))));
+    }
+    out.rgba.push_back(255);
+  }
+  return out;
 }
 
 void CompensationPlan::add_measured_albedo(std::size_t target, const Eigen::Vector3d& albedo) {
@@ -231,6 +338,13 @@ void CompensationPlan::add_measured_albedo(std::size_t target, const Eigen::Vect
   mean = c.measurements == 0 ? albedo : Eigen::Vector3d((mean * c.measurements + albedo) / (c.measurements + 1));
   ++c.measurements;
   c.made = false;
+}
+
+void CompensationPlan::set_surface(std::size_t target, std::shared_ptr<const assets::Image> surface) {
+  Target& t = targets_.at(target);
+  t.surface = std::move(surface);
+  t.albedo = Eigen::Vector3d::Ones();
+  chosen_.at(target).made = false;
 }
 
 CompensationPlan::CompensationPlan(std::vector<Target> targets, double ambient_lux, bool on)

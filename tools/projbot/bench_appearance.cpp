@@ -36,15 +36,19 @@ void print_table(const twin::TourReport& report) {
     }
 }
 
-// --reflectance measured: each visit's measurement beside the scene's surface (the twin's truth).
-void print_albedo(const twin::TourReport& report, const config::Scene& scene) {
+// --reflectance measured or mapped: each visit's measurement (its median, for a map) beside the scene's
+// surface (the twin's truth).
+void print_albedo(const twin::TourReport& report, const config::Scene& scene, bool mapped) {
   for (const auto& v : report.visits) {
     if (!v.measured_albedo) continue;
     const config::TargetSurface& surface = scene.targets[static_cast<std::size_t>(scene.target_index(v.target))].surface;
     const Eigen::Vector3d &truth = surface.albedo, &m = *v.measured_albedo;
-    if (!surface.texture.empty()) {  // one colour measured over a print is not the print
-      std::printf("visit %d %s: reflectance measured %.3f %.3f %.3f over its printed surface (%s, kept)\n", v.visit,
-                  v.target.c_str(), m.x(), m.y(), m.z(), surface.texture.filename().c_str());
+    if (mapped || !surface.texture.empty()) {  // one colour is not the print; a map is not one colour
+      std::printf("visit %d %s: reflectance measured %s, median %.3f %.3f %.3f%s\n", v.visit, v.target.c_str(),
+                  mapped ? "over its texture coordinates" : "as one colour", m.x(), m.y(), m.z(),
+                  surface.texture.empty()
+                      ? ""
+                      : (" (the scene's surface: " + surface.texture.filename().string() + (mapped ? ")" : ", kept)")).c_str());
       continue;
     }
     std::printf("visit %d %s: reflectance measured %.3f %.3f %.3f, the scene's %.3f %.3f %.3f (worst channel %+.1f %%)\n",
@@ -88,7 +92,7 @@ const Command kBenchAppearance{
     "bench appearance",
     "benchmark what a visitor sees of each target, radiometric compensation off and on (the twin)",
     "projbot bench appearance [--scene S.yaml] [--visits N] [--seed K] [--dwell S] [--frames DIR]\n"
-    "                         [--reflectance scene|measured] [--report FILE.json]\n\n"
+    "                         [--reflectance scene|measured|mapped] [--report FILE.json]\n\n"
     "Runs the scene's tour in the digital twin, tracking. At each arrival, and once in the middle of a\n"
     "scripted motion, the visited target's projector frame is drawn with compensation off (the content as\n"
     "stored) and on (what makes the target's surface show it: the content x k / the surface's reflectance,\n"
@@ -103,14 +107,18 @@ const Command kBenchAppearance{
     "runs. With --frames, DIR/visitNN_TARGET_spectator_off.png and _spectator_on.png at each arrival.\n"
     "With --reflectance measured, each target's reflectance is measured at its stop (the colour camera under\n"
     "the projector's black and mid grey, read at the estimated pose) instead of taken from the scene, and\n"
-    "printed beside the scene's (the twin's truth).\n"
+    "printed beside the scene's (the twin's truth). With --reflectance mapped, it is measured into the\n"
+    "model's texture space (128 x 128 texels over its UVs, each the median of the points seen in it, refined over\n"
+    "the target's visits, grown into the texels none fell in) and compensated for as a printed surface.\n"
     "Ctrl-C prints and reports the visits finished so far.\n",
     {{"scene", "FILE", "scene with a tour (default: assets/scenes/shop.yaml)", cli::PathRole::input_file},
      {"visits", "N", "visits, cycling through the scene's list (default: the list once)"},
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
      {"dwell", "S", "simulated seconds of projection per visit (default 3)"},
      {"frames", "DIR", "write each visit's pictures here", cli::PathRole::output_folder},
-     {"reflectance", "scene|measured", "each target's reflectance: the scene's surface (default) or measured at its stop"},
+     {"reflectance", "scene|measured|mapped",
+      "each target's reflectance: the scene's surface (default), measured at its stop as one colour, or measured over "
+      "its texture coordinates"},
      {"report", "FILE", "JSON report, one row per visit and compensation", cli::PathRole::output_file}},
     [](const cli::Args& args) {
       twin::TourOptions o;
@@ -122,9 +130,10 @@ const Command kBenchAppearance{
       if (!(o.dwell_s >= 0.1 && o.dwell_s <= 600.0)) throw cli::UsageError("--dwell must be 0.1..600 seconds");
       if (const auto frames = args.get("frames")) o.frames_dir = *frames;
       const std::string reflectance = args.get_or("reflectance", "scene");
-      if (reflectance != "scene" && reflectance != "measured")
-        throw cli::UsageError("--reflectance must be scene or measured, not '" + reflectance + "'");
-      o.measure_reflectance = reflectance == "measured";
+      if (reflectance != "scene" && reflectance != "measured" && reflectance != "mapped")
+        throw cli::UsageError("--reflectance must be scene, measured or mapped, not '" + reflectance + "'");
+      o.measure_reflectance = reflectance != "scene";
+      o.reflectance_map = reflectance == "mapped";
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
       catch_interrupts();
       o.stop_requested = [] { return interrupted(); };
@@ -134,7 +143,7 @@ const Command kBenchAppearance{
       note_twin_on_odometry(std::cout);
       const twin::TourReport report = twin::run_tour(scene, o);
       print_table(report);
-      print_albedo(report, scene);
+      print_albedo(report, scene, o.reflectance_map);
       std::printf("\nroom %.0f lux; projector %.0f lm, gamma %.2f, black %.4f; tour in %.1f s\n", scene.room.ambient_lux,
                   scene.projector.photometry.brightness_lm, scene.projector.photometry.gamma,
                   scene.projector.photometry.black_level, report.wall_s);

@@ -151,12 +151,12 @@ AppearanceScore score_appearance(const SpectatorPicture& seen, const ContentView
   return s;
 }
 
-std::optional<Eigen::Vector3d> measured_reflectance(SpectatorView& camera, Twin& twin, std::size_t target,
-                                                    const Eigen::Matrix4d& T_world_camera,
-                                                    const Eigen::Matrix4d& T_world_projector,
-                                                    const Eigen::Matrix4d& T_camera_target,
-                                                    const config::ProjectorConfig& believed,
-                                                    const Eigen::Matrix4d& T_projector_target) {
+std::vector<engine::ReflectancePoint> measured_reflectance(SpectatorView& camera, Twin& twin, std::size_t target,
+                                                           const Eigen::Matrix4d& T_world_camera,
+                                                           const Eigen::Matrix4d& T_world_projector,
+                                                           const Eigen::Matrix4d& T_camera_target,
+                                                           const config::ProjectorConfig& believed,
+                                                           const Eigen::Matrix4d& T_projector_target) {
   constexpr std::uint8_t kGrey = 128;
   const config::ProjectorConfig& p = twin.scene().projector;
   assets::Image frame;
@@ -166,8 +166,8 @@ std::optional<Eigen::Vector3d> measured_reflectance(SpectatorView& camera, Twin&
   const assets::Image black = camera.light(seen, frame).image;
   std::fill(frame.rgba.begin(), frame.rgba.end(), kGrey);
   const assets::Image grey = camera.light(seen, frame).image;
-  return engine::measure_albedo(twin.targets().at(target).model, twin.camera_pinhole(), T_camera_target, believed,
-                                T_projector_target, black, grey, kGrey / 255.0);
+  return engine::reflectance_points(twin.targets().at(target).model, twin.camera_pinhole(), T_camera_target, believed,
+                                    T_projector_target, black, grey, kGrey / 255.0);
 }
 
 }  // namespace projbot::twin

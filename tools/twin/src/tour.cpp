@@ -239,8 +239,9 @@ struct Tour {
   std::vector<alignment::PoseTracker*> by_scene;          // the trackers by scene index, for Session::visit
   std::unique_ptr<engine::RenderTarget> projector_frame;  // with --frames or appearance
   std::unique_ptr<SpectatorView> spectator;
-  std::unique_ptr<SpectatorView> colour_camera;  // the RGB-D camera's colour under the projector's light
-  engine::CompensationPlan plan;                 // by index into Twin::targets()
+  std::unique_ptr<SpectatorView> colour_camera;          // the RGB-D camera's colour under the projector's light
+  engine::CompensationPlan plan;                         // by index into Twin::targets()
+  std::vector<engine::ReflectanceMap> reflectance_maps;  // likewise: TourOptions::reflectance_map's
 };
 
 Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Twin& t)
@@ -251,6 +252,7 @@ Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Tw
       models(projector_models(s, o)),
       plan(compensation_targets(t), s.room.ambient_lux, true) {
   clock.processing_ms = options.processing_ms;
+  reflectance_maps.resize(twin.targets().size());
   const alignment::WorkerConfig follow = follower_config(options);
   followers.reserve(twin.targets().size());
   for (const auto& target : twin.targets()) followers.emplace_back(target.cloud, twin.camera(), follow);
@@ -463,10 +465,21 @@ assets::Image TourStop::spectator_picture(const assets::Image& projector) {
 // The visited target's reflectance, measured at its estimated pose; the compensation takes the mean of
 // its measurements so far from now on.
 void TourStop::measure_reflectance() {
-  report.measured_albedo = measured_reflectance(*tour_.colour_camera, tour_.twin, target_index_, truth_.T_world_camera.matrix(),
-                                                truth_.T_world_projector.matrix(), report.icp.T_scan_model, tour_.models.believed,
-                                                report.T_projector_target_estimated);
-  if (report.measured_albedo) tour_.plan.add_measured_albedo(target_index_, *report.measured_albedo);
+  const std::vector<engine::ReflectancePoint> points = measured_reflectance(
+      *tour_.colour_camera, tour_.twin, target_index_, truth_.T_world_camera.matrix(), truth_.T_world_projector.matrix(),
+      report.icp.T_scan_model, tour_.models.believed, report.T_projector_target_estimated);
+  report.measured_albedo = engine::median_albedo(points);
+  if (!tour_.options.reflectance_map) {
+    if (report.measured_albedo) tour_.plan.add_measured_albedo(target_index_, *report.measured_albedo);
+    return;
+  }
+  engine::ReflectanceMap& map = tour_.reflectance_maps[target_index_];  // refined over its visits
+  map.add(points);
+  if (const std::optional<assets::Image> image = map.image()) {
+    auto surface = std::make_shared<const assets::Image>(*image);
+    tour_.renderer.set_surface(tour_.twin.target_model_ids()[target_index_], *surface);
+    tour_.plan.set_surface(target_index_, std::move(surface));
+  }
 }
 
 // What a visitor sees of the visited target drawn at T_projector_target, compensation off and on, against

@@ -80,6 +80,38 @@ double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vecto
 /// both, lit less than 60 degrees off its normal (about one per 4 x 4 camera pixels), give (grey - black)
 /// kReferenceLux / ((drive(grey) - drive(0)) white_lux) at their pixels (the room's light cancels); the
 /// median over them per channel. Empty when fewer than 20 points can be read unsaturated.
+/// One point of a target's surface as measure_albedo reads it: where it lies in the model's texture
+/// coordinates and its reflectance per channel there (valid: the grey picture was not saturated).
+struct ReflectancePoint {
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  Eigen::Vector3d rho = Eigen::Vector3d::Zero();
+  std::array<bool, 3> valid{};
+};
+/// The points measure_albedo takes its medians over (the same arguments); empty for pictures it cannot read.
+std::vector<ReflectancePoint> reflectance_points(const assets::Model& model, const config::Camera& camera,
+                                                 const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
+                                                 const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
+                                                 const assets::Image& under_grey, double grey);
+
+/// The median reflectance of `points` per channel (measure_albedo's); empty where a channel has fewer than 20.
+std::optional<Eigen::Vector3d> median_albedo(const std::vector<ReflectancePoint>& points);
+
+/// A target's reflectance measured into its model's texture space (issue 43, a printed surface learnt at its
+/// stops): each texel the median of the points that fell in it over every measurement so far (refined
+/// over visits), grown into the texels none fell in from their nearest measured ones in texture space,
+/// and the median of all points where none reaches (a chart never seen). Its image is a surface texture (Renderer::set_surface).
+class ReflectanceMap {
+ public:
+  ReflectanceMap(int width = 128, int height = 128);
+  void add(const std::vector<ReflectancePoint>& points);
+  /// sRGB, width x height, repeating over the UVs; empty while a channel has fewer than 20 points.
+  std::optional<assets::Image> image() const;
+
+ private:
+  int width_, height_;
+  std::vector<ReflectancePoint> all_;  ///< every measurement's points
+};
+
 std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::Camera& camera,
                                               const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
                                               const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
@@ -108,6 +140,11 @@ class CompensationPlan {
   /// surface is a texture keeps it (one colour measured over it would blur its print).
   void add_measured_albedo(std::size_t target, const Eigen::Vector3d& albedo);
   const Eigen::Vector3d& albedo(std::size_t target) const { return targets_.at(target).albedo; }
+  /// A target's surface measured into its texture space (ReflectanceMap::image): it replaces the scene's
+  /// surface, its albedo becomes 1, and its gain is chosen again. Bind the same to its model
+  /// (Renderer::set_surface).
+  void set_surface(std::size_t target, std::shared_ptr<const assets::Image> surface);
+  const assets::Image* surface(std::size_t target) const { return targets_.at(target).surface.get(); }
   /// The gain chosen for `target` in its latest visit; 1 before any.
   double gain(std::size_t target) const { return chosen_.at(target).gain; }
   bool on() const { return on_; }

@@ -36,13 +36,13 @@ AppearanceScore score_appearance(const SpectatorPicture& seen, const ContentView
 
 /// A target's reflectance as a session measures it at a stop (issue 43): the colour camera (`camera`, a
 /// SpectatorView through the RGB-D camera's pinhole) takes it under the projector's black and mid grey,
-/// lit by the twin from the true frames; engine::measure_albedo reads the pictures at the estimated poses
-/// (T_camera_target, and T_projector_target through the believed projector). Empty when it cannot.
-std::optional<Eigen::Vector3d> measured_reflectance(SpectatorView& camera, Twin& twin, std::size_t target,
-                                                    const Eigen::Matrix4d& T_world_camera,
-                                                    const Eigen::Matrix4d& T_world_projector,
-                                                    const Eigen::Matrix4d& T_camera_target,
-                                                    const config::ProjectorConfig& believed,
-                                                    const Eigen::Matrix4d& T_projector_target);
+/// lit by the twin from the true frames; engine::reflectance_points reads the pictures at the estimated
+/// poses (T_camera_target, and T_projector_target through the believed projector). Empty when it cannot.
+std::vector<engine::ReflectancePoint> measured_reflectance(SpectatorView& camera, Twin& twin, std::size_t target,
+                                                           const Eigen::Matrix4d& T_world_camera,
+                                                           const Eigen::Matrix4d& T_world_projector,
+                                                           const Eigen::Matrix4d& T_camera_target,
+                                                           const config::ProjectorConfig& believed,
+                                                           const Eigen::Matrix4d& T_projector_target);
 
 }  // namespace projbot::twin

@@ -62,6 +62,9 @@ struct TourOptions {
   /// projector's black and grey, engine::measure_albedo at the estimated pose) and replaces the scene's
   /// `surface:` in the compensation from then on. False: the scene's is taken as known.
   bool measure_reflectance = false;
+  /// With measure_reflectance: measured into each target's texture space (engine::ReflectanceMap, refined
+  /// over its visits) and bound as its surface, so a printed surface is learnt; false: one colour.
+  bool reflectance_map = false;
   /// Issue 43: at each arrival (and once in the middle of a scripted motion) the visited target's frame is
   /// drawn with compensation off and on, and what a visitor sees of it scored (VisitReport::appearance).
   bool appearance = false;
