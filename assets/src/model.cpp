@@ -20,11 +20,11 @@ double wrapped(double x, Wrap w) {
 
 }  // namespace
 
+int texel_index(double t, int n, Wrap wrap) { return std::min(n - 1, static_cast<int>(wrapped(t, wrap) * n)); }
+
 Eigen::Vector3f texel_colour(const Image& image, double u, double v, Wrap wrap_s, Wrap wrap_t) {
   if (image.width <= 0 || image.height <= 0) return Eigen::Vector3f::Ones();
-  const int x = std::min(image.width - 1, static_cast<int>(wrapped(u, wrap_s) * image.width));
-  const int y = std::min(image.height - 1, static_cast<int>(wrapped(v, wrap_t) * image.height));
-  const std::uint8_t* px = image.pixel(x, y);
+  const std::uint8_t* px = image.pixel(texel_index(u, image.width, wrap_s), texel_index(v, image.height, wrap_t));
   return Eigen::Vector3f(px[0], px[1], px[2]) / 255.0F;
 }
 

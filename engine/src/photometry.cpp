@@ -106,13 +106,14 @@ std::vector<SurfaceSample> surface_samples(const assets::Model& model, const con
       const Eigen::Vector2d x = p.project(q);
       if (x.x() < -0.5 || x.y() < -0.5 || x.x() > p.width_px - 0.5 || x.y() > p.height_px - 0.5) continue;
       SurfaceSample s;
-      if (surface) s.reflectance.setZero();
       s.content =
           (vertex_content(model, prim.material, prim.vertices[a]) + vertex_content(model, prim.material, prim.vertices[b]) +
            vertex_content(model, prim.material, prim.vertices[c])) /
           3.0;
       if (surface)
-        for (const std::uint32_t k : {a, b, c}) s.reflectance += surface_reflectance(*surface, prim.vertices[k]) / 3.0;
+        s.reflectance = (surface_reflectance(*surface, prim.vertices[a]) + surface_reflectance(*surface, prim.vertices[b]) +
+                         surface_reflectance(*surface, prim.vertices[c])) /
+                        3.0;
       s.white_lux = white_lux(p, q, n);
       s.weight = std::abs(n.dot(q)) / (2.0 * q.norm() * q.squaredNorm());  // its solid angle: the projector's pixels on it
       if (s.weight > 0.0) out.push_back(s);
@@ -221,23 +222,18 @@ std::vector<ReflectancePoint> reflectance_points(const assets::Model& model, con
   return out;
 }
 
-namespace {
-
-// The median of each channel's valid values; empty when a channel has fewer than `least`.
-std::optional<Eigen::Vector3d> channel_medians(const std::vector<ReflectancePoint>& points, std::size_t least) {
+std::optional<Eigen::Vector3d> median_albedo(const std::vector<ReflectancePoint>& points) {
   Eigen::Vector3d median;
   for (int ch = 0; ch < 3; ++ch) {
     std::vector<double> r;
     for (const ReflectancePoint& p : points)
       if (p.valid[static_cast<std::size_t>(ch)]) r.push_back(p.rho[ch]);
-    if (r.size() < least || r.empty()) return std::nullopt;
+    if (r.size() < 20) return std::nullopt;
     std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
     median[ch] = std::clamp(r[r.size() / 2], 0.0, 1.0);
   }
   return median;
 }
-
-}  // namespace
 
 std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::Camera& camera,
                                               const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
@@ -246,8 +242,6 @@ std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const 
   return median_albedo(
       reflectance_points(model, camera, T_camera_target, projector, T_projector_target, under_black, under_grey, grey));
 }
-
-std::optional<Eigen::Vector3d> median_albedo(const std::vector<ReflectancePoint>& points) { return channel_medians(points, 20); }
 
 ReflectanceMap::ReflectanceMap(int width, int height) : width_(width), height_(height) {}
 
@@ -262,10 +256,10 @@ namespace {
 // a surface); known: whether it had any.
 void texel_medians(const std::vector<ReflectancePoint>& points, int width, int height, std::vector<Eigen::Vector3d>& rho,
                    std::vector<Eigen::Vector3i>& known) {
-  const auto texel = [](double t, int n) { return std::clamp(static_cast<int>((t - std::floor(t)) * n), 0, n - 1); };
   std::vector<std::array<std::vector<double>, 3>> in(static_cast<std::size_t>(width) * height);
   for (const ReflectancePoint& p : points) {
-    auto& values = in[static_cast<std::size_t>(texel(p.uv.y(), height)) * width + texel(p.uv.x(), width)];
+    auto& values =
+        in[static_cast<std::size_t>(assets::texel_index(p.uv.y(), height)) * width + assets::texel_index(p.uv.x(), width)];
     for (int ch = 0; ch < 3; ++ch)
       if (p.valid[static_cast<std::size_t>(ch)]) values[static_cast<std::size_t>(ch)].push_back(p.rho[ch]);
   }

@@ -81,6 +81,9 @@ Model load_model(const std::filesystem::path& path);
 /// Scales the model frame uniformly, then (if recenter) moves the origin to the surface centroid.
 void scale_and_recenter(Model& model, double scale, bool recenter);
 
+/// The texel column (or row) of n that texture coordinate t falls in, wrapped as given: 0..n-1.
+int texel_index(double t, int n, Wrap wrap = Wrap::kRepeat);
+
 /// The texel of `image` at texture coordinate (u, v), nearest, wrapped as given: RGB 0..1 as stored (white
 /// for an empty image).
 Eigen::Vector3f texel_colour(const Image& image, double u, double v, Wrap wrap_s = Wrap::kRepeat, Wrap wrap_t = Wrap::kRepeat);

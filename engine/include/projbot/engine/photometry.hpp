@@ -80,6 +80,11 @@ double choose_gain(const std::vector<SurfaceSample>& samples, const Eigen::Vecto
 /// both, lit less than 60 degrees off its normal (about one per 4 x 4 camera pixels), give (grey - black)
 /// kReferenceLux / ((drive(grey) - drive(0)) white_lux) at their pixels (the room's light cancels); the
 /// median over them per channel. Empty when fewer than 20 points can be read unsaturated.
+std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::Camera& camera,
+                                              const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
+                                              const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
+                                              const assets::Image& under_grey, double grey);
+
 /// One point of a target's surface as measure_albedo reads it: where it lies in the model's texture
 /// coordinates and its reflectance per channel there (valid: the grey picture was not saturated).
 struct ReflectancePoint {
@@ -112,11 +117,6 @@ class ReflectanceMap {
   std::vector<ReflectancePoint> all_;  ///< every measurement's points
 };
 
-std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const config::Camera& camera,
-                                              const Eigen::Matrix4d& T_camera_target, const config::ProjectorConfig& projector,
-                                              const Eigen::Matrix4d& T_projector_target, const assets::Image& under_black,
-                                              const assets::Image& under_grey, double grey);
-
 /// The compensation of each target a session draws (issue 43): a target's gain is chosen the first time it
 /// is drawn in a visit, from its surface at that pose, and kept until the visit changes, so a target that
 /// moves or is tracked does not flicker. Off: every target's content as stored. One thread (the render
@@ -144,7 +144,6 @@ class CompensationPlan {
   /// surface, its albedo becomes 1, and its gain is chosen again. Bind the same to its model
   /// (Renderer::set_surface).
   void set_surface(std::size_t target, std::shared_ptr<const assets::Image> surface);
-  const assets::Image* surface(std::size_t target) const { return targets_.at(target).surface.get(); }
   /// The gain chosen for `target` in its latest visit; 1 before any.
   double gain(std::size_t target) const { return chosen_.at(target).gain; }
   bool on() const { return on_; }
