@@ -1,6 +1,6 @@
 #version 450
-// Unlit: the model's colouring is the projection content. Texture texels are sampled from a UNORM
-// image and written to a UNORM target, so stored values reach the projector unchanged; with compensation
+// Unlit: the model's colouring (its emission added) is the projection content. Texture texels are sampled
+// from a UNORM image and written to a UNORM target, so stored values reach the projector unchanged; with compensation
 // (issue 43) the output is what makes the target's surface show them (engine/photometry.hpp, whose
 // compensated_input is this pass on the CPU).
 
@@ -13,11 +13,22 @@ layout(set = 0, binding = 0) uniform sampler2D base_color_texture;
 // compensation divides by besides compensate.rgb's per-channel albedo; white unless the scene gives one.
 layout(set = 0, binding = 1) uniform sampler2D surface_texture;
 
+// The material's emission (white where it has no emissive texture; its factor is 0 where it emits nothing).
+layout(set = 0, binding = 2) uniform sampler2D emissive_texture;
+
 // The projector's response, per frame (renderer.cpp's FrameUniform).
 layout(set = 1, binding = 0) uniform Frame {
   vec4 unmix[3];  // rows of the mixing matrix's inverse: the channels' drives from the light wanted in R, G, B
   vec4 response;  // xyz: 1 / each channel's gamma; w: the black level
 } frame;
+
+// This draw's material as it is now (renderer_impl.hpp's DrawUniform, issue 44): its emission, and where
+// its textures lie over the model's texture coordinates (rows of 2x3 matrices; identity unless animated).
+layout(set = 1, binding = 1) uniform Material {
+  vec4 emissive;  // rgb: emissive factor x strength, added as stored
+  vec4 base_uv[2];
+  vec4 emissive_uv[2];
+} material;
 
 // glTF alphaMode, fixed per pipeline so OPAQUE and BLEND carry no discard (which would stop early depth
 // testing) and no per-fragment branch: 0 opaque, 1 mask, 2 blend.
@@ -59,9 +70,15 @@ vec3 compensated(vec3 c, float white) {
   return pow(clamp(x, 0.0, 1.0), frame.response.xyz);
 }
 
+vec2 placed(vec4 rows[2]) {
+  vec3 uv1 = vec3(in_uv, 1.0);
+  return vec2(dot(rows[0].xyz, uv1), dot(rows[1].xyz, uv1));
+}
+
 void main() {
   float white = draw.compensate.r > 0.0 ? white_lux() : 0.0;
-  vec4 c = texture(base_color_texture, in_uv) * draw.base_color_factor * in_color;
+  vec4 c = texture(base_color_texture, placed(material.base_uv)) * draw.base_color_factor * in_color;
+  c.rgb += material.emissive.rgb * texture(emissive_texture, placed(material.emissive_uv)).rgb;
   if (kAlphaMode == 1) {
     if (c.a < draw.projector.w) discard;
     c.a = 1.0;

@@ -197,3 +197,46 @@ TEST_F(CliTest, RenderShowsTheContentOfItsContentTime) {
     differ += a.rgba[i] != c.rgba[i] || a.rgba[i + 1] != c.rgba[i + 1] || a.rgba[i + 2] != c.rgba[i + 2] ? 1 : 0;
   EXPECT_GT(differ, 5000U);  // frame 15's colour wash and stripes, not frame 75's
 }
+
+// A glTF model's own material animation (KHR_animation_pointer, issue 44) through the executable: BoxTextured
+// fading from black to its texture over 2 s (and again), rendered at content times 0.5, 1 and 3 with no
+// `content:` key.
+TEST_F(CliTest, RenderPlaysAModelsMaterialAnimation) {
+  const fs::path box = dir_ / "box";
+  fs::create_directories(box);
+  fs::copy(fs::path(PROJBOT_SHARED_DATA) / "gltf" / "BoxTextured" / "glTF", box, fs::copy_options::recursive);
+  std::ifstream in(box / "BoxTextured.gltf");
+  nlohmann::json j = nlohmann::json::parse(in);
+  // Times 0 and 2 s, then factors black and white: little-endian floats in a second buffer (base64).
+  j["buffers"].push_back(
+      {{"byteLength", 40},
+       {"uri", "data:application/octet-stream;base64,AAAAAAAAAEAAAAAAAAAAAAAAAAAAAIA/AACAPwAAgD8AAIA/AACAPw=="}});
+  const std::size_t buffer = j["buffers"].size() - 1, view = j["bufferViews"].size(), accessor = j["accessors"].size();
+  j["bufferViews"].push_back({{"buffer", buffer}, {"byteLength", 8}});
+  j["bufferViews"].push_back({{"buffer", buffer}, {"byteOffset", 8}, {"byteLength", 32}});
+  j["accessors"].push_back({{"bufferView", view}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}});
+  j["accessors"].push_back({{"bufferView", view + 1}, {"componentType", 5126}, {"count", 2}, {"type", "VEC4"}});
+  const nlohmann::json pointer = {{"KHR_animation_pointer", {{"pointer", "/materials/0/pbrMetallicRoughness/baseColorFactor"}}}};
+  nlohmann::json animation;
+  animation["samplers"] = {{{"input", accessor}, {"output", accessor + 1}}};
+  animation["channels"] = {{{"sampler", 0}, {"target", {{"path", "pointer"}, {"extensions", pointer}}}}};
+  j["animations"] = {animation};
+  std::ofstream(box / "fade.gltf") << j.dump();
+  write("fade.yaml",
+        "projector: {width: 320, height: 240, fx: 300, fy: 300, cx: 159.5, cy: 119.5}\ntargets:\n  - {name: box, model: " +
+            (box / "fade.gltf").string() + ", scale: 0.3, pose: {translation: [0, 0, 1], rpy_deg: [200, 35, 0]}}\n");
+  const auto mean_at = [&](const std::string& t) {
+    const fs::path out = dir_ / ("fade_" + t + ".png");
+    const CliRun r =
+        run_projbot("render --scene " + (dir_ / "fade.yaml").string() + " --content-time " + t + " --out " + out.string());
+    EXPECT_EQ(r.code, 0) << r.output;
+    const projbot::assets::Image img = projbot::assets::read_image(out);
+    double sum = 0.0;
+    for (std::size_t i = 0; i + 3 < img.rgba.size(); i += 4) sum += img.rgba[i] + img.rgba[i + 1] + img.rgba[i + 2];
+    return sum;
+  };
+  const double quarter = mean_at("0.5"), half = mean_at("1"), again = mean_at("3");
+  EXPECT_GT(half, 1e6);  // the box's texture at half its brightness
+  EXPECT_NEAR(quarter / half, 0.5, 0.01);
+  EXPECT_EQ(again, half);  // the animation repeats every 2 s
+}

@@ -118,8 +118,25 @@ TEST(SceneTest, TargetContent) {
   ASSERT_EQ(t.targets[0].content->timeline.size(), 2U);
   EXPECT_TRUE(t.targets[0].content->video.empty());
   EXPECT_DOUBLE_EQ(t.targets[0].content->timeline[1].at_s, 2.5);
-  EXPECT_DOUBLE_EQ(t.targets[0].content->timeline[1].base_color_factor[2], 1.0);
-  EXPECT_DOUBLE_EQ(t.targets[0].content->timeline[1].base_color_factor[3], 0.5);
+  EXPECT_DOUBLE_EQ(t.targets[0].content->timeline[1].base_color_factor->at(2), 1.0);
+  EXPECT_DOUBLE_EQ(t.targets[0].content->timeline[1].base_color_factor->at(3), 0.5);
+  EXPECT_FALSE(t.targets[0].content->timeline[0].emissive_factor);
+  // Emission and the texture's placement (issue 44): what none of the keys gives stays unset.
+  const auto u = parse_scene(
+      "projector: {width: 64, height: 48, fx: 5, fy: 5, cx: 3, cy: 2}\n"
+      "targets:\n  - name: a\n    model: a.glb\n    pose: {translation: [0, 0, 1]}\n"
+      "    content: {timeline: [{at_s: 0, emissive_factor: [0, 0.5, 1], uv_offset: [0, 0], uv_scale: [1, 1], "
+      "uv_rotation_deg: 0},\n"
+      "                         {at_s: 3, emissive_factor: [1, 1, 1], uv_offset: [0.5, -2], uv_scale: [2, 1], "
+      "uv_rotation_deg: 90}]}\n",
+      "/scenes/s.yaml");
+  const auto& k = u.targets[0].content->timeline;
+  ASSERT_EQ(k.size(), 2U);
+  EXPECT_FALSE(k[0].base_color_factor);
+  EXPECT_DOUBLE_EQ(k[0].emissive_factor->at(1), 0.5);
+  EXPECT_DOUBLE_EQ(k[1].uv_offset->at(1), -2.0);
+  EXPECT_DOUBLE_EQ(k[1].uv_scale->at(0), 2.0);
+  EXPECT_DOUBLE_EQ(*k[1].uv_rotation_deg, 90.0);
 }
 
 TEST(SceneTest, RpyIsRzRyRx) {
@@ -228,6 +245,17 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"content_timeline_key_without_time",
                 kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {timeline: [{base_color_factor: [1, 1, 1, 1]}]}\n",
                 {"targets[0].content.timeline[0].at_s", "missing"}},
+        BadCase{"content_timeline_key_without_property",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {timeline: [{at_s: 0}]}\n",
+                {"targets[0].content.timeline[0]", "gives nothing to animate"}},
+        BadCase{"content_timeline_keys_differ",
+                kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {timeline: [{at_s: 0, uv_offset: [0, 0]}, "
+                        "{at_s: 1, uv_offset: [1, 0], emissive_factor: [1, 0, 0]}]}\n",
+                {"targets[0].content.timeline[1]", "gives emissive_factor, uv_offset but the first key gives uv_offset"}},
+        BadCase{
+            "content_timeline_emission_over_one",
+            kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {timeline: [{at_s: 0, emissive_factor: [2, 0, 0]}]}\n",
+            {"targets[0].content.timeline[0].emissive_factor", "each of r, g, b must be 0..1"}},
         BadCase{"content_start_negative",
                 kProj + "targets:\n  - name: a\n    model: a.glb\n    content: {video: v.mp4, start: -2}\n",
                 {"targets[0].content.start", "'-2'"}},

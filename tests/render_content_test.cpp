@@ -1,6 +1,8 @@
 // The lens pass, streamed textures and moving content on whatever Vulkan device is there (lavapipe in CI),
 // with the validation layer on.
 
+#include <nlohmann/json.hpp>
+
 #include "render_fixture.hpp"
 
 using namespace render_test;
@@ -259,7 +261,10 @@ TEST_F(RenderTest, SceneContentTimelineAnimatesTheBaseColourFactor) {
   // A timeline (issue 44) on a white quad: red at 0 s, blue at 2 s, looping; the colour drawn at each content
   // time against the linear interpolation between the keys (CPU reference), within one 8-bit step.
   projbot::config::TargetContent timeline;
-  timeline.timeline = {{0.0, {1.0, 0.0, 0.0, 1.0}}, {2.0, {0.0, 0.0, 1.0, 1.0}}};
+  timeline.timeline.resize(2);
+  timeline.timeline[0].base_color_factor = {1.0, 0.0, 0.0, 1.0};
+  timeline.timeline[1].at_s = 2.0;
+  timeline.timeline[1].base_color_factor = {0.0, 0.0, 1.0, 1.0};
   const ContentQuad q = content_quad(*renderer_, projector(100, 100, 80, 80, 49.5, 49.5), timeline);
   const projbot::config::Scene& scene = q.scene;
   const std::size_t model = q.items[0].model;
@@ -327,5 +332,190 @@ TEST_F(RenderTest, SceneContentSwapsAChangedVideoAndKeepsTheOldOneWhenTheNewFail
   EXPECT_EQ(code_at(0.0), 500);
   EXPECT_TRUE(content.reload_changed(5000.0).empty());  // said once
   renderer_->finish(*target);
+  fs::remove_all(dir);
+}
+
+namespace {
+
+// A 4 x 1 strip (red, green, blue, white), sampled nearest and repeating: the texel for texture coordinate u.
+Image strip() {
+  Image s;
+  s.width = 4;
+  s.height = 1;
+  s.rgba = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+  return s;
+}
+
+Eigen::Vector3d strip_texel(double u) {
+  const int k = ((static_cast<int>(std::floor(4.0 * u)) % 4) + 4) % 4;
+  const Image s = strip();
+  return Eigen::Vector3d(s.rgba[4 * k], s.rgba[4 * k + 1], s.rgba[4 * k + 2]) / 255.0;
+}
+
+// KHR_texture_transform's T R S, multiplied out here, applied to (u, v).
+Eigen::Vector2d placed(const projbot::assets::TextureTransform& t, double u, double v) {
+  const double c = std::cos(t.rotation_rad), s = std::sin(t.rotation_rad);
+  const Eigen::Matrix3d T = (Eigen::Matrix3d() << 1, 0, t.offset[0], 0, 1, t.offset[1], 0, 0, 1).finished();
+  const Eigen::Matrix3d R = (Eigen::Matrix3d() << c, s, 0, -s, c, 0, 0, 0, 1).finished();
+  const Eigen::Matrix3d S = Eigen::Vector3d(t.scale[0], t.scale[1], 1).asDiagonal();
+  return (T * R * S * Eigen::Vector3d(u, v, 1)).head<2>();
+}
+
+bool near_texel_edge(double u) { return std::abs(4.0 * u - std::round(4.0 * u)) < 0.15; }
+
+}  // namespace
+
+// An animated material (issue 44) on the quad wearing the strip, whose placement as loaded (offset 0.5 along
+// u) is baked into its UVs as the loader bakes it: drawn with other placements of its base colour and
+// emissive textures and with an emission, every pixel away from a texel edge against the CPU reference: the
+// texel at the new placement of the pixel's own texture coordinate times the base colour factor, plus the
+// emission times the emissive texel.
+TEST_F(RenderTest, AnAnimatedMaterialPlacesItsTexturesAndEmitsAsItsStateSays) {
+  const ProjectorConfig p = projector(100, 100, 80, 80, 49.5, 49.5);
+  projbot::assets::Material mat;
+  mat.base_color_image = mat.emissive_image = 0;
+  mat.sampler.mag = mat.sampler.min = projbot::assets::Filter::kNearest;
+  mat.emissive_sampler = mat.sampler;
+  mat.base_color_transform.offset = {0.5, 0.0};
+  Model m = quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
+                  Eigen::Vector3d(-0.5, 0.5, 1)},
+                 {1, 1, 1, 1}, mat);
+  m.images.push_back(strip());
+  for (auto& v : m.primitives[0].vertices) v.uv[0] += 0.5F;  // baked
+  const std::size_t id = renderer_->add_model(m);
+  struct Case {
+    projbot::assets::TextureTransform base, emissive;
+    std::array<float, 4> factor;
+    std::array<float, 3> emission;
+  };
+  const Case cases[] = {{{}, {}, {1, 1, 1, 1}, {0, 0, 0}},  // the file's own texture coordinates again, not the baked
+                        {{{0.3, 0.1}, {2.0, 1.0}, 0.4}, {{0.25, 0.0}, {1.0, 1.0}, 0.0}, {1, 1, 1, 1}, {0.2F, 0.1F, 0.0F}},
+                        {{}, {{0.6, 0.0}, {-1.0, 1.0}, 0.0}, {0, 0, 0, 1}, {0.3F, 0.6F, 0.9F}}};
+  for (std::size_t k = 0; k < std::size(cases); ++k) {
+    const Case& c = cases[k];
+    projbot::assets::MaterialState s = mat.state();
+    s.base_color_transform = c.base;
+    s.emissive_transform = c.emissive;
+    s.base_color_factor = c.factor;
+    s.emissive_factor = c.emission;
+    s.emissive_strength = 1.0F;
+    DrawItem item{id, Eigen::Matrix4d::Identity()};
+    item.materials = {{0, s}};
+    const Image img = render(p, {item});
+    int checked = 0;
+    for (int y = 12; y <= 87; ++y)
+      for (int x = 12; x <= 87; ++x) {
+        const double u = (x - 9.5) / 80.0, v = (y - 9.5) / 80.0;  // the file's texture coordinate at this pixel
+        const Eigen::Vector2d b = placed(c.base, u, v), e = placed(c.emissive, u, v);
+        if (near_texel_edge(b.x()) || near_texel_edge(e.x())) continue;
+        const Eigen::Vector3d want =
+            (strip_texel(b.x()).cwiseProduct(Eigen::Vector3d(c.factor[0], c.factor[1], c.factor[2])) +
+             strip_texel(e.x()).cwiseProduct(Eigen::Vector3d(c.emission[0], c.emission[1], c.emission[2])))
+                .cwiseMin(1.0) *
+            255.0;
+        for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(img.pixel(x, y)[ch], want[ch], 1.5) << k << " at " << x << ", " << y;
+        ++checked;
+      }
+    EXPECT_GT(checked, 2000) << k;
+  }
+}
+
+// A model's own material animations (glTF KHR_animation_pointer) play on the content clock without a
+// `content:` key, and a timeline's keys lie over them: red to blue over 2 s (repeating), and a timeline's
+// emission from none to green.
+TEST_F(RenderTest, SceneContentPlaysTheModelsMaterialAnimationsUnderItsTimeline) {
+  ContentQuad q = content_quad(*renderer_, projector(100, 100, 80, 80, 49.5, 49.5), {});
+  q.scene.targets[0].content.reset();
+  projbot::assets::MaterialChannel ch;
+  ch.times = {0.0F, 2.0F};
+  ch.values = {1, 0, 0, 1, 0, 0, 1, 1};
+  q.models[0].material_animations.push_back({"fade", 2.0, {ch}});
+  const auto colour_at = [&](const projbot::engine::SceneContent& content, double at) {
+    std::vector<DrawItem> items = q.items;
+    content.animate(0, at, items[0]);
+    const Image img = render(q.scene.projector, items);
+    return Eigen::Vector3d(img.pixel(50, 50)[0], img.pixel(50, 50)[1], img.pixel(50, 50)[2]);
+  };
+  {
+    const projbot::engine::SceneContent content(*renderer_, q.scene, q.models, q.items);
+    ASSERT_TRUE(content.has(0));
+    EXPECT_FALSE(content.has_video(0));
+    for (const double at : {0.0, 0.5, 1.5, 3.0}) {
+      const double w = std::fmod(at, 2.0) / 2.0;
+      EXPECT_LT((colour_at(content, at) - 255.0 * Eigen::Vector3d(1.0 - w, 0.0, w)).cwiseAbs().maxCoeff(), 1.5) << at;
+    }
+  }
+  projbot::config::TargetContent glow;
+  glow.timeline.resize(2);
+  glow.timeline[0].emissive_factor = {0.0, 0.0, 0.0};
+  glow.timeline[1].at_s = 4.0;
+  glow.timeline[1].emissive_factor = {0.0, 1.0, 0.0};
+  q.scene.targets[0].content = glow;
+  const projbot::engine::SceneContent content(*renderer_, q.scene, q.models, q.items);
+  EXPECT_LT((colour_at(content, 1.0) - Eigen::Vector3d(127.5, 63.75, 127.5)).cwiseAbs().maxCoeff(), 1.5);
+}
+
+// run's and show's watch on a target's model files (issue 44): BoxTextured's texture repainted on disk is
+// drawn at a later frame without a restart; a texture that no longer decodes, and a model of another shape
+// (its root node scaled), leave the model as drawn, saying why.
+TEST_F(RenderTest, SceneContentSwapsAChangedTextureAndKeepsTheModelWhereItCannot) {
+  const fs::path dir = fs::temp_directory_path() / ("projbot_render_model_swap_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy(fs::path(PROJBOT_SHARED_DATA) / "gltf" / "BoxTextured" / "glTF", dir, fs::copy_options::recursive);
+  projbot::config::Scene scene;
+  scene.projector = projector(200, 200, 200, 200, 99.5, 99.5);
+  projbot::config::TargetConfig t;
+  t.name = "box";
+  t.model = dir / "BoxTextured.gltf";
+  t.scale = 0.3;
+  t.T_projector_target = pose(0, 0, 1, 200 * M_PI / 180, 35 * M_PI / 180, 0);
+  scene.targets.push_back(t);
+  std::vector<Model> models;
+  const std::vector<DrawItem> items = projbot::engine::upload_scene(*renderer_, scene, &models);
+  ASSERT_EQ(models[0].files.size(), 3U);  // the .gltf, its .bin and its texture
+  projbot::engine::SceneContent content(*renderer_, scene, models, items);
+  const auto await = [&](const std::string& part) {  // the line saying what became of the change
+    for (int k = 0; k < 200; ++k) {
+      for (const std::string& line : content.reload_changed(k, 0.0))
+        if (line.find(part) != std::string::npos) return line;
+      std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    }
+    return std::string("nothing said with '" + part + "'");
+  };
+  const auto red_share = [&] {
+    const Image img = render(scene.projector, items);
+    std::size_t lit = 0, red = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        const auto* px = img.pixel(x, y);
+        if (px[0] + px[1] + px[2] == 0) continue;
+        ++lit;
+        red += px[0] > 200 && px[1] < 10 && px[2] < 10 ? 1 : 0;
+      }
+    EXPECT_GT(lit, 3000U);
+    return static_cast<double>(red) / static_cast<double>(std::max<std::size_t>(lit, 1));
+  };
+  EXPECT_LT(red_share(), 0.05);  // the Cesium logo: white and green
+  Image solid;
+  solid.width = solid.height = 8;
+  solid.rgba.assign(8 * 8 * 4, 0);
+  for (std::size_t i = 0; i < solid.rgba.size(); i += 4) solid.rgba[i] = solid.rgba[i + 3] = 255;
+  projbot::assets::write_png(dir / "CesiumLogoFlat.png", solid);
+  EXPECT_NE(await("changed;").find("its textures and materials are drawn from now on"), std::string::npos);
+  EXPECT_GT(red_share(), 0.99);
+  std::ofstream(dir / "CesiumLogoFlat.png") << "not a PNG any more";
+  const std::string broken = await("stays");
+  EXPECT_NE(broken.find("BoxTextured.gltf: "), std::string::npos) << broken;
+  EXPECT_NE(broken.find("image[0]"), std::string::npos) << broken;  // tinygltf's word for it
+  EXPECT_GT(red_share(), 0.99);
+  projbot::assets::write_png(dir / "CesiumLogoFlat.png", solid);
+  EXPECT_NE(await("changed;").find("drawn from now on"), std::string::npos);
+  std::ifstream in(dir / "BoxTextured.gltf");
+  nlohmann::json j = nlohmann::json::parse(in);
+  j["nodes"][0]["matrix"][0] = 2.0;
+  std::ofstream(dir / "BoxTextured.gltf") << j.dump();
+  EXPECT_NE(await("changed shape").find("restart to use it"), std::string::npos);
+  EXPECT_GT(red_share(), 0.99);
   fs::remove_all(dir);
 }

@@ -10,11 +10,13 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <iterator>
 #include <mutex>
 #include <set>
 #include <sstream>
 
 #include "default_material.hpp"
+#include "gltf_reader.hpp"
 #include "image_info.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/paths.hpp"
@@ -22,26 +24,23 @@
 namespace projbot::assets {
 namespace {
 
-class Loader {
+class Loader : detail::GltfReader {
  public:
-  Loader(const tinygltf::Model& gltf, std::string file) : g_(gltf), file_(std::move(file)) {}
+  using GltfReader::GltfReader;
 
-  [[noreturn]] void fail(const std::string& why) const { throw AssetError(file_ + ": " + why); }
-
-  Model build() {
+  // `json`: the document's JSON (the animations' pointer channels are read from it).
+  Model build(const std::string& json) {
     Model out;
     out.source = file_;
     load_images(out);
-    load_materials(out);
+    detail::read_materials(*this, out);
     for (int root : root_nodes()) {
       std::set<int> path;
       visit_node(root, Eigen::Matrix4d::Identity(), path, out);
     }
     if (out.primitives.empty()) fail("no triangle meshes in the scene");
-    apply_texture_transforms(out);
-    if (!g_.animations.empty())
-      warn_once("its " + std::to_string(g_.animations.size()) +
-                " animation(s) are not played (the object does not move with them)");
+    detail::bake_texture_transforms(out);
+    if (!g_.animations.empty()) detail::read_material_animations(*this, json, out);
     detail::give_default_material(out);
     return out;
   }
@@ -50,12 +49,6 @@ class Loader {
   static constexpr std::size_t kMaxNodeDepth = 256;
   static constexpr std::size_t kMaxNodeVisits = 100000;
   std::size_t visits_ = 0;
-
-  template <typename T>
-  void check_index(int index, const std::vector<T>& items, const std::string& what) const {
-    if (index < 0 || static_cast<std::size_t>(index) >= items.size())
-      fail(what + " index " + std::to_string(index) + " is out of range (have " + std::to_string(items.size()) + ")");
-  }
 
   std::vector<int> root_nodes() const {
     if (!g_.scenes.empty()) {
@@ -115,74 +108,6 @@ class Loader {
     }
     for (int child : node.children) visit_node(child, world, path, out);
     path.erase(index);
-  }
-
-  // Returns a pointer to element i of an accessor after checking it lies inside its buffer view.
-  struct View {
-    const unsigned char* base = nullptr;
-    std::size_t stride = 0;
-    std::size_t count = 0;
-    int component_type = 0;
-    int type = 0;
-    bool normalized = false;
-  };
-
-  View accessor_view(int accessor_index, const std::string& what) const {
-    check_index(accessor_index, g_.accessors, what + " accessor");
-    const auto& a = g_.accessors[static_cast<std::size_t>(accessor_index)];
-    const std::string name = what + " (accessor " + std::to_string(accessor_index) + ")";
-    if (a.sparse.isSparse) fail(name + ": sparse accessors are not supported");
-    if (a.bufferView < 0) fail(name + ": has no bufferView");
-    check_index(a.bufferView, g_.bufferViews, name + ": bufferView");
-    const auto& bv = g_.bufferViews[static_cast<std::size_t>(a.bufferView)];
-    check_index(bv.buffer, g_.buffers, name + ": buffer");
-    const auto& buffer = g_.buffers[static_cast<std::size_t>(bv.buffer)];
-    const int comp_size = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType));
-    const int comps = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
-    if (comp_size <= 0 || comps <= 0) fail(name + ": unknown component or element type");
-    const std::size_t elem = static_cast<std::size_t>(comp_size) * static_cast<std::size_t>(comps);
-    const std::size_t stride = bv.byteStride > 0 ? bv.byteStride : elem;
-    if (stride < elem) fail(name + ": byteStride " + std::to_string(stride) + " is smaller than the element");
-    if (bv.byteOffset > buffer.data.size() || bv.byteLength > buffer.data.size() - bv.byteOffset)
-      fail(name + ": bufferView " + std::to_string(a.bufferView) + " runs past the end of buffer " + std::to_string(bv.buffer) +
-           " (" + std::to_string(buffer.data.size()) + " bytes loaded)");
-    if (a.count > 0) {
-      const std::size_t needed = a.byteOffset + stride * (a.count - 1) + elem;
-      if (needed < a.byteOffset || needed > bv.byteLength)
-        fail(name + ": " + std::to_string(a.count) + " elements need " + std::to_string(needed) + " bytes but bufferView " +
-             std::to_string(a.bufferView) + " has " + std::to_string(bv.byteLength));
-    }
-    return {buffer.data.data() + bv.byteOffset + a.byteOffset, stride, a.count, a.componentType, a.type, a.normalized};
-  }
-
-  // Reads component c of element i as float, applying glTF's normalisation rules.
-  static float read_component(const View& v, std::size_t i, int c) {
-    const unsigned char* p = v.base + v.stride * i;
-    switch (v.component_type) {
-      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-        float f;
-        std::memcpy(&f, p + 4 * c, 4);
-        return f;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-        return static_cast<float>(p[c]) / (v.normalized ? 255.0F : 1.0F);
-      case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        const float f = static_cast<float>(static_cast<std::int8_t>(p[c]));
-        return v.normalized ? std::max(f / 127.0F, -1.0F) : f;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        std::uint16_t s;
-        std::memcpy(&s, p + 2 * c, 2);
-        return static_cast<float>(s) / (v.normalized ? 65535.0F : 1.0F);
-      }
-      case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        std::int16_t s;
-        std::memcpy(&s, p + 2 * c, 2);
-        return v.normalized ? std::max(static_cast<float>(s) / 32767.0F, -1.0F) : static_cast<float>(s);
-      }
-      default:
-        return 0.0F;  // rejected by the callers' type checks
-    }
   }
 
   View float_attribute(int accessor, const std::string& what, std::initializer_list<int> types, bool allow_normalized) const {
@@ -392,129 +317,6 @@ class Loader {
       out.images.push_back(std::move(img));
     }
   }
-
-  static Wrap wrap_of(int mode) {
-    switch (mode) {
-      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
-        return Wrap::kClampToEdge;
-      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
-        return Wrap::kMirroredRepeat;
-      default:
-        return Wrap::kRepeat;
-    }
-  }
-
-  void load_materials(Model& out) {
-    for (std::size_t i = 0; i < g_.materials.size(); ++i) {
-      const auto& gm = g_.materials[i];
-      const std::string name = "material " + std::to_string(i);
-      Material m;
-      m.name = gm.name;
-      const auto& f = gm.pbrMetallicRoughness.baseColorFactor;
-      if (f.size() == 4)
-        for (std::size_t k = 0; k < 4; ++k) {
-          if (!std::isfinite(f[k])) fail(name + ": baseColorFactor is not finite");
-          m.base_color_factor[k] = static_cast<float>(f[k]);
-        }
-      const int tex = gm.pbrMetallicRoughness.baseColorTexture.index;
-      if (tex >= 0) {
-        check_index(tex, g_.textures, name + ": baseColorTexture");
-        const auto& t = g_.textures[static_cast<std::size_t>(tex)];
-        check_index(t.source, g_.images, name + ": texture " + std::to_string(tex) + " source image");
-        const auto& img = out.images[static_cast<std::size_t>(t.source)];
-        if (img.rgba.empty()) {
-          const auto& uri = g_.images[static_cast<std::size_t>(t.source)].uri;
-          fail(name + ": base colour image " + std::to_string(t.source) +
-               (uri.empty() || uri.rfind("data:", 0) == 0 ? "" : " ('" + uri + "')") + " is missing or could not be decoded");
-        }
-        if (gm.pbrMetallicRoughness.baseColorTexture.texCoord != 0)
-          fail(name + ": baseColorTexture uses TEXCOORD_" + std::to_string(gm.pbrMetallicRoughness.baseColorTexture.texCoord) +
-               "; only TEXCOORD_0 is supported");
-        m.base_color_image = t.source;
-        if (t.sampler >= 0) {
-          check_index(t.sampler, g_.samplers, name + ": sampler");
-          const auto& s = g_.samplers[static_cast<std::size_t>(t.sampler)];
-          m.sampler.wrap_s = wrap_of(s.wrapS);
-          m.sampler.wrap_t = wrap_of(s.wrapT);
-          m.sampler.mag = s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ? Filter::kNearest : Filter::kLinear;
-          m.sampler.min =
-              (s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST || s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
-               s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR)
-                  ? Filter::kNearest
-                  : Filter::kLinear;
-        }
-      }
-      if (gm.alphaMode == "MASK")
-        m.alpha_mode = AlphaMode::kMask;
-      else if (gm.alphaMode == "BLEND")
-        m.alpha_mode = AlphaMode::kBlend;
-      else if (gm.alphaMode.empty() || gm.alphaMode == "OPAQUE")
-        m.alpha_mode = AlphaMode::kOpaque;
-      else
-        fail(name + ": alphaMode '" + gm.alphaMode + "' is not OPAQUE, MASK or BLEND");
-      if (!std::isfinite(gm.alphaCutoff) || gm.alphaCutoff < 0.0) fail(name + ": alphaCutoff must be a finite number >= 0");
-      m.alpha_cutoff = static_cast<float>(gm.alphaCutoff);
-      m.double_sided = gm.doubleSided;
-      out.materials.push_back(m);
-    }
-  }
-
-  // KHR_texture_transform on a material's base colour texture (uv' = T R S uv, rotation counter-clockwise in
-  // UV space), row-major 2x3; identity without the extension.
-  std::array<double, 6> texture_transform(const tinygltf::Material& gm, const std::string& name) const {
-    std::array<double, 6> m{1, 0, 0, 0, 1, 0};
-    const auto& ext = gm.pbrMetallicRoughness.baseColorTexture.extensions;
-    const auto it = ext.find("KHR_texture_transform");
-    if (it == ext.end()) return m;
-    const tinygltf::Value& t = it->second;
-    if (!t.IsObject()) fail(name + ": KHR_texture_transform is not an object");
-    const auto pair = [&](const char* key, double fallback, std::size_t i) {
-      if (!t.Has(key)) return fallback;
-      const tinygltf::Value& v = t.Get(key);
-      if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(static_cast<int>(i)).IsNumber())
-        fail(name + ": KHR_texture_transform." + key + " is not two numbers");
-      return v.Get(static_cast<int>(i)).GetNumberAsDouble();
-    };
-    const double ox = pair("offset", 0.0, 0), oy = pair("offset", 0.0, 1);
-    const double sx = pair("scale", 1.0, 0), sy = pair("scale", 1.0, 1);
-    double r = 0.0;
-    if (t.Has("rotation")) {
-      if (!t.Get("rotation").IsNumber()) fail(name + ": KHR_texture_transform.rotation is not a number");
-      r = t.Get("rotation").GetNumberAsDouble();
-    }
-    if (t.Has("texCoord") && t.Get("texCoord").GetNumberAsInt() != 0)
-      fail(name + ": KHR_texture_transform.texCoord names another UV set; only TEXCOORD_0 is supported");
-    for (const double x : {ox, oy, sx, sy, r})
-      if (!std::isfinite(x) || std::abs(x) > 1e6) fail(name + ": KHR_texture_transform has a value that is not finite");
-    const double c = std::cos(r), sn = std::sin(r);
-    return {c * sx, sn * sy, ox, -sn * sx, c * sy, oy};
-  }
-
-  // The materials' texture transforms baked into their primitives' UVs (each primitive has its own
-  // vertices): the renderer and the CPU samplers then read the same coordinates.
-  void apply_texture_transforms(Model& out) const {
-    for (auto& p : out.primitives) {
-      if (p.material < 0 || static_cast<std::size_t>(p.material) >= g_.materials.size()) continue;
-      const auto m =
-          texture_transform(g_.materials[static_cast<std::size_t>(p.material)], "material " + std::to_string(p.material));
-      if (m == std::array<double, 6>{1, 0, 0, 0, 1, 0}) continue;
-      for (auto& v : p.vertices) {
-        const double u = v.uv[0], w = v.uv[1];
-        v.uv = {static_cast<float>(m[0] * u + m[1] * w + m[2]), static_cast<float>(m[3] * u + m[4] * w + m[5])};
-      }
-    }
-  }
-
-  // A warning on stderr, once per file and process (a tour loads its models several times).
-  void warn_once(const std::string& what) const {
-    static std::mutex mutex;
-    static std::set<std::string> said;
-    std::lock_guard lock(mutex);
-    if (said.insert(file_ + what).second) std::cerr << file_ << ": warning: " << what << '\n';
-  }
-
-  const tinygltf::Model& g_;
-  std::string file_;
 };
 
 bool is_glb(const std::filesystem::path& path) {
@@ -558,6 +360,20 @@ bool read_regular_file(std::vector<unsigned char>* out, std::string* err, const 
   return tinygltf::ReadWholeFile(out, err, file, user);
 }
 
+// The document's JSON: a .gltf file's text, or a .glb's first chunk (already read whole by tinygltf, so
+// its header is sound; checked again all the same).
+std::string document_json(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!is_glb(path)) return bytes;
+  std::uint32_t length = 0, type = 0;
+  if (bytes.size() < 20) return {};
+  std::memcpy(&length, bytes.data() + 12, 4);
+  std::memcpy(&type, bytes.data() + 16, 4);
+  if (type != 0x4E4F534AU || length > bytes.size() - 20) return {};  // 'JSON'
+  return bytes.substr(20, length);
+}
+
 }  // namespace
 
 Model load_gltf(const std::filesystem::path& path) {
@@ -586,7 +402,14 @@ Model load_gltf(const std::filesystem::path& path) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     throw AssetError(file + ": " + (err.empty() ? std::string("tinygltf could not parse the file") : err));
   }
-  return Loader(gltf, file).build();
+  Model model = Loader(gltf, file).build(gltf.animations.empty() ? std::string() : document_json(path));
+  model.files = {path};
+  const auto external = [&](const std::string& uri) {
+    if (!uri.empty() && uri.rfind("data:", 0) != 0) model.files.push_back(path.parent_path() / uri);
+  };
+  for (const auto& b : gltf.buffers) external(b.uri);
+  for (const auto& i : gltf.images) external(i.uri);
+  return model;
 }
 
 }  // namespace projbot::assets

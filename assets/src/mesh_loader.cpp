@@ -179,7 +179,9 @@ Model load_mesh(const std::filesystem::path& path) {
     const std::string what = e.what();
     throw AssetError(what.rfind(path.string(), 0) == 0 ? what : path.string() + ": " + what);
   }
-  return model_from_bytes(bytes, path);
+  Model model = model_from_bytes(bytes, path);
+  model.files = {path};
+  return model;
 }
 
 Model load_model(const std::filesystem::path& path) {

@@ -1,28 +1,75 @@
 #include "target_reader.hpp"
 
+#include <cmath>
+
 namespace projbot::config {
 namespace {
 
-// `content.timeline`: keys of a material's base colour factor over content time, times increasing.
+// An optional list of n numbers at `name` in a timeline key, each within [lo, hi].
+template <std::size_t N>
+std::optional<std::array<double, N>> key_numbers(MapReader& key, const YAML::Node& node, const std::string& where,
+                                                 const char* name, double lo, double hi, const char* range) {
+  const YAML::Node f = key.child(name, false);
+  if (!f) return std::nullopt;
+  const auto v = key.numbers(f, where + "." + name, N);
+  std::array<double, N> out{};
+  for (std::size_t i = 0; i < N; ++i) {
+    if (!(v[i] >= lo && v[i] <= hi)) key.fail(node[name], where + "." + name, range);
+    out[i] = v[i];
+  }
+  return out;
+}
+
+TargetContent::Key read_key(MapReader& key, const YAML::Node& node, const std::string& where) {
+  TargetContent::Key out;
+  out.at_s = key.get<double>("at_s", 0.0, true);
+  if (!(out.at_s >= 0.0 && out.at_s <= 1e6)) key.fail(node["at_s"], where + ".at_s", "must be 0..1e6 seconds");
+  out.base_color_factor = key_numbers<4>(key, node, where, "base_color_factor", 0.0, 1.0, "each of r, g, b, a must be 0..1");
+  out.emissive_factor = key_numbers<3>(key, node, where, "emissive_factor", 0.0, 1.0, "each of r, g, b must be 0..1");
+  out.uv_offset = key_numbers<2>(key, node, where, "uv_offset", -1e6, 1e6, "each of u, v must be -1e6..1e6");
+  out.uv_scale = key_numbers<2>(key, node, where, "uv_scale", -1e6, 1e6, "each of u, v must be -1e6..1e6");
+  if (key.has("uv_rotation_deg")) {
+    out.uv_rotation_deg = key.get<double>("uv_rotation_deg", 0.0);
+    if (!(std::abs(*out.uv_rotation_deg) <= 1e6))
+      key.fail(node["uv_rotation_deg"], where + ".uv_rotation_deg", "must be -1e6..1e6 degrees");
+  }
+  key.reject_unknown();
+  return out;
+}
+
+// Which of a key's properties it gives, as a word each.
+std::string given(const TargetContent::Key& k) {
+  std::string out;
+  const auto add = [&](bool has, const char* name) {
+    if (has) out += (out.empty() ? "" : ", ") + std::string(name);
+  };
+  add(k.base_color_factor.has_value(), "base_color_factor");
+  add(k.emissive_factor.has_value(), "emissive_factor");
+  add(k.uv_offset.has_value(), "uv_offset");
+  add(k.uv_scale.has_value(), "uv_scale");
+  add(k.uv_rotation_deg.has_value(), "uv_rotation_deg");
+  return out;
+}
+
+// `content.timeline`: keys of a material's properties over content time, times increasing, each key giving
+// the same properties.
 std::vector<TargetContent::Key> read_timeline(MapReader& m, const YAML::Node& list, const std::string& path) {
   if (!list.IsSequence() || list.size() == 0)
-    m.fail(list, path, "expected a non-empty list of {at_s: S, base_color_factor: [r, g, b, a]}");
+    m.fail(list, path, "expected a non-empty list of {at_s: S, base_color_factor: [r, g, b, a], ...}");
   std::vector<TargetContent::Key> keys;
   for (std::size_t k = 0; k < list.size(); ++k) {
     const std::string where = path + "[" + std::to_string(k) + "]";
     MapReader key(list[k], where, m.file());
-    TargetContent::Key out;
-    out.at_s = key.get<double>("at_s", 0.0, true);
-    if (!(out.at_s >= 0.0 && out.at_s <= 1e6)) key.fail(list[k]["at_s"], where + ".at_s", "must be 0..1e6 seconds");
+    TargetContent::Key out = read_key(key, list[k], where);
     if (!keys.empty() && !(out.at_s > keys.back().at_s))
       key.fail(list[k]["at_s"], where + ".at_s", "must come after the key before it (times increase)");
-    const YAML::Node f = key.child("base_color_factor", true);
-    const auto v = key.numbers(f, where + ".base_color_factor", 4);
-    for (std::size_t i = 0; i < 4; ++i) {
-      if (!(v[i] >= 0.0 && v[i] <= 1.0)) key.fail(f, where + ".base_color_factor", "each of r, g, b, a must be 0..1");
-      out.base_color_factor[i] = v[i];
-    }
-    key.reject_unknown();
+    if (given(out).empty())
+      key.fail(list[k], where,
+               "gives nothing to animate: base_color_factor, emissive_factor, uv_offset, uv_scale or uv_rotation_deg");
+    if (!keys.empty() && given(out) != given(keys.front()))
+      key.fail(
+          list[k], where,
+          "gives " + given(out) + " but the first key gives " + given(keys.front()) + ": every key gives the same properties");
     keys.push_back(out);
   }
   return keys;

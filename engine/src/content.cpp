@@ -5,6 +5,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <optional>
 
 #include "projbot/assets/image.hpp"
@@ -88,38 +89,42 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
     : renderer_(renderer) {
   for (std::size_t i = 0; i < scene.targets.size() && i < models.size() && i < items.size(); ++i) {
     const auto& content = scene.targets[i].content;
-    if (!content) continue;
+    if (!content && models[i].material_animations.empty()) continue;
     Stream s;
     s.target = static_cast<int>(i);
-    s.spec = *content;
-    const int material = content_material(models[i], content->material);
+    s.spec = content.value_or(config::TargetContent{});
+    const int material = content_material(models[i], s.spec.material);
     s.material = material;
     s.model = items[i].model;
-    if (content->video.empty()) {  // a timeline alone
+    s.materials = std::make_shared<assets::Model>();
+    s.materials->materials = models[i].materials;
+    s.materials->material_animations = models[i].material_animations;
+    if (s.spec.video.empty()) {  // a timeline, or the model's own animations, alone
       players_.push_back(std::move(s));
       continue;
     }
     // The same video from the same start on several targets: one player and one texture (decoded and
     // uploaded once, and in step by construction).
     const auto same = std::find_if(players_.begin(), players_.end(), [&](const Stream& o) {
-      return o.player && o.spec.video == content->video && o.spec.loop == content->loop && o.spec.start == content->start &&
-             o.spec.at_s == content->at_s;
+      return o.player && o.spec.video == s.spec.video && o.spec.loop == s.spec.loop && o.spec.start == s.spec.start &&
+             o.spec.at_s == s.spec.at_s;
     });
     if (same != players_.end()) {
       s.player = same->player;
       s.texture = same->texture;
       renderer.bind_streamed_texture(s.texture, s.model, material);
     } else {
-      s.player = make_player(std::make_unique<assets::VideoDecoder>(content->video), content->loop);
+      s.player = make_player(std::make_unique<assets::VideoDecoder>(s.spec.video), s.spec.loop);
       s.texture = renderer.add_streamed_texture(s.model, material, s.player->info().width, s.player->info().height);
       Watch w;
       w.player = s.player;
-      w.file = content->video;
-      file_stamp(w.file, w.written, w.size);
+      w.stamp.file = s.spec.video;
+      w.stamp.changed();
       watches_.push_back(std::move(w));
     }
     players_.push_back(std::move(s));
   }
+  watch_models(scene, models, items);
 }
 
 const SceneContent::Stream* SceneContent::find(int target) const {
@@ -134,10 +139,43 @@ bool SceneContent::has_video(int target) const {
   return s != nullptr && s->player != nullptr;
 }
 
+namespace {
+
+// Material `material`'s state in `item`: the one set there, else as loaded (added to the item).
+assets::MaterialState& look(DrawItem& item, const assets::Model& materials, int material) {
+  for (auto& [m, state] : item.materials)
+    if (m == material) return state;
+  item.materials.emplace_back(material, materials.materials[static_cast<std::size_t>(material)].state());
+  return item.materials.back().second;
+}
+
+// `a` and `b` (the same properties given) mixed w of the way to b, over `state`.
+void mix_keys(const config::TargetContent::Key& a, const config::TargetContent::Key& b, double w, assets::MaterialState& state) {
+  const auto mix = [w](double x, double y) { return x + w * (y - x); };
+  if (a.base_color_factor && b.base_color_factor)
+    for (std::size_t c = 0; c < 4; ++c)
+      state.base_color_factor[c] = static_cast<float>(mix((*a.base_color_factor)[c], (*b.base_color_factor)[c]));
+  if (a.emissive_factor && b.emissive_factor)
+    for (std::size_t c = 0; c < 3; ++c)
+      state.emissive_factor[c] = static_cast<float>(mix((*a.emissive_factor)[c], (*b.emissive_factor)[c]));
+  auto& t = state.base_color_transform;
+  for (std::size_t c = 0; c < 2; ++c) {
+    if (a.uv_offset && b.uv_offset) t.offset[c] = mix((*a.uv_offset)[c], (*b.uv_offset)[c]);
+    if (a.uv_scale && b.uv_scale) t.scale[c] = mix((*a.uv_scale)[c], (*b.uv_scale)[c]);
+  }
+  if (a.uv_rotation_deg && b.uv_rotation_deg)
+    t.rotation_rad = mix(*a.uv_rotation_deg, *b.uv_rotation_deg) * std::numbers::pi / 180.0;
+}
+
+}  // namespace
+
 void SceneContent::animate(int target, double content_s, DrawItem& item) const {
   const Stream* s = find(target);
-  if (s == nullptr || s->spec.timeline.empty()) return;
+  if (s == nullptr) return;
+  for (const auto& [material, state] : assets::animate_materials(*s->materials, content_s))
+    look(item, *s->materials, material) = state;
   const auto& keys = s->spec.timeline;
+  if (keys.empty()) return;
   double t = std::max(0.0, content_s);
   const double period = keys.back().at_s;
   if (s->spec.loop && period > 0.0) t = std::fmod(t, period);
@@ -146,10 +184,7 @@ void SceneContent::animate(int target, double content_s, DrawItem& item) const {
   const auto& a = keys[k];
   const auto& b = keys[std::min(k + 1, keys.size() - 1)];
   const double w = b.at_s > a.at_s ? std::clamp((t - a.at_s) / (b.at_s - a.at_s), 0.0, 1.0) : 0.0;
-  item.animated_material = s->material;
-  for (std::size_t c = 0; c < 4; ++c)
-    item.base_color_factor[c] =
-        static_cast<float>(a.base_color_factor[c] + w * (b.base_color_factor[c] - a.base_color_factor[c]));
+  mix_keys(a, b, w, look(item, *s->materials, s->material));
 }
 
 double SceneContent::start_s(int target, double tour_start_s, double arrival_s) const {
@@ -194,27 +229,113 @@ SceneContent::Sample SceneContent::apply(int target, double content_s, DrawItem&
 
 std::vector<std::string> SceneContent::reload_changed(double now_s, double interval_s) {
   std::vector<std::string> said;
+  const bool look = now_s - last_look_s_ >= interval_s;
+  if (look) last_look_s_ = now_s;
+  reload_videos(look, said);
+  reload_models(look, said);
+  return said;
+}
+
+void SceneContent::reload_videos(bool look, std::vector<std::string>& said) {
   for (Watch& w : watches_) {  // loads that have finished
     if (!w.loading.valid() || w.loading.wait_for(std::chrono::seconds(0)) != std::future_status::ready) continue;
     try {
       swap_in(w, w.loading.get());
-      said.push_back(w.file.string() + ": changed; the new video plays from its start");
+      said.push_back(w.stamp.file.string() + ": changed; the new video plays from its start");
     } catch (const std::exception& e) {
       said.push_back(std::string(e.what()) + " (changed on disk; the old video goes on)");
     }
   }
-  if (now_s - last_look_s_ < interval_s) return said;
-  last_look_s_ = now_s;
+  if (!look) return;
   for (Watch& w : watches_) {
-    if (w.loading.valid()) continue;
-    std::filesystem::file_time_type written;
-    std::uintmax_t size = 0;
-    if (!file_stamp(w.file, written, size) || (written == w.written && size == w.size)) continue;  // gone for now, or as it was
-    w.written = written;
-    w.size = size;
-    w.loading = std::async(std::launch::async, [file = w.file] { return std::make_unique<assets::VideoDecoder>(file); });
+    if (w.loading.valid() || !w.stamp.changed()) continue;  // loading, gone for now, or as it was
+    w.loading = std::async(std::launch::async, [file = w.stamp.file] { return std::make_unique<assets::VideoDecoder>(file); });
   }
-  return said;
+}
+
+bool SceneContent::FileStamp::changed() {
+  std::filesystem::file_time_type now_written;
+  std::uintmax_t now_size = 0;
+  if (!file_stamp(file, now_written, now_size) || (now_written == written && now_size == size)) return false;
+  written = now_written;
+  size = now_size;
+  return true;
+}
+
+std::uint64_t SceneContent::shape_of(const assets::Model& model) {
+  std::uint64_t h = 1469598103934665603ULL;  // FNV-1a over the positions' and indices' bytes
+  const auto mix = [&h](const void* data, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ static_cast<const std::uint8_t*>(data)[i]) * 1099511628211ULL;
+  };
+  for (const assets::Primitive& p : model.primitives) {
+    for (const assets::Vertex& v : p.vertices) mix(v.position.data(), sizeof v.position);
+    mix(p.indices.data(), p.indices.size() * sizeof(std::uint32_t));
+  }
+  return h;
+}
+
+void SceneContent::watch_models(const config::Scene& scene, const std::vector<assets::Model>& models,
+                                const std::vector<DrawItem>& items) {
+  for (std::size_t i = 0; i < scene.targets.size() && i < models.size() && i < items.size(); ++i) {
+    ModelWatch w;
+    w.target = static_cast<int>(i);
+    w.model = items[i].model;
+    w.path = scene.targets[i].model;
+    w.scale = scene.targets[i].scale;
+    w.recenter = scene.targets[i].recenter;
+    for (const auto& f : models[i].files) {
+      FileStamp st{f};
+      st.changed();
+      w.files.push_back(std::move(st));
+    }
+    w.shape = shape_of(models[i]);
+    model_watches_.push_back(std::move(w));
+  }
+}
+
+void SceneContent::reload_models(bool look, std::vector<std::string>& said) {
+  for (ModelWatch& w : model_watches_) {  // loads that have finished
+    if (!w.loading.valid() || w.loading.wait_for(std::chrono::seconds(0)) != std::future_status::ready) continue;
+    try {
+      said.push_back(swap_model(w, w.loading.get()));
+    } catch (const std::exception& e) {
+      said.push_back(std::string(e.what()) + " (changed on disk; the model as it was stays)");
+    }
+  }
+  if (!look) return;
+  for (ModelWatch& w : model_watches_) {
+    if (w.loading.valid()) continue;
+    bool changed = false;
+    for (FileStamp& f : w.files) changed = f.changed() || changed;  // every stamp brought up to date
+    if (!changed) continue;
+    w.loading = std::async(std::launch::async, [path = w.path, scale = w.scale, recenter = w.recenter] {
+      assets::Model m = assets::load_model(path);
+      assets::scale_and_recenter(m, scale, recenter);
+      return m;
+    });
+  }
+}
+
+std::string SceneContent::swap_model(ModelWatch& w, assets::Model fresh) {
+  const std::string name = w.path.string();
+  if (shape_of(fresh) != w.shape)
+    return name + ": changed shape; the trackers keep the shape they were given, so it is not drawn (restart to use it)";
+  renderer_.replace_model(w.model, fresh);  // throws, keeping the old, where its materials differ in number
+  Stream* s = find(w.target);
+  if (s == nullptr && !fresh.material_animations.empty()) {  // animated now: played from here on
+    Stream animated;
+    animated.target = w.target;
+    animated.model = w.model;
+    animated.material = content_material(fresh, "");
+    animated.materials = std::make_shared<assets::Model>();
+    players_.push_back(std::move(animated));
+    s = &players_.back();
+  }
+  if (s != nullptr) {
+    s->materials->materials = fresh.materials;
+    s->materials->material_animations = fresh.material_animations;
+  }
+  return name + ": changed; its textures and materials are drawn from now on";
 }
 
 void SceneContent::swap_in(Watch& w, std::unique_ptr<assets::VideoDecoder> decoder) {

@@ -89,6 +89,8 @@ struct FrameSlot {
   Buffer photometry;  ///< the projector's response for mesh.frag (set 1), written before this slot's frame
   vk::raii::DescriptorPool pool{nullptr};
   vk::raii::DescriptorSet set{nullptr};
+  Buffer draws;                   ///< each draw's material block (set 1 binding 1, dynamic offsets), host visible
+  std::size_t draw_capacity = 0;  ///< how many blocks `draws` holds
   vk::raii::Fence fence{nullptr};
   vk::raii::Semaphore acquired{nullptr};
   std::vector<std::shared_ptr<const void>> held;  ///< what this slot's frame reads from host memory (video frames)

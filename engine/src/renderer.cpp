@@ -69,13 +69,54 @@ void Renderer::Impl::ensure_slots(detail::TargetBackend& t) {
 void Renderer::Impl::make_frame_set(detail::FrameSlot& slot) {
   slot.photometry = gpu->make_buffer(sizeof(FrameUniform), vk::BufferUsageFlagBits::eUniformBuffer,
                                      vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
-  vk::DescriptorPoolSize size(vk::DescriptorType::eUniformBuffer, 1);
+  const vk::DescriptorPoolSize sizes[] = {{vk::DescriptorType::eUniformBuffer, 1},
+                                          {vk::DescriptorType::eUniformBufferDynamic, 1}};
   slot.pool = vk::raii::DescriptorPool(
-      gpu->device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, size));
+      gpu->device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, sizes));
   const vk::DescriptorSetLayout layout = *frame_set_layout;
   slot.set = std::move(vk::raii::DescriptorSets(gpu->device, vk::DescriptorSetAllocateInfo(*slot.pool, layout)).front());
   const vk::DescriptorBufferInfo info(*slot.photometry.buffer, 0, sizeof(FrameUniform));
   gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*slot.set, 0, 0, vk::DescriptorType::eUniformBuffer, {}, info), {});
+  ensure_draw_blocks(slot, 16);
+}
+
+void Renderer::Impl::ensure_draw_blocks(detail::FrameSlot& slot, std::size_t count) {
+  if (count <= slot.draw_capacity) return;
+  const std::size_t capacity = std::max(count, 2 * slot.draw_capacity);
+  slot.draws = gpu->make_buffer(capacity * draw_stride, vk::BufferUsageFlagBits::eUniformBuffer,
+                                vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent);
+  slot.draw_capacity = capacity;
+  const vk::DescriptorBufferInfo info(*slot.draws.buffer, 0, sizeof(DrawUniform));
+  gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*slot.set, 1, 0, vk::DescriptorType::eUniformBufferDynamic, {}, info),
+                                   {});
+}
+
+namespace {
+
+// A 2x3 placement as a 3x3 matrix, and back into a block's two rows.
+Eigen::Matrix3d homogeneous(const std::array<double, 6>& m) {
+  Eigen::Matrix3d h;
+  h << m[0], m[1], m[2], m[3], m[4], m[5], 0.0, 0.0, 1.0;
+  return h;
+}
+
+void put_rows(const Eigen::Matrix3d& h, std::array<float, 8>& rows) {
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 3; ++c) rows[static_cast<std::size_t>(4 * r + c)] = static_cast<float>(h(r, c));
+}
+
+}  // namespace
+
+DrawUniform detail::draw_uniform(const assets::Material& loaded, const assets::MaterialState& now) {
+  DrawUniform u{};
+  for (std::size_t c = 0; c < 3; ++c) u.emissive[c] = now.emissive_factor[c] * now.emissive_strength;
+  // The model's UVs carry the loaded base colour transform: each texture's placement is taken from there.
+  const Eigen::Matrix3d baked = homogeneous(loaded.base_color_transform.matrix());
+  const Eigen::Matrix3d from_model =
+      std::abs(baked.determinant()) > 1e-12 ? Eigen::Matrix3d(baked.inverse()) : Eigen::Matrix3d::Identity();
+  put_rows(homogeneous(now.base_color_transform.matrix()) * from_model, u.base_uv);
+  put_rows(homogeneous(now.emissive_transform.matrix()) * from_model, u.emissive_uv);
+  return u;
 }
 
 void Renderer::Impl::retire(detail::TargetBackend& t, std::size_t index) {
@@ -97,11 +138,12 @@ void Renderer::Impl::retire(detail::TargetBackend& t, std::size_t index) {
   slot.profiler->add(slot.record);
 }
 
-void Renderer::Impl::record_draws(const vk::raii::CommandBuffer& cmd, vk::Format format, const config::ProjectorConfig& projector,
-                                  bool depth_camera, const config::ProjectorConfig& panel, vk::DescriptorSet frame_set) {
+std::size_t Renderer::Impl::record_draws(const vk::raii::CommandBuffer& cmd, vk::Format format,
+                                         const config::ProjectorConfig& projector, bool depth_camera,
+                                         const config::ProjectorConfig& panel, detail::FrameSlot& slot, std::size_t first_block) {
   const Eigen::Matrix4d clip_from_projector_m = clip_from_projector(projector);
   const DrawConstants shared = frame_constants(panel, clip_from_projector_m);
-  cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout, 1, frame_set, {});
+  std::size_t block = first_block;
   // Opaque and masked first, blended after them so they blend over what is behind.
   // A depth camera sees every surface, whatever its material: one opaque pass.
   static constexpr bool kPasses[] = {false, true};
@@ -120,15 +162,22 @@ void Renderer::Impl::record_draws(const vk::raii::CommandBuffer& cmd, vk::Format
         if (!depth_camera && (mat.alpha_mode == assets::AlphaMode::kBlend) != blend_pass) continue;
         cmd.bindPipeline(vk::PipelineBindPoint::eGraphics,
                          *pipeline(format, !mat.double_sided, depth_camera ? 0 : alpha_mode_id(mat.alpha_mode), depth_camera));
-        cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout, 0, *m.sets[part.material], {});
-        c.base_color_factor =
-            static_cast<int>(part.material) == item.animated_material ? item.base_color_factor : mat.base_color_factor;
+        const auto animated = std::find_if(item.materials.begin(), item.materials.end(),
+                                           [&](const auto& look) { return look.first == static_cast<int>(part.material); });
+        const assets::MaterialState state = animated != item.materials.end() ? animated->second : mat.state();
+        const DrawUniform u = draw_uniform(mat, state);
+        const auto offset = static_cast<std::uint32_t>(block++ * draw_stride);
+        std::memcpy(static_cast<std::uint8_t*>(slot.draws.mapped) + offset, &u, sizeof u);  // the slot's last frame is retired
+        const vk::DescriptorSet sets[] = {*m.sets[part.material], *slot.set};
+        cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout, 0, sets, offset);
+        c.base_color_factor = state.base_color_factor;
         c.projector[3] = mat.alpha_cutoff;
         cmd.pushConstants<DrawConstants>(*pipeline_layout, vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment,
                                          0, c);
         cmd.drawIndexed(part.index_count, 1, part.first_index, part.vertex_offset, 0);
       }
     }
+  return block;
 }
 
 void Renderer::Impl::transition_depth(const vk::raii::CommandBuffer& cmd, vk::Image depth) {
@@ -150,7 +199,7 @@ void Renderer::Impl::begin_pass(const vk::raii::CommandBuffer& cmd, vk::ImageVie
   cmd.setScissor(0, vk::Rect2D({0, 0}, extent));
 }
 
-void Renderer::Impl::record_canvas(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, vk::DescriptorSet frame_set) {
+void Renderer::Impl::record_canvas(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, detail::FrameSlot& slot) {
   detail::LensCanvasImages& c = *t.canvas;  // made by draw_frame before the fence was reset
   detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                      vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eFragmentShader,
@@ -158,7 +207,7 @@ void Renderer::Impl::record_canvas(const vk::raii::CommandBuffer& cmd, detail::T
                      vk::AccessFlagBits2::eColorAttachmentWrite);
   transition_depth(cmd, *c.depth.image);
   begin_pass(cmd, *c.color.view, *c.depth.view, c.color.extent, 1.0F);
-  record_draws(cmd, t.color_format(), c.lens.pinhole, false, c.projector, frame_set);
+  record_draws(cmd, t.color_format(), c.lens.pinhole, false, c.projector, slot, 0);
   cmd.endRendering();
   detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eColorAttachmentOptimal,
                      vk::ImageLayout::eShaderReadOnlyOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
@@ -197,6 +246,9 @@ bool Renderer::Impl::draw_frame(detail::TargetBackend& t, const config::Projecto
 
   const bool lens = !t.depth_output() && config::has_distortion(projector.distortion);
   if (lens) ensure_canvas(t, projector);
+  std::size_t draws = 0;
+  for (const DrawItem& item : items) draws += models[item.model].parts.size();
+  ensure_draw_blocks(slot, draws);
 
   gpu->device.resetFences(*slot.fence);
   const FrameUniform uniform = frame_uniform(projector.photometry);  // the slot's last frame is done (retired)
@@ -211,7 +263,7 @@ bool Renderer::Impl::draw_frame(detail::TargetBackend& t, const config::Projecto
   }
   const double upload_start_ms = profiler ? profiler->now_ms() : 0.0;
   if (record_uploads(cmd, slot) > 0 && profiler) rec.upload_ms = profiler->now_ms() - upload_start_ms;
-  if (lens) record_canvas(cmd, t, *slot.set);
+  if (lens) record_canvas(cmd, t, slot);
   detail::transition(cmd, frame->color, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eUndefined,
                      vk::ImageLayout::eColorAttachmentOptimal, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
                      vk::AccessFlagBits2::eNone, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
@@ -222,7 +274,7 @@ bool Renderer::Impl::draw_frame(detail::TargetBackend& t, const config::Projecto
     transition_depth(cmd, *t.depth().image);
     begin_pass(cmd, frame->color_view, *t.depth().view, t.extent(), t.depth_output() ? 0.0F : 1.0F);
     // The projector image (width x height of the intrinsics) is stretched onto the target.
-    record_draws(cmd, t.color_format(), projector, t.depth_output(), projector, *slot.set);
+    record_draws(cmd, t.color_format(), projector, t.depth_output(), projector, slot, 0);
     cmd.endRendering();
   }
   const bool to_present = frame->color_final_layout == vk::ImageLayout::ePresentSrcKHR;
@@ -266,6 +318,7 @@ Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl
 Renderer::~Renderer() = default;
 const DeviceInfo& Renderer::device_info() const { return impl_->gpu->info; }
 std::size_t Renderer::add_model(const assets::Model& model) { return impl_->add_model(model); }
+void Renderer::replace_model(std::size_t model, const assets::Model& fresh) { impl_->replace_model(model, fresh); }
 void Renderer::set_surface(std::size_t model, const assets::Image& reflectance) { impl_->set_surface(model, reflectance); }
 std::size_t Renderer::add_streamed_texture(std::size_t model, int material, int width_px, int height_px) {
   return impl_->add_streamed_texture(model, material, width_px, height_px);

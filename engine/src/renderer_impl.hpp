@@ -44,6 +44,19 @@ inline FrameUniform frame_uniform(const config::Photometry& p) {
   return u;
 }
 
+/// mesh.frag's per-draw material block (set 1 binding 1, a dynamic uniform buffer; std140: 80 bytes): the
+/// emission, and where the base colour and emissive textures lie over the model's texture coordinates (the
+/// base colour transform as loaded is baked into those), as the rows of two 2x3 matrices.
+struct DrawUniform {
+  std::array<float, 4> emissive;     // rgb: emissive factor x strength
+  std::array<float, 8> base_uv;      // rows (xyz_) of the base colour texture's placement
+  std::array<float, 8> emissive_uv;  // rows of the emissive texture's
+};
+static_assert(sizeof(DrawUniform) == 80);
+
+/// A material's block in a draw where its state is `now` (its state as loaded, or animated).
+DrawUniform draw_uniform(const assets::Material& loaded, const assets::MaterialState& now);
+
 /// What every draw of a frame shares: full white's lux at 1 m, and how mesh.vert recovers the
 /// projector-frame position from clip coordinates (x = (clip.x - m02 clip.w) / m00, likewise y).
 inline DrawConstants frame_constants(const config::ProjectorConfig& projector, const Eigen::Matrix4d& clip_from_projector_m) {
@@ -110,10 +123,11 @@ struct GpuModel {
   std::vector<Part> parts;
   std::vector<assets::Material> materials;
   std::vector<detail::Image> textures;
-  std::vector<vk::raii::Sampler> samplers;
+  std::vector<vk::raii::Sampler> samplers;  // two per material: its base colour's, then its emission's
   vk::raii::DescriptorPool pool{nullptr};
-  std::vector<vk::raii::DescriptorSet> sets;  // one per material: binding 0 its base colour, 1 the surface
+  std::vector<vk::raii::DescriptorSet> sets;  // one per material: binding 0 its base colour, 1 the surface, 2 its emission
   detail::Image surface;                      // Renderer::set_surface's, sRGB; none: `white` is bound
+  std::map<int, std::size_t> streamed;        // material -> the streamed texture bound as its base colour
 };
 
 // A texture rewritten while it is drawn (a video on a material): the image the material samples, and one
@@ -188,8 +202,14 @@ struct Renderer::Impl {
   // projector's lens changes (the canvas's size and the warp map follow from those three).
   detail::LensCanvasImages& ensure_canvas(detail::TargetBackend& t, const config::ProjectorConfig& p);
 
+  // A model's buffers, textures and descriptor sets (its surface white).
+  GpuModel make_gpu_model(const assets::Model& model);
   std::size_t add_model(const assets::Model& model);
+  void replace_model(std::size_t model, const assets::Model& fresh);
   void set_surface(std::size_t model, const assets::Image& reflectance);
+  // A material's texture (`image` in the model's, -1: white) and a sampler of its own at `binding` of `set`.
+  void bind_material_texture(GpuModel& g, vk::DescriptorSet set, std::uint32_t binding, int image, const assets::Sampler& sampler,
+                             const std::string& what);
   // Binds `view` as each of model g's materials' surface (binding 1).
   void bind_surface(GpuModel& g, vk::ImageView view);
 
@@ -212,6 +232,9 @@ struct Renderer::Impl {
   std::size_t record_uploads(const vk::raii::CommandBuffer& cmd, detail::FrameSlot& slot);
 
   void ensure_slots(detail::TargetBackend& t);
+  // The slot's material blocks: room for `count` draws (grown when short; its last frame is retired).
+  void ensure_draw_blocks(detail::FrameSlot& slot, std::size_t count);
+  vk::DeviceSize draw_stride = 0;  // a material block's size rounded up to the device's uniform offset alignment
 
   // A slot's FrameUniform buffer (host visible, mapped) and its descriptor set.
   void make_frame_set(detail::FrameSlot& slot);
@@ -221,8 +244,10 @@ struct Renderer::Impl {
 
   // `projector`: the pinhole drawn through (a lens canvas's, or the projector's); `panel`: the projector
   // whose light compensation divides out.
-  void record_draws(const vk::raii::CommandBuffer& cmd, vk::Format format, const config::ProjectorConfig& projector,
-                    bool depth_camera, const config::ProjectorConfig& panel, vk::DescriptorSet frame_set);
+  // `slot`'s material blocks are written from `first_block` on; returns the next free one.
+  std::size_t record_draws(const vk::raii::CommandBuffer& cmd, vk::Format format, const config::ProjectorConfig& projector,
+                           bool depth_camera, const config::ProjectorConfig& panel, detail::FrameSlot& slot,
+                           std::size_t first_block);
 
   static void transition_depth(const vk::raii::CommandBuffer& cmd, vk::Image depth);
 
@@ -232,7 +257,7 @@ struct Renderer::Impl {
 
   // The lens pass's first half: the models through the canvas's pinhole, left ready to sample. One canvas
   // serves both frames in flight: the barriers order this frame's drawing after the last frame's sampling.
-  void record_canvas(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, vk::DescriptorSet frame_set);
+  void record_canvas(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, detail::FrameSlot& slot);
 
   // The lens pass's second half: every target pixel takes the canvas at its panel position's ray.
   // (ensure_canvas made its warp map for this projector and target size.)

@@ -19,13 +19,19 @@ using namespace detail;
 
 Renderer::Impl::Impl(const RendererOptions& options) : gpu(std::make_shared<Gpu>(options)) {
   const vk::DescriptorSetLayoutBinding bindings[] = {
-      // a material's base colour, its target's surface
+      // a material's base colour, its target's surface, the material's emission
       {0, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment},
-      {1, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment}};
+      {1, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment},
+      {2, vk::DescriptorType::eCombinedImageSampler, 1, vk::ShaderStageFlagBits::eFragment}};
   set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, bindings));
   vk::PushConstantRange push(vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment, 0, sizeof(DrawConstants));
-  vk::DescriptorSetLayoutBinding frame_binding(0, vk::DescriptorType::eUniformBuffer, 1, vk::ShaderStageFlagBits::eFragment);
-  frame_set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, frame_binding));
+  const vk::DescriptorSetLayoutBinding frame_bindings[] = {
+      // the projector's response; each draw's material block
+      {0, vk::DescriptorType::eUniformBuffer, 1, vk::ShaderStageFlagBits::eFragment},
+      {1, vk::DescriptorType::eUniformBufferDynamic, 1, vk::ShaderStageFlagBits::eFragment}};
+  frame_set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, frame_bindings));
+  const vk::DeviceSize align = std::max<vk::DeviceSize>(1, gpu->physical.getProperties().limits.minUniformBufferOffsetAlignment);
+  draw_stride = (sizeof(DrawUniform) + align - 1) / align * align;
   const vk::DescriptorSetLayout layouts[] = {*set_layout, *frame_set_layout};
   pipeline_layout = vk::raii::PipelineLayout(gpu->device, vk::PipelineLayoutCreateInfo({}, layouts, push));
   vert = vk::raii::ShaderModule(gpu->device, vk::ShaderModuleCreateInfo({}, sizeof(k_mesh_vert_spv), k_mesh_vert_spv));
@@ -159,7 +165,7 @@ const vk::raii::Pipeline& Renderer::Impl::lens_pipeline(vk::Format format) {
   return lens_pipelines.emplace(format, vk::raii::Pipeline(gpu->device, nullptr, info)).first->second;
 }
 
-std::size_t Renderer::Impl::add_model(const assets::Model& model) {
+GpuModel Renderer::Impl::make_gpu_model(const assets::Model& model) {
   if (model.primitives.empty()) throw EngineError(model.source + ": model has no triangles to draw");
   GpuModel g;
   std::vector<GpuVertex> vertices;
@@ -178,29 +184,53 @@ std::size_t Renderer::Impl::add_model(const assets::Model& model) {
   g.materials = model.materials;
 
   const auto n = static_cast<std::uint32_t>(model.materials.size());
-  vk::DescriptorPoolSize size(vk::DescriptorType::eCombinedImageSampler, 2 * n);
+  vk::DescriptorPoolSize size(vk::DescriptorType::eCombinedImageSampler, 3 * n);
   g.pool = vk::raii::DescriptorPool(gpu->device,
                                     vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, n, size));
   std::vector<vk::DescriptorSetLayout> layouts(n, *set_layout);
   vk::raii::DescriptorSets sets(gpu->device, vk::DescriptorSetAllocateInfo(*g.pool, layouts));
   for (std::uint32_t i = 0; i < n; ++i) {
     const auto& m = model.materials[i];
-    const bool textured = m.base_color_image >= 0 && static_cast<std::size_t>(m.base_color_image) < g.textures.size() &&
-                          *g.textures[static_cast<std::size_t>(m.base_color_image)].view;
-    if (m.base_color_image >= 0 && !textured)
-      throw EngineError(model.source + ": material " + std::to_string(i) + " has no usable texture");
-    g.samplers.emplace_back(
-        gpu->device, vk::SamplerCreateInfo({}, to_vk(m.sampler.mag), to_vk(m.sampler.min), vk::SamplerMipmapMode::eNearest,
-                                           to_vk(m.sampler.wrap_s), to_vk(m.sampler.wrap_t), vk::SamplerAddressMode::eRepeat));
-    const vk::ImageView view = textured ? *g.textures[static_cast<std::size_t>(m.base_color_image)].view : *white.view;
-    vk::DescriptorImageInfo image_info(*g.samplers.back(), view, vk::ImageLayout::eShaderReadOnlyOptimal);
-    gpu->device.updateDescriptorSets(
-        vk::WriteDescriptorSet(*sets[i], 0, 0, vk::DescriptorType::eCombinedImageSampler, image_info), {});
+    bind_material_texture(g, *sets[i], 0, m.base_color_image, m.sampler, "material " + std::to_string(i));
+    bind_material_texture(g, *sets[i], 2, m.emissive_image, m.emissive_sampler, "material " + std::to_string(i) + "'s emission");
   }
   for (auto& s : sets) g.sets.push_back(std::move(s));
   bind_surface(g, *white.view);
-  models.push_back(std::move(g));
+  return g;
+}
+
+std::size_t Renderer::Impl::add_model(const assets::Model& model) {
+  models.push_back(make_gpu_model(model));
   return models.size() - 1;
+}
+
+void Renderer::Impl::replace_model(std::size_t model, const assets::Model& fresh) {
+  if (model >= models.size()) throw EngineError("model " + std::to_string(model) + " to replace, not uploaded");
+  GpuModel& old = models[model];
+  if (fresh.materials.size() != old.materials.size())
+    throw EngineError(fresh.source + ": " + std::to_string(fresh.materials.size()) + " materials where the model drawn has " +
+                      std::to_string(old.materials.size()));
+  GpuModel g = make_gpu_model(fresh);  // refused (thrown) before anything drawn changes
+  gpu->device.waitIdle();              // the old model's buffers and sets may be in a frame in flight
+  g.surface = std::move(old.surface);
+  if (*g.surface.view) bind_surface(g, *g.surface.view);
+  const std::map<int, std::size_t> streamed_before = old.streamed;
+  old.sets.clear();              // freed into their pool before it goes (a move would destroy the pool first)
+  models[model] = std::move(g);  // `old` is the new one from here
+  for (const auto& [material, texture] : streamed_before) bind_streamed_texture(texture, model, material);
+}
+
+void Renderer::Impl::bind_material_texture(GpuModel& g, vk::DescriptorSet set, std::uint32_t binding, int image,
+                                           const assets::Sampler& sampler, const std::string& what) {
+  const bool textured =
+      image >= 0 && static_cast<std::size_t>(image) < g.textures.size() && *g.textures[static_cast<std::size_t>(image)].view;
+  if (image >= 0 && !textured) throw EngineError(what + " has no usable texture");
+  g.samplers.emplace_back(gpu->device,
+                          vk::SamplerCreateInfo({}, to_vk(sampler.mag), to_vk(sampler.min), vk::SamplerMipmapMode::eNearest,
+                                                to_vk(sampler.wrap_s), to_vk(sampler.wrap_t), vk::SamplerAddressMode::eRepeat));
+  const vk::ImageView view = textured ? *g.textures[static_cast<std::size_t>(image)].view : *white.view;
+  const vk::DescriptorImageInfo info(*g.samplers.back(), view, vk::ImageLayout::eShaderReadOnlyOptimal);
+  gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(set, binding, 0, vk::DescriptorType::eCombinedImageSampler, info), {});
 }
 
 void Renderer::Impl::bind_surface(GpuModel& g, vk::ImageView view) {
@@ -251,7 +281,8 @@ void Renderer::Impl::bind_streamed_texture(std::size_t id, std::size_t model, in
   GpuModel& g = model_with_material(model, material);
   const auto m = static_cast<std::size_t>(material);
   gpu->device.waitIdle();  // the material's descriptor set may be in a frame in flight
-  vk::DescriptorImageInfo info(*g.samplers[m], *streamed[id].image.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+  g.streamed[material] = id;
+  vk::DescriptorImageInfo info(*g.samplers[2 * m], *streamed[id].image.view, vk::ImageLayout::eShaderReadOnlyOptimal);
   gpu->device.updateDescriptorSets(vk::WriteDescriptorSet(*g.sets[m], 0, 0, vk::DescriptorType::eCombinedImageSampler, info), {});
 }
 

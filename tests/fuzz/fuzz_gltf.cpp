@@ -9,6 +9,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const auto& p : model.primitives)
       for (auto i : p.indices)
         if (i >= p.vertices.size()) __builtin_trap();  // the loader promised in-range indices
+    for (const double t : {-1.0, 0.0, 0.7, 1e3})       // its material animations played, whatever their keys
+      for (const auto& [material, state] : projbot::assets::animate_materials(model, t))
+        if (material < 0 || static_cast<std::size_t>(material) >= model.materials.size()) __builtin_trap();
   } catch (const projbot::assets::AssetError&) {
   }
   return 0;

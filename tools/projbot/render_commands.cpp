@@ -114,7 +114,8 @@ const Command kShow{
     "projbot show [--scene S.yaml] [--fullscreen] [--monitor N] [--present-mode fifo|mailbox|immediate]\n\n"
     "Opens a window showing the projector image and redraws it every frame until the window is closed\n"
     "(or --frames have been drawn). Without --fullscreen the window has the projector's size. Targets with\n"
-    "`content:` play their videos from the moment the window opens.\n",
+    "`content:` or animated materials play them from the moment the window opens; a model, texture or\n"
+    "video changed on disk is drawn anew within a second.\n",
     with_scene_options({{"fullscreen", "", "fullscreen on --monitor (the projector)"},
                         {"monitor", "N", "monitor index for --fullscreen (default 0)"},
                         {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
@@ -129,7 +130,7 @@ const Command kShow{
       std::cout << "device: " << renderer.device_info().name << '\n';
       std::vector<assets::Model> models;
       const auto items = engine::upload_scene(renderer, scene, &models);
-      engine::SceneContent content(renderer, scene, models, items);  // the targets' videos, previewed
+      engine::SceneContent content(renderer, scene, models, items);  // the targets' videos and animations, previewed
       auto window = open_window(renderer, w, scene.projector);
       engine::FrameProfiler profiler;
       int drawn = 0;
@@ -140,8 +141,11 @@ const Command kShow{
         for (int i = 0; i < static_cast<int>(items.size()); ++i)
           if (content.has(i)) content.apply(i, now - content.start_s(i, t0, t0), out[static_cast<std::size_t>(i)]);
       };
-      while (!window->poll_close() && (frames == 0 || drawn < frames))
+      while (!window->poll_close() && (frames == 0 || drawn < frames)) {
         if (renderer.draw_frame(*window, scene.projector, read, &profiler)) ++drawn;
+        for (const std::string& e : content.reload_changed(config::steady_now_s()))  // a texture or video edited
+          std::cout << "content: " << e << '\n';
+      }
       renderer.finish(*window);
       finish_profile(args, profiler);
       return report_validation(args, renderer) ? 0 : 1;

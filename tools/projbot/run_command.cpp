@@ -161,9 +161,10 @@ const Command kRun{
     "what they answered then, each stop's frames play at their recorded pace and are tracked in lockstep,\n"
     "and every pose is compared with the recording's (the largest difference is printed); no device and\n"
     "no twin is used, so nothing is measured against a truth.\n"
-    "Targets with `content:` (a video, a timeline) play it on each frame's display time; a video file that\n"
-    "changes on disk is loaded again and swapped in at a later frame (tracking goes on), and one that fails\n"
-    "to load leaves the old one playing and says why.\n"
+    "Targets with `content:` (a video, a timeline) or animated materials play them on each frame's display\n"
+    "time; a video, model or texture file that changes on disk is loaded again and swapped in at a later\n"
+    "frame (tracking goes on; a model of another shape is not), and one that fails to load leaves the old\n"
+    "one and says why.\n"
     "Without --config the shipped demo tour runs in the twin.\n",
     {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)", cli::PathRole::input_file},
      {"sim", "", "run against the digital twin, whatever `devices:` configures (the default without one)"},

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "projbot/assets/image.hpp"
@@ -25,7 +26,30 @@ struct Sampler {
   Filter min = Filter::kLinear;
 };
 
-/// Unlit material: a pixel shows texture * base_color_factor * vertex colour.
+/// A texture's placement (glTF KHR_texture_transform): uv' = T(offset) R(rotation) S(scale) uv, the rotation
+/// counter-clockwise in UV space.
+struct TextureTransform {
+  std::array<double, 2> offset{0.0, 0.0};
+  std::array<double, 2> scale{1.0, 1.0};
+  double rotation_rad = 0.0;
+  /// Row-major 2x3: u' = m0 u + m1 v + m2, v' = m3 u + m4 v + m5.
+  std::array<double, 6> matrix() const;
+  bool operator==(const TextureTransform&) const = default;
+};
+
+/// What of a material changes over time (issue 44): what glTF's KHR_animation_pointer channels and a
+/// scene's content timeline animate.
+struct MaterialState {
+  std::array<float, 4> base_color_factor{1.0F, 1.0F, 1.0F, 1.0F};
+  std::array<float, 3> emissive_factor{0.0F, 0.0F, 0.0F};  ///< glTF emissiveFactor
+  float emissive_strength = 1.0F;                          ///< KHR_materials_emissive_strength
+  TextureTransform base_color_transform;                   ///< of the base colour texture
+  TextureTransform emissive_transform;                     ///< of the emissive texture
+  bool operator==(const MaterialState&) const = default;
+};
+
+/// Unlit material: a pixel shows texture * base_color_factor * vertex colour, plus its emission
+/// (emissive texture * emissive_factor * emissive_strength), each as stored.
 struct Material {
   std::string name;                                                ///< as the file names it (glTF), or empty
   std::array<float, 4> base_color_factor{1.0F, 1.0F, 1.0F, 1.0F};  ///< linear RGBA multiplier
@@ -34,6 +58,48 @@ struct Material {
   AlphaMode alpha_mode = AlphaMode::kOpaque;
   float alpha_cutoff = 0.5F;  ///< used with kMask
   bool double_sided = false;
+  std::array<float, 3> emissive_factor{0.0F, 0.0F, 0.0F};  ///< 0: no emission
+  float emissive_strength = 1.0F;
+  int emissive_image = -1;  ///< index into Model::images, -1 for none (white)
+  Sampler emissive_sampler;
+  /// The base colour texture's transform as loaded: already baked into the primitives' texture coordinates
+  /// (what the CPU samplers and the renderer read), kept to place an animated one relative to it.
+  TextureTransform base_color_transform;
+  TextureTransform emissive_transform;  ///< the emissive texture's, from the file's texture coordinates
+
+  /// Its state as loaded.
+  MaterialState state() const;
+};
+
+/// One glTF KHR_animation_pointer channel on a material property, sampled as glTF says (step, linear, or
+/// cubic spline with in- and out-tangents).
+struct MaterialChannel {
+  enum class Property {
+    kBaseColorFactor,    // 4 numbers
+    kEmissiveFactor,     // 3
+    kEmissiveStrength,   // 1
+    kBaseColorOffset,    // 2
+    kBaseColorScale,     // 2
+    kBaseColorRotation,  // 1
+    kEmissiveOffset,     // 2
+    kEmissiveScale,      // 2
+    kEmissiveRotation    // 1
+  };
+  enum class Interpolation { kStep, kLinear, kCubicSpline };
+  int material = 0;
+  Property property = Property::kBaseColorFactor;
+  Interpolation interpolation = Interpolation::kLinear;
+  std::vector<float> times;   ///< seconds, increasing
+  std::vector<float> values;  ///< width(property) numbers per time; cubic spline: in-tangent, value, out-tangent
+  /// The numbers a value of `p` has.
+  static int width(Property p);
+};
+
+/// A glTF animation's material channels, repeating every duration_s (its last key's time).
+struct MaterialAnimation {
+  std::string name;
+  double duration_s = 0.0;
+  std::vector<MaterialChannel> channels;
 };
 
 /// Interleaved vertex as uploaded to the GPU. Position in the model frame, metres.
@@ -54,9 +120,14 @@ struct Primitive {
 /// A whole model in its model frame (glTF scene frame with node transforms applied), metres.
 struct Model {
   std::string source;  ///< file name, for messages
+  /// The files it was read from: the model file, and a glTF's external buffers and images (what `run`
+  /// watches for changes).
+  std::vector<std::filesystem::path> files;
   std::vector<Primitive> primitives;
   std::vector<Material> materials;  ///< never empty after loading (a default material is added)
   std::vector<Image> images;
+  /// The file's animations of material properties (KHR_animation_pointer); node animations are not kept.
+  std::vector<MaterialAnimation> material_animations;
 
   std::size_t triangle_count() const;
   Eigen::AlignedBox3d bounds() const;
@@ -66,7 +137,15 @@ struct Model {
 
 /// Loads a glTF 2.0 file (.gltf with external or data-URI buffers, or .glb).
 /// Throws AssetError naming the file and the problem; never returns a partly loaded model.
+/// Honours KHR_texture_transform (the base colour texture's baked into the UVs), KHR_materials_emissive_strength
+/// and KHR_animation_pointer on material properties (Model::material_animations); node animations are not
+/// played (the object does not move with them: one warning per file).
 Model load_gltf(const std::filesystem::path& path);
+
+/// Each animated material's state at `t_s` seconds: every animation plays from 0 and repeats over its own
+/// duration (a negative time is its first key); a channel sets its property over the material's state as
+/// loaded. Pairs of (material index, state), by material; empty for a model without material animations.
+std::vector<std::pair<int, MaterialState>> animate_materials(const Model& model, double t_s);
 
 /// Loads a PLY (binary or ASCII), OBJ (with its .mtl) or STL mesh through Assimp, in a child process (the
 /// importers are not safe on hostile files). Faces are triangulated; normals come from the faces where the

@@ -99,11 +99,17 @@ struct TargetSurface {
 /// texture, on the display clock of each frame drawn.
 struct TargetContent {
   enum class Start { kArrival, kTour, kAt };
-  /// One key of `timeline:`: the material's base colour factor (linear RGBA, each 0..1) at at_s seconds of
-  /// content time; between keys it is interpolated linearly, before the first and after the last it holds.
+  /// One key of `timeline:`: the material's properties at at_s seconds of content time; between keys they are
+  /// interpolated linearly, before the first and after the last they hold. Every key gives the same ones
+  /// (at least one); what none gives stays as the model has it.
   struct Key {
     double at_s = 0.0;
-    std::array<double, 4> base_color_factor{1.0, 1.0, 1.0, 1.0};
+    std::optional<std::array<double, 4>> base_color_factor;  ///< linear RGBA, each 0..1
+    std::optional<std::array<double, 3>> emissive_factor;    ///< each 0..1, added as stored
+    /// The base colour texture's (or the video's) placement: KHR_texture_transform's offset, scale, rotation.
+    std::optional<std::array<double, 2>> uv_offset;
+    std::optional<std::array<double, 2>> uv_scale;
+    std::optional<double> uv_rotation_deg;
   };
   std::filesystem::path video;  ///< `video:`; relative paths resolved against the scene's folder; empty: none
   /// `material:` as written: a material's name or its index; empty: the model's first textured material
@@ -114,8 +120,9 @@ struct TargetContent {
   /// (when the tour began), or a number: that many seconds after the tour began (kAt, at_s).
   Start start = Start::kArrival;
   double at_s = 0.0;
-  /// `timeline: [{at_s: 0, base_color_factor: [r, g, b, a]}, ...]`: the material's colour over content time
-  /// (times increasing; with loop, it repeats every last at_s). A model's own animations are not used.
+  /// `timeline: [{at_s: 0, base_color_factor: [r, g, b, a], emissive_factor: [r, g, b], uv_offset: [u, v],
+  /// uv_scale: [u, v], uv_rotation_deg: D}, ...]`: the material over content time (times increasing; with
+  /// loop, it repeats every last at_s), over the model's own material animations where it has any.
   std::vector<Key> timeline;
 };
 

@@ -6,6 +6,7 @@
 // threads). Also what a scene's targets are uploaded with: their models and their surfaces.
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <future>
 #include <memory>
@@ -44,13 +45,14 @@ int content_material(const assets::Model& model, const std::string& spec);
 
 class SceneContent {
  public:
-  /// Opens every target's video and makes it its material's base colour (`items[i]`: target i's uploaded
+  /// Opens every target's video and makes it its material's base colour, and keeps its model's material
+  /// animations (`items[i]`: target i's uploaded
   /// model, as upload_scene gives them; `models[i]` its CPU copy). Throws assets::AssetError naming the file
   /// or the material.
   SceneContent(Renderer& renderer, const config::Scene& scene, const std::vector<assets::Model>& models,
                const std::vector<DrawItem>& items);
   bool empty() const { return players_.empty(); }
-  bool has(int target) const;        ///< target `target` has content (a video, a timeline or both)
+  bool has(int target) const;        ///< target `target` has content (a video, a timeline, its model's animations)
   bool has_video(int target) const;  ///< target `target` plays a video
 
   /// When target `target`'s content time is 0, on the display clock: the tour's start, the arrival at its stop
@@ -70,16 +72,20 @@ class SceneContent {
   /// timeline (animate).
   Sample apply(int target, double content_s, DrawItem& item);
 
-  /// Target `target`'s animated material at `content_s`: its timeline's base colour factor (linear between
-  /// keys, held outside them, repeating every last key's time where it loops) set on `item`. A target
-  /// without a timeline leaves `item` as it is.
+  /// Target `target`'s animated materials at `content_s`, set on `item` (DrawItem::materials): the model's own
+  /// material animations (glTF KHR_animation_pointer, each repeating over its length), then its timeline's
+  /// properties on its content material (linear between keys, held outside them, repeating every last key's
+  /// time where it loops). A target with neither leaves `item` as it is.
   void animate(int target, double content_s, DrawItem& item) const;
 
   /// Watches the content files while it runs: at most every `interval_s` (on `now_s`'s clock) it looks at
   /// each video's size and modification time; a changed one is opened again on a loader thread, and a later
   /// call swaps it in (the texture kept where the size is the same) from content time 0 of its own; a file
-  /// that fails to load leaves the old one playing. Call once per frame on the render thread. Returns one
-  /// line per swap or failure, naming the file.
+  /// that fails to load leaves the old one playing. Each target's model files (Model::files: the model, a
+  /// glTF's buffers and textures) likewise: a changed one is loaded again and its textures, materials and
+  /// their animations are drawn from then on, where its shape is the same (the trackers keep the shape
+  /// they were given: a new one needs a restart) and its materials as many. Call once per frame on the
+  /// render thread. Returns one line per swap or failure, naming the file.
   std::vector<std::string> reload_changed(double now_s, double interval_s = 0.5);
 
   /// Target `target`'s player (it must have a video; targets with the same video and start share one).
@@ -99,24 +105,48 @@ class SceneContent {
     std::size_t texture = 0;
     int material = 0;
     std::size_t model = 0;  ///< its model in the renderer
+    /// The model's materials as loaded and their animations (no geometry): what animate() starts from.
+    std::shared_ptr<assets::Model> materials;
     double offset_s = 0.0;  ///< content time when its video was swapped in (it plays from its own start)
     double last_s = 0.0;    ///< the content time last shown
+  };
+  // A file as it was when last looked at.
+  struct FileStamp {
+    std::filesystem::path file;
+    std::filesystem::file_time_type written{};
+    std::uintmax_t size = 0;
+    bool changed();  // since the last look (which it becomes); false while it cannot be read
   };
   // A video as played (one per player) and its file as it was when loaded, and its reload under way.
   struct Watch {
     std::shared_ptr<assets::VideoPlayer> player;
-    std::filesystem::path file;
-    std::filesystem::file_time_type written{};
-    std::uintmax_t size = 0;
+    FileStamp stamp;
     std::future<std::unique_ptr<assets::VideoDecoder>> loading;
   };
+  // A target's model as drawn: where it came from, its files, its shape, and its reload under way.
+  struct ModelWatch {
+    int target = -1;
+    std::size_t model = 0;  // in the renderer
+    std::filesystem::path path;
+    double scale = 1.0;
+    bool recenter = false;
+    std::vector<FileStamp> files;
+    std::uint64_t shape = 0;  // shape_of its model
+    std::future<assets::Model> loading;
+  };
+  static std::uint64_t shape_of(const assets::Model& model);
+  void watch_models(const config::Scene& scene, const std::vector<assets::Model>& models, const std::vector<DrawItem>& items);
+  void reload_videos(bool look, std::vector<std::string>& said);
+  void reload_models(bool look, std::vector<std::string>& said);
+  std::string swap_model(ModelWatch& w, assets::Model fresh);
   const Stream* find(int target) const;
   Stream* find(int target) { return const_cast<Stream*>(std::as_const(*this).find(target)); }
   std::shared_ptr<assets::VideoPlayer> make_player(std::unique_ptr<assets::VideoDecoder> decoder, bool loop);
   void swap_in(Watch& w, std::unique_ptr<assets::VideoDecoder> decoder);
   Renderer& renderer_;
   std::vector<Stream> players_;
-  std::vector<Watch> watches_;  // one per player
+  std::vector<Watch> watches_;             // one per player
+  std::vector<ModelWatch> model_watches_;  // one per target
   double last_look_s_ = -1e300;
 };
 

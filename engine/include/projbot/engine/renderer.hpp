@@ -82,10 +82,9 @@ struct DrawItem {
   std::size_t model = 0;
   Eigen::Matrix4d T_projector_target = Eigen::Matrix4d::Identity();
   Compensation compensation;  ///< off: the content as stored; on: what makes its surface show it (issue 43)
-  /// An animated material (issue 44): material `animated_material` of the model draws with this base colour
-  /// factor in place of its own; -1: none.
-  int animated_material = -1;
-  std::array<float, 4> base_color_factor{1.0F, 1.0F, 1.0F, 1.0F};
+  /// Materials drawn other than as loaded (issue 44: a content timeline, the model's own animations): each a
+  /// material index of the model and its state in this draw (base colour factor, emission, texture placements).
+  std::vector<std::pair<int, assets::MaterialState>> materials;
 };
 
 /// Called once per frame, as late as possible, to fill the poses to draw (the newest ones).
@@ -133,6 +132,11 @@ class Renderer {
 
   /// Uploads a model's meshes and textures; returns its id for DrawItem::model.
   std::size_t add_model(const assets::Model& model);
+  /// Model `model` drawn from `fresh` from the next frame: its vertices, materials and textures (a texture
+  /// or material changed on disk, issue 44). Its surface and the streamed textures bound to its materials
+  /// stay. `fresh` must have as many materials; its shape is the caller's to check (the trackers keep the
+  /// old one). Waits for the frames in flight. Throws EngineError, leaving the old one drawn.
+  void replace_model(std::size_t model, const assets::Model& fresh);
   /// The physical surface of model `model`'s target (issue 43, `surface.texture`): its reflectance over the
   /// model's UVs (RGBA8, sRGB-coded), which compensation divides the content by, per fragment, besides the
   /// Compensation's per-channel scale (give the target an albedo of 1 there). Until set, every model's is
