@@ -7,6 +7,8 @@
 layout(location = 0) in vec2 in_uv;
 layout(location = 1) in vec4 in_color;
 layout(location = 2) in vec3 in_q;
+layout(location = 0, component = 2) in vec2 in_base_uv;  // the base colour texture's placement of in_uv (mesh.vert)
+layout(location = 3) in vec2 in_emissive_uv;  // the emissive texture's
 
 layout(set = 0, binding = 0) uniform sampler2D base_color_texture;
 // The target's physical surface over the same UVs (Renderer::set_surface): linear reflectance, which
@@ -22,8 +24,8 @@ layout(set = 1, binding = 0) uniform Frame {
   vec4 response;  // xyz: 1 / each channel's gamma; w: the black level
 } frame;
 
-// This draw's material as it is now (renderer_impl.hpp's DrawUniform, issue 44): its emission, and where
-// its textures lie over the model's texture coordinates (rows of 2x3 matrices; identity unless animated).
+// This draw's material as it is now (renderer_impl.hpp's DrawUniform, issue 44): its emission here, its
+// textures' placements in mesh.vert.
 layout(set = 1, binding = 1) uniform Material {
   vec4 emissive;  // rgb: emissive factor x strength, added as stored
   vec4 base_uv[2];
@@ -33,6 +35,9 @@ layout(set = 1, binding = 1) uniform Material {
 // glTF alphaMode, fixed per pipeline so OPAQUE and BLEND carry no discard (which would stop early depth
 // testing) and no per-fragment branch: 0 opaque, 1 mask, 2 blend.
 layout(constant_id = 0) const int kAlphaMode = 0;
+// renderer_impl.hpp's Shading: the textures placed other than over in_uv as it is (mesh.vert), an emission.
+layout(constant_id = 1) const bool kPlaced = false;
+layout(constant_id = 2) const bool kEmissive = false;
 
 layout(push_constant) uniform Draw {
   mat4 clip_from_model;
@@ -70,15 +75,10 @@ vec3 compensated(vec3 c, float white) {
   return pow(clamp(x, 0.0, 1.0), frame.response.xyz);
 }
 
-vec2 placed(vec4 rows[2]) {
-  vec3 uv1 = vec3(in_uv, 1.0);
-  return vec2(dot(rows[0].xyz, uv1), dot(rows[1].xyz, uv1));
-}
-
 void main() {
   float white = draw.compensate.r > 0.0 ? white_lux() : 0.0;
-  vec4 c = texture(base_color_texture, placed(material.base_uv)) * draw.base_color_factor * in_color;
-  c.rgb += material.emissive.rgb * texture(emissive_texture, placed(material.emissive_uv)).rgb;
+  vec4 c = texture(base_color_texture, kPlaced ? in_base_uv : in_uv) * draw.base_color_factor * in_color;
+  if (kEmissive) c.rgb += material.emissive.rgb * texture(emissive_texture, kPlaced ? in_emissive_uv : in_uv).rgb;
   if (kAlphaMode == 1) {
     if (c.a < draw.projector.w) discard;
     c.a = 1.0;

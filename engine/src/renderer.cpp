@@ -107,6 +107,14 @@ void put_rows(const Eigen::Matrix3d& h, std::array<float, 8>& rows) {
 
 }  // namespace
 
+Shading detail::shading(const DrawUniform& u) {
+  static constexpr std::array<float, 8> kIdentity{1, 0, 0, 0, 0, 1, 0, 0};
+  Shading s;
+  s.emissive = u.emissive[0] > 0.0F || u.emissive[1] > 0.0F || u.emissive[2] > 0.0F ? VK_TRUE : VK_FALSE;
+  s.placed = u.base_uv != kIdentity || (s.emissive && u.emissive_uv != kIdentity) ? VK_TRUE : VK_FALSE;
+  return s;
+}
+
 DrawUniform detail::draw_uniform(const assets::Material& loaded, const assets::MaterialState& now) {
   DrawUniform u{};
   for (std::size_t c = 0; c < 3; ++c) u.emissive[c] = now.emissive_factor[c] * now.emissive_strength;
@@ -160,12 +168,13 @@ std::size_t Renderer::Impl::record_draws(const vk::raii::CommandBuffer& cmd, vk:
       for (const auto& part : m.parts) {
         const assets::Material& mat = m.materials[part.material];
         if (!depth_camera && (mat.alpha_mode == assets::AlphaMode::kBlend) != blend_pass) continue;
-        cmd.bindPipeline(vk::PipelineBindPoint::eGraphics,
-                         *pipeline(format, !mat.double_sided, depth_camera ? 0 : alpha_mode_id(mat.alpha_mode), depth_camera));
         const auto animated = std::find_if(item.materials.begin(), item.materials.end(),
                                            [&](const auto& look) { return look.first == static_cast<int>(part.material); });
         const assets::MaterialState state = animated != item.materials.end() ? animated->second : mat.state();
         const DrawUniform u = draw_uniform(mat, state);
+        Shading sh = depth_camera ? Shading{} : shading(u);
+        sh.alpha_mode = depth_camera ? 0 : alpha_mode_id(mat.alpha_mode);
+        cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline(format, !mat.double_sided, sh, depth_camera));
         const auto offset = static_cast<std::uint32_t>(block++ * draw_stride);
         std::memcpy(static_cast<std::uint8_t*>(slot.draws.mapped) + offset, &u, sizeof u);  // the slot's last frame is retired
         const vk::DescriptorSet sets[] = {*m.sets[part.material], *slot.set};

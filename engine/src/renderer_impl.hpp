@@ -75,6 +75,20 @@ inline bool same_lens(const config::ProjectorConfig& a, const config::ProjectorC
          a.cx_px == b.cx_px && a.cy_px == b.cy_px && a.distortion == b.distortion;
 }
 
+/// The mesh shaders' specialisation constants (constant_id 0, 1, 2): glTF's alpha mode; whether the draw's
+/// textures are placed other than over the model's UVs as they are (an animated KHR_texture_transform, an
+/// emissive texture's own); whether it emits. A draw without either runs the shaders as they were before
+/// materials moved (no per-vertex placement, no emissive fetch): on lavapipe that kept the 1080p frame of
+/// the 100k-triangle sphere at its former time.
+struct Shading {
+  std::int32_t alpha_mode = 0;
+  vk::Bool32 placed = VK_FALSE;
+  vk::Bool32 emissive = VK_FALSE;
+};
+
+/// How a draw whose material block is `u` shades (alpha mode aside).
+Shading shading(const DrawUniform& u);
+
 /// The fragment shader's kAlphaMode specialisation constant.
 inline std::int32_t alpha_mode_id(assets::AlphaMode mode) {
   return mode == assets::AlphaMode::kOpaque ? 0 : mode == assets::AlphaMode::kMask ? 1 : 2;
@@ -162,8 +176,8 @@ struct Renderer::Impl {
   vk::raii::ShaderModule vert{nullptr};
   vk::raii::ShaderModule frag{nullptr};
   vk::raii::ShaderModule depth_frag{nullptr};
-  // (format, cull back, alpha mode, depth camera)
-  std::map<std::tuple<vk::Format, bool, std::int32_t, bool>, vk::raii::Pipeline> pipelines;
+  // (format, cull back, alpha mode, placed, emissive, depth camera)
+  std::map<std::tuple<vk::Format, bool, std::int32_t, vk::Bool32, vk::Bool32, bool>, vk::raii::Pipeline> pipelines;
   // The lens pass (a projector with distortion): one full-target triangle sampling the canvas.
   vk::raii::PipelineLayout lens_layout{nullptr};
   vk::raii::ShaderModule lens_vert{nullptr};
@@ -194,7 +208,7 @@ struct Renderer::Impl {
                                 vk::ImageLayout before, vk::PipelineStageFlags2 before_stage, vk::AccessFlags2 before_access);
 
   // One pipeline builder: every variant differs only in target format, culling and blending.
-  const vk::raii::Pipeline& pipeline(vk::Format format, bool cull_back, std::int32_t alpha_mode, bool depth_camera);
+  const vk::raii::Pipeline& pipeline(vk::Format format, bool cull_back, const detail::Shading& shading, bool depth_camera);
 
   const vk::raii::Pipeline& lens_pipeline(vk::Format format);
 

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include "renderer_impl.hpp"
@@ -28,7 +29,7 @@ Renderer::Impl::Impl(const RendererOptions& options) : gpu(std::make_shared<Gpu>
   const vk::DescriptorSetLayoutBinding frame_bindings[] = {
       // the projector's response; each draw's material block
       {0, vk::DescriptorType::eUniformBuffer, 1, vk::ShaderStageFlagBits::eFragment},
-      {1, vk::DescriptorType::eUniformBufferDynamic, 1, vk::ShaderStageFlagBits::eFragment}};
+      {1, vk::DescriptorType::eUniformBufferDynamic, 1, vk::ShaderStageFlagBits::eVertex | vk::ShaderStageFlagBits::eFragment}};
   frame_set_layout = vk::raii::DescriptorSetLayout(gpu->device, vk::DescriptorSetLayoutCreateInfo({}, frame_bindings));
   const vk::DeviceSize align = std::max<vk::DeviceSize>(1, gpu->physical.getProperties().limits.minUniformBufferOffsetAlignment);
   draw_stride = (sizeof(DrawUniform) + align - 1) / align * align;
@@ -100,14 +101,16 @@ void Renderer::Impl::record_image_copy(const vk::raii::CommandBuffer& cmd, vk::B
                      vk::AccessFlagBits2::eShaderSampledRead);
 }
 
-const vk::raii::Pipeline& Renderer::Impl::pipeline(vk::Format format, bool cull_back, std::int32_t alpha_mode,
+const vk::raii::Pipeline& Renderer::Impl::pipeline(vk::Format format, bool cull_back, const detail::Shading& shading,
                                                    bool depth_camera) {
-  const auto key = std::make_tuple(format, cull_back, alpha_mode, depth_camera);
+  const auto key = std::make_tuple(format, cull_back, shading.alpha_mode, shading.placed, shading.emissive, depth_camera);
   if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
-  const bool blend = alpha_mode == 2;
-  const vk::SpecializationMapEntry entry(0, 0, sizeof(std::int32_t));
-  const vk::SpecializationInfo specialization(1, &entry, sizeof(alpha_mode), &alpha_mode);
-  const vk::PipelineShaderStageCreateInfo stages[] = {{{}, vk::ShaderStageFlagBits::eVertex, *vert, "main"},
+  const bool blend = shading.alpha_mode == 2;
+  const vk::SpecializationMapEntry entries[] = {{0, offsetof(Shading, alpha_mode), sizeof(std::int32_t)},
+                                                {1, offsetof(Shading, placed), sizeof(vk::Bool32)},
+                                                {2, offsetof(Shading, emissive), sizeof(vk::Bool32)}};
+  const vk::SpecializationInfo specialization(3, entries, sizeof(Shading), &shading);
+  const vk::PipelineShaderStageCreateInfo stages[] = {{{}, vk::ShaderStageFlagBits::eVertex, *vert, "main", &specialization},
                                                       {{},
                                                        vk::ShaderStageFlagBits::eFragment,
                                                        depth_camera ? *depth_frag : *frag,
