@@ -172,7 +172,8 @@ std::size_t Renderer::Impl::record_draws(const vk::raii::CommandBuffer& cmd, vk:
                                            [&](const auto& look) { return look.first == static_cast<int>(part.material); });
         const assets::MaterialState state = animated != item.materials.end() ? animated->second : mat.state();
         const DrawUniform u = draw_uniform(mat, state);
-        Shading sh = depth_camera ? Shading{} : shading(u);
+        // An animated material takes the full path throughout: no new pipeline mid-run as its state moves.
+        Shading sh = depth_camera ? Shading{} : animated != item.materials.end() ? Shading{0, VK_TRUE, VK_TRUE} : shading(u);
         sh.alpha_mode = depth_camera ? 0 : alpha_mode_id(mat.alpha_mode);
         cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline(format, !mat.double_sided, sh, depth_camera));
         const auto offset = static_cast<std::uint32_t>(block++ * draw_stride);
