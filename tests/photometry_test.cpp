@@ -338,4 +338,28 @@ TEST(Photometry, AReflectanceMapKeepsEachTexelsMedianAndGrowsIntoTheRest) {
     }
 }
 
+// A long tour keeps a bounded map (issue 43): a thousand visits of a print, each a hundred points in every
+// texel of a 4 x 4 map, hold at most kPerTexel values a texel and channel and kFillPoints points; each texel
+// follows the newest values (the print repainted grey after 900 visits shows grey, not the old red).
+TEST(Photometry, AReflectanceMapStaysBoundedAndFollowsTheNewestValues) {
+  engine::ReflectanceMap map(4, 4);
+  const Eigen::Vector3d red(0.6, 0.1, 0.1), grey(0.3, 0.3, 0.3);
+  std::vector<engine::ReflectancePoint> visit(1600);
+  for (int visit_index = 0; visit_index < 1000; ++visit_index) {
+    for (std::size_t k = 0; k < visit.size(); ++k) {
+      visit[k].uv = Eigen::Vector2d((static_cast<double>(k % 4) + 0.5) / 4.0, (static_cast<double>(k / 4 % 4) + 0.5) / 4.0);
+      visit[k].rho = visit_index < 900 ? red : grey;
+      visit[k].valid = {true, true, true};
+    }
+    map.add(visit);
+  }
+  EXPECT_LE(map.values_kept(), 16 * 3 * engine::ReflectanceMap::kPerTexel + engine::ReflectanceMap::kFillPoints);
+  const std::optional<projbot::assets::Image> image = map.image();
+  ASSERT_TRUE(image);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(engine::srgb_to_linear(image->pixel(x, y)[ch] / 255.0), grey[ch], 0.005) << x << ", " << y;
+}
+
 }  // namespace

@@ -243,31 +243,49 @@ std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const 
       reflectance_points(model, camera, T_camera_target, projector, T_projector_target, under_black, under_grey, grey));
 }
 
-ReflectanceMap::ReflectanceMap(int width, int height) : width_(width), height_(height) {}
+ReflectanceMap::ReflectanceMap(int width, int height)
+    : width_(width), height_(height), texels_(static_cast<std::size_t>(width) * height) {}
 
 void ReflectanceMap::add(const std::vector<ReflectancePoint>& points) {
-  for (const ReflectancePoint& p : points)
-    if (p.uv.allFinite() && p.rho.allFinite()) all_.push_back(p);
+  for (const ReflectancePoint& p : points) {
+    if (!p.uv.allFinite() || !p.rho.allFinite()) continue;
+    Texel& t = texels_[static_cast<std::size_t>(assets::texel_index(p.uv.y(), height_)) * width_ +
+                       assets::texel_index(p.uv.x(), width_)];
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+      if (!p.valid[ch]) continue;
+      const auto v = static_cast<float>(p.rho[static_cast<int>(ch)]);
+      if (t.values[ch].size() < kPerTexel)
+        t.values[ch].push_back(v);
+      else
+        t.values[ch][t.seen[ch] % kPerTexel] = v;  // the oldest goes
+      ++t.seen[ch];
+    }
+    if (recent_.size() < kFillPoints)
+      recent_.push_back(p);
+    else
+      recent_[added_ % kFillPoints] = p;
+    ++added_;
+  }
+}
+
+std::size_t ReflectanceMap::values_kept() const {
+  std::size_t n = recent_.size();
+  for (const Texel& t : texels_)
+    for (const auto& v : t.values) n += v.size();
+  return n;
 }
 
 namespace {
 
-// Each texel's median of the points that fell in it, per channel (repeating UVs, as the renderer samples
-// a surface); known: whether it had any.
-void texel_medians(const std::vector<ReflectancePoint>& points, int width, int height, std::vector<Eigen::Vector3d>& rho,
-                   std::vector<Eigen::Vector3i>& known) {
-  std::vector<std::array<std::vector<double>, 3>> in(static_cast<std::size_t>(width) * height);
-  for (const ReflectancePoint& p : points) {
-    auto& values =
-        in[static_cast<std::size_t>(assets::texel_index(p.uv.y(), height)) * width + assets::texel_index(p.uv.x(), width)];
-    for (int ch = 0; ch < 3; ++ch)
-      if (p.valid[static_cast<std::size_t>(ch)]) values[static_cast<std::size_t>(ch)].push_back(p.rho[ch]);
-  }
-  rho.assign(in.size(), Eigen::Vector3d::Zero());
-  known.assign(in.size(), Eigen::Vector3i::Zero());
-  for (std::size_t i = 0; i < in.size(); ++i)
+// Each texel's median per channel; known: whether any value fell in it.
+template <typename Texel>
+void texel_medians(const std::vector<Texel>& texels, std::vector<Eigen::Vector3d>& rho, std::vector<Eigen::Vector3i>& known) {
+  rho.assign(texels.size(), Eigen::Vector3d::Zero());
+  known.assign(texels.size(), Eigen::Vector3i::Zero());
+  std::vector<float> v;
+  for (std::size_t i = 0; i < texels.size(); ++i)
     for (int ch = 0; ch < 3; ++ch) {
-      std::vector<double>& v = in[i][static_cast<std::size_t>(ch)];
+      v = texels[i].values[static_cast<std::size_t>(ch)];
       if (v.empty()) continue;
       std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
       rho[i][ch] = v[v.size() / 2];
@@ -306,11 +324,11 @@ void grow_known(int width, int height, std::vector<Eigen::Vector3d>& rho, std::v
 }  // namespace
 
 std::optional<assets::Image> ReflectanceMap::image() const {
-  const std::optional<Eigen::Vector3d> fill = median_albedo(all_);  // where no measurement reaches
+  const std::optional<Eigen::Vector3d> fill = median_albedo(recent_);  // where no measurement reaches
   if (!fill) return std::nullopt;
   std::vector<Eigen::Vector3d> rho;
   std::vector<Eigen::Vector3i> known;
-  texel_medians(all_, width_, height_, rho, known);
+  texel_medians(texels_, rho, known);
   grow_known(width_, height_, rho, known);
   assets::Image out;
   out.width = width_, out.height = height_;

@@ -102,19 +102,30 @@ std::vector<ReflectancePoint> reflectance_points(const assets::Model& model, con
 std::optional<Eigen::Vector3d> median_albedo(const std::vector<ReflectancePoint>& points);
 
 /// A target's reflectance measured into its model's texture space (issue 43, a printed surface learnt at its
-/// stops): each texel the median of the points that fell in it over every measurement so far (refined
-/// over visits), grown into the texels none fell in from their nearest measured ones in texture space,
-/// and the median of all points where none reaches (a chart never seen). Its image is a surface texture (Renderer::set_surface).
+/// stops): each texel the median of the newest kPerTexel values that fell in it (refined over visits,
+/// following a surface that changes), grown into the texels none fell in from their nearest measured ones
+/// in texture space, and the median of the newest kFillPoints points where none reaches (a chart never
+/// seen). Its memory is bounded however long the tour. Its image is a surface texture (Renderer::set_surface).
 class ReflectanceMap {
  public:
+  static constexpr std::size_t kPerTexel = 32;
+  static constexpr std::size_t kFillPoints = 200000;
   ReflectanceMap(int width = 128, int height = 128);
   void add(const std::vector<ReflectancePoint>& points);
   /// sRGB, width x height, repeating over the UVs; empty while a channel has fewer than 20 points.
   std::optional<assets::Image> image() const;
+  /// The values it holds: at most kPerTexel per texel and channel, plus kFillPoints points.
+  std::size_t values_kept() const;
 
  private:
+  struct Texel {
+    std::array<std::vector<float>, 3> values;  ///< per channel, the newest kPerTexel (a ring once full)
+    std::array<std::size_t, 3> seen{};         ///< per channel, every value that fell in it
+  };
   int width_, height_;
-  std::vector<ReflectancePoint> all_;  ///< every measurement's points
+  std::vector<Texel> texels_;
+  std::vector<ReflectancePoint> recent_;  ///< the newest kFillPoints points (a ring once full)
+  std::size_t added_ = 0;                 ///< every point added
 };
 
 /// The compensation of each target a session draws (issue 43): a target's gain is chosen the first time it
