@@ -66,6 +66,12 @@ bool file_stamp(const std::filesystem::path& file, std::filesystem::file_time_ty
   return !ec1 && !ec2;
 }
 
+// Whether a reload under way has finished (its result or its failure waits in it).
+template <typename T>
+bool loaded(const std::future<T>& loading) {
+  return loading.valid() && loading.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+}
+
 }  // namespace
 
 std::vector<DrawItem> upload_scene(Renderer& renderer, const config::Scene& scene, std::vector<assets::Model>* models) {
@@ -229,16 +235,16 @@ SceneContent::Sample SceneContent::apply(int target, double content_s, DrawItem&
 
 std::vector<std::string> SceneContent::reload_changed(double now_s, double interval_s) {
   std::vector<std::string> said;
-  const bool look = now_s - last_look_s_ >= interval_s;
-  if (look) last_look_s_ = now_s;
-  reload_videos(look, said);
-  reload_models(look, said);
+  const bool due = now_s - last_look_s_ >= interval_s;  // the files looked at again
+  if (due) last_look_s_ = now_s;
+  reload_videos(due, said);
+  reload_models(due, said);
   return said;
 }
 
-void SceneContent::reload_videos(bool look, std::vector<std::string>& said) {
+void SceneContent::reload_videos(bool due, std::vector<std::string>& said) {
   for (Watch& w : watches_) {  // loads that have finished
-    if (!w.loading.valid() || w.loading.wait_for(std::chrono::seconds(0)) != std::future_status::ready) continue;
+    if (!loaded(w.loading)) continue;
     try {
       swap_in(w, w.loading.get());
       said.push_back(w.stamp.file.string() + ": changed; the new video plays from its start");
@@ -246,7 +252,7 @@ void SceneContent::reload_videos(bool look, std::vector<std::string>& said) {
       said.push_back(std::string(e.what()) + " (changed on disk; the old video goes on)");
     }
   }
-  if (!look) return;
+  if (!due) return;
   for (Watch& w : watches_) {
     if (w.loading.valid() || !w.stamp.changed()) continue;  // loading, gone for now, or as it was
     w.loading = std::async(std::launch::async, [file = w.stamp.file] { return std::make_unique<assets::VideoDecoder>(file); });
@@ -293,16 +299,16 @@ void SceneContent::watch_models(const config::Scene& scene, const std::vector<as
   }
 }
 
-void SceneContent::reload_models(bool look, std::vector<std::string>& said) {
+void SceneContent::reload_models(bool due, std::vector<std::string>& said) {
   for (ModelWatch& w : model_watches_) {  // loads that have finished
-    if (!w.loading.valid() || w.loading.wait_for(std::chrono::seconds(0)) != std::future_status::ready) continue;
+    if (!loaded(w.loading)) continue;
     try {
       said.push_back(swap_model(w, w.loading.get()));
     } catch (const std::exception& e) {
       said.push_back(std::string(e.what()) + " (changed on disk; the model as it was stays)");
     }
   }
-  if (!look) return;
+  if (!due) return;
   for (ModelWatch& w : model_watches_) {
     if (w.loading.valid()) continue;
     bool changed = false;

@@ -136,8 +136,8 @@ class SceneContent {
   };
   static std::uint64_t shape_of(const assets::Model& model);
   void watch_models(const config::Scene& scene, const std::vector<assets::Model>& models, const std::vector<DrawItem>& items);
-  void reload_videos(bool look, std::vector<std::string>& said);
-  void reload_models(bool look, std::vector<std::string>& said);
+  void reload_videos(bool due, std::vector<std::string>& said);
+  void reload_models(bool due, std::vector<std::string>& said);
   std::string swap_model(ModelWatch& w, assets::Model fresh);
   const Stream* find(int target) const;
   Stream* find(int target) { return const_cast<Stream*>(std::as_const(*this).find(target)); }
