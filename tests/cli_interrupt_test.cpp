@@ -22,10 +22,11 @@ TEST_F(CliTest, RunInterruptedKeepsTheProfile) {
   std::ifstream in(csv);
   std::string line;
   ASSERT_TRUE(std::getline(in, line));
-  EXPECT_EQ(line, "frame,start_ms,pose_age_ms,target,capture_ms,display_ms,error_mm");
+  EXPECT_EQ(line,
+            "frame,start_ms,pose_age_ms,target,capture_ms,display_ms,error_mm,clock_s,content_s,video_pts_s,x_mm,y_mm,z_mm");
   int rows = 0, lit = 0;
   for (; std::getline(in, line); ++rows) {
-    ASSERT_EQ(std::count(line.begin(), line.end(), ','), 6) << line;
+    ASSERT_EQ(std::count(line.begin(), line.end(), ','), 12) << line;
     std::vector<std::string> f;
     std::istringstream cells(line);
     for (std::string c; std::getline(cells, c, ',');) f.push_back(c);

@@ -12,6 +12,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
+#include <sstream>
 #include <thread>
 
 #include "cli_run.hpp"
@@ -421,6 +423,68 @@ TEST_F(DevicesCli, RunReplaysARecordingFrameForFrame) {
   const CliRun none = run_projbot("run --headless --replay " + (dir_ / "nothing").string());
   EXPECT_EQ(none.code, 1) << none.output;
   EXPECT_NE(none.output.find("no such recording folder"), std::string::npos) << none.output;
+}
+
+namespace {
+
+// A --profile CSV's rows, each split into its cells (the header left out).
+std::vector<std::vector<std::string>> profile_rows(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::vector<std::vector<std::string>> rows;
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::istringstream row(line);
+    for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+    cells.resize(13);  // trailing empty cells of a blank frame
+    rows.push_back(std::move(cells));
+  }
+  return rows;
+}
+
+}  // namespace
+
+// Issue 44, one clock: a replay runs on the recording's clock, so it draws the same frames, poses and
+// content every time, however fast the machine. The shipped content scene (a 30 fps clip on both targets
+// from the tour's start) recorded at 2 stops and replayed twice: frame for frame the same run clock,
+// target, pose age, content time, video frame and position; each frame one 60 Hz refresh of the clock;
+// each video frame shown the one due at its content time (the decoder waited for, never repeated).
+TEST_F(DevicesCli, AReplayDrawsTheSameContentFrameForFrameOnTheRecordingsClock) {
+  const fs::path rec = dir_ / "rec";
+  const CliRun r = run_projbot("record --out " + rec.string() + " --visits 2 --dwell 1 --config " +
+                                   std::string(PROJBOT_ASSET_DIR) + "/scenes/content.yaml",
+                               180);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::vector<std::vector<std::vector<std::string>>> runs;
+  for (const char* name : {"a.csv", "b.csv"}) {
+    const CliRun replay = run_projbot("run --headless --replay " + rec.string() + " --profile " + (dir_ / name).string(), 300);
+    ASSERT_EQ(replay.code, 0) << replay.output;
+    EXPECT_NE(replay.output.find(" deg; 0 found or lost in one and not the other"), std::string::npos) << replay.output;
+    EXPECT_NE(replay.output.find(" 0 repeated"), std::string::npos) << replay.output;  // content's summary
+    runs.push_back(profile_rows(dir_ / name));
+  }
+  const auto& a = runs[0];
+  ASSERT_EQ(a.size(), runs[1].size());
+  ASSERT_GT(a.size(), 120U);  // two dwells of 1 s at 60 Hz, and the drives
+  std::set<std::string> lit;
+  double lead_s = std::nan("");
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (const std::size_t c : {2, 3, 7, 8, 9, 10, 11, 12})  // pose age, target, clock, content, video, position
+      EXPECT_EQ(a[i][c], runs[1][i][c]) << "frame " << i << ", column " << c;
+    EXPECT_NEAR(std::stod(a[i][7]), static_cast<double>(i + 1) / 60.0, 1e-6) << i;  // one refresh a frame
+    if (a[i][3].empty()) continue;                                                  // blank: driving, acquiring
+    lit.insert(a[i][3]);
+    // Content from the tour's start, on the frame's display time: a fixed lead over the frame's start.
+    const double content = std::stod(a[i][8]), pts = std::stod(a[i][9]);
+    if (std::isnan(lead_s)) lead_s = content - std::stod(a[i][7]);
+    EXPECT_NEAR(content - std::stod(a[i][7]), lead_s, 1e-5) << i;
+    EXPECT_LE(pts, content + 1e-5) << i;  // the frame due: the last one presented at or before it
+    EXPECT_GT(pts + 1.0 / 30.0, content + 1e-5) << i;
+  }
+  EXPECT_EQ(lit, (std::set<std::string>{"duck", "box"}));
+  EXPECT_GT(lead_s, 0.0);  // one refresh ahead, and the projector's input lag
+  EXPECT_LT(lead_s, 0.1);
 }
 
 // The whole robot from the config, no twin (issue 12): the twin's youBot served over DDS by `projbot

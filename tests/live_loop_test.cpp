@@ -52,7 +52,7 @@ Eigen::Matrix4d at(double x, double y, double z) {
 // sees exactly the frames it scripts, however slow the renderer.
 struct FakeClock {
   double t_s = 10.0;
-  session::LiveClock clock() {
+  config::Clock clock() {
     return {[this] { return t_s += 1e-6; }, [this](double until_s) { t_s = std::max(t_s, until_s); }};
   }
 };

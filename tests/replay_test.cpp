@@ -6,9 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 
 using namespace projbot;
 
@@ -116,8 +120,12 @@ TEST_F(ReplayTest, TheRecordingsDevicesAnswerWhatWasRecordedAndRefuseAStopItDoes
   alignment::ModelCloud cloud;
   std::vector<session::Target> targets;
   for (int i = 0; i < static_cast<int>(scene.targets.size()); ++i) targets.push_back({i, &cloud, Eigen::Vector3d::Zero()});
-  session::ReplaySession replay(scene, recording, targets);
+  session::ReplayClock clock;
+  clock.close();  // no projector: the robot does not wait for one
+  const config::Clock robot = clock.robot();
+  session::ReplaySession replay(scene, recording, targets, robot);
   const robot::StopReport r = replay.drive_to({1.0, 2.0, 0.5}, 0);
+  EXPECT_DOUBLE_EQ(robot.now_s(), 7.5);  // the drive took its recorded time on the replay's clock
   EXPECT_TRUE(r.arrived);
   EXPECT_DOUBLE_EQ(r.drive_seconds, 7.5);
   EXPECT_DOUBLE_EQ(replay.believed_pose().x_m, 1.01);
@@ -132,6 +140,46 @@ TEST_F(ReplayTest, TheRecordingsDevicesAnswerWhatWasRecordedAndRefuseAStopItDoes
     EXPECT_NE(std::string(e.what()).find("asked for stop 2 but the recording holds 1"), std::string::npos) << e.what();
   }
   EXPECT_THROW(replay.drive_to({3.0, 2.0, 0.5}, 0), session::SessionError);  // another stop than recorded
+}
+
+// A replay's clock keeps the projector's frames and the session in step: the frame of time T is drawn
+// once the robot has done everything it did up to T and before anything after, whether the robot is quick
+// or slow; once the robot has finished the frames go on unheld, and close() releases a robot that waits.
+TEST(ReplayClock, EachProjectorFrameSeesWhatTheRobotDidUpToItsTimeAndNothingAfter) {
+  const std::vector<double> events = {0.0, 0.01, 0.05, 0.05, 0.1, 0.3335, 0.5};
+  for (const bool slow_robot : {false, true}) {
+    session::ReplayClock clock;
+    std::atomic<int> done{0};
+    std::jthread robot([&] {
+      const config::Clock c = clock.robot();
+      for (const double t : events) {
+        c.sleep_until(t);
+        EXPECT_DOUBLE_EQ(c.now_s(), t);
+        if (slow_robot) std::this_thread::sleep_for(std::chrono::milliseconds(3));  // tracking a frame
+        done.fetch_add(1);
+      }
+      clock.robot_finished();
+    });
+    const config::Clock projector = clock.projector();
+    for (int n = 1; n <= 45; ++n) {
+      const double T = n / 60.0;
+      projector.sleep_until(T);
+      EXPECT_DOUBLE_EQ(projector.now_s(), T);
+      const auto expected = std::count_if(events.begin(), events.end(), [&](double t) { return t <= T; });
+      EXPECT_EQ(done.load(), expected) << "frame at " << T << " s, slow robot " << slow_robot;
+    }
+  }
+  session::ReplayClock clock;
+  std::atomic<bool> released{false};
+  std::jthread robot([&] {
+    clock.robot().sleep_until(10.0);  // the projector never gets there: the run ends first
+    released = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(released);
+  clock.close();
+  robot.join();
+  EXPECT_TRUE(released);
 }
 
 }  // namespace

@@ -262,3 +262,33 @@ TEST(VideoPlayer, ContentFarAheadIsJumpedToNotDecodedThrough) {
   }
   EXPECT_EQ(read_frame_code(s.frame->image, 0, 0, 64, 48), 89);
 }
+
+// A replay's player (frame_due): every ask, straight after opening, across a loop, a jump far ahead and
+// back to the start, gets the frame due at its time without the test waiting for the decoder; nothing
+// is repeated, and the same asks give the same frames again.
+TEST(VideoPlayer, FrameDueWaitsForTheFrameOfItsTimeEveryTime) {
+  const fs::path clip = write_clip("due.mp4", 20, 64, 48);  // 2/3 s, looping
+  const std::vector<double> asks = {0.0, 1 / 60.0, 0.1, 0.1 + 1 / 60.0, 0.5, 0.66, 0.7, 1.3, 6.1, 6.15, 0.05, 0.4};
+  std::vector<std::int64_t> first;
+  for (int pass = 0; pass < 2; ++pass) {
+    VideoPlayer p(std::make_unique<VideoDecoder>(clip), true, 2);
+    std::vector<std::int64_t> codes;
+    for (const double t : asks) {
+      const VideoPlayer::Shown s = p.frame_due(t);
+      ASSERT_TRUE(s.frame) << t;
+      const auto due = static_cast<std::int64_t>(std::floor(t * 30.0 + 1e-9));
+      EXPECT_NEAR(s.frame->pts_s, static_cast<double>(due) / 30.0, 1e-3) << t;  // loops add on
+      codes.push_back(read_frame_code(s.frame->image, 0, 0, 64, 48));
+      EXPECT_EQ(codes.back(), due % 20) << t;
+    }
+    EXPECT_EQ(p.stats().repeated, 0U);
+    EXPECT_GE(p.stats().loops, 1U);
+    EXPECT_EQ(p.stats().seeks, 1U);  // 1.3 s to 6.1 s: jumped to
+    if (pass == 0) first = codes;
+    EXPECT_EQ(codes, first);
+  }
+  // Not looping: past the end, the last frame, at once.
+  VideoPlayer once(std::make_unique<VideoDecoder>(clip), false, 2);
+  EXPECT_EQ(read_frame_code(once.frame_due(0.2).frame->image, 0, 0, 64, 48), 6);
+  EXPECT_EQ(read_frame_code(once.frame_due(30.0).frame->image, 0, 0, 64, 48), 19);
+}

@@ -1,11 +1,9 @@
 // Reading fakenect dumps back without libfreenect (the replay's camera).
 
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
-#include <thread>
 #include <vector>
 
 #include "kinect_frames.hpp"
@@ -83,8 +81,8 @@ DepthImage kinect_quantised(DepthImage depth) {
   return depth;
 }
 
-FakenectDumpReader::FakenectDumpReader(const std::filesystem::path& folder, bool realtime)
-    : folder_(folder), realtime_(realtime) {
+FakenectDumpReader::FakenectDumpReader(const std::filesystem::path& folder, bool realtime, config::Clock clock)
+    : folder_(folder), realtime_(realtime), clock_(std::move(clock)) {
   const std::filesystem::path index = folder / "INDEX.txt";
   std::ifstream in(index);
   if (!in) throw AlignmentError(index.string() + ": cannot read (not a fakenect dump?)");
@@ -122,12 +120,9 @@ RgbdFrame FakenectDumpReader::next() {
   std::memcpy(raw.data(), bytes.data(), bytes.size());  // as fakenect hands it to the driver: the host's byte order
   kinect_depth_from_raw(raw.data(), f.depth);
   kinect_colour_from_rgb(reinterpret_cast<const std::uint8_t*>(read_pnm(folder_ / e.colour, "P6", 255, 3).data()), f.colour);
-  if (next_ == 0) offset_s_ = config::steady_now_s() - e.time_s;
+  if (next_ == 0) offset_s_ = clock_.now_s() - e.time_s;
   f.depth.capture_time_s = e.time_s + offset_s_;
-  if (realtime_) {
-    const double wait_s = f.depth.capture_time_s - config::steady_now_s();
-    if (wait_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
-  }
+  if (realtime_) clock_.sleep_until(f.depth.capture_time_s);
   f.depth_timestamp = e.depth_stamp;
   f.colour_timestamp = e.colour_stamp;
   ++next_;

@@ -1,6 +1,7 @@
 // The video player: a decoder thread ahead of the content clock, a bounded queue, and frame_at() for the
 // render thread, which never waits for decoding.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "projbot/assets/video.hpp"
@@ -125,12 +126,14 @@ void VideoPlayer::decode_loop(const std::stop_token& stop) {
     if (!got) {
       ended_ = true;  // the end (not looping), or an error: the last frame stays
       seeking_ = false;
+      wake_.notify_all();
       continue;
     }
     if (restart_ || seek_s_ >= 0.0) continue;  // decoded before a restart or a jump was asked for: dropped
     ++stats_.decoded;
     seeking_ = false;
     queue_.push_back(std::move(f));
+    wake_.notify_all();  // frame_due may wait for it
   }
 }
 
@@ -140,6 +143,38 @@ VideoPlayer::Shown VideoPlayer::frame_at(double content_s) {
     lock.lock();
     ++stats_.waits;
   }
+  return take_due(content_s, true);
+}
+
+// Whether the frame due at content_s is decoded: a queued frame after it (all before it are queued), the
+// frame shown lasting past it, or the end of the stream.
+bool VideoPlayer::due_known(double content_s) const {
+  if (restart_ || seeking_ || seek_s_ >= 0.0) return false;
+  if (ended_) return true;
+  for (const auto& f : queue_)
+    if (f->pts_s > content_s + kEpsS) return true;
+  return queue_.empty() && current_ && content_s >= current_->pts_s - kEpsS &&
+         content_s < current_->pts_s + current_->duration_s - kEpsS;
+}
+
+VideoPlayer::Shown VideoPlayer::frame_due(double content_s, double timeout_s) {
+  std::unique_lock lock(mutex_);
+  Shown out = take_due(content_s, false);  // asks for a restart or a jump where the content needs one
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!due_known(content_s)) {
+    if (queue_.size() >= capacity_) {  // full of frames before it: taken in turn, making room
+      const Shown more = take_due(content_s, false);
+      out = {more.frame, out.fresh || more.fresh};
+      continue;
+    }
+    ++stats_.waits;
+    if (wake_.wait_until(lock, give_up) == std::cv_status::timeout) break;
+  }
+  const Shown last = take_due(content_s, true);
+  return {last.frame, out.fresh || last.fresh};
+}
+
+VideoPlayer::Shown VideoPlayer::take_due(double content_s, bool count_repeat) {
   const double period = 1.0 / info_.fps;
   if (content_s < last_ask_s_ - 0.5 * period) {  // the content began again
     restart_ = true;
@@ -171,7 +206,7 @@ VideoPlayer::Shown VideoPlayer::frame_at(double content_s) {
     out.fresh = true;
     wake_.notify_all();
   }
-  if (!current_ || (!ended_ && content_s >= current_->pts_s + current_->duration_s + kEpsS))
+  if (count_repeat && (!current_ || (!ended_ && content_s >= current_->pts_s + current_->duration_s + kEpsS)))
     ++stats_.repeated;  // the due frame is not decoded yet: an older one stays up
   out.frame = current_;
   return out;

@@ -216,7 +216,7 @@ SceneContent::Sample SceneContent::show(int target, double content_s) {
   s->last_s = content_s;
   // Before its start the content waits on its first frame.
   out.content_s = std::max(0.0, content_s - s->offset_s);
-  const assets::VideoPlayer::Shown shown = s->player->frame_at(out.content_s);
+  const assets::VideoPlayer::Shown shown = exact_ ? s->player->frame_due(out.content_s) : s->player->frame_at(out.content_s);
   if (!shown.frame) return out;
   out.pts_s = shown.frame->pts_s;
   out.fresh = shown.fresh;

@@ -5,7 +5,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
-#include <thread>
 
 #include "commands.hpp"
 #include "projbot/assets/model.hpp"
@@ -42,21 +41,10 @@ void finish_profile(const cli::Args& args, const engine::FrameProfiler& profiler
 }
 
 // A still frame's content: each target's video frame and timeline at content time `at_s`. Offline, so it
-// waits (up to 10 s a video) for the decoder to reach the frame of that time.
+// waits for the decoder to reach the frame of that time (a clip that does not loop holds its last frame).
 void content_at(engine::SceneContent& content, std::vector<engine::DrawItem>& items, double at_s) {
-  for (int i = 0; i < static_cast<int>(items.size()); ++i) {
-    content.animate(i, at_s, items[static_cast<std::size_t>(i)]);
-    if (!content.has_video(i)) continue;
-    const auto& info = content.player(i).info();
-    const double period = 1.0 / info.fps;
-    double want = at_s;  // a clip that does not loop holds its last frame
-    if (!content.player(i).loop() && info.duration_s > 0.0) want = std::min(at_s, info.duration_s - 0.5 * period);
-    for (int k = 0; k < 5000; ++k) {
-      const auto s = content.show(i, want);
-      if (s.pts_s <= want + 1e-6 && want - s.pts_s < period - 1e-6) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-  }
+  content.set_exact(true);
+  for (int i = 0; i < static_cast<int>(items.size()); ++i) content.apply(i, at_s, items[static_cast<std::size_t>(i)]);
 }
 
 }  // namespace

@@ -112,15 +112,21 @@ void print_replay(std::ostream& out, const config::Recording& recording, int vis
 }
 
 // Per frame: when it started, the capture time of the depth its pose came from and its expected display
-// time (empty for a blank frame), all on the frame profiler's clock.
+// time (empty for a blank frame), all on the frame profiler's clock; then its start on the run's clock (a
+// replay: the recording's), the first drawn target's content time, its video frame's presentation time
+// and where it was drawn (its origin in the projector's frame, mm).
 void write_profile(const std::string& csv, const std::vector<session::LiveRow>& rows, const config::Scene& scene) {
   std::ostringstream f;
-  f << "frame,start_ms,pose_age_ms,target,capture_ms,display_ms,error_mm\n";
+  f << "frame,start_ms,pose_age_ms,target,capture_ms,display_ms,error_mm,clock_s,content_s,video_pts_s,x_mm,y_mm,z_mm\n";
   const auto opt = [](double v) { return std::isnan(v) ? std::string() : std::to_string(v); };
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    f << i << ',' << rows[i].start_ms << ',' << (rows[i].age_ms >= 0 ? std::to_string(rows[i].age_ms) : std::string()) << ','
-      << (rows[i].target >= 0 ? scene.targets[static_cast<std::size_t>(rows[i].target)].name : std::string()) << ','
-      << opt(rows[i].capture_ms) << ',' << opt(rows[i].display_ms) << ',' << opt(rows[i].error_mm) << '\n';
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const session::LiveRow& r = rows[i];
+    f << i << ',' << r.start_ms << ',' << (r.age_ms >= 0 ? std::to_string(r.age_ms) : std::string()) << ','
+      << (r.target >= 0 ? scene.targets[static_cast<std::size_t>(r.target)].name : std::string()) << ',' << opt(r.capture_ms)
+      << ',' << opt(r.display_ms) << ',' << opt(r.error_mm) << ',' << opt(r.clock_s) << ',' << opt(r.content_s) << ','
+      << opt(r.video_pts_s) << ',' << opt(r.position_mm.x()) << ',' << opt(r.position_mm.y()) << ',' << opt(r.position_mm.z())
+      << '\n';
+  }
   config::write_file_atomically(csv, f.str());
   std::cout << "per-frame profile written to " << csv << '\n';
 }
@@ -158,9 +164,12 @@ const Command kRun{
     "blanks the projector at once; what was measured until then is printed and written, and the failure is\n"
     "reported (exit 1).\n"
     "With --replay DIR the session runs from a recording (projbot record): the base and pan-tilt answer\n"
-    "what they answered then, each stop's frames play at their recorded pace and are tracked in lockstep,\n"
+    "what they answered then, each stop's frames play at their recorded times and are tracked in lockstep,\n"
     "and every pose is compared with the recording's (the largest difference is printed); no device and\n"
-    "no twin is used, so nothing is measured against a truth.\n"
+    "no twin is used, so nothing is measured against a truth. A replay runs on the recording's clock: each\n"
+    "projector frame is one refresh of it and is drawn once the session has done everything before it\n"
+    "(drives take their recorded time, each video frame is waited for), so a replay draws the same frames,\n"
+    "poses and content every time (--profile shows them), as fast as the machine tracks and draws.\n"
     "Targets with `content:` (a video, a timeline) or animated materials play them on each frame's display\n"
     "time; a video, model or texture file that changes on disk is loaded again and swapped in at a later\n"
     "frame (tracking goes on; a model of another shape is not), and one that fails to load leaves the old\n"
@@ -174,7 +183,9 @@ const Command kRun{
      {"monitor", "N", "monitor index for --fullscreen (default 0)"},
      {"headless", "", "draw offscreen at 60 Hz instead of a window (profiling without a display)"},
      {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
-     {"profile", "FILE", "write one CSV row per frame: start, pose age, capture and display time, error",
+     {"profile", "FILE",
+      "write one CSV row per frame: start, pose age, capture and display time, error; the run's clock, content and "
+      "video time, where the target was drawn",
       cli::PathRole::output_file},
      {"seconds", "S", "stop after S seconds (default 0: when the tour ends, the window is closed or Ctrl-C)"},
      {"visits", "N", "visits, cycling through the tour (default: the list once)"},

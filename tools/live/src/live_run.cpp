@@ -59,9 +59,9 @@ struct Handoffs {
 class RunObserver final : public session::StopObserver {
  public:
   RunObserver(const config::Scene& scene, alignment::LatestValue<RobotState>& state, Handoffs& handoffs, twin::Twin* twin,
-              session::PoseCheck* check, std::ostream& log)
-      : scene_(scene), state_(state), handoffs_(handoffs), twin_(twin), check_(check), log_(log) {}
-  void driving(int visit) override { state_.publish({.lit = {}, .since_s = config::steady_now_s(), .visit = visit + 1}); }
+              session::PoseCheck* check, std::ostream& log, config::Clock clock)
+      : scene_(scene), state_(state), handoffs_(handoffs), twin_(twin), check_(check), log_(log), clock_(std::move(clock)) {}
+  void driving(int visit) override { state_.publish({.lit = {}, .since_s = clock_.now_s(), .visit = visit + 1}); }
   void lit(const session::Stop& stop, double since_s) override {
     say_lit(stop);
     std::vector<DrawnTarget> lit;
@@ -107,22 +107,26 @@ class RunObserver final : public session::StopObserver {
   twin::Twin* twin_;
   session::PoseCheck* check_;
   std::ostream& log_;
+  config::Clock clock_;  // the session's
 };
 
 // The robot thread of a run: the session at each stop (the rig built on this thread: the twin renders on
-// it), publishing what the render thread draws; a failure is kept for the render thread to report.
+// it), publishing what the render thread draws; a failure is kept for the render thread to report. A
+// replay's session keeps time on `replay_clock` (null: the steady clock).
 class RobotThread {
  public:
-  RobotThread(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers, const RunSources& sources)
-      : thread_([this, &scene, &o, &trackers, &sources](std::stop_token cancel) {
+  RobotThread(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers, const RunSources& sources,
+              session::ReplayClock* replay_clock)
+      : replay_clock_(replay_clock), thread_([this, &scene, &o, &trackers, &sources](std::stop_token cancel) {
           try {
             drive(scene, o, trackers, sources, cancel);
           } catch (...) {
             error_ = std::current_exception();
           }
           done_ = true;
+          if (replay_clock_) replay_clock_->robot_finished();
         }) {}
-  bool done() const { return done_; }
+  bool failed() const { return done_ && error_; }
   alignment::LatestValue<RobotState>& state() { return state_; }
   Handoffs& handoffs() { return handoffs_; }  // the robot thread's until finish()
   // After the frame loop: a device (or the twin) that failed while projecting blanks the projector at once,
@@ -133,6 +137,7 @@ class RobotThread {
  private:
   void drive(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers, const RunSources& sources,
              const std::stop_token& cancel);
+  session::ReplayClock* replay_clock_;
   alignment::LatestValue<RobotState> state_;
   Handoffs handoffs_;
   std::exception_ptr error_;
@@ -142,14 +147,18 @@ class RobotThread {
 
 void RobotThread::drive(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers,
                         const RunSources& sources, const std::stop_token& cancel) {
-  Rig rig(scene, trackers.targets, *sources.devices, sources.replay, {.seed = o.seed, .interrupted = sources.interrupted});
-  RunObserver observer(scene, state_, handoffs_, rig.twin(), sources.check, *sources.log);
+  Rig rig(scene, trackers.targets, *sources.devices, sources.replay,
+          {.seed = o.seed,
+           .interrupted = sources.interrupted,
+           .replay_clock = replay_clock_ ? replay_clock_->robot() : config::Clock{}});
+  const config::Clock& clock = rig.session().clock();
+  RunObserver observer(scene, state_, handoffs_, rig.twin(), sources.check, *sources.log, clock);
   const int visits = rig.visits(o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size()));
   const session::Dwell dwell = rig.dwell(o.dwell_s);
   for (int v = 0; v < visits && !cancel.stop_requested(); ++v) rig.session().visit(v, trackers.workers, dwell, observer, cancel);
   RobotState last;
   state_.read(last);
-  state_.publish({.lit = {}, .since_s = config::steady_now_s(), .visit = last.visit, .done = true});
+  state_.publish({.lit = {}, .since_s = clock.now_s(), .visit = last.visit, .done = true});
 }
 
 std::string RobotThread::finish(engine::Renderer& renderer, engine::RenderTarget& target,
@@ -165,6 +174,7 @@ std::string RobotThread::finish(engine::Renderer& renderer, engine::RenderTarget
   }
   renderer.finish(target);
   thread_.request_stop();
+  if (replay_clock_) replay_clock_->close();  // the robot waits for no more frames
   thread_.join();
   if (error_ && failure.empty()) std::rethrow_exception(error_);
   return failure;
@@ -193,6 +203,8 @@ session::LiveLoopConfig loop_config(const config::Scene& scene, const RunOptions
   if (replay) c.projection.silent_camera_s = 0.0;  // a replay's frames play in lockstep
   c.seconds = o.seconds;
   c.paced_hz = o.headless ? 60.0 : 0.0;  // offscreen, no vsync: like a 60 Hz projector
+  // A replay's frames step its clock (window or not): one refresh each, so the same frames every time.
+  if (replay) c.paced_hz = scene.projector.refresh_hz > 0.0 ? scene.projector.refresh_hz : 60.0;
   return c;
 }
 
@@ -212,7 +224,10 @@ session::LiveInputs live_inputs(const config::Scene& scene, RobotThread& robot, 
     return trackers.owned[static_cast<std::size_t>(index)]->latest(pose);
   };
   in.camera_last_s = [&robot] { return robot.handoffs().last_s.load(); };
-  in.keep_going = [&robot, &sources] { return !(sources.interrupted && sources.interrupted()) && !robot.done(); };
+  // Until the tour's end as last read (a replay ends on the same frame every time), or a failure.
+  in.keep_going = [&robot, &seen, &sources] {
+    return !(sources.interrupted && sources.interrupted()) && !seen.done && !robot.failed();
+  };
   in.meter = [&scene, &seen](const session::DrawnPose& drawn) { return marker_error(scene, seen, drawn); };
   in.after_frame = [&content, &sources] {
     for (const std::string& e : content.take_errors())  // the last good frame stays up; said once
@@ -230,13 +245,20 @@ RunResult run(engine::Renderer& renderer, const config::Scene& scene, const RunO
     throw std::invalid_argument("live::run needs devices, open_output, log and errors in its RunSources");
   Output out(renderer, scene, options, sources);
   const session::LiveLoopConfig lc = loop_config(scene, options, sources.replay != nullptr);
-  session::LiveLoop loop(renderer, scene.projector, out.items, lc);
+  // A replay runs on the recording's clock, the projector's frames and the session in step.
+  std::unique_ptr<session::ReplayClock> replay_clock;
+  if (sources.replay) {
+    replay_clock = std::make_unique<session::ReplayClock>();
+    out.content.set_exact(true);  // each frame's video frame waited for: the same every time
+  }
+  session::LiveLoop loop(renderer, scene.projector, out.items, lc,
+                         replay_clock ? replay_clock->projector() : config::Clock::steady());
   loop.set_compensation(&out.plan);
   loop.set_content(&out.content);
   // One tracker worker per target on the map.
   session::SceneTrackers trackers =
       session::make_trackers(scene, session::worker_config(options.predict, sources.replay != nullptr));
-  RobotThread robot(scene, options, trackers, sources);
+  RobotThread robot(scene, options, trackers, sources, replay_clock.get());
   RobotState seen;  // as the render thread last read it
   engine::FrameProfiler profiler;
   RunResult r;

@@ -1,5 +1,7 @@
 #include "projbot/live/rig.hpp"
 
+#include <stdexcept>
+
 namespace projbot::live {
 
 Rig::Rig(const config::Scene& scene, const std::vector<session::Target>& targets, hardware::Devices& devices,
@@ -8,9 +10,10 @@ Rig::Rig(const config::Scene& scene, const std::vector<session::Target>& targets
   if (!options_.interrupted) options_.interrupted = [] { return false; };
   if (devices.base)
     devices_ = std::make_unique<hardware::DeviceSession>(scene, targets, devices);
-  else if (replay)
-    replay_session_ = std::make_unique<session::ReplaySession>(scene, *replay, targets);
-  else
+  else if (replay) {
+    if (!options_.replay_clock.now_s) throw std::invalid_argument("a replay's rig needs the replay's clock");
+    replay_session_ = std::make_unique<session::ReplaySession>(scene, *replay, targets, options_.replay_clock);
+  } else
     twin_ = std::make_unique<twin::TwinSession>(scene, targets, options_.seed, devices.camera.get(), options_.interrupted,
                                                 options_.recording);
 }

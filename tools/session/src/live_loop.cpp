@@ -1,23 +1,14 @@
 #include "projbot/session/live_loop.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <thread>
 
 #include "projbot/config/clock.hpp"
 
 namespace projbot::session {
 
-LiveClock LiveClock::steady() {
-  return {config::steady_now_s, [](double until_s) {
-            const double wait_s = until_s - config::steady_now_s();
-            if (wait_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
-          }};
-}
-
 LiveLoop::LiveLoop(engine::Renderer& renderer, const config::ProjectorConfig& projector, std::vector<engine::DrawItem> items,
-                   LiveLoopConfig config, LiveClock clock)
+                   LiveLoopConfig config, config::Clock clock)
     : renderer_(renderer),
       projector_(projector),
       items_(std::move(items)),
@@ -31,6 +22,7 @@ LiveLoop::LiveLoop(engine::Renderer& renderer, const config::ProjectorConfig& pr
 void LiveLoop::compose(const LiveStop& stop, const LiveInputs& in, std::vector<engine::DrawItem>& out,
                        std::vector<DrawnPose>& drawn) {
   out.clear();
+  first_content_ = {std::nan(""), std::nan(""), false};
   const double now_s = clock_.now_s();
   drawn = frames_.compose(now_s, {stop.targets, stop.since_s, in.camera_last_s()}, in.poses);
   const auto content_s = [&](int target, double display_s) { return display_s - content_->start_s(target, t0_s_, stop.since_s); };
@@ -48,6 +40,7 @@ void LiveLoop::compose(const LiveStop& stop, const LiveInputs& in, std::vector<e
     if (content_ && content_->has(d.target)) {  // on the display clock of this frame, as its pose
       const auto shown = content_->apply(d.target, content_s(d.target, d.display_s), out.back());
       if (!std::isnan(shown.pts_s)) figures_.content_offsets_ms.push_back(1000.0 * (shown.content_s - shown.pts_s));
+      if (&d == &drawn.front()) first_content_ = shown;
     }
   }
 }
@@ -56,9 +49,10 @@ void LiveLoop::compose(const LiveStop& stop, const LiveInputs& in, std::vector<e
 // to the expected display time) is the first drawn one's.
 void LiveLoop::measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s) {
   const double nan = std::nan("");
+  const double clock_s = start_s - t0_s_;
   if (drawn.empty()) {
     ++figures_.blank;
-    figures_.rows.push_back({start_ms, -1.0, nan, nan, nan, -1});
+    figures_.rows.push_back({start_ms, -1.0, nan, nan, nan, -1, clock_s, nan, nan, Eigen::Vector3d::Constant(nan)});
     return;
   }
   double first_error = nan;
@@ -72,7 +66,9 @@ void LiveLoop::measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& 
   const double age_ms = 1000.0 * (std::max(clock_.now_s(), first.display_s) - first.capture_s);
   figures_.ages_ms.push_back(age_ms);
   figures_.rows.push_back({start_ms, age_ms, start_ms + 1000.0 * (first.capture_s - start_s),
-                           start_ms + 1000.0 * (first.display_s - start_s), first_error, first.target});
+                           start_ms + 1000.0 * (first.display_s - start_s), first_error, first.target, clock_s,
+                           first_content_.content_s, first_content_.pts_s,
+                           1000.0 * first.T_projector_target.topRightCorner<3, 1>()});
 }
 
 LiveFigures LiveLoop::run(engine::RenderTarget& target, const LiveInputs& in, engine::FrameProfiler& profiler) {
@@ -81,12 +77,12 @@ LiveFigures LiveLoop::run(engine::RenderTarget& target, const LiveInputs& in, en
   double next_s = t0_s_;
   std::vector<DrawnPose> drawn;
   while (in.keep_going() && !target.poll_close() && (cfg_.seconds == 0.0 || clock_.now_s() - t0_s_ < cfg_.seconds)) {
-    const LiveStop stop = in.stop();
     if (cfg_.paced_hz > 0.0) {  // no vsync: paced like a projector at that rate
       next_s += 1.0 / cfg_.paced_hz;
       clock_.sleep_until(next_s);
       if (clock_.now_s() > next_s + 0.05) next_s = clock_.now_s();  // fell behind: do not race to catch up
     }
+    const LiveStop stop = in.stop();  // after the wait: on a replay's clock, the robot has done all before it
     const double start_ms = profiler.now_ms(), start_s = clock_.now_s();
     frames_.frame_started(start_s);
     drawn.clear();

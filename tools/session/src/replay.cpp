@@ -1,5 +1,6 @@
 #include "projbot/session/replay.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -11,14 +12,59 @@
 
 namespace projbot::session {
 
-ReplaySession::ReplaySession(const config::Scene& scene, const config::Recording& recording, const std::vector<Target>& targets)
-    : recording_(recording), session_(std::make_unique<Session>(scene, targets, *this, *this)) {}
+config::Clock ReplayClock::projector() {
+  return {[this] {
+            std::lock_guard lock(mutex_);
+            return projector_s_;
+          },
+          [this](double t_s) { projector_until(t_s); }};
+}
+
+config::Clock ReplayClock::robot() {
+  return {[this] {
+            std::lock_guard lock(mutex_);
+            return robot_s_;
+          },
+          [this](double t_s) { robot_until(t_s); }};
+}
+
+void ReplayClock::projector_until(double t_s) {
+  std::unique_lock lock(mutex_);
+  projector_s_ = std::max(projector_s_, t_s);
+  moved_.notify_all();
+  moved_.wait(lock, [&] { return finished_ || closed_ || (robot_waiting_ && robot_s_ > projector_s_); });
+}
+
+void ReplayClock::robot_until(double t_s) {
+  std::unique_lock lock(mutex_);
+  robot_s_ = std::max(robot_s_, t_s);
+  robot_waiting_ = true;
+  moved_.notify_all();
+  moved_.wait(lock, [&] { return closed_ || projector_s_ >= robot_s_; });
+  robot_waiting_ = false;
+}
+
+void ReplayClock::robot_finished() {
+  std::lock_guard lock(mutex_);
+  finished_ = true;
+  moved_.notify_all();
+}
+
+void ReplayClock::close() {
+  std::lock_guard lock(mutex_);
+  closed_ = true;
+  moved_.notify_all();
+}
+
+ReplaySession::ReplaySession(const config::Scene& scene, const config::Recording& recording, const std::vector<Target>& targets,
+                             config::Clock clock)
+    : recording_(recording), clock_(clock), session_(std::make_unique<Session>(scene, targets, *this, *this, std::move(clock))) {}
 
 Dwell ReplaySession::dwell() {
   Dwell d;
   d.camera = [this](const Stop&, double) -> alignment::RgbdCamera& {
     const config::RecordedStop& s = recording_.stops.at(static_cast<std::size_t>(stop_));
-    camera_ = std::make_unique<alignment::FakenectDumpReader>(recording_.folder() / s.frames, true);
+    camera_ = std::make_unique<alignment::FakenectDumpReader>(recording_.folder() / s.frames, true, clock_);
     if (camera_->frames() < s.frame_count)
       throw SessionError(recording_.source.string() + ": stop " + std::to_string(stop_ + 1) + " lists " +
                          std::to_string(s.frame_count) + " frames but its dump " + s.frames + " holds " +
@@ -42,6 +88,7 @@ robot::StopReport ReplaySession::drive_to(const robot::Pose2D& goal, int index) 
     throw SessionError(recording_.source.string() + ": stop " + std::to_string(index + 1) + " of the recording went to '" +
                        s.target + "''s stop, but the scene's tour asks for another one here (a different scene or tour?)");
   stop_ = index;
+  clock_.sleep_until(clock_.now_s() + s.drive_s);  // the drive takes its recorded time on the replay's clock
   robot::StopReport r;
   r.index = index;
   r.goal = goal;

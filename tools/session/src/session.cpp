@@ -27,8 +27,14 @@ void drive_and_aim(const config::Scene& scene, const config::TargetConfig& targe
   stop.believed = robot::head_poses(base.believed_pose(), stop.angles, scene.pan_tilt);
 }
 
-Session::Session(const config::Scene& scene, std::vector<Target> targets, robot::Navigator& base, robot::PanTilt& pan_tilt)
-    : scene_(scene), targets_(std::move(targets)), base_(base), pan_tilt_(pan_tilt), visits_per_target_(scene.targets.size(), 0) {
+Session::Session(const config::Scene& scene, std::vector<Target> targets, robot::Navigator& base, robot::PanTilt& pan_tilt,
+                 config::Clock clock)
+    : scene_(scene),
+      targets_(std::move(targets)),
+      base_(base),
+      pan_tilt_(pan_tilt),
+      clock_(std::move(clock)),
+      visits_per_target_(scene.targets.size(), 0) {
   const std::string where = scene.source.empty() ? std::string("<scene>") : scene.source.string();
   if (scene.visits.empty()) throw SessionError(where + ": a session needs a 'tour: {visits: [...]}' section");
   for (const Target& t : targets_)
@@ -118,11 +124,11 @@ Stop Session::visit(int visit, const std::vector<alignment::PoseTracker*>& worke
                          " but has no tracker worker");
     lit.push_back(workers[t]);
   }
-  const double since = config::steady_now_s();
+  const double since = clock_.now_s();
   alignment::RgbdCamera& camera = dwell.camera(at, since);
   const auto read = [&] {
     auto f = std::make_shared<alignment::RgbdFrame>(camera.next());
-    f->delivered_s = config::steady_now_s();
+    f->delivered_s = clock_.now_s();
     return f;
   };
   // The first frame's colour, taken before anything is lit, guides each lit target's acquisition.
@@ -142,7 +148,7 @@ Stop Session::visit(int visit, const std::vector<alignment::PoseTracker*>& worke
       else
         w->submit(depth);
     observer.frame(at, k, *frame, samples);
-    if (cancel.stop_requested() || dwell.over(at, k + 1, config::steady_now_s() - since)) break;
+    if (cancel.stop_requested() || dwell.over(at, k + 1, clock_.now_s() - since)) break;
     frame = read();
   }
   observer.left(at);

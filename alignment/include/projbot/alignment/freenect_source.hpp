@@ -17,6 +17,7 @@
 #include "projbot/alignment/depth.hpp"
 #include "projbot/alignment/rgbd_camera.hpp"
 #include "projbot/assets/image.hpp"
+#include "projbot/config/clock.hpp"
 
 namespace projbot::alignment {
 
@@ -91,13 +92,13 @@ DepthImage kinect_quantised(DepthImage depth);
 
 /// A fakenect dump read back frame by frame without libfreenect (`projbot run --replay` plays one per
 /// stop): depth through kinect_raw_to_metres() as the Kinect driver converts raw disparity, colour as
-/// RGBA. Frame k is stamped on the host's steady clock at the first frame's reading time plus its
-/// recorded offset from the first; with `realtime`, next() also waits until then.
+/// RGBA. Frame k is stamped on `clock` (the host's steady clock, or a replay's) at the first frame's
+/// reading time plus its recorded offset from the first; with `realtime`, next() also waits until then.
 class FakenectDumpReader final : public RgbdCamera {
  public:
   /// Reads folder/INDEX.txt (pairs of d-TIME-STAMP.pgm and r-TIME-STAMP.ppm lines, as libfreenect's
   /// record tool and FakenectDumpWriter write them). Throws AlignmentError naming the file (and line).
-  FakenectDumpReader(const std::filesystem::path& folder, bool realtime);
+  FakenectDumpReader(const std::filesystem::path& folder, bool realtime, config::Clock clock = config::Clock::steady());
   /// The next frame. Throws AlignmentError naming the file for a missing or malformed one, and at the end
   /// of the dump.
   RgbdFrame next() override;
@@ -112,9 +113,10 @@ class FakenectDumpReader final : public RgbdCamera {
   };
   std::filesystem::path folder_;
   bool realtime_;
+  config::Clock clock_;
   std::vector<Entry> entries_;
   int next_ = 0;
-  double offset_s_ = 0.0;  // host steady time minus recorded time, set at the first frame
+  double offset_s_ = 0.0;  // the clock's time minus recorded time, set at the first frame
 };
 
 }  // namespace projbot::alignment

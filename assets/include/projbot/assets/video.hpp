@@ -91,7 +91,7 @@ struct PlaybackStats {
   std::size_t shown = 0;     ///< frames handed out for the first time
   std::size_t skipped = 0;   ///< decoded frames passed over: their time had gone when they were asked for
   std::size_t repeated = 0;  ///< asks answered with an older frame because the due one was not decoded yet
-  std::size_t waits = 0;     ///< asks that found the queue locked by the decoder thread and waited for it
+  std::size_t waits = 0;     ///< asks that waited: the queue locked by the decoder thread, or frame_due for a frame
   std::size_t loops = 0;     ///< times the stream started again from its first frame
   std::size_t seeks = 0;     ///< jumps ahead: content asked for more than a second past what was decoded
 };
@@ -114,9 +114,13 @@ class VideoPlayer {
     bool fresh = false;                       ///< a frame not handed out before: upload it
   };
   /// The frame to show at `content_s` seconds after the content began: the latest decoded one presented
-  /// at or before it. Never waits for decoding. Content times before the previous ask's mean the content
-  /// began again (a new arrival): the stream restarts from its first frame.
+  /// at or before it. Never waits for decoding (live: a late decoder repeats the frame shown). Content
+  /// times before the previous ask's mean the content began again (a new arrival): the stream restarts
+  /// from its first frame.
   Shown frame_at(double content_s);
+  /// The same, but waits for the decoder until the frame due at `content_s` is known (a replay: the same
+  /// frame every time, never a repeat), up to `timeout_s`; past it, as frame_at.
+  Shown frame_due(double content_s, double timeout_s = 5.0);
   PlaybackStats stats() const;
   /// The playback error, once: empty after the first call that returned it, and while there is none.
   std::string take_error();
@@ -126,6 +130,8 @@ class VideoPlayer {
 
  private:
   void decode_loop(const std::stop_token& stop);
+  Shown take_due(double content_s, bool count_repeat);  // frame_at's work, the mutex held
+  bool due_known(double content_s) const;
   struct FramePool;
   std::shared_ptr<VideoFrame> spare_frame();  // a frame to decode into, back to the pool when let go
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <thread>
 
 namespace projbot::config {
@@ -11,6 +12,20 @@ namespace projbot::config {
 inline double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
+
+/// A clock and a wait on it, in seconds: the steady clock, a replay's recording clock (session::ReplayClock)
+/// or a test's. Whoever keeps time through one (the live loop, a session, a recorded camera) asks it alone.
+struct Clock {
+  std::function<double()> now_s;
+  std::function<void(double until_s)> sleep_until;  ///< returns at until_s (or at once, when past)
+  /// steady_now_s and a sleep on the steady clock.
+  static Clock steady() {
+    return {steady_now_s, [](double until_s) {
+              const double wait_s = until_s - steady_now_s();
+              if (wait_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
+            }};
+  }
+};
 
 /// Milliseconds since `t0` on the steady clock: how long a step took.
 inline double ms_since(std::chrono::steady_clock::time_point t0) {

@@ -52,6 +52,9 @@ class SceneContent {
   SceneContent(Renderer& renderer, const config::Scene& scene, const std::vector<assets::Model>& models,
                const std::vector<DrawItem>& items);
   bool empty() const { return players_.empty(); }
+  /// Exact: show() waits for the decoder until the frame due is decoded (a replay: the same frames every
+  /// time); otherwise (live) it never waits, and a late decoder repeats the frame shown.
+  void set_exact(bool exact) { exact_ = exact; }
   bool has(int target) const;        ///< target `target` has content (a video, a timeline, its model's animations)
   bool has_video(int target) const;  ///< target `target` plays a video
 
@@ -148,6 +151,7 @@ class SceneContent {
   std::vector<Watch> watches_;             // one per player
   std::vector<ModelWatch> model_watches_;  // one per target
   double last_look_s_ = -1e300;
+  bool exact_ = false;
 };
 
 }  // namespace projbot::engine

@@ -24,6 +24,7 @@ struct RigOptions {
   /// frame (a fakenect dump holds both). A replay is always tracked in lockstep.
   bool recording = false;
   std::function<bool()> interrupted;  ///< the twin's set-up (its map survey) gives up when it says so
+  config::Clock replay_clock;         ///< a replay's robot keeps time on it (ReplayClock::robot()); required with one
 };
 
 /// A robot's laser scans with the wheel odometry at each.
@@ -33,7 +34,8 @@ class Rig {
  public:
   /// The configured robot when `devices` holds a base (open_session_devices has checked it has the pan-tilt
   /// and camera too), else `replay` when given, else the twin (with `devices.camera` when one is open).
-  /// They must outlive the rig. Built on the thread that drives it (the twin renders on it).
+  /// They must outlive the rig. Built on the thread that drives it (the twin renders on it). Throws
+  /// std::invalid_argument for a replay without options.replay_clock.
   Rig(const config::Scene& scene, const std::vector<session::Target>& targets, hardware::Devices& devices,
       const config::Recording* replay, RigOptions options);
   ~Rig();

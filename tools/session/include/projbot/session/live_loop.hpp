@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "projbot/config/clock.hpp"
 #include "projbot/engine/content.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/photometry.hpp"
@@ -25,13 +26,6 @@ struct LiveStop {
   int visit = 0;             ///< the visit (a target's compensation gain is chosen once per visit)
 };
 
-/// The loop's clock: the steady clock and a sleep on it, or a test's.
-struct LiveClock {
-  std::function<double()> now_s;                    ///< seconds
-  std::function<void(double until_s)> sleep_until;  ///< returns at until_s (or at once, when past)
-  static LiveClock steady();
-};
-
 /// A drawn target's error against a truth at its display time: the mean marker error (mm; NaN where
 /// it is not measured) and whether the target was moving then.
 struct DisplayError {
@@ -44,7 +38,12 @@ using DisplayMeter = std::function<DisplayError(const DrawnPose& drawn)>;
 /// -1 for a blank frame), its capture and display times (profiler ms, NaN blank) and error (mm, NaN).
 struct LiveRow {
   double start_ms = 0.0, age_ms = -1.0, capture_ms = 0.0, display_ms = 0.0, error_mm = 0.0;
-  int target = -1;  ///< scene index of the first drawn target; -1: blank
+  int target = -1;       ///< scene index of the first drawn target; -1: blank
+  double clock_s = 0.0;  ///< the frame's start on the loop's clock since the loop began (a replay: the recording's)
+  /// The first drawn target's content time and the presentation time of its video's frame shown (s; NaN:
+  /// none), and where it was drawn: its origin in the projector's frame (mm; NaN blank).
+  double content_s = 0.0, video_pts_s = 0.0;
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
 };
 
 /// What the loop measured.
@@ -79,7 +78,7 @@ class LiveLoop {
   /// `items[i]` draws scene target i (its model). `plan` and `content` may be null (no compensation, no
   /// content); they and the renderer must outlive the loop.
   LiveLoop(engine::Renderer& renderer, const config::ProjectorConfig& projector, std::vector<engine::DrawItem> items,
-           LiveLoopConfig config, LiveClock clock = LiveClock::steady());
+           LiveLoopConfig config, config::Clock clock = config::Clock::steady());
   void set_compensation(engine::CompensationPlan* plan) { plan_ = plan; }
   void set_content(engine::SceneContent* content) { content_ = content; }
   /// Draws frames into `target` until `in.keep_going` says no, `seconds` have passed or the target is
@@ -91,12 +90,13 @@ class LiveLoop {
  private:
   void compose(const LiveStop& stop, const LiveInputs& in, std::vector<engine::DrawItem>& out, std::vector<DrawnPose>& drawn);
   void measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s);
+  engine::SceneContent::Sample first_content_;  // the first drawn target's, this frame
 
   engine::Renderer& renderer_;
   const config::ProjectorConfig& projector_;
   std::vector<engine::DrawItem> items_;
   LiveLoopConfig cfg_;
-  LiveClock clock_;
+  config::Clock clock_;
   ProjectionFrames frames_;
   engine::CompensationPlan* plan_ = nullptr;
   engine::SceneContent* content_ = nullptr;

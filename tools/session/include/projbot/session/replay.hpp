@@ -3,9 +3,11 @@
 // poses.csv it keeps of every frame's poses, and the check of a replay's poses against them.
 
 #include <Eigen/Core>
+#include <condition_variable>
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include "projbot/alignment/freenect_source.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/config/recording.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/navigator.hpp"
@@ -21,12 +24,42 @@
 
 namespace projbot::session {
 
+/// A replay's one clock: seconds on the recording's time line (0 where the replay starts), kept by the
+/// projector's frames (the render thread) and the session (the robot thread) together, so that a replay is
+/// the same frame for frame however fast the machine: the robot does what it did at time t (a frame handed
+/// to the trackers and tracked, a drive) only once the projector has reached t, and the projector draws
+/// its frame of time T only once the robot has done everything up to T and waits for something later.
+/// Nothing sleeps on the wall clock: a headless replay runs as fast as it can track and draw.
+class ReplayClock {
+ public:
+  /// The render thread's: now is the frame's time; sleep_until(T) moves it on to T, then waits for the
+  /// robot to be past T (or finished).
+  config::Clock projector();
+  /// The robot thread's: now is the time of what it does; sleep_until(t) moves it on to t, then waits
+  /// for the projector to reach t (or to be closed).
+  config::Clock robot();
+  /// The session is over (or failed): the projector no longer waits for it.
+  void robot_finished();
+  /// The projector draws no more (the run ends): the robot no longer waits for it.
+  void close();
+
+ private:
+  void projector_until(double t_s);
+  void robot_until(double t_s);
+  std::mutex mutex_;
+  std::condition_variable moved_;
+  double projector_s_ = 0.0, robot_s_ = 0.0;
+  bool robot_waiting_ = false, finished_ = false, closed_ = false;
+};
+
 /// A recording's devices: what the base and pan-tilt answered at each stop, and each stop's dump played
 /// at its recorded pace. The session must ask for the recorded stops in order; anything else is a
 /// SessionError saying where the replay left the recording.
 class ReplaySession final : public robot::Navigator, public robot::PanTilt {
  public:
-  ReplaySession(const config::Scene& scene, const config::Recording& recording, const std::vector<session::Target>& targets);
+  /// Its drives, frames and stops keep time on `clock` (the robot's side of a ReplayClock).
+  ReplaySession(const config::Scene& scene, const config::Recording& recording, const std::vector<session::Target>& targets,
+                config::Clock clock);
   Session& session() { return *session_; }
   Dwell dwell();
 
@@ -37,6 +70,7 @@ class ReplaySession final : public robot::Navigator, public robot::PanTilt {
 
  private:
   const config::Recording& recording_;
+  config::Clock clock_;
   int stop_ = -1;  // the recorded stop the robot is at
   std::unique_ptr<alignment::FakenectDumpReader> camera_;
   std::unique_ptr<Session> session_;

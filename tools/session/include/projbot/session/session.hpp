@@ -21,6 +21,7 @@
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/rgbd_camera.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
+#include "projbot/config/clock.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/navigator.hpp"
 #include "projbot/robot/pan_tilt.hpp"
@@ -99,7 +100,11 @@ class Session {
  public:
   /// `targets` are those the tour may visit or light; every visit in scene.visits must name one with a
   /// stop. Throws SessionError naming the first that does not. The devices outlive the session.
-  Session(const config::Scene& scene, std::vector<Target> targets, robot::Navigator& base, robot::PanTilt& pan_tilt);
+  /// Stops and frames are timed on `clock` (a replay's, or the steady clock).
+  Session(const config::Scene& scene, std::vector<Target> targets, robot::Navigator& base, robot::PanTilt& pan_tilt,
+          config::Clock clock = config::Clock::steady());
+  /// The clock its stops and frames are timed on.
+  const config::Clock& clock() const { return clock_; }
 
   /// The target of the tour's `visit`-th stop (0-based, cycling through scene.visits): its scene index.
   int target_of(int visit) const;
@@ -126,6 +131,7 @@ class Session {
   std::vector<Target> targets_;
   robot::Navigator& base_;
   robot::PanTilt& pan_tilt_;
+  config::Clock clock_;
   std::vector<int> visits_per_target_;  // by scene index
 };
 
