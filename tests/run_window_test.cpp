@@ -14,6 +14,7 @@
 #include <string>
 #include <thread>
 
+#include "cli_fixture.hpp"
 #include "projbot/alignment/freenect_source.hpp"
 #include "x11_screenshot.hpp"
 
@@ -63,6 +64,29 @@ TEST(RunWindowTest, FullscreenTwinRunLightsTheTargets) {
   EXPECT_GT(best, 0.005) << output;
   EXPECT_LT(best, 0.6);
   if (best_image.width > 0) projbot::assets::write_png(::testing::TempDir() + "run_window.png", best_image);
+}
+
+// `show` stopped by Ctrl-C two seconds after its window opened closes at the next frame, prints its
+// summary and writes its per-frame profile, whole, with its output redirected: exit 130 within a second.
+TEST(RunWindowTest, ShowInterruptedKeepsTheProfile) {
+  projbot::testing::X11Display x11;
+  ASSERT_TRUE(x11.ok()) << "no X display (run under xvfb-run)";
+  const std::string csv = ::testing::TempDir() + "projbot_show_interrupted.csv";
+  std::filesystem::remove(csv);
+  cli_fixture::Background show({"show", "--profile", csv}, ::testing::TempDir() + "projbot_show_interrupted.log");
+  ASSERT_GT(show.pid, 0);
+  ASSERT_TRUE(show.wait_for_output("device: ", std::chrono::seconds(60))) << show.output();
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const auto [code, seconds] = show.signal_and_wait(SIGINT, std::chrono::seconds(30));
+  const std::string output = show.output();
+  EXPECT_EQ(code, 130) << output;
+  EXPECT_LT(seconds, 1.0) << output;
+  EXPECT_NE(output.find("frame time p50"), std::string::npos) << output;
+  EXPECT_NE(output.find("per-frame profile written to " + csv), std::string::npos) << output;
+  std::ifstream in(csv);
+  int rows = -1;  // the header
+  for (std::string line; std::getline(in, line);) ++rows;
+  EXPECT_GT(rows, 5) << output;  // frames drawn over the seconds it was open
 }
 
 // `calibrate capture` on configured devices: a Kinect v1 (libfreenect, played by fakenect from a dump of a

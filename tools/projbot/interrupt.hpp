@@ -1,7 +1,7 @@
 #pragma once
-// Ctrl-C and SIGTERM for the long commands (run, tour, slam, localize, the benchmarks): the first signal asks the work
-// to stop at its next frame, visit or scan, so what was measured is still written; a second one ends
-// the process at once.
+// Ctrl-C and SIGTERM for the long commands (run, show, tour, slam, localize, the benchmarks): the first
+// signal asks the work to stop at its next frame, visit or scan, so what was measured is still written; a
+// second one ends the process at once.
 
 #include <string>
 

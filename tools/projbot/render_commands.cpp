@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/clock.hpp"
 #include "projbot/engine/content.hpp"
@@ -103,23 +104,26 @@ const Command kShow{
     "Opens a window showing the projector image and redraws it every frame until the window is closed\n"
     "(or --frames have been drawn). Without --fullscreen the window has the projector's size. Targets with\n"
     "`content:` or animated materials play them from the moment the window opens; a model, texture or\n"
-    "video changed on disk is drawn anew within a second.\n",
+    "video changed on disk is drawn anew within a second. Ctrl-C closes it at the next frame, and what was\n"
+    "measured is printed and written (exit 130).\n",
     with_scene_options({{"fullscreen", "", "fullscreen on --monitor (the projector)"},
                         {"monitor", "N", "monitor index for --fullscreen (default 0)"},
                         {"present-mode", "MODE", "fifo (default, vsync), mailbox or immediate"},
                         {"frames", "N", "close after N frames (default: run until closed)"},
                         {"profile", "FILE", "write one CSV row of timings per frame", cli::PathRole::output_file}}),
     [](const cli::Args& args) {
+      catch_interrupts();  // Ctrl-C / SIGTERM: close at the next frame, then write what was measured
       const config::Scene scene = scene_from_args(args);
       const int frames = args.get_int("frames", 0, 0, 100000000);
       const engine::WindowOptions w = window_options(
           args, scene.projector, "projbot: " + (scene.source.empty() ? std::string("model") : scene.source.filename().string()));
       engine::Renderer renderer(renderer_options(args, true));
-      std::cout << "device: " << renderer.device_info().name << '\n';
+      std::cout << "device: " << renderer.device_info().name << std::endl;  // said at once: the window comes next
       std::vector<assets::Model> models;
       const auto items = engine::upload_scene(renderer, scene, &models);
       engine::SceneContent content(renderer, scene, models, items);  // the targets' videos and animations, previewed
       auto window = open_window(renderer, w, scene.projector);
+      if (interrupted()) return nothing_written("before the window opened");
       engine::FrameProfiler profiler;
       int drawn = 0;
       const double t0 = config::steady_now_s();  // every content start (arrival, tour) is the window's opening
@@ -129,14 +133,16 @@ const Command kShow{
         for (int i = 0; i < static_cast<int>(items.size()); ++i)
           if (content.has(i)) content.apply(i, now - content.start_s(i, t0, t0), out[static_cast<std::size_t>(i)]);
       };
-      while (!window->poll_close() && (frames == 0 || drawn < frames)) {
+      while (!window->poll_close() && (frames == 0 || drawn < frames) && !interrupted()) {
         if (renderer.draw_frame(*window, scene.projector, read, &profiler)) ++drawn;
         for (const std::string& e : content.reload_changed(config::steady_now_s()))  // a texture or video edited
           std::cout << "content: " << e << '\n';
       }
       renderer.finish(*window);
       finish_profile(args, profiler);
-      return report_validation(args, renderer) ? 0 : 1;
+      const bool clean = report_validation(args, renderer);
+      if (interrupted()) return interrupt_exit_code();
+      return clean ? 0 : 1;
     }};
 
 }  // namespace projbot::tools
