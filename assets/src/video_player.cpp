@@ -161,13 +161,15 @@ VideoPlayer::Shown VideoPlayer::frame_due(double content_s, double timeout_s) {
   std::unique_lock lock(mutex_);
   Shown out = take_due(content_s, false);  // asks for a restart or a jump where the content needs one
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  bool waited = false;
   while (!due_known(content_s)) {
-    if (queue_.size() >= capacity_) {  // full of frames before it: taken in turn, making room
+    if (queue_.size() >= capacity_ && !restart_ && !seeking_) {  // full of frames before it: taken, making room
       const Shown more = take_due(content_s, false);
       out = {more.frame, out.fresh || more.fresh};
       continue;
     }
-    ++stats_.waits;
+    if (!waited) ++stats_.waits;  // once an ask
+    waited = true;
     if (wake_.wait_until(lock, give_up) == std::cv_status::timeout) break;
   }
   const Shown last = take_due(content_s, true);
