@@ -341,7 +341,12 @@ bool load_checked_image(tinygltf::Image* image, const int index, std::string* er
               " pixels, larger than the " + std::to_string(detail::kMaxTextureSide) + " pixels a side a texture may have";
     return false;
   }
-  return tinygltf::LoadImageData(image, index, err, warn, width, height, bytes, size, user);
+  if (tinygltf::LoadImageData(image, index, err, warn, width, height, bytes, size, user)) return true;
+  if (err != nullptr && image != nullptr && !image->uri.empty() && image->uri.rfind("data:", 0) != 0) {
+    while (!err->empty() && (err->back() == '\n' || err->back() == ' ')) err->pop_back();
+    *err += " (image " + std::to_string(index) + " is " + image->uri + ")\n";  // tinygltf names it by its index only
+  }
+  return false;
 }
 
 // Whether a file exists, without opening it (tinygltf's fopen()s it: on a FIFO that blocks).
