@@ -6,6 +6,7 @@
 
 #include <fstream>
 
+#include "projbot/assets/image.hpp"
 #include "projbot/assets/model.hpp"
 
 namespace fs = std::filesystem;
@@ -87,6 +88,25 @@ TEST_F(MeshFiles, NormalsComeFromTheFacesWhenTheFileHasNone) {
       EXPECT_NEAR(n.norm(), 1.0, 1e-4);
       EXPECT_GT(n.dot(out), 0.0);
     }
+}
+
+// What `run` watches of a mesh: the OBJ, the material library it names and the texture that names; a
+// texture not there yet is watched all the same (drawn once it appears).
+TEST_F(MeshFiles, AnObjsFilesAreItselfItsMaterialLibraryAndItsTextures) {
+  projbot::assets::Image texture;
+  texture.width = texture.height = 2;
+  texture.rgba.assign(16, 200);
+  projbot::assets::write_png((dir_ / "wood.png").string(), texture);
+  write("wood.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd wood.png\nnewmtl stone\nKd 0.2 0.2 0.2\nmap_Kd stone.png\n");
+  const fs::path obj = write("two.obj",
+                             "mtllib wood.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                             "usemtl wood\nf 1/1 2/2 3/3\nusemtl stone\nf 1/1 2/2 4/3\n");
+  testing::internal::CaptureStderr();
+  const auto model = load_model(obj);
+  EXPECT_NE(testing::internal::GetCapturedStderr().find("stone.png not used"), std::string::npos);
+  const std::vector<fs::path> expected = {obj, dir_ / "wood.png", dir_ / "stone.png", dir_ / "wood.mtl"};
+  EXPECT_EQ(model.files, expected);
+  EXPECT_EQ(load_model(write("t.ply", kTetraPly)).files, std::vector<fs::path>{dir_ / "t.ply"});
 }
 
 TEST_F(MeshFiles, ReadsAnAsciiStl) {

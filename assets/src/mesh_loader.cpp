@@ -11,7 +11,11 @@
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
+#include <fstream>
 #include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "default_material.hpp"
 #include "projbot/assets/model.hpp"
@@ -135,6 +139,22 @@ int load_texture(const std::filesystem::path& model, const std::string& name, Mo
   }
 }
 
+// The material libraries an OBJ file names (`mtllib a.mtl b.mtl`), declared before its faces: what it
+// is drawn with besides itself. None for other formats.
+std::vector<std::string> obj_material_libraries(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  std::vector<std::string> out;
+  if (ext != ".obj") return out;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line) && line.rfind("f ", 0) != 0;) {
+    if (line.rfind("mtllib", 0) != 0) continue;
+    std::istringstream names(line.substr(6));
+    for (std::string name; names >> name;) out.push_back(name);
+  }
+  return out;
+}
+
 Model model_from_bytes(const std::string& bytes, const std::filesystem::path& path) {
   const std::string file = path.string();
   config::BytesReader in(bytes);
@@ -150,7 +170,9 @@ Model model_from_bytes(const std::string& bytes, const std::filesystem::path& pa
     Material mat;
     mat.base_color_factor = values.base_color_factor;
     mat.double_sided = values.double_sided;
-    mat.base_color_image = load_texture(path, std::string(name.begin(), name.end()), out);
+    const std::string texture(name.begin(), name.end());
+    mat.base_color_image = load_texture(path, texture, out);
+    if (!texture.empty() && texture[0] != '*') out.files.push_back(path.parent_path() / texture);  // watched, read or not
     // OBJ's diffuse colour multiplies the texture in its own renderers only when no map is given
     // (MeshLab writes a grey Kd beside every map_Kd): with a texture, the texture alone is the content.
     if (mat.base_color_image >= 0) mat.base_color_factor = {1.0F, 1.0F, 1.0F, 1.0F};
@@ -180,7 +202,8 @@ Model load_mesh(const std::filesystem::path& path) {
     throw AssetError(what.rfind(path.string(), 0) == 0 ? what : path.string() + ": " + what);
   }
   Model model = model_from_bytes(bytes, path);
-  model.files = {path};
+  model.files.insert(model.files.begin(), path);
+  for (const std::string& library : obj_material_libraries(path)) model.files.push_back(path.parent_path() / library);
   return model;
 }
 

@@ -120,8 +120,8 @@ struct Primitive {
 /// A whole model in its model frame (glTF scene frame with node transforms applied), metres.
 struct Model {
   std::string source;  ///< file name, for messages
-  /// The files it was read from: the model file, and a glTF's external buffers and images (what `run`
-  /// watches for changes).
+  /// The files it was read from: the model file, a glTF's external buffers and images, a mesh's
+  /// textures and an OBJ's material libraries (what `run` watches for changes).
   std::vector<std::filesystem::path> files;
   std::vector<Primitive> primitives;
   std::vector<Material> materials;  ///< never empty after loading (a default material is added)
