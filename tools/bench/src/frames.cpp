@@ -1,6 +1,5 @@
 #include "projbot/bench/frames.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <string>
@@ -64,10 +63,11 @@ ContentRun run_content(engine::Renderer& renderer, engine::RenderTarget& target,
   run.rss_start_mb = rss_mb();
   const double period_s = 1.0 / scene.projector.refresh_hz;
   const double t0 = config::steady_now_s();
-  auto next = std::chrono::steady_clock::now();
+  const config::Clock clock = config::Clock::steady();
+  double next_s = t0;
   std::size_t within = 0;
   while (keep_going() && config::steady_now_s() - t0 < seconds) {
-    config::pace_frame(next, std::chrono::microseconds(static_cast<std::int64_t>(1e6 * period_s)));
+    clock.pace(next_s, period_s);
     const auto read = [&](std::vector<engine::DrawItem>& out) {
       out.assign(items.begin(), items.end());
       const double display_s = config::steady_now_s() + period_s;

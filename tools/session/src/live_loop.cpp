@@ -77,11 +77,7 @@ LiveFigures LiveLoop::run(engine::RenderTarget& target, const LiveInputs& in, en
   double next_s = t0_s_;
   std::vector<DrawnPose> drawn;
   while (in.keep_going() && !target.poll_close() && (cfg_.seconds == 0.0 || clock_.now_s() - t0_s_ < cfg_.seconds)) {
-    if (cfg_.paced_hz > 0.0) {  // no vsync: paced like a projector at that rate
-      next_s += 1.0 / cfg_.paced_hz;
-      clock_.sleep_until(next_s);
-      if (clock_.now_s() > next_s + 0.05) next_s = clock_.now_s();  // fell behind: do not race to catch up
-    }
+    if (cfg_.paced_hz > 0.0) clock_.pace(next_s, 1.0 / cfg_.paced_hz);  // no vsync: paced like a projector
     const LiveStop stop = in.stop();  // after the wait: on a replay's clock, the robot has done all before it
     const double start_ms = profiler.now_ms(), start_s = clock_.now_s();
     frames_.frame_started(start_s);

@@ -25,19 +25,18 @@ struct Clock {
               if (wait_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
             }};
   }
+  /// Paces frames without vsync (offscreen) like a projector: sleeps until `next_s` moved on by one
+  /// `period_s`, and starts the cadence afresh after a frame more than 50 ms late (no race to catch up).
+  void pace(double& next_s, double period_s) const {
+    next_s += period_s;
+    sleep_until(next_s);
+    if (const double now = now_s(); now > next_s + 0.05) next_s = now;
+  }
 };
 
 /// Milliseconds since `t0` on the steady clock: how long a step took.
 inline double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-/// Paces a target without vsync (offscreen) like a projector: sleeps until `next` moved on by one `period`,
-/// and starts the cadence afresh after a frame more than 50 ms late.
-inline void pace_frame(std::chrono::steady_clock::time_point& next, std::chrono::microseconds period) {
-  next += period;
-  std::this_thread::sleep_until(next);
-  if (std::chrono::steady_clock::now() > next + std::chrono::milliseconds(50)) next = std::chrono::steady_clock::now();
 }
 
 }  // namespace projbot::config
