@@ -58,13 +58,13 @@ void ReplayClock::close() {
 
 ReplaySession::ReplaySession(const config::Scene& scene, const config::Recording& recording, const std::vector<Target>& targets,
                              config::Clock clock)
-    : recording_(recording), clock_(clock), session_(std::make_unique<Session>(scene, targets, *this, *this, std::move(clock))) {}
+    : recording_(recording), session_(std::make_unique<Session>(scene, targets, *this, *this, std::move(clock))) {}
 
 Dwell ReplaySession::dwell() {
   Dwell d;
   d.camera = [this](const Stop&, double) -> alignment::RgbdCamera& {
     const config::RecordedStop& s = recording_.stops.at(static_cast<std::size_t>(stop_));
-    camera_ = std::make_unique<alignment::FakenectDumpReader>(recording_.folder() / s.frames, true, clock_);
+    camera_ = std::make_unique<alignment::FakenectDumpReader>(recording_.folder() / s.frames, true, session_->clock());
     if (camera_->frames() < s.frame_count)
       throw SessionError(recording_.source.string() + ": stop " + std::to_string(stop_ + 1) + " lists " +
                          std::to_string(s.frame_count) + " frames but its dump " + s.frames + " holds " +
@@ -88,7 +88,8 @@ robot::StopReport ReplaySession::drive_to(const robot::Pose2D& goal, int index) 
     throw SessionError(recording_.source.string() + ": stop " + std::to_string(index + 1) + " of the recording went to '" +
                        s.target + "''s stop, but the scene's tour asks for another one here (a different scene or tour?)");
   stop_ = index;
-  clock_.sleep_until(clock_.now_s() + s.drive_s);  // the drive takes its recorded time on the replay's clock
+  const config::Clock& clock = session_->clock();
+  clock.sleep_until(clock.now_s() + s.drive_s);  // the drive takes its recorded time on the replay's clock
   robot::StopReport r;
   r.index = index;
   r.goal = goal;

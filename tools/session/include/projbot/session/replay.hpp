@@ -70,7 +70,6 @@ class ReplaySession final : public robot::Navigator, public robot::PanTilt {
 
  private:
   const config::Recording& recording_;
-  config::Clock clock_;
   int stop_ = -1;  // the recorded stop the robot is at
   std::unique_ptr<alignment::FakenectDumpReader> camera_;
   std::unique_ptr<Session> session_;
