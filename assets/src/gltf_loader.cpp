@@ -4,7 +4,6 @@
 
 #include <tiny_gltf.h>
 
-#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -387,8 +386,7 @@ Model load_gltf(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(path, ec)) throw AssetError(file + ": is a folder, not a model file (.gltf or .glb)");
   if (const std::string kind = config::input_file_problem(path); !kind.empty())
     throw AssetError(file + (kind == "does not exist" ? std::string(": no such model file") : ": " + kind));
-  std::string ext = path.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = detail::lowercase_extension(path);
   if (ext == ".glb" && !is_glb(path))
     throw AssetError(file + ": not a binary glTF: a .glb file starts with the bytes 'glTF' (wrong extension, or not a model?)");
   tinygltf::TinyGLTF loader;

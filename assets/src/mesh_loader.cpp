@@ -9,7 +9,6 @@
 
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
-#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -142,10 +141,8 @@ int load_texture(const std::filesystem::path& model, const std::string& name, Mo
 // The material libraries an OBJ file names (`mtllib a.mtl b.mtl`), declared before its faces: what it
 // is drawn with besides itself. None for other formats.
 std::vector<std::string> obj_material_libraries(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   std::vector<std::string> out;
-  if (ext != ".obj") return out;
+  if (detail::lowercase_extension(path) != ".obj") return out;
   std::ifstream in(path);
   for (std::string line; std::getline(in, line) && line.rfind("f ", 0) != 0;) {
     if (line.rfind("mtllib", 0) != 0) continue;
@@ -210,8 +207,7 @@ Model load_mesh(const std::filesystem::path& path) {
 Model load_model(const std::filesystem::path& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw AssetError(path.string() + ": is a folder, not a model file");
-  std::string ext = path.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = detail::lowercase_extension(path);
   if (ext == ".gltf" || ext == ".glb") return load_gltf(path);
   if (ext == ".ply" || ext == ".obj" || ext == ".stl") return load_mesh(path);
   throw AssetError(path.string() + ": unknown model format '" + ext + "' (use .gltf, .glb, .ply, .obj or .stl)");
