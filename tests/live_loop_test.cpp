@@ -166,3 +166,52 @@ TEST_F(LiveLoopTest, DrawsAMovingTargetWhereItWillBeAtDisplayTimeAndMeasuresIt) 
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(LiveLoopTest, StepsFrameByFrameOnASimulatedClockWithoutDrawing) {
+  // As the twin's tour runs it: one frame per step at the clock's time, decided and measured, nothing
+  // drawn. Found at 0.1 s, lost at 0.3 s; a truth 2 mm off in x while still, 0 mm after 0.25 s.
+  double now_s = 0.0;
+  session::LiveLoopConfig c;
+  c.projection.T_projector_camera = at(0.1, 0.0, 0.0);
+  c.projection.input_lag_ms = 20.0;
+  c.projection.silent_camera_s = 0.0;
+  session::LiveLoop loop(*renderer_, projector_, {}, c, {[&] { return now_s; }, [&](double t) { now_s = t; }});
+  session::LiveInputs in;
+  in.stop = [] { return session::LiveStop{{0}, 0.0, 1}; };
+  in.poses = [&](int, alignment::PoseSample& out) {
+    if (now_s < 0.1 - 1e-9) return false;
+    out = seen(at(0, 0, 1), 0.1, Eigen::Vector3d::Zero());
+    out.lost = now_s >= 0.3 - 1e-9;
+    return true;
+  };
+  in.meter = [](const session::DrawnPose& d) {
+    return session::DisplayError{d.display_s > 0.25 ? 0.0 : 2.0, d.display_s > 0.25};
+  };
+  loop.begin();
+  std::size_t drawn = 0;
+  for (int k = 0; k < 30; ++k) {
+    now_s = k / 60.0;
+    const std::optional<session::LiveFrame> f = loop.frame(nullptr, in, nullptr);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_DOUBLE_EQ(f->start_s, now_s);
+    EXPECT_NEAR(f->display_s, now_s + 1.0 / 60.0 + 0.020, 1e-9);  // a frame period and the input lag later
+    drawn += f->drawn.size();
+    for (const session::DrawnPose& d : f->drawn) {
+      EXPECT_EQ(d.target, 0);
+      EXPECT_NEAR(d.T_projector_target(0, 3), 0.1, 1e-12);  // Eq. 2 with the configured R_cp, T_cp
+      EXPECT_NEAR(d.display_s, f->display_s, 1e-12);
+    }
+  }
+  EXPECT_EQ(drawn, 12U);  // frames 6..17: found at 0.1 s, lost at 0.3 s
+  const session::LiveFigures& figures = loop.figures();
+  ASSERT_EQ(figures.rows.size(), 30U);
+  EXPECT_EQ(figures.blank, 18U);
+  EXPECT_EQ(figures.still_mm.size() + figures.moving_mm.size(), 12U);
+  for (const double e : figures.still_mm) EXPECT_DOUBLE_EQ(e, 2.0);
+  EXPECT_NEAR(figures.rows[6].age_ms, 1000.0 * (6 / 60.0 + 1.0 / 60.0 + 0.020 - 0.1), 1e-6);
+  EXPECT_NEAR(figures.rows[29].clock_s, 29 / 60.0, 1e-12);
+}
+
+}  // namespace

@@ -19,12 +19,17 @@ LiveLoop::LiveLoop(engine::Renderer& renderer, const config::ProjectorConfig& pr
 // This frame's draw items: each lit target found, at its pose for the display time, with its content on
 // that display time's clock. A lit target's video runs before its pose is found (the acquisition's first
 // second), so that it has caught up with its clock when it is first drawn.
+std::vector<DrawnPose> LiveLoop::decide(const LiveStop& stop, const LiveInputs& in, double now_s) {
+  decided_s_ = now_s;
+  const double camera_last_s = in.camera_last_s ? in.camera_last_s() : now_s;
+  return frames_.compose(now_s, {stop.targets, stop.since_s, camera_last_s}, in.poses);
+}
+
 void LiveLoop::compose(const LiveStop& stop, const LiveInputs& in, std::vector<engine::DrawItem>& out,
                        std::vector<DrawnPose>& drawn) {
   out.clear();
-  first_content_ = {std::nan(""), std::nan(""), false};
   const double now_s = clock_.now_s();
-  drawn = frames_.compose(now_s, {stop.targets, stop.since_s, in.camera_last_s()}, in.poses);
+  drawn = decide(stop, in, now_s);
   const auto content_s = [&](int target, double display_s) { return display_s - content_->start_s(target, t0_s_, stop.since_s); };
   if (content_) {
     const double display_s = frames_.display_time_s(now_s);
@@ -71,21 +76,36 @@ void LiveLoop::measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& 
                            1000.0 * first.T_projector_target.topRightCorner<3, 1>()});
 }
 
-LiveFigures LiveLoop::run(engine::RenderTarget& target, const LiveInputs& in, engine::FrameProfiler& profiler) {
+void LiveLoop::begin() {
   figures_ = {};
   t0_s_ = clock_.now_s();
+}
+
+std::optional<LiveFrame> LiveLoop::frame(engine::RenderTarget* target, const LiveInputs& in, engine::FrameProfiler* profiler) {
+  const LiveStop stop = in.stop();  // after the wait: on a replay's clock, the robot has done all before it
+  LiveFrame f;
+  f.start_s = clock_.now_s();
+  const double start_ms = profiler ? profiler->now_ms() : 1000.0 * (f.start_s - t0_s_);
+  frames_.frame_started(f.start_s);
+  first_content_ = {std::nan(""), std::nan(""), false};
+  if (target) {
+    const auto read = [&](std::vector<engine::DrawItem>& out) { compose(stop, in, out, f.drawn); };
+    if (!renderer_.draw_frame(*target, projector_, read, profiler)) return std::nullopt;
+  } else {
+    f.drawn = decide(stop, in, f.start_s);
+  }
+  f.display_s = frames_.display_time_s(decided_s_);
+  if (in.after_frame) in.after_frame();
+  measure(f.drawn, in.meter, start_ms, f.start_s);
+  return f;
+}
+
+LiveFigures LiveLoop::run(engine::RenderTarget& target, const LiveInputs& in, engine::FrameProfiler& profiler) {
+  begin();
   double next_s = t0_s_;
-  std::vector<DrawnPose> drawn;
   while (in.keep_going() && !target.poll_close() && (cfg_.seconds == 0.0 || clock_.now_s() - t0_s_ < cfg_.seconds)) {
     if (cfg_.paced_hz > 0.0) clock_.pace(next_s, 1.0 / cfg_.paced_hz);  // no vsync: paced like a projector
-    const LiveStop stop = in.stop();  // after the wait: on a replay's clock, the robot has done all before it
-    const double start_ms = profiler.now_ms(), start_s = clock_.now_s();
-    frames_.frame_started(start_s);
-    drawn.clear();
-    const auto read = [&](std::vector<engine::DrawItem>& out) { compose(stop, in, out, drawn); };
-    if (!renderer_.draw_frame(target, projector_, read, &profiler)) continue;
-    if (in.after_frame) in.after_frame();
-    measure(drawn, in.meter, start_ms, start_s);
+    frame(&target, in, &profiler);
   }
   return std::move(figures_);
 }

@@ -17,7 +17,7 @@
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/photometry.hpp"
 #include "projbot/engine/projection.hpp"
-#include "projbot/session/projection.hpp"
+#include "projbot/session/live_loop.hpp"
 #include "projbot/twin/display_error.hpp"
 #include "projbot/twin/spectator.hpp"
 #include "projbot/twin/world.hpp"
@@ -274,11 +274,11 @@ Tour::Tour(const config::Scene& s, const TourOptions& o, engine::Renderer& r, Tw
 // One visit of the tour as the session runs it (session::Session::visit, in lockstep). On the stop's
 // first frame: the acquisitions' errors (the visited target's and each neighbour's) and, with --frames,
 // the pictures. Then, while the robot dwells (tracking mode, or a target that moves), projection on the
-// simulated clock: the projector at its refresh rate; each frame decides what it draws as `run`'s live
-// loop does (session::ProjectionFrames: each lit target's newest result ready when the frame starts,
-// blanked when lost, else predicted to the frame's display time and moved to the projector by Eq. 2), and
-// its error is measured against the target's true pose at its display time. The frames are measured, not
-// drawn (drawn only for --frames and appearance).
+// simulated clock: the projector at its refresh rate; each frame is a step of `run`'s projection loop
+// (session::LiveLoop::frame on the simulated clock: each lit target's newest result ready when the frame
+// starts, blanked when lost, else predicted to the frame's display time and moved to the projector by
+// Eq. 2), and its error is measured against the target's true pose at its display time. The frames are
+// measured, not drawn (drawn only for --frames and appearance).
 class TourStop final : public session::StopObserver {
  public:
   TourStop(Tour& tour, int visit) : tour_(tour), visit_(visit) {}
@@ -319,11 +319,12 @@ class TourStop final : public session::StopObserver {
   bool dwelling_ = false;
   int frames_ = 0, next_ = 1;  // projector frames: in all, and the next to measure (1-based)
   double period_s_ = 0.0;
-  std::optional<session::ProjectionFrames> projection_;  // what each frame draws, as in `run`
-  session::LitNow lit_now_;                              // to it: the lit targets by their place in lit_
-  std::vector<alignment::PoseSample> newest_;            // each lit target's newest result: at first its arrival's
-  alignment::PoseSample drawn_;                          // the visited target's newest result not lost
-  bool shown_ = false;                                   // the visited target is lit in the newest frame
+  std::optional<session::LiveLoop> loop_;      // `run`'s projection loop, stepped on the simulated clock
+  session::LiveInputs inputs_;                 // to it: the lit targets by their place in lit_, newest_
+  double now_s_ = 0.0;                         // the simulated clock: the stop's time, the loop's too
+  std::vector<alignment::PoseSample> newest_;  // each lit target's newest result: at first its arrival's
+  alignment::PoseSample drawn_;                // the visited target's newest result not lost
+  bool shown_ = false;                         // the visited target is lit in the newest frame
   double wall_to_light_ms_ = 0.0, seen_track_ms_ = 0.0;
   double motion_end_s_ = 0.0;
   double back_under_ = -1.0;  // when the error went back under the goal for good, -1 while it is not
@@ -416,16 +417,16 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
 // paces them (its refresh and input lag), Eq. 2 with the believed R_cp, T_cp; the camera is not watched for
 // silence (the tour runs in lockstep with it).
 void TourStop::start_projection() {
-  session::ProjectionConfig config;
-  config.T_projector_camera = tour_.models.T_projector_camera;
-  config.refresh_hz = tour_.models.truth.refresh_hz;
-  config.input_lag_ms = tour_.models.truth.input_lag_ms;
-  config.predict = tour_.options.predict;
-  config.silent_camera_s = 0.0;
-  projection_.emplace(config);
-  period_s_ = 1.0 / config.refresh_hz;
+  session::LiveLoopConfig config;
+  config.projection.T_projector_camera = tour_.models.T_projector_camera;
+  config.projection.refresh_hz = tour_.models.truth.refresh_hz;
+  config.projection.input_lag_ms = tour_.models.truth.input_lag_ms;
+  config.projection.predict = tour_.options.predict;
+  config.projection.silent_camera_s = 0.0;
+  period_s_ = 1.0 / config.projection.refresh_hz;
+  session::LiveStop lit{{}, 0.0, visit_};
   for (std::size_t k = 0; k < lit_.size(); ++k) {
-    lit_now_.targets.push_back(static_cast<int>(k));
+    lit.targets.push_back(static_cast<int>(k));
     alignment::PoseSample arrival;
     const Acquired& a = tour_.trackers[lit_[k]].acquired();
     arrival.T_camera_target = arrival.motion.T = a.icp.T_scan_model;
@@ -434,6 +435,11 @@ void TourStop::start_projection() {
   }
   drawn_ = newest_.front();
   shown_ = report.projected;
+  inputs_.stop = [lit] { return lit; };
+  inputs_.poses = [this](int k, alignment::PoseSample& out) { return (out = newest_[static_cast<std::size_t>(k)]), true; };
+  const config::Clock simulated{[this] { return now_s_; }, [this](double until_s) { now_s_ = std::max(now_s_, until_s); }};
+  loop_.emplace(tour_.renderer, tour_.models.believed, std::vector<engine::DrawItem>{}, config, simulated);
+  loop_->begin();
 }
 
 // The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else
@@ -534,17 +540,17 @@ void TourStop::take_results(double start_s) {
 // measured at its display time.
 void TourStop::project(double start_s) {
   const DwellContext& c = *dwell_;
+  now_s_ = start_s;
   if (tour_.options.mode == TourMode::tracking) take_results(start_s);
-  projection_->frame_started(start_s);
-  const auto newest = [this](int k, alignment::PoseSample& out) { return (out = newest_[static_cast<std::size_t>(k)]), true; };
-  const std::vector<session::DrawnPose> drawn = projection_->compose(start_s, lit_now_, newest);
+  const session::LiveFrame frame = *loop_->frame(nullptr, inputs_, nullptr);  // not drawn: always a frame
+  const std::vector<session::DrawnPose>& drawn = frame.drawn;
   const auto drawn_of = [&drawn](int k) {
     const auto it = std::find_if(drawn.begin(), drawn.end(), [k](const session::DrawnPose& d) { return d.target == k; });
     return it == drawn.end() ? nullptr : &*it;
   };
   const session::DrawnPose* visited = drawn_of(0);
   shown_ = visited != nullptr;
-  const TimelineSample s = measure_frame(c, report, projection_->display_time_s(start_s), visited, drawn_);
+  const TimelineSample s = measure_frame(c, report, frame.display_s, visited, drawn_);
   const config::TargetMotion* motion = tour_.twin.targets()[target_index_].config.motion_on(report.target_visit);
   if (tour_.options.appearance && s.moving && !moving_measured_ && s.t_s >= motion->start_s + motion->duration_s / 2) {
     moving_measured_ = true;

@@ -1,12 +1,15 @@
 #pragma once
-// The live projection loop (`run`, `run --replay`): every projector frame draws each lit target at its
-// newest accepted pose, moved on to the frame's display time (ProjectionFrames: Eq. 2), with its content
-// and compensation, or a blank frame; and measures it (the pose's age at display, the display error where
-// a truth is known). Times are seconds on the loop's clock; rows' times are the frame profiler's ms.
-// Runs on the render thread; the robot's state, the poses and the truth come in through callbacks.
+// The projection loop (`run`, `run --replay`, the twin's `tour` and `bench motion`): every projector frame
+// draws each lit target at its newest accepted pose, moved on to the frame's display time
+// (ProjectionFrames: Eq. 2), with its content and compensation, or a blank frame; and measures it (the
+// pose's age at display, the display error where a truth is known). `run` paces the frames on its clock
+// and draws them; the tour steps them one by one on its simulated clock (`frame`) and measures them
+// without drawing. Times are seconds on the loop's clock; rows' times are the frame profiler's ms (the
+// clock's, from the start, without one). The robot's state, the poses and the truth come in through callbacks.
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,14 +65,21 @@ struct LiveLoopConfig {
   double paced_hz = 0.0;  ///< offscreen: frames paced at this rate (no vsync to pace them); 0: the target paces
 };
 
-/// What the loop reads and calls each frame. `stop`, `poses`, `camera_last_s` and `keep_going` are needed.
+/// One frame as it was decided: the targets drawn (empty: blank), its start and expected display time (s).
+struct LiveFrame {
+  std::vector<DrawnPose> drawn;
+  double start_s = 0.0, display_s = 0.0;
+};
+
+/// What the loop reads and calls each frame. `stop` and `poses` are needed; `camera_last_s` where the
+/// projection watches for a silent camera, `keep_going` for `run`.
 struct LiveInputs {
   std::function<LiveStop()> stop;         ///< the robot's newest state, read once per frame
   PoseSource poses;                       ///< each target's newest accepted pose
   std::function<double()> camera_last_s;  ///< the camera's newest hand-off to the trackers
   std::function<bool()> keep_going;       ///< asked before each frame
   DisplayMeter meter;                     ///< empty: nothing measured against a truth
-  std::function<void()> after_frame;      ///< after each frame drawn (the content's messages)
+  std::function<void()> after_frame;      ///< after each frame (the content's messages)
 };
 
 /// The render thread's loop. Not thread-safe: one owner, the thread that owns the renderer.
@@ -84,10 +94,17 @@ class LiveLoop {
   /// Draws frames into `target` until `in.keep_going` says no, `seconds` have passed or the target is
   /// closed; what was measured.
   LiveFigures run(engine::RenderTarget& target, const LiveInputs& in, engine::FrameProfiler& profiler);
+  /// Stepping the loop by hand: `begin` starts a run at the clock's now (figures cleared); each `frame`
+  /// is one projector frame starting at the clock's now, decided, drawn into `target` (null: not drawn)
+  /// and measured; nullopt when the target had no image to draw into. `figures` are those so far.
+  void begin();
+  std::optional<LiveFrame> frame(engine::RenderTarget* target, const LiveInputs& in, engine::FrameProfiler* profiler);
+  const LiveFigures& figures() const { return figures_; }
   /// Frames blanked because the camera was silent.
   std::size_t silent_frames() const { return frames_.silent_frames(); }
 
  private:
+  std::vector<DrawnPose> decide(const LiveStop& stop, const LiveInputs& in, double now_s);
   void compose(const LiveStop& stop, const LiveInputs& in, std::vector<engine::DrawItem>& out, std::vector<DrawnPose>& drawn);
   void measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s);
   engine::SceneContent::Sample first_content_;  // the first drawn target's, this frame
@@ -101,6 +118,7 @@ class LiveLoop {
   engine::CompensationPlan* plan_ = nullptr;
   engine::SceneContent* content_ = nullptr;
   double t0_s_ = 0.0;
+  double decided_s_ = 0.0;  // when this frame's poses were read
   LiveFigures figures_;
 };
 
