@@ -22,159 +22,22 @@
 #include "projbot/twin/spectator.hpp"
 #include "projbot/twin/world.hpp"
 #include "sim_clock_devices.hpp"
+#include "tour_frames.hpp"
 
 namespace projbot::twin {
 namespace {
 
+using namespace detail;  // the tour's frame measurement (tour_frames.hpp)
+
 using Clock = std::chrono::steady_clock;
 
 constexpr double kConvergedMm = 3.0;  // the issue's goal for a visit's mean error
-
-// A neighbour lit with the visited target (issue 11, item 5): what the projector draws for it, and the
-// error of its lit frames so far.
-struct NeighbourLight {
-  std::size_t target = 0;  // index into Twin::targets()
-  alignment::PoseSample drawn;
-  bool shown = false;
-  double sum_mm = 0.0;     // over the lit frames with a marker in the light...
-  int measured = 0;        // ...this many
-  NeighbourReport report;  // frames, lit_frames and worst_mm counted as the frames come
-};
-
-// One projector frame of a neighbour: counted, and its error added when it was lit and measured.
-void count_frame(NeighbourLight& n, double mean_mm) {
-  ++n.report.frames;
-  if (!n.shown) return;
-  ++n.report.lit_frames;
-  if (std::isnan(mean_mm)) return;
-  n.sum_mm += mean_mm;
-  n.report.worst_mm = n.measured == 0 ? mean_mm : std::max(n.report.worst_mm, mean_mm);
-  ++n.measured;
-}
-
-// Eq. 1's guess against the truth: how far off it is (cm, degrees).
-std::pair<double, double> guess_error(const robot::HeadPoses& truth, const TwinTarget& t, const Eigen::Matrix4d& guess) {
-  const Eigen::Matrix4d T_camera_true = alignment::rigid_inverse(truth.T_world_camera.matrix()) * t.T_world_target_true;
-  const Eigen::Matrix4d error = alignment::rigid_inverse(T_camera_true) * guess;
-  return {100.0 * alignment::translation_norm_m(error), alignment::rotation_angle_deg(error)};
-}
-
-// A neighbour's report after the stop: the mean over its lit frames added.
-NeighbourReport finished(const NeighbourLight& l) {
-  NeighbourReport r = l.report;
-  r.lit_mean_mm = l.measured > 0 ? l.sum_mm / l.measured : std::nan("");
-  return r;
-}
-
-// What a dwell's projector frames are measured against (measure_frame, measure_neighbour).
-struct DwellContext {
-  Twin& twin;
-  std::size_t target;
-  const ProjectorModels& models;
-  const robot::HeadPoses& truth;
-  const TourOptions& options;
-  std::vector<NeighbourLight>& neighbours;
-};
-
-// Where a frame puts the target's light: at the pose it draws, or in a blank frame where the last pose lit
-// would have put it at the display time (camera frame).
-Eigen::Matrix4d light_pose(const session::DrawnPose* drawn, const alignment::PoseSample& last_lit, double display_s,
-                           bool predict) {
-  if (drawn) return drawn->T_camera_target;
-  return predict ? alignment::predict_pose(last_lit.motion, display_s) : last_lit.T_camera_target;
-}
-
-// The error of one projector frame, against the target's true pose at the frame's display time: of the
-// pose drawn (`drawn`), or for a blank frame of where the last pose lit (`last_lit`) would have put the light.
-TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double display_s, const session::DrawnPose* drawn,
-                             const alignment::PoseSample& last_lit) {
-  TwinTarget& target = c.twin.targets()[c.target];
-  target.T_world_target_true = c.twin.scripted_pose(c.target, r.target_visit, display_s);
-  target.in_world = c.twin.scripted_presence(c.target, r.target_visit, display_s);
-  const config::TargetMotion* motion = target.config.motion_on(r.target_visit);
-  TimelineSample s;
-  s.t_s = display_s;
-  s.shown = drawn != nullptr;
-  s.moving = motion && motion->moving_at(display_s);
-  s.age_ms = 1000.0 * (display_s - (drawn ? drawn->capture_s : last_lit.capture_time_s));
-  s.in_world = target.in_world;
-  const Eigen::Matrix4d T_camera_target = light_pose(drawn, last_lit, display_s, c.options.predict);
-  const MarkerErrors e = marker_errors(c.twin, c.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
-  s.mean_mm = e.mean_mm;
-  s.max_mm = e.max_mm;
-  return s;
-}
-
-// A neighbour's projector frame: counted, and the error of the pose drawn measured when it is lit
-// (neighbours stand still: their motion scripts run on their own visits).
-void measure_neighbour(const DwellContext& c, NeighbourLight& n, const session::DrawnPose* drawn) {
-  n.shown = drawn != nullptr;
-  if (!drawn) return count_frame(n, std::nan(""));
-  const MarkerErrors e = marker_errors(c.twin, n.target, c.models, c.truth.T_world_projector.matrix(), drawn->T_camera_target);
-  count_frame(n, e.mean_mm);
-}
-
-void summarise_timeline(VisitReport& r) {
-  std::vector<double> moving, ages;
-  double still_sum = 0.0;
-  int still_n = 0;
-  for (const auto& s : r.timeline) {
-    if (s.moving && !s.shown) ++r.moving_blank_frames;
-    if (!s.shown || std::isnan(s.mean_mm)) continue;  // blank, or no marker in the projector's light
-    ages.push_back(s.age_ms);
-    if (s.moving) {
-      moving.push_back(s.mean_mm);
-    } else {
-      still_sum += s.mean_mm;
-      ++still_n;
-    }
-  }
-  for (const double m : moving) r.moving_mean_mm += m / static_cast<double>(moving.size());
-  r.moving_p95_mm = engine::percentile(moving, 0.95);
-  r.still_mean_mm = still_n > 0 ? still_sum / still_n : 0.0;
-  double lost_at = -1.0;  // when the current blank episode began, -1 while lit
-  bool was_lit = false;
-  for (const auto& s : r.timeline) {
-    if (s.shown && lost_at >= 0.0) {
-      r.recovery_s = std::max(r.recovery_s, s.t_s - lost_at);
-      lost_at = -1.0;
-    } else if (!s.shown && was_lit && s.in_world && lost_at < 0.0) {
-      lost_at = s.t_s;
-    }
-    was_lit = was_lit || s.shown;
-    if (!s.in_world) lost_at = -1.0;  // carried away: blank is right, nothing to recover
-  }
-  if (lost_at >= 0.0) r.recovery_s = -1.0;
-  r.age_p50_ms = engine::percentile(ages, 0.5);
-  r.age_p95_ms = engine::percentile(ages, 0.95);
-}
 
 // Where --frames writes one of a visit's pictures: DIR/visitNN_TARGET<suffix>.png.
 std::filesystem::path frame_path(const TourOptions& options, const VisitReport& r, const char* suffix) {
   char file[96];
   std::snprintf(file, sizeof file, "visit%02d_%s%s.png", r.visit, r.target.c_str(), suffix);
   return options.frames_dir / file;
-}
-
-// A neighbour at arrival: acquired from the stop's capture (and colour) from its own Eq. 1 guess, as
-// the visited target is (its tracker's acquisition), and its error at the markers measured.
-NeighbourLight neighbour_light(const Twin& twin, const Acquired& a, std::size_t target, const session::LitTarget& n,
-                               const robot::HeadPoses& truth, const ProjectorModels& models) {
-  const TwinTarget& t = twin.targets()[target];
-  NeighbourLight l;
-  l.target = target;
-  l.shown = a.projected;
-  l.drawn.T_camera_target = l.drawn.motion.T = a.icp.T_scan_model;
-  NeighbourReport& r = l.report;
-  r.target = t.config.name;
-  r.projected = a.projected;
-  r.align_ms = a.align_ms;
-  std::tie(r.guess_error_cm, r.guess_error_deg) = guess_error(truth, t, n.T_camera_target_guess);
-  const MarkerErrors e = marker_errors(twin, target, models, truth.T_world_projector.matrix(), a.icp.T_scan_model);
-  r.mean_mm = e.mean_mm;
-  r.max_mm = e.max_mm;
-  count_frame(l, e.mean_mm);  // the arrival's frame
-  return l;
 }
 
 // The projector as the twin's light follows it and as the session believes it (options.calibration).
