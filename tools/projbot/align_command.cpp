@@ -62,13 +62,7 @@ Eigen::Matrix4d initial_guess(const cli::Args& args) {
     return config::orthonormalised_rigid(T, "--init-matrix");  // a dataset's float32 rotation is good to ~1e-7
   }
   if (xyz_rpy) {
-    std::string text = *xyz_rpy;
-    for (auto& c : text)
-      if (c == ' ' || c == '\t') c = ',';
-    while (text.find(",,") != std::string::npos) text.replace(text.find(",,"), 2, ",");
-    if (!text.empty() && text.front() == ',') text.erase(0, 1);
-    if (!text.empty() && text.back() == ',') text.pop_back();
-    const auto v = config::parse_number_list(text, 6, "--init \"x y z roll pitch yaw\"");
+    const auto v = cli::spaced_numbers(*xyz_rpy, 6, "--init \"x y z roll pitch yaw\"");
     return config::pose_from_xyz_rpy({v[0], v[1], v[2]}, {v[3], v[4], v[5]});
   }
   return Eigen::Matrix4d::Identity();

@@ -7,9 +7,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <regex>
 #include <sstream>
 
 #include "projbot/config/output_file.hpp"
+#include "projbot/config/scene.hpp"
 
 namespace projbot::cli {
 
@@ -157,6 +159,13 @@ double Args::get_double(const std::string& name, double fallback) const {
   if (ec != std::errc() || end != v->data() + v->size() || !std::isfinite(out))
     throw UsageError("--" + name + " must be a finite number, got '" + *v + "'");
   return out;
+}
+
+std::vector<double> spaced_numbers(const std::string& text, std::size_t count, const std::string& what) {
+  static const std::regex separator(R"(\s*,\s*|\s+)");
+  const std::size_t first = text.find_first_not_of(" \t"), last = text.find_last_not_of(" \t");
+  const std::string trimmed = first == std::string::npos ? std::string() : text.substr(first, last - first + 1);
+  return config::parse_number_list(std::regex_replace(trimmed, separator, ","), count, what);
 }
 
 std::string format_options(const std::vector<OptionSpec>& specs) {

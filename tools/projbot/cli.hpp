@@ -74,6 +74,10 @@ class Args {
 std::pair<double, double> parse_distance_angle(const std::string& text, const std::string& option, const std::string& unit,
                                                int max_distance);
 
+/// `count` numbers separated by commas or spaces ("x y phi", "0.1, 0.2, 0.3"): config::parse_number_list's
+/// checks and errors naming `what`.
+std::vector<double> spaced_numbers(const std::string& text, std::size_t count, const std::string& what);
+
 /// "  --scene FILE     help" lines for a subcommand's help text.
 std::string format_options(const std::vector<OptionSpec>& specs);
 

@@ -38,10 +38,7 @@ const fs::path kDefaultGtRawlog = fs::path(PROJBOT_SHARED_DATA) / "mrpt" / "rang
 }  // namespace
 
 Pose2D parse_pose(const std::string& text, const std::string& what) {
-  std::string commas = text;
-  for (char& c : commas)
-    if (c == ' ') c = ',';
-  const auto v = config::parse_number_list(commas, 3, what);
+  const auto v = cli::spaced_numbers(text, 3, what);
   return {v[0], v[1], v[2]};
 }
 
