@@ -1,6 +1,6 @@
 // The acquisition (TargetFollower's search for a target from a guess): what is near the guess, projective
 // and point-to-plane ICP on it, the candidates around a gross guess, the polish and colour's placing.
-// TargetFollower's tracking and search policy and the worker thread are in tracker_worker.cpp.
+// TargetFollower's tracking and search policy are in target_follower.cpp, the worker thread in tracker_worker.cpp.
 
 #include <algorithm>
 #include <chrono>
@@ -8,7 +8,7 @@
 
 #include "projbot/alignment/coarse_search.hpp"
 #include "projbot/alignment/equations.hpp"
-#include "projbot/alignment/tracker_worker.hpp"
+#include "projbot/alignment/target_follower.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/config/clock.hpp"
 
