@@ -20,6 +20,7 @@
 #include "dds_loopback.hpp"
 #include "device_fixtures.hpp"
 #include "projbot/alignment/freenect_source.hpp"
+#include "projbot/assets/image.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/pan_tilt.hpp"
 #include "projbot/robot/pose2d.hpp"
@@ -393,9 +394,21 @@ TEST_F(DevicesCli, RunReplaysARecordingFrameForFrame) {
   EXPECT_LT(number_after(r.output, "largest difference "), 0.1) << r.output;  // mm, the goal
   EXPECT_NE(r.output.find(" deg; 0 found or lost in one and not the other"), std::string::npos) << r.output;
   EXPECT_GT(number_after(r.output, "pose age at display (depth capture to expected display), "), 20.0) << r.output;
+  // The twin's camera measured both targets' reflectance (display.yaml: the default light grey surface,
+  // albedo 0.75, sRGB 225) and the replay compensates with what was learnt.
+  for (const char* name : {"box", "duck"}) {
+    const projbot::assets::Image map = projbot::assets::read_image(rec / "reflectance" / (std::string(name) + ".png"));
+    double sum = 0.0;
+    for (std::size_t i = 0; i < map.rgba.size(); i += 4) sum += (map.rgba[i] + map.rgba[i + 1] + map.rgba[i + 2]) / 3.0;
+    EXPECT_NEAR(sum / static_cast<double>(map.rgba.size() / 4), 225.0, 20.0) << name;
+  }
+  EXPECT_NE(r.output.find("compensated with the reflectance learnt while recording: box (reflectance/box.png) duck "
+                          "(reflectance/duck.png)"),
+            std::string::npos)
+      << r.output;
 
   // What the replay cannot do is named: options that do not apply, a scene whose tour went elsewhere, a
-  // frame file gone, a recording that is not one.
+  // frame file gone, a recording that is not one, a learnt reflectance map gone.
   EXPECT_EQ(run_projbot("run --headless --replay " + rec.string() + " --visits 1").code, 2);
   const CliRun other = run_projbot(
       "run --headless --replay " + rec.string() + " --config " + std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml", 120);
@@ -423,6 +436,10 @@ TEST_F(DevicesCli, RunReplaysARecordingFrameForFrame) {
   const CliRun none = run_projbot("run --headless --replay " + (dir_ / "nothing").string());
   EXPECT_EQ(none.code, 1) << none.output;
   EXPECT_NE(none.output.find("no such recording folder"), std::string::npos) << none.output;
+  fs::remove(rec / "reflectance" / "box.png");
+  const CliRun no_map = run_projbot("run --headless --replay " + rec.string());
+  EXPECT_EQ(no_map.code, 1) << no_map.output;
+  EXPECT_NE(no_map.output.find("reflectance.box: no such file: "), std::string::npos) << no_map.output;
 }
 
 namespace {

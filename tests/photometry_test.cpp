@@ -362,4 +362,23 @@ TEST(Photometry, AReflectanceMapStaysBoundedAndFollowsTheNewestValues) {
         EXPECT_NEAR(engine::srgb_to_linear(image->pixel(x, y)[ch] / 255.0), grey[ch], 0.005) << x << ", " << y;
 }
 
+// A model without texture coordinates puts every point of a measurement in one texel: the texel's median
+// is that of the whole measurement (2500 points, the last 400 of them in shadow), not of its last points.
+TEST(Photometry, AReflectanceMapOfAModelWithoutTextureCoordinatesTakesTheWholeMeasurement) {
+  engine::ReflectanceMap map(8, 8);
+  std::vector<engine::ReflectancePoint> points(2500);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    points[k].rho = k < 2100 ? Eigen::Vector3d(0.72, 0.58, 0.44) : Eigen::Vector3d(0.02, 0.02, 0.02);
+    points[k].valid = {true, true, true};
+  }
+  map.add(points);
+  const std::optional<projbot::assets::Image> image = map.image();
+  ASSERT_TRUE(image);
+  for (const auto& [x, y] : {std::pair{0, 0}, std::pair{4, 4}, std::pair{7, 3}}) {
+    EXPECT_NEAR(engine::srgb_to_linear(image->pixel(x, y)[0] / 255.0), 0.72, 0.005) << x << ", " << y;
+    EXPECT_NEAR(engine::srgb_to_linear(image->pixel(x, y)[2] / 255.0), 0.44, 0.005) << x << ", " << y;
+  }
+  EXPECT_LE(map.values_kept(), 3 * engine::ReflectanceMap::kPerTexel + points.size());
+}
+
 }  // namespace

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <thread>
 
@@ -140,6 +141,57 @@ TEST_F(ReplayTest, TheRecordingsDevicesAnswerWhatWasRecordedAndRefuseAStopItDoes
     EXPECT_NE(std::string(e.what()).find("asked for stop 2 but the recording holds 1"), std::string::npos) << e.what();
   }
   EXPECT_THROW(replay.drive_to({3.0, 2.0, 0.5}, 0), session::SessionError);  // another stop than recorded
+}
+
+// What `record` learnt of the targets' reflectance travels in recording.yaml (`reflectance:`, a PNG per
+// target inside the folder) and replaces the scene's `surface:` in a replay; a map of a target the scene
+// lacks, a file outside the folder or gone is refused, naming it.
+TEST_F(ReplayTest, ARecordingsLearntReflectanceReplacesTheScenesSurfaceAndIsRefusedWhenNotThere) {
+  config::Recording recording;
+  config::RecordedStop s;
+  s.target = "duck";
+  s.frames = "stop01";
+  s.frame_count = 3;
+  recording.stops.push_back(s);
+  recording.reflectance["duck"].texture = "reflectance/duck.png";
+  recording.reflectance["box"].albedo = {0.5, 0.4, 0.25};  // a model without texture coordinates
+  std::filesystem::create_directories(dir_ / "reflectance");
+  std::ofstream(dir_ / "reflectance" / "duck.png") << "png";
+  std::ofstream(dir_ / "recording.yaml") << config::recording_yaml(recording);
+  const config::Recording read = config::load_recording(dir_);
+  ASSERT_EQ(read.reflectance.size(), 2U);
+  EXPECT_EQ(read.reflectance.at("duck").texture, "reflectance/duck.png");
+  EXPECT_TRUE(read.reflectance.at("box").texture.empty());
+  EXPECT_EQ(read.reflectance.at("box").albedo, Eigen::Vector3d(0.5, 0.4, 0.25));
+  config::Scene scene = two_targets();
+  config::use_learnt_reflectance(scene, read);
+  EXPECT_EQ(scene.targets[0].surface.texture, dir_ / "reflectance" / "duck.png");
+  EXPECT_TRUE(scene.targets[1].surface.texture.empty());
+  EXPECT_EQ(scene.targets[1].surface.albedo, Eigen::Vector3d(0.5, 0.4, 0.25));
+
+  const auto refusal = [&](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const config::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  config::Recording cat = read;
+  cat.reflectance = {{"cat", config::TargetSurface{}}};
+  EXPECT_NE(refusal([&] { config::use_learnt_reflectance(scene, cat); }).find("reflectance.cat: "), std::string::npos);
+  recording.reflectance["duck"].texture = "../duck.png";
+  std::ofstream(dir_ / "recording.yaml") << config::recording_yaml(recording);
+  EXPECT_NE(refusal([&] { config::load_recording(dir_); }).find("reflectance.duck: must name a PNG file inside the recording"),
+            std::string::npos);
+  recording.reflectance["duck"].texture = "reflectance/gone.png";
+  std::ofstream(dir_ / "recording.yaml") << config::recording_yaml(recording);
+  EXPECT_NE(refusal([&] { config::load_recording(dir_); }).find("reflectance.duck: no such file: "), std::string::npos);
+  recording.reflectance["duck"].texture = "reflectance/duck.png";
+  recording.reflectance["box"].albedo = {0.5, 1.5, 0.25};
+  std::ofstream(dir_ / "recording.yaml") << config::recording_yaml(recording);
+  EXPECT_NE(refusal([&] { config::load_recording(dir_); }).find("reflectance.box: an albedo is 0..1 per channel"),
+            std::string::npos);
 }
 
 // A replay's clock keeps the projector's frames and the session in step: the frame of time T is drawn

@@ -67,6 +67,12 @@ Eigen::Vector3d Model::surface_centroid() const {
   return area > 0.0 ? Eigen::Vector3d(sum / area) : bounds().center();
 }
 
+bool has_texture_coordinates(const Model& model) {
+  return std::any_of(model.primitives.begin(), model.primitives.end(), [](const Primitive& p) {
+    return std::any_of(p.vertices.begin(), p.vertices.end(), [](const Vertex& v) { return v.uv[0] != 0.0F || v.uv[1] != 0.0F; });
+  });
+}
+
 void scale_and_recenter(Model& model, double scale, bool recenter) {
   if (!(scale > 0.0) || !std::isfinite(scale)) throw AssetError(model.source + ": scale must be finite and > 0");
   for (auto& p : model.primitives)

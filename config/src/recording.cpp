@@ -1,8 +1,10 @@
 #include "projbot/config/recording.hpp"
 
+#include <algorithm>
 #include <iomanip>
 
 #include "map_reader.hpp"
+#include "projbot/config/scene.hpp"
 #include "projbot/config/yaml_keys.hpp"
 
 namespace projbot::config {
@@ -24,6 +26,11 @@ std::string triple(const Eigen::Vector3d& v) {
   return out.str();
 }
 
+// A path a recording's file names: relative, inside the folder.
+bool inside_folder(const std::string& path) {
+  return !path.empty() && path.front() != '/' && path.find("..") == std::string::npos;
+}
+
 RecordedStop read_stop(const YAML::Node& node, const std::string& path, const std::string& file) {
   MapReader r(node, path, file);
   RecordedStop s;
@@ -37,14 +44,60 @@ RecordedStop read_stop(const YAML::Node& node, const std::string& path, const st
   s.arrived = r.get<bool>("arrived", false, true);
   s.frames = r.get<std::string>("frames", "", true);
   s.frame_count = r.get<int>("frame_count", 0, true);
-  if (s.frames.empty() || s.frames.find("..") != std::string::npos || s.frames.front() == '/')
-    r.fail(node, r.key_path("frames"), "must name a folder inside the recording");
+  if (!inside_folder(s.frames)) r.fail(node, r.key_path("frames"), "must name a folder inside the recording");
   if (s.frame_count < 1) r.fail(node, r.key_path("frame_count"), "a recorded stop has at least one frame");
   r.reject_unknown();
   return s;
 }
 
+// One `reflectance:` entry: a PNG inside the recording that is there, or an albedo [r, g, b] in 0..1.
+TargetSurface read_learnt(const MapReader& r, const YAML::Node& value, const std::string& key,
+                          const std::filesystem::path& folder) {
+  TargetSurface surface;
+  if (value.IsSequence()) {
+    const auto v = r.numbers(value, key, 3);
+    for (int ch = 0; ch < 3; ++ch)
+      if (v[static_cast<std::size_t>(ch)] < 0.0 || v[static_cast<std::size_t>(ch)] > 1.0)
+        r.fail(value, key, "an albedo is 0..1 per channel");
+    surface.albedo = {v[0], v[1], v[2]};
+    return surface;
+  }
+  if (!value.IsScalar() || !inside_folder(value.Scalar()))
+    r.fail(value, key, "must name a PNG file inside the recording, or give an albedo [r, g, b]");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(folder / value.Scalar(), ec))
+    r.fail(value, key, "no such file: " + (folder / value.Scalar()).string());
+  surface.texture = value.Scalar();
+  return surface;
+}
+
+// `reflectance:`, target name -> what was learnt of it.
+std::map<std::string, TargetSurface> read_reflectance(MapReader& r, const std::filesystem::path& folder) {
+  std::map<std::string, TargetSurface> out;
+  const YAML::Node node = r.child("reflectance", false);
+  if (!node) return out;
+  if (!node.IsMap()) r.fail(node, "reflectance", "expected a map of target: file.png or [r, g, b]");
+  for (const auto& kv : node) {
+    const std::string name = kv.first.IsScalar() ? kv.first.Scalar() : std::string();
+    if (name.empty()) r.fail(kv.first, "reflectance", "a key must be a target's name");
+    out[name] = read_learnt(r, kv.second, "reflectance." + name, folder);
+  }
+  return out;
+}
+
 }  // namespace
+
+void use_learnt_reflectance(Scene& scene, const Recording& recording) {
+  for (const auto& [name, learnt] : recording.reflectance) {
+    const auto it =
+        std::find_if(scene.targets.begin(), scene.targets.end(), [&](const TargetConfig& t) { return t.name == name; });
+    if (it == scene.targets.end())
+      throw ConfigError(recording.source.string() + ": reflectance." + name + ": " + scene.source.string() +
+                        " has no target of that name");
+    it->surface = learnt;
+    if (!learnt.texture.empty()) it->surface.texture = recording.folder() / learnt.texture;
+  }
+}
 
 std::string recording_yaml(const Recording& r) {
   std::ostringstream out;
@@ -53,6 +106,12 @@ std::string recording_yaml(const Recording& r) {
       << "format: 1\nscene: " << quoted(r.scene.string()) << "\ncamera: " << quoted(r.camera) << "\nseed: " << r.seed
       << "\ndwell_s: " << r.dwell_s << "\ninterrupted: " << (r.interrupted ? "true" : "false") << "\n";
   if (!r.laser.empty()) out << "laser: " << quoted(r.laser) << "\n";
+  if (!r.reflectance.empty()) {
+    out << "reflectance:\n";
+    for (const auto& [name, learnt] : r.reflectance)
+      out << "  " << quoted(name) << ": " << (learnt.texture.empty() ? triple(learnt.albedo) : quoted(learnt.texture.string()))
+          << "\n";
+  }
   out << "stops:\n";
   if (r.stops.empty()) out << "  []\n";
   for (const RecordedStop& s : r.stops)
@@ -87,6 +146,7 @@ Recording load_recording(const std::filesystem::path& folder) {
   rec.dwell_s = r.get<double>("dwell_s", 0.0, true);
   rec.interrupted = r.get<bool>("interrupted", false, true);
   rec.laser = r.get<std::string>("laser", "");
+  rec.reflectance = read_reflectance(r, folder);
   const YAML::Node stops = r.child("stops", true);
   if (!stops.IsSequence()) r.fail(stops, "stops", "expected a list of stops");
   for (std::size_t k = 0; k < stops.size(); ++k)

@@ -14,11 +14,7 @@ namespace projbot::engine {
 
 std::shared_ptr<const assets::Image> load_surface_texture(const config::TargetConfig& target, const assets::Model& model) {
   if (target.surface.texture.empty()) return nullptr;
-  const bool has_uvs = std::any_of(model.primitives.begin(), model.primitives.end(), [](const assets::Primitive& p) {
-    return std::any_of(p.vertices.begin(), p.vertices.end(),
-                       [](const assets::Vertex& v) { return v.uv[0] != 0.0F || v.uv[1] != 0.0F; });
-  });
-  if (!has_uvs)
+  if (!assets::has_texture_coordinates(model))
     throw assets::AssetError(target.surface.texture.string() + ": target '" + target.name + "'s surface texture needs texture " +
                              "coordinates, and its model " + target.model.string() + " has none");
   return std::make_shared<const assets::Image>(assets::read_image(target.surface.texture));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 
 namespace projbot::engine {
@@ -246,19 +247,32 @@ std::optional<Eigen::Vector3d> measure_albedo(const assets::Model& model, const 
 ReflectanceMap::ReflectanceMap(int width, int height)
     : width_(width), height_(height), texels_(static_cast<std::size_t>(width) * height) {}
 
+std::size_t ReflectanceMap::texel_of(const ReflectancePoint& p) const {
+  return static_cast<std::size_t>(assets::texel_index(p.uv.y(), height_)) * width_ + assets::texel_index(p.uv.x(), width_);
+}
+
 void ReflectanceMap::add(const std::vector<ReflectancePoint>& points) {
+  // How many values of this measurement fall in each texel and channel: one that brings more than
+  // kPerTexel keeps every stride-th, spread over all of them (a model without texture coordinates puts
+  // every point in one texel: the newest 32 alone would be one corner of it).
+  std::vector<std::array<std::size_t, 3>> count(texels_.size(), {0, 0, 0}), taken(texels_.size(), {0, 0, 0});
+  for (const ReflectancePoint& p : points)
+    if (p.uv.allFinite() && p.rho.allFinite())
+      for (std::size_t ch = 0; ch < 3; ++ch) count[texel_of(p)][ch] += p.valid[ch] ? 1 : 0;
   for (const ReflectancePoint& p : points) {
     if (!p.uv.allFinite() || !p.rho.allFinite()) continue;
-    Texel& t = texels_[static_cast<std::size_t>(assets::texel_index(p.uv.y(), height_)) * width_ +
-                       assets::texel_index(p.uv.x(), width_)];
+    const std::size_t i = texel_of(p);
+    Texel& t = texels_[i];
     for (std::size_t ch = 0; ch < 3; ++ch) {
       if (!p.valid[ch]) continue;
+      const std::size_t stride = (count[i][ch] + kPerTexel - 1) / kPerTexel;
+      if (taken[i][ch]++ % stride != 0) continue;
       const auto v = static_cast<float>(p.rho[static_cast<int>(ch)]);
       if (t.values[ch].size() < kPerTexel)
         t.values[ch].push_back(v);
       else
-        t.values[ch][t.seen[ch] % kPerTexel] = v;  // the oldest goes
-      ++t.seen[ch];
+        t.values[ch][t.kept[ch] % kPerTexel] = v;  // the oldest goes
+      ++t.kept[ch];
     }
     if (recent_.size() < kFillPoints)
       recent_.push_back(p);

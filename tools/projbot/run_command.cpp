@@ -109,6 +109,17 @@ void print_replay(std::ostream& out, const config::Recording& recording, int vis
       << " compared, largest difference " << std::setprecision(4) << check.max_mm << " mm, " << check.max_deg << " deg; "
       << check.mismatched << " found or lost in one and not the other; " << check.unreached()
       << " recorded rows for frames the replay did not reach\n";
+  if (!recording.reflectance.empty()) {
+    out << "compensated with the reflectance learnt while recording:";
+    for (const auto& [name, learnt] : recording.reflectance) {
+      out << ' ' << name << " (";
+      if (learnt.texture.empty())
+        out << "albedo " << learnt.albedo.x() << " / " << learnt.albedo.y() << " / " << learnt.albedo.z() << ")";
+      else
+        out << learnt.texture.string() << ")";
+    }
+    out << '\n';
+  }
 }
 
 // Per frame: when it started, the capture time of the depth its pose came from and its expected display
@@ -169,7 +180,9 @@ const Command kRun{
     "no twin is used, so nothing is measured against a truth. A replay runs on the recording's clock: each\n"
     "projector frame is one refresh of it and is drawn once the session has done everything before it\n"
     "(drives take their recorded time, each video frame is waited for), so a replay draws the same frames,\n"
-    "poses and content every time (--profile shows them), as fast as the machine tracks and draws.\n"
+    "poses and content every time (--profile shows them), as fast as the machine tracks and draws. Targets\n"
+    "whose reflectance the recording learnt (recording.yaml's `reflectance:`) are compensated with it in place\n"
+    "of the scene's `surface:`.\n"
     "Targets with `content:` (a video, a timeline) or animated materials play them on each frame's display\n"
     "time; a video, model or texture file that changes on disk is loaded again and swapped in at a later\n"
     "frame (tracking goes on; a model of another shape is not), and one that fails to load leaves the old\n"
@@ -200,7 +213,8 @@ const Command kRun{
       const std::string scene_path =
           args.get_or("config", recording ? recording->scene.string() : (asset_dir() / "scenes" / "tour.yaml").string());
       args.check_clashes({{recording ? "the recording's scene" : "the default scene", scene_path, false}});
-      const config::Scene scene = config::load_scene(scene_path);
+      config::Scene scene = config::load_scene(scene_path);
+      if (recording) config::use_learnt_reflectance(scene, *recording);  // compensated as the session learnt it
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
       std::optional<session::PoseCheck> check;

@@ -1,11 +1,13 @@
 #include "projbot/live/recorder.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <optional>
 #include <stdexcept>
 
 #include "projbot/alignment/freenect_source.hpp"
+#include "projbot/assets/image.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/hardware/devices.hpp"
 #include "projbot/live/rig.hpp"
@@ -36,8 +38,9 @@ class QuantisedCamera final : public alignment::RgbdCamera {
 // so a recording cut short holds every stop that was left.
 class RecordObserver final : public session::StopObserver {
  public:
-  RecordObserver(const config::Scene& scene, config::Recording& recording, const fs::path& out, const RecordHooks& hooks)
-      : scene_(scene), rec_(recording), out_(out), hooks_(hooks) {}
+  RecordObserver(const config::Scene& scene, config::Recording& recording, const fs::path& out, const RecordHooks& hooks,
+                 twin::ReflectanceSurvey* survey)
+      : scene_(scene), rec_(recording), out_(out), hooks_(hooks), survey_(survey) {}
   void lit(const session::Stop& stop, double) override {
     char name[32];
     std::snprintf(name, sizeof name, "stop%02d", stop.visit + 1);
@@ -52,21 +55,25 @@ class RecordObserver final : public session::StopObserver {
     current_.arrived = stop.drive.arrived;
     current_.frames = name;
     writer_ = std::make_unique<alignment::FakenectDumpWriter>(out_ / name);
+    accepted_.assign(stop.lit.size(), std::nullopt);
   }
   void frame(const session::Stop& stop, int k, const alignment::RgbdFrame& f,
              const std::vector<std::optional<alignment::PoseSample>>& samples) override {
     if (t0_s_ < 0.0) t0_s_ = f.depth.capture_time_s;
     writer_->add({&f.depth, &f.colour, f.depth.capture_time_s - t0_s_});
     poses_.add(scene_, stop, k, samples);
+    for (std::size_t j = 0; j < samples.size() && j < accepted_.size(); ++j)
+      if (samples[j]) accepted_[j] = samples[j]->lost ? std::nullopt : std::optional(samples[j]->T_camera_target);
     current_.frame_count = k + 1;
     ++frames;
     if (hooks_.frame) hooks_.frame(frames);
   }
-  void left(const session::Stop&) override {
+  void left(const session::Stop& stop) override {
     rec_.stops.push_back(current_);
+    const std::string measured = measure_reflectance(stop);
     save();
     *hooks_.log << "stop " << rec_.stops.size() << ": " << current_.target << ", " << current_.frame_count << " frames recorded"
-                << std::endl;
+                << measured << std::endl;
   }
   // A laser scan with the odometry then, as a rawlog step (its odometry the increment since the last).
   void scan(const robot::LaserScan& scan, const robot::Pose2D& odometry) {
@@ -83,12 +90,42 @@ class RecordObserver final : public session::StopObserver {
       fs::rename(out_ / "laser.rawlog.tmp", out_ / "laser.rawlog");
       rec_.laser = "laser.rawlog";
     }
+    if (survey_) save_reflectance();
     config::write_file_atomically(out_ / "poses.csv", poses_.text());
     config::write_file_atomically(out_ / "recording.yaml", config::recording_yaml(rec_));
   }
   int frames = 0;
 
  private:
+  // With the twin's camera: each lit target whose last pose was accepted, measured at that pose; what the
+  // log line says of it.
+  std::string measure_reflectance(const session::Stop& stop) {
+    if (!survey_) return "";
+    std::string said;
+    for (std::size_t j = 0; j < accepted_.size() && j < stop.lit.size(); ++j) {
+      if (!accepted_[j]) continue;
+      const std::string& name = scene_.targets[static_cast<std::size_t>(stop.lit[j].target)].name;
+      said += (said.empty() ? "; reflectance measured: " : ", ") + name + " (" +
+              std::to_string(survey_->measure(name, *accepted_[j])) + " points)";
+    }
+    return said;
+  }
+  // What was learnt so far, in recording.yaml: a map as reflectance/NAME.png, a target without texture
+  // coordinates as its albedo.
+  void save_reflectance() const {
+    for (const auto& [name, learnt] : survey_->learnt()) {
+      config::TargetSurface& surface = rec_.reflectance[name];
+      surface.albedo = learnt.albedo;
+      if (!learnt.map) continue;
+      std::string file = name;
+      for (char& c : file)
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+      surface.texture = "reflectance/" + file + ".png";
+      fs::create_directories(out_ / "reflectance");
+      assets::write_png(out_ / surface.texture, *learnt.map);
+    }
+  }
+
   const config::Scene& scene_;
   config::Recording& rec_;
   fs::path out_;
@@ -99,6 +136,8 @@ class RecordObserver final : public session::StopObserver {
   std::vector<robot::RawlogStep> scans_;  // the robot's laser and odometry so far
   std::optional<robot::Pose2D> last_odometry_;
   double t0_s_ = -1.0;
+  twin::ReflectanceSurvey* survey_;                       // null: no reflectance measured
+  std::vector<std::optional<Eigen::Matrix4d>> accepted_;  // each lit target's last accepted pose at this stop
 };
 
 // The scene's devices for a recording (none with `sim`); the camera's name goes into the recording.
@@ -151,7 +190,8 @@ Recorded record(const config::Scene& scene, const RecordOptions& o, const fs::pa
   fs::create_directories(out, ec);  // only now: a set-up that fails or is stopped leaves no folder behind
   if (ec) throw config::ConfigError(out.string() + ": cannot create: " + ec.message());
   result.started = true;
-  RecordObserver observer(scene, rec, out, hooks);
+  const std::unique_ptr<twin::ReflectanceSurvey> survey = rig.reflectance_survey();
+  RecordObserver observer(scene, rec, out, hooks, survey.get());
   rig.on_scan([&observer](const robot::LaserScan& scan, const robot::Pose2D& odometry) { observer.scan(scan, odometry); });
   const std::stop_source never;
   for (int v = 0; v < o.visits && !interrupted(); ++v)

@@ -13,9 +13,11 @@ Rig::Rig(const config::Scene& scene, const std::vector<session::Target>& targets
   else if (replay) {
     if (!options_.replay_clock.now_s) throw std::invalid_argument("a replay's rig needs the replay's clock");
     replay_session_ = std::make_unique<session::ReplaySession>(scene, *replay, targets, options_.replay_clock);
-  } else
+  } else {
     twin_ = std::make_unique<twin::TwinSession>(scene, targets, options_.seed, devices.camera.get(), options_.interrupted,
                                                 options_.recording);
+    twin_camera_ = devices.camera == nullptr;
+  }
 }
 
 Rig::~Rig() = default;
@@ -33,6 +35,11 @@ session::Dwell Rig::dwell(double dwell_s) {
 }
 
 twin::Twin* Rig::twin() { return twin_ ? &twin_->twin() : nullptr; }
+
+std::unique_ptr<twin::ReflectanceSurvey> Rig::reflectance_survey() {
+  if (!twin_ || !twin_camera_) return nullptr;
+  return std::make_unique<twin::ReflectanceSurvey>(twin_->twin(), twin_->renderer());
+}
 
 int Rig::visits(int asked) const { return replay_ ? static_cast<int>(replay_->stops.size()) : asked; }
 

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <numbers>
 
+#include "projbot/alignment/equations.hpp"
 #include "projbot/engine/photometry.hpp"
+#include "projbot/twin/world.hpp"
 
 namespace projbot::twin {
 
@@ -168,6 +170,32 @@ std::vector<engine::ReflectancePoint> measured_reflectance(SpectatorView& camera
   const assets::Image grey = camera.light(seen, frame).image;
   return engine::reflectance_points(twin.targets().at(target).model, twin.camera_pinhole(), T_camera_target, believed,
                                     T_projector_target, black, grey, kGrey / 255.0);
+}
+
+ReflectanceSurvey::ReflectanceSurvey(Twin& twin, engine::Renderer& renderer)
+    : twin_(twin), camera_(renderer, twin.scene().projector, twin.camera_pinhole()) {}
+
+std::size_t ReflectanceSurvey::measure(const std::string& name, const Eigen::Matrix4d& T_camera_target) {
+  const config::Scene& scene = twin_.scene();
+  const robot::HeadPoses truth = twin_.true_head();
+  const Eigen::Matrix4d T_projector_target = alignment::projector_from_target(scene.pan_tilt.T_projector_camera, T_camera_target);
+  const std::vector<engine::ReflectancePoint> points =
+      measured_reflectance(camera_, twin_, twin_.target_index(name), truth.T_world_camera.matrix(),
+                           truth.T_world_projector.matrix(), T_camera_target, scene.projector, T_projector_target);
+  maps_[name].add(points);
+  return points.size();
+}
+
+std::map<std::string, ReflectanceSurvey::Learnt> ReflectanceSurvey::learnt() const {
+  std::map<std::string, Learnt> out;
+  for (const auto& [name, map] : maps_) {
+    const std::optional<Eigen::Vector3d> albedo = map.median();
+    if (!albedo) continue;
+    Learnt& l = out[name];
+    l.albedo = *albedo;
+    if (assets::has_texture_coordinates(twin_.targets().at(twin_.target_index(name)).model)) l.map = map.image();
+  }
+  return out;
 }
 
 }  // namespace projbot::twin

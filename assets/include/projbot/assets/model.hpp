@@ -160,6 +160,9 @@ Model load_model(const std::filesystem::path& path);
 /// Scales the model frame uniformly, then (if recenter) moves the origin to the surface centroid.
 void scale_and_recenter(Model& model, double scale, bool recenter);
 
+/// Whether any vertex of `model` has texture coordinates other than (0, 0): a texture can be laid on it.
+bool has_texture_coordinates(const Model& model);
+
 /// The texel column (or row) of n that texture coordinate t falls in, wrapped as given: 0..n-1.
 int texel_index(double t, int n, Wrap wrap = Wrap::kRepeat);
 

@@ -7,8 +7,11 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
+
+#include "projbot/config/scene.hpp"
 
 namespace projbot::config {
 
@@ -36,9 +39,18 @@ struct Recording {
   /// a configured robot's laser is not recorded yet).
   std::string laser;
   std::vector<RecordedStop> stops;
+  /// Each target's reflectance as the session learnt it, by target name: a map over its model's texture
+  /// coordinates (`texture`, a PNG relative to the folder), or for a model without them one `albedo`.
+  /// `run --replay` compensates with it in place of the scene's `surface:`. Empty: none learnt (a
+  /// configured camera's recording).
+  std::map<std::string, TargetSurface> reflectance;
   /// The folder the recording's relative paths start from.
   std::filesystem::path folder() const { return source.parent_path(); }
 };
+
+/// `scene` with each target's `surface:` replaced by the reflectance `recording` learnt for it (a texture,
+/// the file in the recording's folder). Throws ConfigError for a map of a target the scene does not hold.
+void use_learnt_reflectance(Scene& scene, const Recording& recording);
 
 /// recording.yaml's text for `r` (its source is not written).
 std::string recording_yaml(const Recording& r);

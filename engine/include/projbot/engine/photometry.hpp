@@ -103,9 +103,10 @@ std::optional<Eigen::Vector3d> median_albedo(const std::vector<ReflectancePoint>
 
 /// A target's reflectance measured into its model's texture space (issue 43, a printed surface learnt at its
 /// stops): each texel the median of the newest kPerTexel values that fell in it (refined over visits,
-/// following a surface that changes), grown into the texels none fell in from their nearest measured ones
-/// in texture space, and the median of the newest kFillPoints points where none reaches (a chart never
-/// seen). Its memory is bounded however long the tour. Its image is a surface texture (Renderer::set_surface).
+/// following a surface that changes; of one measurement's many in a texel, kPerTexel spread over them), grown into the texels
+/// none fell in from their nearest measured ones in texture space, and the median of the newest kFillPoints points where none
+/// reaches (a chart never seen). Its memory is bounded however long the tour. Its image is a surface texture
+/// (Renderer::set_surface).
 class ReflectanceMap {
  public:
   static constexpr std::size_t kPerTexel = 32;
@@ -114,14 +115,18 @@ class ReflectanceMap {
   void add(const std::vector<ReflectancePoint>& points);
   /// sRGB, width x height, repeating over the UVs; empty while a channel has fewer than 20 points.
   std::optional<assets::Image> image() const;
+  /// The median of the newest kFillPoints points per channel (what fills the texels none reached); empty
+  /// while a channel has fewer than 20.
+  std::optional<Eigen::Vector3d> median() const { return median_albedo(recent_); }
   /// The values it holds: at most kPerTexel per texel and channel, plus kFillPoints points.
   std::size_t values_kept() const;
 
  private:
   struct Texel {
-    std::array<std::vector<float>, 3> values;  ///< per channel, the newest kPerTexel (a ring once full)
-    std::array<std::size_t, 3> seen{};         ///< per channel, every value that fell in it
+    std::array<std::vector<float>, 3> values;  ///< per channel, the newest kPerTexel kept (a ring once full)
+    std::array<std::size_t, 3> kept{};         ///< per channel, every value kept so far
   };
+  std::size_t texel_of(const ReflectancePoint& p) const;
   int width_, height_;
   std::vector<Texel> texels_;
   std::vector<ReflectancePoint> recent_;  ///< the newest kFillPoints points (a ring once full)

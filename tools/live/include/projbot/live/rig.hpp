@@ -14,6 +14,7 @@
 #include "projbot/hardware/devices.hpp"
 #include "projbot/session/replay.hpp"
 #include "projbot/session/session.hpp"
+#include "projbot/twin/appearance.hpp"
 #include "projbot/twin/twin_session.hpp"
 
 namespace projbot::live {
@@ -47,6 +48,9 @@ class Rig {
   session::Dwell dwell(double dwell_s);
   /// The twin when it serves the session (its truth measures the display error); null otherwise.
   twin::Twin* twin();
+  /// A survey of the targets' reflectance when the twin serves the camera too (its colour camera sees the
+  /// twin's projector light); null otherwise: a configured camera's session drives no projector here.
+  std::unique_ptr<twin::ReflectanceSurvey> reflectance_survey();
   /// The visits a tour of `asked` makes: a recording plays its own stops.
   int visits(int asked) const;
   /// Each laser scan while driving and settling: the twin's, or the configured laser's; a recording has none.
@@ -58,6 +62,7 @@ class Rig {
   std::unique_ptr<hardware::DeviceSession> devices_;
   std::unique_ptr<session::ReplaySession> replay_session_;
   std::unique_ptr<twin::TwinSession> twin_;
+  bool twin_camera_ = false;  // the twin serves the camera too
 };
 
 }  // namespace projbot::live

@@ -6,11 +6,14 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "projbot/assets/image.hpp"
 #include "projbot/config/scene.hpp"
+#include "projbot/engine/photometry.hpp"
 #include "projbot/twin/spectator.hpp"
 
 namespace projbot::twin {
@@ -44,5 +47,30 @@ std::vector<engine::ReflectancePoint> measured_reflectance(SpectatorView& camera
                                                            const Eigen::Matrix4d& T_camera_target,
                                                            const config::ProjectorConfig& believed,
                                                            const Eigen::Matrix4d& T_projector_target);
+
+/// A session's learnt reflectance in the twin (`record`): at the end of each stop, every lit target whose
+/// pose was accepted is measured at that pose (measured_reflectance: the RGB-D camera's colour under the
+/// projector's black and mid grey, the projector as the scene believes it, Eq. 2) into a map over its
+/// model's texture coordinates, refined over its visits. Renders on the twin's renderer's thread.
+class ReflectanceSurvey {
+ public:
+  ReflectanceSurvey(Twin& twin, engine::Renderer& renderer);
+  /// Measures scene target `name` at T_camera_target (its estimate, the twin's camera frame): the points
+  /// read (0: none of it in the camera's view and the projector's light).
+  std::size_t measure(const std::string& name, const Eigen::Matrix4d& T_camera_target);
+  /// What was learnt of a target: the median reflectance of its measurements (linear, 0..1 per channel)
+  /// and, for a model with texture coordinates, its map (sRGB, repeating over the UVs).
+  struct Learnt {
+    Eigen::Vector3d albedo = Eigen::Vector3d::Zero();
+    std::optional<assets::Image> map;
+  };
+  /// Each measured target's, by name; a target with too few points is left out.
+  std::map<std::string, Learnt> learnt() const;
+
+ private:
+  Twin& twin_;
+  SpectatorView camera_;
+  std::map<std::string, engine::ReflectanceMap> maps_;
+};
 
 }  // namespace projbot::twin

@@ -23,6 +23,8 @@ class TwinSession {
               alignment::RgbdCamera* configured, std::function<bool()> stop_requested, bool colour_every_frame = false);
   session::Session& session() { return session_; }
   Twin& twin() { return twin_; }
+  /// The renderer the twin draws with (its thread is the one that built the session).
+  engine::Renderer& renderer() { return renderer_; }
   /// The dwell: `dwell_s` at each stop, the camera the configured one or the twin's.
   session::Dwell dwell(double dwell_s, bool lockstep);
 
