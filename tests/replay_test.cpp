@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -89,6 +90,21 @@ TEST_F(ReplayTest, APoseLogReadBackComparesItsOwnPosesExactlyAndMeasuresADiffere
   EXPECT_EQ(moved.compared, 1);
   EXPECT_EQ(moved.mismatched, 1);
   EXPECT_EQ(moved.unreached(), 2);  // frame 1's two rows
+  // Rotations: the same pose a float's rounding left 1e-7 off orthonormal compares as 0 degrees; a turn of
+  // 2 degrees about z as 2.
+  alignment::PoseSample rounded = pose_at(0.1);
+  rounded.T_camera_target.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix() * (1.0 + 1e-7);
+  session::PoseLog turned_log;
+  turned_log.add(scene, stop_lighting_both(0), 1, {rounded, std::nullopt});
+  session::PoseCheck turned(write(turned_log.text()));
+  turned.compare(scene, stop_lighting_both(0), 1, {rounded, std::nullopt});
+  EXPECT_EQ(turned.max_deg, 0.0);
+  alignment::PoseSample two = rounded;
+  two.T_camera_target.topLeftCorner<3, 3>() = rounded.T_camera_target.topLeftCorner<3, 3>() *
+                                              Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  turned.compare(scene, stop_lighting_both(0), 1, {two, std::nullopt});
+  EXPECT_NEAR(turned.max_deg, 2.0, 1e-4);
 }
 
 TEST_F(ReplayTest, AMalformedPoseFileIsRefusedNamingItsLine) {

@@ -186,6 +186,17 @@ int PoseCheck::unreached() const {
   return n;
 }
 
+namespace {
+
+// The angle between two poses' rotations from their difference: for rotations ||R1 - R2|| (Frobenius) is
+// 2 sqrt(2) sin(angle / 2), exactly 0 for the same matrix (the trace of R1^T R2 reads 1e-6 degrees there).
+double rotation_difference_deg(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
+  const double s = std::min(1.0, (a.topLeftCorner<3, 3>() - b.topLeftCorner<3, 3>()).norm() / (2.0 * std::sqrt(2.0)));
+  return 2.0 * std::asin(s) * 180.0 / M_PI;
+}
+
+}  // namespace
+
 void PoseCheck::compare(const config::Scene& scene, const Stop& stop, int frame,
                         const std::vector<std::optional<alignment::PoseSample>>& samples) {
   for (std::size_t j = 0; j < samples.size() && j < stop.lit.size(); ++j) {
@@ -198,9 +209,11 @@ void PoseCheck::compare(const config::Scene& scene, const Stop& stop, int frame,
       continue;
     }
     if (!samples[j]) continue;
-    const Eigen::Matrix4d d = alignment::rigid_inverse(it->second.T) * samples[j]->T_camera_target;
+    // As the recorded pose was read: its rotation made orthonormal (a tracker's float steps leave ~1e-7).
+    const Eigen::Matrix4d T = config::orthonormalised_rigid(samples[j]->T_camera_target, "the replay's pose", 1e-3);
+    const Eigen::Matrix4d d = alignment::rigid_inverse(it->second.T) * T;
     max_mm = std::max(max_mm, 1000.0 * alignment::translation_norm_m(d));
-    max_deg = std::max(max_deg, alignment::rotation_angle_deg(d));
+    max_deg = std::max(max_deg, rotation_difference_deg(it->second.T, T));
     ++compared;
   }
 }
