@@ -1,5 +1,6 @@
 #include "projbot/live/recorder.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -117,13 +118,25 @@ class RecordObserver final : public session::StopObserver {
       config::TargetSurface& surface = rec_.reflectance[name];
       surface.albedo = learnt.albedo;
       if (!learnt.map) continue;
-      std::string file = name;
-      for (char& c : file)
-        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-      surface.texture = "reflectance/" + file + ".png";
+      if (surface.texture.empty()) surface.texture = map_file(name);
       fs::create_directories(out_ / "reflectance");
       assets::write_png(out_ / surface.texture, *learnt.map);
     }
+  }
+
+  // reflectance/NAME.png, NAME's characters other than letters, digits, - and _ made _, and a number added
+  // where that names another target's file.
+  std::string map_file(const std::string& name) const {
+    std::string stem = name;
+    for (char& c : stem)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+    const auto taken = [&](const std::string& file) {
+      return std::any_of(rec_.reflectance.begin(), rec_.reflectance.end(),
+                         [&](const auto& r) { return r.second.texture == file; });
+    };
+    std::string file = "reflectance/" + stem + ".png";
+    for (int k = 2; taken(file); ++k) file = "reflectance/" + stem + "_" + std::to_string(k) + ".png";
+    return file;
   }
 
   const config::Scene& scene_;
