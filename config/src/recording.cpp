@@ -4,7 +4,6 @@
 #include <iomanip>
 
 #include "map_reader.hpp"
-#include "projbot/config/scene.hpp"
 #include "projbot/config/yaml_keys.hpp"
 
 namespace projbot::config {

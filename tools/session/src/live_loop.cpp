@@ -16,15 +16,17 @@ LiveLoop::LiveLoop(engine::Renderer& renderer, const config::ProjectorConfig& pr
       clock_(std::move(clock)),
       frames_(config.projection) {}
 
-// This frame's draw items: each lit target found, at its pose for the display time, with its content on
-// that display time's clock. A lit target's video runs before its pose is found (the acquisition's first
-// second), so that it has caught up with its clock when it is first drawn.
+// What the frame whose poses are read at now_s draws (ProjectionFrames); a loop given no camera to watch
+// takes it as never silent.
 std::vector<DrawnPose> LiveLoop::decide(const LiveStop& stop, const LiveInputs& in, double now_s) {
   decided_s_ = now_s;
   const double camera_last_s = in.camera_last_s ? in.camera_last_s() : now_s;
   return frames_.compose(now_s, {stop.targets, stop.since_s, camera_last_s}, in.poses);
 }
 
+// This frame's draw items: each lit target found, at its pose for the display time, with its content on
+// that display time's clock. A lit target's video runs before its pose is found (the acquisition's first
+// second), so that it has caught up with its clock when it is first drawn.
 void LiveLoop::compose(const LiveStop& stop, const LiveInputs& in, std::vector<engine::DrawItem>& out,
                        std::vector<DrawnPose>& drawn) {
   out.clear();

@@ -48,8 +48,8 @@ struct Recording {
   std::filesystem::path folder() const { return source.parent_path(); }
 };
 
-/// `scene` with each target's `surface:` replaced by the reflectance `recording` learnt for it (a texture,
-/// the file in the recording's folder). Throws ConfigError for a map of a target the scene does not hold.
+/// `scene` with each target's `surface:` replaced by the reflectance `recording` learnt for it (a map, its
+/// file in the recording's folder, or one albedo). Throws ConfigError for a target the scene does not hold.
 void use_learnt_reflectance(Scene& scene, const Recording& recording);
 
 /// recording.yaml's text for `r` (its source is not written).
