@@ -88,8 +88,9 @@ std::map<std::string, TargetSurface> read_reflectance(MapReader& r, const std::f
 
 void use_learnt_reflectance(Scene& scene, const Recording& recording) {
   for (const auto& [name, learnt] : recording.reflectance) {
+    const std::string& wanted = name;  // a structured binding is not captured by a lambda in clang's C++20
     const auto it =
-        std::find_if(scene.targets.begin(), scene.targets.end(), [&](const TargetConfig& t) { return t.name == name; });
+        std::find_if(scene.targets.begin(), scene.targets.end(), [&](const TargetConfig& t) { return t.name == wanted; });
     if (it == scene.targets.end())
       throw ConfigError(recording.source.string() + ": reflectance." + name + ": " + scene.source.string() +
                         " has no target of that name");
