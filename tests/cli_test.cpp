@@ -12,6 +12,15 @@ TEST_F(CliTest, HelpNamesTheCommands) {
   const CliRun sub = run_projbot("render --help");
   EXPECT_EQ(sub.code, 0);
   EXPECT_NE(sub.output.find("--pose-matrix"), std::string::npos);
+  // A group's help lists its commands with what each does.
+  const CliRun group = run_projbot("calibrate --help");
+  EXPECT_EQ(group.code, 0) << group.output;
+  EXPECT_NE(group.output.find("Usage: projbot calibrate WHAT"), std::string::npos) << group.output;
+  EXPECT_NE(group.output.find("  photometric  the projector's response per channel"), std::string::npos) << group.output;
+  const CliRun bench = run_projbot("bench -h");
+  EXPECT_EQ(bench.code, 0) << bench.output;
+  EXPECT_NE(bench.output.find("  dataset      pose estimation on a BOP dataset's real frames"), std::string::npos)
+      << bench.output;
 }
 
 TEST_F(CliTest, RendersTheDemoSceneToAPng) {

@@ -93,6 +93,23 @@ struct Group {
 };
 constexpr Group kGroups[] = {{"bench", "say what to benchmark", "no benchmark"}, {"calibrate", "say which step", "no step"}};
 
+// `projbot bench --help`, `projbot calibrate -h`: the group's commands with what each does; false for
+// anything else.
+bool print_group_help(int argc, char** argv) {
+  if (argc != 3 || (std::string(argv[2]) != "--help" && std::string(argv[2]) != "-h")) return false;
+  const std::string prefix = std::string(argv[1]) + " ";
+  if (std::none_of(std::begin(kGroups), std::end(kGroups), [&](const Group& g) { return argv[1] == std::string(g.name); }))
+    return false;
+  std::cout << "Usage: projbot " << argv[1] << " WHAT [options] (projbot " << argv[1] << " WHAT --help for each)\n\n";
+  for (const Command* c : commands())
+    if (c->name.rfind(prefix, 0) == 0) {
+      std::string what = "  " + c->name.substr(prefix.size());
+      what.resize(std::max<std::size_t>(15, what.size() + 2), ' ');
+      std::cout << what << (c->left_out.empty() ? c->summary : "(not in this build: " + c->left_out + ")") << '\n';
+    }
+  return true;
+}
+
 // The command argv names (`name` gets it as typed, "align", "bench motion"; `first` the index of its first
 // option); null, said on stderr, when there is none.
 const Command* find_command(int argc, char** argv, std::string& name, int& first) {
@@ -178,6 +195,7 @@ static int dispatch(int argc, char** argv, std::string& name) {
     std::cout << "projbot " << PROJBOT_VERSION << kBuild << '\n';
     return 0;
   }
+  if (print_group_help(argc, argv)) return 0;
   int first = 2;
   const Command* cmd = find_command(argc, argv, name, first);
   if (cmd == nullptr) return 2;
