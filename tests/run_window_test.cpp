@@ -89,16 +89,11 @@ TEST(RunWindowTest, ShowInterruptedKeepsTheProfile) {
   EXPECT_GT(rows, 5) << output;  // frames drawn over the seconds it was open
 }
 
-// `calibrate capture` on configured devices: a Kinect v1 (libfreenect, played by fakenect from a dump of a
-// grey wall) and the projector window full screen on Xvfb. The person is asked to hold the board (Enter
-// on stdin), the window shows the Gray-code patterns (a screenshot half white, half black: a stripe
-// pattern), the camera's colour frames are taken, and the pose is refused on the spot (no board on a
-// bare wall); q ends the session with nothing written.
-TEST(RunWindowTest, CalibrateCaptureOnAKinectAndTheProjectorWindow) {
+// A site whose camera is a Kinect v1 (libfreenect, played by fakenect from a dump of a grey wall: 600
+// frames, 20 s at 30 Hz) and whose projector is a full-screen window: `dir`/site.yaml, the dump in
+// `dir`/dump. The command line prefix that plays it.
+std::string fakenect_site(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
-  projbot::testing::X11Display x11;
-  ASSERT_TRUE(x11.ok()) << "no X display (run under xvfb-run)";
-  const fs::path dir = fs::temp_directory_path() / ("projbot_capture_window_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   projbot::alignment::DepthImage depth;
@@ -114,7 +109,7 @@ TEST(RunWindowTest, CalibrateCaptureOnAKinectAndTheProjectorWindow) {
     once.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   {
-    std::ofstream out(dir / "dump" / "INDEX.txt");  // fakenect plays the list once: 600 frames, 20 s at 30 Hz
+    std::ofstream out(dir / "dump" / "INDEX.txt");  // fakenect plays the list once
     for (int i = 0; i < 300; ++i) out << once;
   }
   std::ifstream shop(std::string(PROJBOT_ASSET_DIR) + "/scenes/shop.yaml");
@@ -126,11 +121,24 @@ TEST(RunWindowTest, CalibrateCaptureOnAKinectAndTheProjectorWindow) {
   std::ofstream(dir / "site.yaml") << yaml
                                    << "devices:\n  camera: {driver: freenect, registered: false}\n"
                                       "  projector: {monitor: 0, fullscreen: true}\n";
+  return "env LD_LIBRARY_PATH=" PROJBOT_FAKENECT_DIR " FAKENECT_PATH=" + (dir / "dump").string() + " timeout 120 " +
+         std::string(PROJBOT_EXE);
+}
+
+// `calibrate capture` on configured devices: a Kinect v1 (libfreenect, played by fakenect from a dump of a
+// grey wall) and the projector window full screen on Xvfb. The person is asked to hold the board (Enter
+// on stdin), the window shows the Gray-code patterns (a screenshot half white, half black: a stripe
+// pattern), the camera's colour frames are taken, and the pose is refused on the spot (no board on a
+// bare wall); q ends the session with nothing written.
+TEST(RunWindowTest, CalibrateCaptureOnAKinectAndTheProjectorWindow) {
+  namespace fs = std::filesystem;
+  projbot::testing::X11Display x11;
+  ASSERT_TRUE(x11.ok()) << "no X display (run under xvfb-run)";
+  const fs::path dir = fs::temp_directory_path() / ("projbot_capture_window_" + std::to_string(::getpid()));
+  const std::string projbot = fakenect_site(dir);
   std::ofstream(dir / "answers.txt") << "\nq\n";
-  const std::string cmd = "env LD_LIBRARY_PATH=" PROJBOT_FAKENECT_DIR " FAKENECT_PATH=" + (dir / "dump").string() +
-                          " timeout 120 " + std::string(PROJBOT_EXE) + " calibrate capture --settle-ms 60 --config " +
-                          (dir / "site.yaml").string() + " --out " + (dir / "cap").string() + " <" +
-                          (dir / "answers.txt").string() + " 2>&1";
+  const std::string cmd = projbot + " calibrate capture --settle-ms 60 --config " + (dir / "site.yaml").string() + " --out " +
+                          (dir / "cap").string() + " <" + (dir / "answers.txt").string() + " 2>&1";
   auto run = run_in_background(cmd);
   bool stripes = false;
   std::string shares;  // what the screenshots showed, for the message
@@ -148,6 +156,32 @@ TEST(RunWindowTest, CalibrateCaptureOnAKinectAndTheProjectorWindow) {
   EXPECT_NE(output.find("no pose kept (1 refused); nothing written"), std::string::npos) << output;
   EXPECT_TRUE(stripes) << "no screenshot showed a stripe pattern; lit shares: " << shares;
   EXPECT_FALSE(fs::exists(dir / "cap"));
+  fs::remove_all(dir);
+}
+
+// `calibrate photometric` on the same devices: the window shows black, then white full screen (a screenshot
+// wholly lit), the camera's frames are taken after each, and since the dump's grey wall does not change
+// with the projector's light the session stops there naming why; nothing is written.
+TEST(RunWindowTest, CalibratePhotometricOnAKinectAndTheProjectorWindow) {
+  namespace fs = std::filesystem;
+  projbot::testing::X11Display x11;
+  ASSERT_TRUE(x11.ok()) << "no X display (run under xvfb-run)";
+  const fs::path dir = fs::temp_directory_path() / ("projbot_photometric_window_" + std::to_string(::getpid()));
+  const std::string projbot = fakenect_site(dir);
+  const std::string cmd = projbot + " calibrate photometric --settle-ms 300 --config " + (dir / "site.yaml").string() +
+                          " --out " + (dir / "photo.yaml").string() + " 2>&1";
+  auto run = run_in_background(cmd);
+  double most = 0.0;
+  while (run.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready)
+    most = std::max(most, lit_share(x11.screenshot(x11.root_window(), x11.screen_width(), x11.screen_height())));
+  const auto [code, output] = run.get();
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_NE(output.find("opened camera: freenect #0"), std::string::npos) << output;
+  EXPECT_NE(output.find("the camera's response is taken as gamma 2.20"), std::string::npos) << output;
+  EXPECT_NE(output.find("the projector's light is not in the camera's view: under its white 0 pixels"), std::string::npos)
+      << output;
+  EXPECT_GT(most, 0.99) << "no screenshot showed the projector's white over the whole screen";
+  EXPECT_FALSE(fs::exists(dir / "photo.yaml"));
   fs::remove_all(dir);
 }
 

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "calibrate_devices.hpp"
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "progress.hpp"
@@ -155,31 +156,13 @@ int run_solve(const cli::Args& args) {
 }
 
 // The session on the configured projector and colour camera (the projector's window, the camera's
-// colour frames after each pattern settles), or the twin's with --sim: the patterns the engine draws
-// fall on the twin's board.
+// colour frames after each pattern settles).
 calibrate::CaptureSummary capture_on_devices(const cli::Args& args, const config::Scene& scene,
                                              const calibrate::CaptureOptions& o, const std::filesystem::path& out) {
-  config::DevicesConfig wanted;
-  wanted.camera = scene.devices.camera;
-  wanted.projector = scene.devices.projector;
-  std::vector<hardware::DeviceCheck> checks;
-  hardware::Devices devices =
-      hardware::open_devices(wanted, checks, true);  // an absent device: an error naming it, before anything is shown
-  for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
-  engine::RendererOptions ro;  // after the monitors were checked: that check starts and stops GLFW
-  ro.windowing = true;
-  engine::Renderer renderer(ro);
-  calibrate::PatternScreen screen(renderer, scene.projector);
-  engine::WindowOptions wo = window_options(args, scene.projector, "projbot calibrate capture");
-  if (scene.devices.projector) {
-    wo.fullscreen = args.flag("fullscreen") || scene.devices.projector->fullscreen;
-    if (!args.get("monitor")) wo.monitor = scene.devices.projector->monitor;
-  }
-  auto window = open_window(renderer, wo, scene.projector);
-  const double settle_ms = args.get_double("settle-ms", 150.0);
-  if (!(settle_ms >= 0.0 && settle_ms <= 5000.0)) throw cli::UsageError("--settle-ms must be 0..5000");
-  auto rig = calibrate::make_device_rig(screen, renderer, *window, *devices.camera, settle_ms, scene.projector.input_lag_ms,
-                                        std::cin, std::cout);
+  CalibrationDevices d = open_calibration_devices(args, scene, "projbot calibrate capture");
+  calibrate::PatternScreen screen(*d.renderer, scene.projector);
+  auto rig = calibrate::make_device_rig(screen, *d.renderer, *d.window, *d.devices.camera, settle_ms_option(args),
+                                        scene.projector.input_lag_ms, std::cin, std::cout);
   return calibrate::capture(
       *rig, o, out, [](const std::string& line) { std::cout << line << std::endl; }, interrupted);
 }
@@ -224,6 +207,32 @@ int run_capture(const cli::Args& args) {
 }
 
 }  // namespace
+
+CalibrationDevices open_calibration_devices(const cli::Args& args, const config::Scene& scene, const std::string& title) {
+  config::DevicesConfig wanted;
+  wanted.camera = scene.devices.camera;
+  wanted.projector = scene.devices.projector;
+  std::vector<hardware::DeviceCheck> checks;
+  CalibrationDevices d;
+  d.devices = hardware::open_devices(wanted, checks, true);  // an absent device: an error naming it, before anything is shown
+  for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
+  engine::RendererOptions ro;  // after the monitors were checked: that check starts and stops GLFW
+  ro.windowing = true;
+  d.renderer = std::make_unique<engine::Renderer>(ro);
+  engine::WindowOptions wo = window_options(args, scene.projector, title);
+  if (scene.devices.projector) {
+    wo.fullscreen = args.flag("fullscreen") || scene.devices.projector->fullscreen;
+    if (!args.get("monitor")) wo.monitor = scene.devices.projector->monitor;
+  }
+  d.window = open_window(*d.renderer, wo, scene.projector);
+  return d;
+}
+
+double settle_ms_option(const cli::Args& args) {
+  const double settle_ms = args.get_double("settle-ms", 150.0);
+  if (!(settle_ms >= 0.0 && settle_ms <= 5000.0)) throw cli::UsageError("--settle-ms must be 0..5000");
+  return settle_ms;
+}
 
 const Command kCalibrateCapture{
     "calibrate capture",

@@ -1,12 +1,14 @@
-// projbot calibrate photometric: the projector's response per channel and colour mixing (issue 43), in the
-// twin; the colour camera's response from exposure brackets first.
+// projbot calibrate photometric: the projector's response per channel and colour mixing (issue 43), on a
+// site's projector and colour camera or in the twin (there the camera's response from exposure brackets first).
 
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 
+#include "calibrate_devices.hpp"
 #include "commands.hpp"
 #include "projbot/calibrate/calibrate.hpp"
+#include "projbot/calibrate/pattern_screen.hpp"
 #include "projbot/calibrate/photometric.hpp"
 #include "projbot/config/scene.hpp"
 #include "scene_setup.hpp"
@@ -22,11 +24,22 @@ void print_against_truth(const calibrate::PhotometricResult& r, const calibrate:
       100.0 * d.gamma_share, d.mixing, r.camera_gamma, sim.camera_gamma);
 }
 
-int run_photometric(const cli::Args& args) {
-  if (!args.flag("sim"))
-    throw cli::UsageError(
-        "on a real projector and camera this session is not available yet: give --sim for the twin's (the projector's "
-        "gamma and black_level then come from the scene)");
+void print_result(const calibrate::PhotometricResult& r) {
+  const auto& p = r.projector;
+  std::printf(
+      "%d captures: gamma R %.3f G %.3f B %.3f; camera gamma %.3f (%s)\nmixing (column j: channel j's light in R, G, B):\n",
+      r.captures, p.gamma_rgb[0], p.gamma_rgb[1], p.gamma_rgb[2], r.camera_gamma,
+      r.camera_gamma_measured ? "from exposure brackets" : "as given");
+  for (int i = 0; i < 3; ++i) std::printf("  %.4f %.4f %.4f\n", p.mixing(i, 0), p.mixing(i, 1), p.mixing(i, 2));
+}
+
+double camera_gamma_option(const cli::Args& args) {
+  const double g = args.get_double("camera-gamma", 2.2);
+  if (!(g >= 1.0 && g <= 3.0)) throw cli::UsageError("--camera-gamma must be 1..3");
+  return g;
+}
+
+int photometric_in_twin(const cli::Args& args, const std::string& out) {
   const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
   calibrate::PhotometricSim sim;
   sim.projector = scene.projector;
@@ -36,46 +49,91 @@ int run_photometric(const cli::Args& args) {
   sim.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
   sim.noise_levels = args.get_double("noise", 2.0);
   if (!(sim.noise_levels >= 0.0 && sim.noise_levels <= 50.0)) throw cli::UsageError("--noise must be 0..50 levels");
-  sim.camera_gamma = args.get_double("camera-gamma", 2.2);
-  if (!(sim.camera_gamma >= 1.0 && sim.camera_gamma <= 3.0)) throw cli::UsageError("--camera-gamma must be 1..3");
+  sim.camera_gamma = camera_gamma_option(args);
   const auto rig = calibrate::make_twin_photometric_rig(sim);
   const calibrate::PhotometricResult r = calibrate::calibrate_photometric(*rig, sim.projector.photometry.black_level);
-  const auto& p = r.projector;
-  std::printf("%d captures: gamma R %.3f G %.3f B %.3f; camera gamma %.3f\nmixing (column j: channel j's light in R, G, B):\n",
-              r.captures, p.gamma_rgb[0], p.gamma_rgb[1], p.gamma_rgb[2], r.camera_gamma);
-  for (int i = 0; i < 3; ++i) std::printf("  %.4f %.4f %.4f\n", p.mixing(i, 0), p.mixing(i, 1), p.mixing(i, 2));
+  print_result(r);
   print_against_truth(r, sim);
-  const std::string out = *args.get("out");
   calibrate::write_photometric(r, out, "projbot calibrate photometric --sim (the twin of " + scene.source.string() + ")");
   std::cout << "wrote " << out << '\n';
   return 0;
+}
+
+// The session on the config's projector (its window) and colour camera.
+int photometric_on_devices(const cli::Args& args, const std::string& out) {
+  const std::string path = *args.get("config");
+  const config::Scene scene = config::load_scene(path);
+  if (!scene.devices.camera)
+    throw cli::UsageError(path +
+                          " configures no camera (devices.camera): the session needs the projector and a colour camera; "
+                          "--sim runs it in the twin");
+  const double camera_gamma = camera_gamma_option(args), settle_ms = settle_ms_option(args);
+  CalibrationDevices d = open_calibration_devices(args, scene, "projbot calibrate photometric");
+  calibrate::ColourScreen screen(*d.renderer, scene.projector);
+  const auto rig = calibrate::make_device_photometric_rig(screen, *d.renderer, *d.window, *d.devices.camera, settle_ms,
+                                                          scene.projector.input_lag_ms);
+  std::printf(
+      "the projector shows black, white, its primaries and their ramps, %.0f ms each; the camera's response is taken as "
+      "gamma %.2f (--camera-gamma: it cannot set its exposure to measure it)\n",
+      settle_ms + scene.projector.input_lag_ms, camera_gamma);
+  std::fflush(stdout);
+  const calibrate::PhotometricResult r =
+      calibrate::calibrate_photometric(*rig, scene.projector.photometry.black_level, camera_gamma);
+  print_result(r);
+  calibrate::write_photometric(r, out, "projbot calibrate photometric on the camera and projector of " + path);
+  std::cout << "wrote " << out << " (paste its photometry: section into the calibration file the scene names)\n";
+  return 0;
+}
+
+int run_photometric(const cli::Args& args) {
+  const auto out = args.get("out");
+  if (!out) throw cli::UsageError("--out FILE is required");
+  const bool sim = args.flag("sim");
+  if (sim && args.get("config")) throw cli::UsageError("--sim and --config: give one (the twin's devices, or the config's)");
+  if (!sim && !args.get("config"))
+    throw cli::UsageError("give --config site.yaml (its devices.camera and devices.projector) or --sim for the twin's");
+  if (!sim && args.get("scene")) throw cli::UsageError("--scene is the twin's (--sim); a site's devices come with --config");
+  return sim ? photometric_in_twin(args, *out) : photometric_on_devices(args, *out);
 }
 
 }  // namespace
 
 const Command kCalibratePhotometric{
     "calibrate photometric",
-    "the projector's response per channel and colour mixing, from its colours on a surface (the twin)",
+    "the projector's response per channel and colour mixing, from its colours on a surface",
+    "projbot calibrate photometric --config site.yaml --out photo.yaml [--camera-gamma G] [--settle-ms MS]\n"
     "projbot calibrate photometric --sim --out photo.yaml [--scene FILE] [--seed K] [--noise LEVELS] [--camera-gamma G]\n\n"
-    "The projector shows uniform colours on a light surface and the colour camera measures them: white at six\n"
-    "exposures for the camera's own response (value against exposure), then black, white, each primary and an\n"
-    "eight-step ramp per channel. From the linearised values: each channel's gamma (its ramp's share of its\n"
-    "full light, log against log) and the colour mixing (each primary's light in the camera's R, G, B as a\n"
-    "share of white's). Black level and the room's light cannot be told apart with the projector on: the\n"
-    "scene's black_level is kept. With --sim the twin's projector (the scene's lumens, gammas, mixing (a DLP's\n"
-    "few percent of crosstalk where the scene has none) and room light) and an 8-bit camera; the result is\n"
-    "compared with that truth. Paste its photometry: section into a calibration file to project with it.\n"
-    "The projector and camera of a site config are not driven yet.\n",
-    {{"sim", "", "the twin's projector and camera"},
+    "The projector shows uniform colours on a light surface and the colour camera measures them: black, white,\n"
+    "each primary and an eight-step ramp per channel (each step the nearest 8-bit level). From the linearised\n"
+    "values: each channel's gamma (its ramp's share of its full light, log against log) and the colour mixing\n"
+    "(each primary's light in the camera's R, G, B as a share of white's). Black level and the room's light\n"
+    "cannot be told apart with the projector on: the scene's black_level is kept.\n\n"
+    "With --config, the config's devices.projector (a window, full screen with --fullscreen or its\n"
+    "`fullscreen: true`) and devices.camera: aim the projector at a light, matt, even surface (a white wall)\n"
+    "that fills part of the camera's view, switch the camera's automatic exposure and white balance off if it\n"
+    "has them, and keep the room's light steady. Each colour is shown for --settle-ms plus the projector's\n"
+    "input lag before the camera's image is taken; the values are averaged over the pixels the projector's\n"
+    "white lights. The cameras projbot drives cannot set their exposure, so the camera's response is taken as\n"
+    "--camera-gamma (2.2, an sRGB camera's, unless told).\n\n"
+    "With --sim, the twin's projector (the scene's lumens, gammas, mixing (a DLP's few percent of crosstalk\n"
+    "where the scene has none) and room light) and an 8-bit camera whose response is measured first, from\n"
+    "white at six exposures; the result is compared with that truth.\n\n"
+    "Paste the written photometry: section into the calibration file a scene names (`calibration:`) to\n"
+    "project with it.\n",
+    {{"config", "FILE", "site config with devices.camera and devices.projector", cli::PathRole::input_file},
+     {"sim", "", "the twin's projector and camera"},
      {"out", "FILE", "the photometry to write (YAML, `photometry:` as a calibration file carries it)",
       cli::PathRole::output_file},
-     {"scene", "FILE", "scene giving the projector and room (default: assets/scenes/shop.yaml)", cli::PathRole::input_file},
-     {"seed", "K", "seed of the camera's noise (default 1)"},
-     {"noise", "LEVELS", "the twin camera's noise per pixel, levels (default 2)"},
-     {"camera-gamma", "G", "the twin camera's response exponent (default 2.2)"}},
-    [](const cli::Args& args) {
-      if (!args.get("out")) throw cli::UsageError("--out FILE is required");
-      return run_photometric(args);
-    }};
+     {"camera-gamma", "G", "the camera's response exponent: --config, taken as given; --sim, the twin's truth (default 2.2)"},
+     {"settle-ms", "MS",
+      "--config: wait after a colour is presented before taking the image (default 150; plus projector.input_lag_ms)"},
+     {"fullscreen", "", "--config: full screen on the projector (the config's devices.projector says so too)"},
+     {"monitor", "N", "--config: the projector's monitor index (default: devices.projector.monitor)"},
+     {"present-mode", "MODE", "--config: fifo (default), mailbox or immediate"},
+     {"scene", "FILE", "--sim: scene giving the projector and room (default: assets/scenes/shop.yaml)",
+      cli::PathRole::input_file},
+     {"seed", "K", "--sim: seed of the camera's noise (default 1)"},
+     {"noise", "LEVELS", "--sim: the twin camera's noise per pixel, levels (default 2)"}},
+    run_photometric};
 
 }  // namespace projbot::tools

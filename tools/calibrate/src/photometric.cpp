@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <sstream>
 #include <vector>
@@ -36,21 +37,39 @@ double camera_gamma(PhotometricRig& rig, int& captures) {
   return 1.0 / slope;
 }
 
+std::string levels(const Eigen::Vector3d& v) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.0f %.0f %.0f", v[0], v[1], v[2]);
+  return text;
+}
+
 }  // namespace
 
-PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level) {
+PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level, double given_camera_gamma) {
   PhotometricResult r;
-  r.camera_gamma = camera_gamma(rig, r.captures);
+  if (given_camera_gamma > 0.0) {
+    r.camera_gamma = given_camera_gamma;
+  } else if (!rig.brackets()) {
+    throw CalibrationError("photometric: this camera cannot set its exposure, so its response cannot be measured: give it");
+  } else {
+    r.camera_gamma = camera_gamma(rig, r.captures);
+    r.camera_gamma_measured = true;
+  }
   const auto linear = [&](const Eigen::Vector3d& input) {
     ++r.captures;
     const Eigen::Vector3d v = rig.show_and_measure(input, 1.0);
+    if (v.maxCoeff() > 250.0)
+      throw CalibrationError("photometric: the camera saturates under input " + levels(input * 255.0) + " (it reads " +
+                             levels(v) + "): lower its exposure, or aim the projector at a darker surface");
     Eigen::Vector3d l;
     for (int ch = 0; ch < 3; ++ch) l[ch] = std::pow(std::clamp(v[ch], 0.0, 255.0) / 255.0, r.camera_gamma);
     return l;
   };
   const Eigen::Vector3d black = linear(Eigen::Vector3d::Zero());
   const Eigen::Vector3d white = linear(Eigen::Vector3d::Ones()) - black;
-  if (!(white.minCoeff() > 1e-3)) throw CalibrationError("photometric: white is no brighter than black in some channel");
+  if (!(white.minCoeff() > 1e-3))
+    throw CalibrationError("photometric: the projector's white is no brighter than its black in the camera (light " +
+                           levels(255.0 * white) + " above black): is its light in the camera's view?");
   r.projector.black_level = black_level;
   for (int j = 0; j < 3; ++j) {
     // Mixing: channel j's light in each camera channel, as a share of white's there (rows sum to 1).
@@ -59,7 +78,7 @@ PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level)
     // Gamma: the ramp in the channel's own camera channel, log(share) = gamma log(c), through the origin.
     double num = 0.0, den = 0.0;
     for (int step = 1; step < 8; ++step) {
-      const double c = step / 8.0;
+      const double c = std::round(255.0 * step / 8.0) / 255.0;  // what an 8-bit projector input shows
       const double share = (linear(c * Eigen::Vector3d::Unit(j)) - black)[j] / full[j];
       if (!(share > 1e-3)) continue;
       // The response's black offset: share = (c^gamma (1 - black) ) / (1 - black) exactly, since black's

@@ -2,12 +2,16 @@
 // `calibrate capture`'s rigs on the engine: the patterns drawn by the renderer (offscreen for the twin,
 // full screen on the projector for the real devices) and the configured colour camera.
 
+#include <array>
+#include <cstdint>
 #include <istream>
+#include <map>
 #include <memory>
 #include <ostream>
 
 #include "projbot/alignment/rgbd_camera.hpp"
 #include "projbot/calibrate/capture.hpp"
+#include "projbot/calibrate/photometric.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
 
@@ -42,5 +46,29 @@ PatternDisplay engine_display(PatternScreen& screen);
 std::unique_ptr<CaptureRig> make_device_rig(PatternScreen& screen, engine::Renderer& renderer, engine::RenderTarget& window,
                                             alignment::RgbdCamera& camera, double settle_ms, double input_lag_ms,
                                             std::istream& answers, std::ostream& prompt);
+
+/// One colour over the projector's whole image (`calibrate photometric`): a quad as PatternScreen's, its
+/// texture one texel of that colour, made the first time the colour is shown.
+class ColourScreen {
+ public:
+  ColourScreen(engine::Renderer& renderer, const config::ProjectorConfig& projector);
+  /// Draws `rgb` (8-bit levels) over the whole image into `target`.
+  void draw(engine::RenderTarget& target, const std::array<std::uint8_t, 3>& rgb);
+
+ private:
+  engine::Renderer& renderer_;
+  config::ProjectorConfig pinhole_;
+  std::map<std::array<std::uint8_t, 3>, std::size_t> models_;
+};
+
+/// The real photometric rig: `screen` drawn into `window` (the projector, full screen), `camera`'s colour
+/// images taken `settle_ms` plus the projector's input lag after each colour is presented, and averaged
+/// over the patch the projector lights: the first measurement takes the camera under black and white and
+/// keeps the pixels whose light rose by at least half as much as the most lit ones' (a CalibrationError
+/// when fewer than 100 did: the projector's light is not in the camera's view). The camera's exposure is
+/// not set (brackets() is false): its response is given.
+std::unique_ptr<PhotometricRig> make_device_photometric_rig(ColourScreen& screen, engine::Renderer& renderer,
+                                                            engine::RenderTarget& window, alignment::RgbdCamera& camera,
+                                                            double settle_ms, double input_lag_ms);
 
 }  // namespace projbot::calibrate

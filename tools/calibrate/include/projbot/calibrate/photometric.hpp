@@ -16,27 +16,33 @@
 
 namespace projbot::calibrate {
 
-/// What a photometric session drives: the projector showing one colour over its whole image, and the
-/// colour camera's mean R, G, B (8-bit levels, 0..255) over the patch of surface it lights, at an exposure
-/// relative to the session's first.
+/// What a photometric session drives: the projector showing one colour over its whole image (each channel
+/// 0..1; a device shows the nearest 8-bit level), and the colour camera's mean R, G, B (8-bit levels,
+/// 0..255) over the patch of surface it lights, at an exposure relative to the session's first.
 class PhotometricRig {
  public:
   virtual ~PhotometricRig() = default;
   virtual Eigen::Vector3d show_and_measure(const Eigen::Vector3d& input, double exposure) = 0;
+  /// Whether the camera's exposure can be set (exposure other than 1 in show_and_measure); without, the
+  /// camera's response is given, not measured.
+  virtual bool brackets() const { return true; }
 };
 
 /// The projector's colour is a config::Photometry: each channel's gamma (`gamma_rgb`), its black level and
 /// its `mixing` (column j: channel j's light in the camera's R, G, B; rows sum to 1, so white is white).
 struct PhotometricResult {
-  config::Photometry projector;  ///< gamma_rgb (gamma their mean) and mixing measured; black_level as given
-  double camera_gamma = 0.0;     ///< the camera's response: value = 255 (exposure x light)^(1 / camera_gamma)
+  config::Photometry projector;        ///< gamma_rgb (gamma their mean) and mixing measured; black_level as given
+  double camera_gamma = 0.0;           ///< the camera's response: value = 255 (exposure x light)^(1 / camera_gamma)
+  bool camera_gamma_measured = false;  ///< from exposure brackets; false: as given
   int captures = 0;
 };
 
-/// The session: white at six exposures (the camera's response), black, white and each primary, and an
-/// eight-step ramp per channel. `black_level`: the projector's, from its scene (not measurable here).
-/// Throws CalibrationError when the captures cannot be fitted (saturated, too dark, not monotonic).
-PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level);
+/// The session: white at six exposures (the camera's response; skipped when `camera_gamma` is given, which
+/// a rig that cannot bracket needs), black, white and each primary, and an eight-step ramp per channel
+/// (each step the 8-bit level nearest k/8). `black_level`: the projector's, from its scene (not
+/// measurable here). Throws CalibrationError when the captures cannot be fitted (saturated, too dark, not
+/// monotonic) or a rig that cannot bracket gets no camera gamma.
+PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level, double camera_gamma = 0.0);
 
 /// The twin's rig: a light grey patch (reflectance 0.8) facing the projector 1.5 m away, lit by the
 /// room's `ambient_lux` and the projector (its lumens and photometry, the truth), seen by an 8-bit camera whose response
