@@ -32,6 +32,32 @@ TEST_F(CliTest, BenchAppearanceScoresCompensationOffAndOn) {
   EXPECT_TRUE(fs::exists(dir_ / "frames" / "visit01_figure_spectator_on.png"));
 }
 
+// bench appearance on targets that move (issue 43): the box carried at 0.5 m/s is scored in the middle of
+// its motion beside the same frame drawn where it truly is (what it would show standing still there);
+// the motion costs little against that, and its gain has followed it down as it moved away from the
+// projector's axis (chosen again as it goes, dimming no faster than the plan's rate).
+TEST_F(CliTest, BenchAppearanceScoresAMovingTargetBesideItselfStandingStill) {
+  const fs::path report = dir_ / "moving.json";
+  const CliRun r = run_projbot("bench appearance --scene " + std::string(PROJBOT_ASSET_DIR) +
+                               "/scenes/motion.yaml --visits 2 --report " + report.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("PSNR still there dB"), std::string::npos) << r.output;
+  std::ifstream in(report);
+  const auto rows = nlohmann::json::parse(in).at("visits");
+  const nlohmann::json *arrival = nullptr, *moving = nullptr;
+  for (const auto& row : rows) {
+    if (row.at("target") != "box" || row.at("compensation") != "on") continue;
+    (row.at("moving").get<bool>() ? moving : arrival) = &row;
+    EXPECT_EQ(row.at("still_psnr_db").is_null(), !row.at("moving").get<bool>()) << row.dump();
+  }
+  ASSERT_TRUE(arrival && moving) << rows.dump(1);
+  const double psnr = moving->at("psnr_db").get<double>(), still = moving->at("still_psnr_db").get<double>();
+  EXPECT_GT(psnr, still - 2.0) << moving->dump();  // measured 1.0 dB apart
+  EXPECT_GT(still, psnr - 0.5) << moving->dump();  // drawn where it is, no worse than where it was tracked
+  EXPECT_GE(psnr, 24.0) << moving->dump();
+  EXPECT_LT(moving->at("gain").get<double>(), arrival->at("gain").get<double>() - 0.03) << rows.dump(1);
+}
+
 // bench appearance --reflectance measured (issue 43): the figure's beige measured at its stop from the
 // colour camera under the projector's black and grey, within 3 % of the scene's (the twin's truth).
 TEST_F(CliTest, BenchAppearanceMeasuresTheFiguresReflectance) {

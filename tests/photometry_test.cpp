@@ -274,6 +274,44 @@ TEST(Photometry, ThePlanKeepsTheGainThroughAVisit) {
   EXPECT_FALSE(off.at(0, 1, kProjector, near).on);
 }
 
+// Given the frames' display times, the gain follows the pose through a visit: a patch carried from 3 m to
+// 4.5 m (2.25 times less light) at t = 0 dims no faster than kRatePerS and settles at the far pose's own
+// gain; a pose a hair away (under kDeadband) leaves it as it is; the next visit chooses at once.
+TEST(Photometry, ThePlanFollowsThePoseSlowlyGivenTheFramesTimes) {
+  using Plan = engine::CompensationPlan;
+  projbot::assets::Model quad = projbot::assets::make_box({-0.2, -0.2, -0.01}, {0.2, 0.2, 0.01}, {1.0F, 1.0F, 1.0F, 1.0F});
+  Eigen::Matrix4d near = Eigen::Matrix4d::Identity(), far = near, hair = near;
+  near(2, 3) = 3.0;
+  far(2, 3) = 4.5;
+  hair(2, 3) = 3.03;  // 2 % less light
+  Plan plan({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5), nullptr}}, 20.0, true);
+  Plan at_far({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5), nullptr}}, 20.0, true);
+  at_far.at(0, 1, kProjector, far);
+  const double k_far = at_far.gain(0);
+  plan.at(0, 1, kProjector, near, 10.0);
+  const double k_near = plan.gain(0);
+  ASSERT_LT(k_far, 0.6 * k_near);
+  for (int frame = 0; frame <= 60; ++frame) plan.at(0, 1, kProjector, hair, 10.0 + frame / 60.0);
+  EXPECT_EQ(plan.gain(0), k_near);  // within the dead band: kept
+  double previous = k_near;
+  for (int frame = 1; frame <= 60 * 3; ++frame) {  // three seconds at 60 Hz, carried away
+    const double t = 11.0 + frame / 60.0;
+    plan.at(0, 1, kProjector, far, t);
+    const double k = plan.gain(0);
+    EXPECT_LE(k, previous + 1e-12) << frame;                                      // only dimmer
+    EXPECT_GE(k, previous * std::exp(-Plan::kRatePerS / 60.0) - 1e-12) << frame;  // never faster than the rate
+    EXPECT_GE(k, k_near * std::exp(-Plan::kRatePerS * (t - 11.0 + Plan::kRechooseS)) - 1e-9) << frame;
+    previous = k;
+  }
+  EXPECT_NEAR(plan.gain(0), k_far, 1e-9 * k_far);  // settled at the far pose's own (ln 2.25 / 0.5 = 1.6 s)
+  plan.at(0, 2, kProjector, near, 15.0);           // the next visit: chosen at once
+  EXPECT_EQ(plan.gain(0), k_near);
+  Plan untimed({{&quad, Eigen::Vector3d(0.5, 0.5, 0.5), nullptr}}, 20.0, true);
+  untimed.at(0, 1, kProjector, near);
+  for (int frame = 0; frame < 60; ++frame) untimed.at(0, 1, kProjector, far);
+  EXPECT_EQ(untimed.gain(0), k_near);  // without times, the visit's first gain
+}
+
 }  // namespace
 
 namespace {

@@ -376,19 +376,49 @@ void CompensationPlan::set_surface(std::size_t target, std::shared_ptr<const ass
 CompensationPlan::CompensationPlan(std::vector<Target> targets, double ambient_lux, bool on)
     : targets_(std::move(targets)), chosen_(targets_.size()), ambient_lux_(ambient_lux), on_(on) {}
 
-Compensation CompensationPlan::at(std::size_t target, long visit, const config::ProjectorConfig& projector,
-                                  const Eigen::Matrix4d& T_projector_target) {
-  if (!on_) return {};
+double CompensationPlan::choose(std::size_t target, const config::ProjectorConfig& projector,
+                                const Eigen::Matrix4d& T_projector_target) const {
   const Target& t = targets_.at(target);
+  return t.model ? choose_gain(surface_samples(*t.model, projector, T_projector_target, t.surface.get()), t.albedo, ambient_lux_,
+                               0.02, projector.photometry.mixing)
+                 : 1.0;
+}
+
+// The gain in use moved towards the pose's own, at most kRatePerS, from when the two differ by more than
+// kDeadband until it is there.
+void CompensationPlan::follow(Chosen& c, std::size_t target, const config::ProjectorConfig& projector,
+                              const Eigen::Matrix4d& T_projector_target, double display_s) const {
+  if (std::isnan(c.chosen_s) || display_s < c.used_s) {  // chosen without a time, or the clock went back
+    c.chosen_s = c.used_s = display_s;
+    return;
+  }
+  if (display_s - c.chosen_s >= kRechooseS) {
+    c.wanted = choose(target, projector, T_projector_target);
+    c.chosen_s = display_s;
+  }
+  const double off = std::log(std::max(c.wanted, 1e-6) / std::max(c.gain, 1e-6));
+  const double step = kRatePerS * (display_s - c.used_s);
+  c.used_s = display_s;
+  c.adjusting = c.adjusting || std::abs(off) > std::log1p(kDeadband);
+  if (!c.adjusting) return;
+  c.gain *= std::exp(std::clamp(off, -step, step));
+  c.adjusting = std::abs(off) > step;  // until it gets there
+}
+
+Compensation CompensationPlan::at(std::size_t target, long visit, const config::ProjectorConfig& projector,
+                                  const Eigen::Matrix4d& T_projector_target, double display_s) {
+  if (!on_) return {};
   Chosen& c = chosen_.at(target);
   if (!c.made || c.visit != visit) {
-    c.gain = t.model ? choose_gain(surface_samples(*t.model, projector, T_projector_target, t.surface.get()), t.albedo,
-                                   ambient_lux_, 0.02, projector.photometry.mixing)
-                     : 1.0;
+    c.gain = c.wanted = choose(target, projector, T_projector_target);
     c.visit = visit;
     c.made = true;
+    c.chosen_s = c.used_s = display_s;
+    c.adjusting = false;
+  } else if (!std::isnan(display_s)) {
+    follow(c, target, projector, T_projector_target, display_s);
   }
-  return compensation(t.albedo, ambient_lux_, c.gain);
+  return compensation(targets_.at(target).albedo, ambient_lux_, c.gain);
 }
 
 }  // namespace projbot::engine

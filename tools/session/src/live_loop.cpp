@@ -43,7 +43,7 @@ void LiveLoop::compose(const LiveStop& stop, const LiveInputs& in, std::vector<e
   for (const DrawnPose& d : drawn) {
     const auto t = static_cast<std::size_t>(d.target);
     out.push_back({items_.at(t).model, d.T_projector_target,
-                   plan_ ? plan_->at(t, stop.visit, projector_, d.T_projector_target) : engine::Compensation{}});
+                   plan_ ? plan_->at(t, stop.visit, projector_, d.T_projector_target, d.display_s) : engine::Compensation{}});
     if (content_ && content_->has(d.target)) {  // on the display clock of this frame, as its pose
       const auto shown = content_->apply(d.target, content_s(d.target, d.display_s), out.back());
       if (!std::isnan(shown.pts_s)) figures_.content_offsets_ms.push_back(1000.0 * (shown.content_s - shown.pts_s));

@@ -161,7 +161,8 @@ class TourStop final : public session::StopObserver {
   void at_arrival(const session::Stop& at, const alignment::RgbdFrame& f);
   // compensate: the plan's compensation (TourOptions::compensation unless said otherwise).
   assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate = {});
-  void measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target);
+  void measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target,
+                          const Eigen::Matrix4d* T_projector_still = nullptr);
   void measure_reflectance();
   assets::Image spectator_picture(const assets::Image& projector);
   void write_pictures(const assets::Image& colour);
@@ -352,8 +353,10 @@ void TourStop::measure_reflectance() {
 }
 
 // What a visitor sees of the visited target drawn at T_projector_target, compensation off and on, against
-// its content under the reference light scaled by the visit's gain; with --frames both pictures.
-void TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target) {
+// its content under the reference light scaled by the visit's gain; with --frames both pictures. With
+// T_projector_still (moving), each also drawn there: the target tracked exactly, as if it stood still.
+void TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target,
+                                  const Eigen::Matrix4d* T_projector_still) {
   const TwinTarget& target = tour_.twin.targets()[target_index_];
   const Eigen::Matrix4d T_world_spectator =
       spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
@@ -362,13 +365,18 @@ void TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& 
   // The geometry and the content once; each frame's light on them.
   const SpectatorScene scene = tour_.spectator->look(tour_.twin, T_world_spectator, truth_.T_world_projector.matrix());
   const ContentView view = tour_.spectator->content(tour_.twin, target_index_, T_world_spectator, scene);
+  const auto score = [&](const SpectatorPicture& seen) {
+    return score_appearance(seen, view, gain, tour_.scene.room.ambient_lux, tour_.models.truth.photometry);
+  };
   for (const bool on : {false, true}) {
     const auto t0 = Clock::now();
     const auto image = projector_image(lit, T_projector_target, on);
     const double ms = ms_since(t0);
     const SpectatorPicture seen = tour_.spectator->light(scene, image);
-    const AppearanceScore score = score_appearance(seen, view, gain, tour_.scene.room.ambient_lux, tour_.models.truth.photometry);
-    report.appearance.push_back({on, moving, gain, ms, score});
+    AppearanceSample sample{on, moving, gain, ms, score(seen)};
+    if (T_projector_still)
+      sample.still_psnr_db = score(tour_.spectator->light(scene, projector_image(true, *T_projector_still, on))).psnr_db;
+    report.appearance.push_back(sample);
     if (!moving && !tour_.options.frames_dir.empty())
       assets::write_png(frame_path(tour_.options, report, on ? "_spectator_on" : "_spectator_off"), seen.image);
   }
@@ -413,12 +421,17 @@ void TourStop::project(double start_s) {
   };
   const session::DrawnPose* visited = drawn_of(0);
   shown_ = visited != nullptr;
+  if (visited && tour_.options.compensation)  // the gain follows the pose, as run's loop has it do
+    tour_.plan.at(target_index_, visit_, tour_.models.believed, visited->T_projector_target, frame.display_s);
   const TimelineSample s = measure_frame(c, report, frame.display_s, visited, drawn_);
   const config::TargetMotion* motion = tour_.twin.targets()[target_index_].config.motion_on(report.target_visit);
   if (tour_.options.appearance && s.moving && !moving_measured_ && s.t_s >= motion->start_s + motion->duration_s / 2) {
     moving_measured_ = true;
     const Eigen::Matrix4d T_camera_target = light_pose(visited, drawn_, s.t_s, tour_.options.predict);
-    measure_appearance(true, shown_, tour_.models.projector_from_target(T_camera_target));
+    const Eigen::Matrix4d T_camera_true =
+        alignment::rigid_inverse(truth_.T_world_camera.matrix()) * tour_.twin.targets()[target_index_].T_world_target_true;
+    const Eigen::Matrix4d T_projector_still = tour_.models.projector_from_target(T_camera_true);
+    measure_appearance(true, shown_, tour_.models.projector_from_target(T_camera_target), &T_projector_still);
   }
   for (std::size_t k = 1; k < lit_.size(); ++k) measure_neighbour(c, lights_[k - 1], drawn_of(static_cast<int>(k)));
   report.timeline.push_back(s);

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -134,9 +135,12 @@ class ReflectanceMap {
 };
 
 /// The compensation of each target a session draws (issue 43): a target's gain is chosen the first time it
-/// is drawn in a visit, from its surface at that pose, and kept until the visit changes, so a target that
-/// moves or is tracked does not flicker. Off: every target's content as stored. One thread (the render
-/// thread, or the tour's).
+/// is drawn in a visit, from its surface at that pose. Given the frames' times, it then follows the pose:
+/// chosen again every kRechooseS, and once that choice differs from the gain in use by more than
+/// kDeadband, the gain moves to it by at most kRatePerS (relative, per second), so a target that turns
+/// towards grazing light dims over a second instead of clipping, and nothing flickers frame to frame.
+/// Without times, the visit's first gain is kept. Off: every target's content as stored. One thread (the
+/// render thread, or the tour's).
 class CompensationPlan {
  public:
   struct Target {
@@ -147,10 +151,14 @@ class CompensationPlan {
     std::shared_ptr<const assets::Image> surface;
   };
   CompensationPlan(std::vector<Target> targets, double ambient_lux, bool on);
+  static constexpr double kRechooseS = 0.1;
+  static constexpr double kDeadband = 0.05;
+  static constexpr double kRatePerS = 0.5;
   /// Target `target`'s compensation in visit `visit` (any number that changes between visits), drawn at
-  /// T_projector_target through `projector`.
+  /// T_projector_target through `projector`, displayed at `display_s` (seconds on any steady clock; NaN:
+  /// the gain is not followed).
   Compensation at(std::size_t target, long visit, const config::ProjectorConfig& projector,
-                  const Eigen::Matrix4d& T_projector_target);
+                  const Eigen::Matrix4d& T_projector_target, double display_s = std::numeric_limits<double>::quiet_NaN());
   /// A target's reflectance measured at a stop (measure_albedo): the mean of its measurements so far
   /// replaces the scene's from now on (refined over visits); its gain is chosen again. A target whose
   /// surface is a texture keeps it (one colour measured over it would blur its print).
@@ -167,10 +175,16 @@ class CompensationPlan {
  private:
   struct Chosen {
     long visit = -1;
-    double gain = 1.0;
+    double gain = 1.0;    // in use
+    double wanted = 1.0;  // the latest choice
+    double chosen_s = std::numeric_limits<double>::quiet_NaN(), used_s = std::numeric_limits<double>::quiet_NaN();
     bool made = false;
-    int measurements = 0;  // add_measured_albedo's so far
+    bool adjusting = false;  // moving towards `wanted`
+    int measurements = 0;    // add_measured_albedo's so far
   };
+  double choose(std::size_t target, const config::ProjectorConfig& projector, const Eigen::Matrix4d& T_projector_target) const;
+  void follow(Chosen& c, std::size_t target, const config::ProjectorConfig& projector, const Eigen::Matrix4d& T_projector_target,
+              double display_s) const;
   std::vector<Target> targets_;
   std::vector<Chosen> chosen_;
   double ambient_lux_;

@@ -77,6 +77,9 @@ struct AppearanceSample {
   double gain = 1.0;          ///< the target's k for this visit (the same off and on)
   double ms_per_frame = 0.0;  ///< wall time to draw the projector's frame and read it back
   AppearanceScore score;
+  /// Moving: the PSNR of the same frame drawn at the target's true pose (tracked exactly: what it shows
+  /// standing still there, the same gain); NaN otherwise. Against `score`, what the motion costs.
+  double still_psnr_db = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The projection error of one projector frame while projecting, at its display time.
