@@ -92,7 +92,12 @@ int run_photometric(const cli::Args& args) {
   if (sim && args.get("config")) throw cli::UsageError("--sim and --config: give one (the twin's devices, or the config's)");
   if (!sim && !args.get("config"))
     throw cli::UsageError("give --config site.yaml (its devices.camera and devices.projector) or --sim for the twin's");
-  if (!sim && args.get("scene")) throw cli::UsageError("--scene is the twin's (--sim); a site's devices come with --config");
+  for (const char* twin_only : {"scene", "seed", "noise"})
+    if (!sim && args.flag(twin_only))
+      throw cli::UsageError(std::string("--") + twin_only + " is the twin's (--sim); a site's devices come with --config");
+  for (const char* site_only : {"settle-ms", "fullscreen", "monitor", "present-mode"})
+    if (sim && args.flag(site_only))
+      throw cli::UsageError(std::string("--") + site_only + " is for the projector window of --config, not --sim");
   return sim ? photometric_in_twin(args, *out) : photometric_on_devices(args, *out);
 }
 
@@ -102,7 +107,8 @@ const Command kCalibratePhotometric{
     "calibrate photometric",
     "the projector's response per channel and colour mixing, from its colours on a surface",
     "projbot calibrate photometric --config site.yaml --out photo.yaml [--camera-gamma G] [--settle-ms MS]\n"
-    "projbot calibrate photometric --sim --out photo.yaml [--scene FILE] [--seed K] [--noise LEVELS] [--camera-gamma G]\n\n"
+    "       projbot calibrate photometric --sim --out photo.yaml [--scene FILE] [--seed K] [--noise LEVELS] [--camera-gamma "
+    "G]\n\n"
     "The projector shows uniform colours on a light surface and the colour camera measures them: black, white,\n"
     "each primary and an eight-step ramp per channel (each step the nearest 8-bit level). From the linearised\n"
     "values: each channel's gamma (its ramp's share of its full light, log against log) and the colour mixing\n"
