@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 
 #include "projbot/alignment/openni2_source.hpp"
@@ -59,6 +60,12 @@ TEST(OpenNi2Test, DummyDeviceDeliversColourOnTheHostClock) {
     EXPECT_GT(f.depth.capture_time_s, last);
     last = f.depth.capture_time_s;
   }
+  // Its exposure cannot be held (the Dummy's colour has no camera controls), said and not thrown; frames go on.
+  const projbot::alignment::ExposureHold hold = source.hold_colour_exposure();
+  EXPECT_FALSE(hold.held);
+  EXPECT_FALSE(hold.detail.empty());
+  std::cout << "Dummy device: " << hold.detail << '\n';
+  EXPECT_EQ(source.next_frame().colour.width, 320);
 }
 
 // The device's clock mapped to the host's: the fastest frame fixes the offset, a late one is stamped at

@@ -140,6 +140,19 @@ FreenectSource::FreenectSource(const FreenectOptions& options) : impl_(std::make
 
 FreenectSource::~FreenectSource() = default;
 
+ExposureHold FreenectSource::hold_colour_exposure() {
+  // Looked up, not linked: fakenect (the dump player standing in for libfreenect) lacks it.
+  using SetFlag = int (*)(freenect_device*, freenect_flag, freenect_flag_value);
+  const auto set_flag = reinterpret_cast<SetFlag>(dlsym(RTLD_DEFAULT, "freenect_set_flag"));
+  if (set_flag == nullptr) return {false, "this libfreenect (fakenect?) cannot set the camera's flags"};
+  const bool exposure = set_flag(impl_->device, FREENECT_AUTO_EXPOSURE, FREENECT_OFF) == 0;
+  const bool balance = set_flag(impl_->device, FREENECT_AUTO_WHITE_BALANCE, FREENECT_OFF) == 0;
+  if (exposure && balance) return {true, "automatic exposure and white balance switched off"};
+  return {false, std::string("libfreenect refused to switch off ") + (exposure  ? "its white balance"
+                                                                      : balance ? "its exposure"
+                                                                                : "its exposure and white balance")};
+}
+
 RgbdFrame FreenectSource::next() {
   Impl& m = *impl_;
   const std::string who = kinect_name(m.options.index);

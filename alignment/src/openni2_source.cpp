@@ -258,6 +258,18 @@ RgbdFrame OpenNi2Source::next_frame() {
 
 bool OpenNi2Source::has_colour() const { return impl_->colour_on; }
 
+ExposureHold OpenNi2Source::hold_colour_exposure() {
+  if (!impl_->colour_on) return {false, "no colour stream"};
+  openni::CameraSettings* settings = impl_->colour.getCameraSettings();
+  if (settings == nullptr || !settings->isValid()) return {false, "its colour stream has no camera settings"};
+  const bool exposure = settings->setAutoExposureEnabled(false) == openni::STATUS_OK;
+  const bool balance = settings->setAutoWhiteBalanceEnabled(false) == openni::STATUS_OK;
+  if (exposure && balance) return {true, "automatic exposure and white balance switched off"};
+  return {false, std::string("OpenNI2 refused to switch off ") + (exposure  ? "its white balance"
+                                                                  : balance ? "its exposure"
+                                                                            : "its exposure and white balance")};
+}
+
 std::optional<CameraIntrinsics> OpenNi2Source::intrinsics() const {
   const Impl& m = *impl_;
   const openni::VideoMode mode = m.depth.getVideoMode();

@@ -69,12 +69,18 @@ int photometric_on_devices(const cli::Args& args, const std::string& out) {
                           "--sim runs it in the twin");
   const double camera_gamma = camera_gamma_option(args), settle_ms = settle_ms_option(args);
   CalibrationDevices d = open_calibration_devices(args, scene, "projbot calibrate photometric");
+  const alignment::ExposureHold hold = d.devices.camera->hold_colour_exposure();
+  if (hold.held)
+    std::cout << "camera: " << hold.detail << '\n';
+  else
+    std::cout << "camera: its exposure is not held (" << hold.detail
+              << "): switch its automatic exposure and white balance off yourself, or the values follow them\n";
   calibrate::ColourScreen screen(*d.renderer, scene.projector);
   const auto rig = calibrate::make_device_photometric_rig(screen, *d.renderer, *d.window, *d.devices.camera, settle_ms,
                                                           scene.projector.input_lag_ms);
   std::printf(
       "the projector shows black, white, its primaries and their ramps, %.0f ms each; the camera's response is taken as "
-      "gamma %.2f (--camera-gamma: it cannot set its exposure to measure it)\n",
+      "gamma %.2f (--camera-gamma: its exposure time cannot be bracketed to measure it)\n",
       settle_ms + scene.projector.input_lag_ms, camera_gamma);
   std::fflush(stdout);
   const calibrate::PhotometricResult r =
@@ -116,11 +122,12 @@ const Command kCalibratePhotometric{
     "cannot be told apart with the projector on: the scene's black_level is kept.\n\n"
     "With --config, the config's devices.projector (a window, full screen with --fullscreen or its\n"
     "`fullscreen: true`) and devices.camera: aim the projector at a light, matt, even surface (a white wall)\n"
-    "that fills part of the camera's view, switch the camera's automatic exposure and white balance off if it\n"
-    "has them, and keep the room's light steady. Each colour is shown for --settle-ms plus the projector's\n"
-    "input lag before the camera's image is taken; the values are averaged over the pixels the projector's\n"
-    "white lights. The cameras projbot drives cannot set their exposure, so the camera's response is taken as\n"
-    "--camera-gamma (2.2, an sRGB camera's, unless told).\n\n"
+    "that fills part of the camera's view and keep the room's light steady. The camera's automatic exposure\n"
+    "and white balance are switched off where its driver lets projbot (it says which); otherwise switch them\n"
+    "off yourself. Each colour is shown for --settle-ms plus the projector's input lag before the camera's\n"
+    "image is taken; the values are averaged over the pixels the projector's white lights. projbot cannot set\n"
+    "the cameras' exposure time to bracket it, so the camera's response is taken as --camera-gamma (2.2, an\n"
+    "sRGB camera's, unless told).\n\n"
     "With --sim, the twin's projector (the scene's lumens, gammas, mixing (a DLP's few percent of crosstalk\n"
     "where the scene has none) and room light) and an 8-bit camera whose response is measured first, from\n"
     "white at six exposures; the result is compared with that truth.\n\n"

@@ -43,6 +43,7 @@ class OpenNi2Camera final : public alignment::RgbdCamera {
  public:
   explicit OpenNi2Camera(const alignment::OpenNi2Options& o) : source_(o) {}
   alignment::RgbdFrame next() override { return source_.next_frame(); }
+  alignment::ExposureHold hold_colour_exposure() override { return source_.hold_colour_exposure(); }
 
  private:
   alignment::OpenNi2Source source_;

@@ -49,6 +49,8 @@ class FreenectSource final : public RgbdCamera {
   /// The next depth frame and the colour frame that followed it (depth: capture_time_s at its arrival).
   /// Throws AlignmentError when none arrives within timeout_ms or the device (or a fakenect dump) stops.
   RgbdFrame next() override;
+  /// freenect_set_flag: automatic exposure and white balance off (not offered by fakenect).
+  ExposureHold hold_colour_exposure() override;
   /// Frame pairs returned so far.
   int frames_read() const;
 

@@ -57,6 +57,8 @@ class OpenNi2Source {
   RgbdFrame next_frame();
   /// Whether next_frame() delivers colour.
   bool has_colour() const;
+  /// The colour stream's automatic exposure and white balance off, through its CameraSettings.
+  ExposureHold hold_colour_exposure();
   /// Pinhole intrinsics from the stream's resolution and fields of view (principal point at the centre);
   /// empty when the device reports no field of view (the Dummy device): then calibrate and pass them.
   std::optional<CameraIntrinsics> intrinsics() const;

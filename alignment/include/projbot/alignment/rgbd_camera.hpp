@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
 
 #include "projbot/alignment/depth.hpp"
 #include "projbot/assets/image.hpp"
@@ -43,11 +44,20 @@ class DeviceClock {
   double last_device_s_ = 0.0;
 };
 
+/// What a camera did when asked to hold its colour exposure (RgbdCamera::hold_colour_exposure).
+struct ExposureHold {
+  bool held = false;   ///< automatic exposure and white balance are off
+  std::string detail;  ///< what was done, or why not
+};
+
 class RgbdCamera {
  public:
   virtual ~RgbdCamera() = default;
   /// The next frame, waiting for it. Throws AlignmentError naming the camera when none comes.
   virtual RgbdFrame next() = 0;
+  /// Switches the colour camera's automatic exposure and white balance off where the device lets it, so
+  /// that its values follow the light (photometric calibration). Call between next() calls.
+  virtual ExposureHold hold_colour_exposure() { return {false, "this camera offers no exposure control"}; }
 };
 
 }  // namespace projbot::alignment
