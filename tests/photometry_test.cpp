@@ -152,6 +152,50 @@ struct Patch {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
 };
 
+// The gain choice reads a texture inside each triangle, not at its corners alone: the patch's two
+// triangles textured black with a white disc over a fifth of it (its corners black) ask about as much of
+// the projector as a white patch (the disc is more than the 2 % allowed to clip), and about 2 % of the
+// projector's pixels on it then need more than full white.
+TEST(Photometry, TheGainReadsATextureInsideLargeTriangles) {
+  Patch white(Eigen::Vector3d::Ones()), disc(Eigen::Vector3d::Ones());
+  projbot::assets::Image texture;
+  texture.width = texture.height = 64;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const bool in = std::hypot(x - 31.5, y - 31.5) < 16.0;  // a fifth of the square
+      const std::uint8_t c = in ? 255 : 0;
+      texture.rgba.insert(texture.rgba.end(), {c, c, c, std::uint8_t{255}});
+    }
+  disc.quad.images.push_back(texture);
+  disc.quad.materials[0].base_color_image = 0;
+  const Eigen::Vector3d albedo(0.5, 0.5, 0.5);
+  const auto gain = [&](const Patch& p) {
+    return engine::choose_gain(engine::surface_samples(p.quad, p.projector, p.T), albedo, 20.0, 0.02,
+                               p.projector.photometry.mixing);
+  };
+  const double k_white = gain(white), k_disc = gain(disc);
+  ASSERT_LT(k_white, 1.0);
+  EXPECT_GE(k_disc, 0.9 * k_white);  // the disc lies where the light is strongest: a little more
+  EXPECT_LE(k_disc, 0.75);           // read at the corners (black), the patch would ask for nothing: k 1
+  // The disc's pixels that need more than full white at that gain: the projector's pixels on the patch,
+  // each through the CPU reference of the shader.
+  const engine::Compensation comp = engine::compensation(albedo, 20.0, k_disc);
+  int on_patch = 0, clipped = 0;
+  for (int v = 0; v < disc.projector.height_px; ++v)
+    for (int u = 0; u < disc.projector.width_px; ++u) {
+      const Eigen::Vector3d q = disc.point(u, v), l = disc.local(q);
+      if (std::abs(l.x()) >= 0.3 || std::abs(l.y()) >= 0.3) continue;
+      const Eigen::Vector2d uv(l.x() / 0.6 + 0.5, l.y() / 0.6 + 0.5);
+      const bool in = std::hypot(64.0 * uv.x() - 32.0, 64.0 * uv.y() - 32.0) < 16.0;
+      bool clip = false;
+      engine::compensated_input(disc.projector, comp, Eigen::Vector3d::Constant(in ? 1.0 : 0.0), q, disc.normal(), &clip);
+      ++on_patch;
+      clipped += in && clip ? 1 : 0;  // black content clips below black (the room's light): not counted
+    }
+  ASSERT_GT(on_patch, 1000);
+  EXPECT_LE(clipped, 0.03 * on_patch) << clipped << " of " << on_patch;
+}
+
 // mesh.frag's compensation against compensated_input: a flat patch of one colour, tilted and off the
 // axis, each pixel's input from the ray's point on the plane.
 TEST(Photometry, TheShaderMatchesItsCpuReference) {

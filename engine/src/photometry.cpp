@@ -88,6 +88,30 @@ Eigen::Vector3d surface_reflectance(const assets::Image& surface, const assets::
 
 }  // namespace
 
+namespace {
+
+// A point of a triangle at barycentric weights (1 - u - v, u, v) of its corners a, b, c: the vertex the
+// renderer interpolates there (texture coordinates and colour).
+assets::Vertex vertex_between(const assets::Vertex& a, const assets::Vertex& b, const assets::Vertex& c, double u, double v) {
+  const auto mix = [&](float x, float y, float z) { return static_cast<float>((1.0 - u - v) * x + u * y + v * z); };
+  assets::Vertex out;
+  for (std::size_t k = 0; k < 2; ++k) out.uv[k] = mix(a.uv[k], b.uv[k], c.uv[k]);
+  for (std::size_t k = 0; k < 4; ++k) out.color[k] = mix(a.color[k], b.color[k], c.color[k]);
+  return out;
+}
+
+// Barycentric points spread over a triangle that covers `area_px` of the projector's pixels: the middles
+// of an m x m subdivision's upright cells, about one per 8 x 8 pixels, at most 36.
+std::vector<Eigen::Vector2d> content_points(double area_px) {
+  const int m = std::clamp(static_cast<int>(std::ceil(std::sqrt(area_px / 64.0))), 1, 8);
+  std::vector<Eigen::Vector2d> out;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; i + j < m; ++j) out.emplace_back((i + 1.0 / 3.0) / m, (j + 1.0 / 3.0) / m);
+  return out;
+}
+
+}  // namespace
+
 std::vector<SurfaceSample> surface_samples(const assets::Model& model, const config::ProjectorConfig& p,
                                            const Eigen::Matrix4d& T_projector_target, const assets::Image* surface) {
   std::vector<SurfaceSample> out;
@@ -106,18 +130,20 @@ std::vector<SurfaceSample> surface_samples(const assets::Model& model, const con
       if (!(q.z() > p.near_m) || (!m.double_sided && n.dot(q) >= 0.0)) continue;  // behind, or facing away
       const Eigen::Vector2d x = p.project(q);
       if (x.x() < -0.5 || x.y() < -0.5 || x.x() > p.width_px - 0.5 || x.y() > p.height_px - 0.5) continue;
-      SurfaceSample s;
-      s.content =
-          (vertex_content(model, prim.material, prim.vertices[a]) + vertex_content(model, prim.material, prim.vertices[b]) +
-           vertex_content(model, prim.material, prim.vertices[c])) /
-          3.0;
-      if (surface)
-        s.reflectance = (surface_reflectance(*surface, prim.vertices[a]) + surface_reflectance(*surface, prim.vertices[b]) +
-                         surface_reflectance(*surface, prim.vertices[c])) /
-                        3.0;
-      s.white_lux = white_lux(p, q, n);
-      s.weight = std::abs(n.dot(q)) / (2.0 * q.norm() * q.squaredNorm());  // its solid angle: the projector's pixels on it
-      if (s.weight > 0.0) out.push_back(s);
+      const double solid_angle = std::abs(n.dot(q)) / (2.0 * q.norm() * q.squaredNorm());  // the projector's pixels on it
+      if (!(solid_angle > 0.0)) continue;
+      // Its content and print where the renderer samples them, spread over it (a texture varies inside a
+      // triangle: its corners alone miss what a large one shows).
+      const std::vector<Eigen::Vector2d> points = content_points(solid_angle * p.fx_px * p.fy_px);
+      for (const Eigen::Vector2d& w : points) {
+        const assets::Vertex v = vertex_between(prim.vertices[a], prim.vertices[b], prim.vertices[c], w.x(), w.y());
+        SurfaceSample s;
+        s.content = vertex_content(model, prim.material, v);
+        if (surface) s.reflectance = surface_reflectance(*surface, v);
+        s.white_lux = white_lux(p, (1.0 - w.x() - w.y()) * qa + w.x() * qb + w.y() * qc, n);
+        s.weight = solid_angle / static_cast<double>(points.size());
+        out.push_back(s);
+      }
     }
   }
   return out;
