@@ -100,10 +100,11 @@ assets::Vertex vertex_between(const assets::Vertex& a, const assets::Vertex& b, 
   return out;
 }
 
-// Barycentric points spread over a triangle that covers `area_px` of the projector's pixels: the middles
-// of an m x m subdivision's upright cells, about one per 8 x 8 pixels, at most 36.
-std::vector<Eigen::Vector2d> content_points(double area_px) {
-  const int m = std::clamp(static_cast<int>(std::ceil(std::sqrt(area_px / 64.0))), 1, 8);
+// Points spread over a triangle that covers `area_px` pixels, one per `px_per_point` of them, at most
+// `most_per_side` along a side: the middles of an m x m subdivision's upright cells, as barycentric
+// weights of its second and third corner.
+std::vector<Eigen::Vector2d> cell_middles(double area_px, double px_per_point, int most_per_side) {
+  const int m = std::clamp(static_cast<int>(std::ceil(std::sqrt(area_px / px_per_point))), 1, most_per_side);
   std::vector<Eigen::Vector2d> out;
   for (int i = 0; i < m; ++i)
     for (int j = 0; i + j < m; ++j) out.emplace_back((i + 1.0 / 3.0) / m, (j + 1.0 / 3.0) / m);
@@ -134,7 +135,8 @@ std::vector<SurfaceSample> surface_samples(const assets::Model& model, const con
       if (!(solid_angle > 0.0)) continue;
       // Its content and print where the renderer samples them, spread over it (a texture varies inside a
       // triangle: its corners alone miss what a large one shows).
-      const std::vector<Eigen::Vector2d> points = content_points(solid_angle * p.fx_px * p.fy_px);
+      // About one per 11 x 11 projector pixels (m = sqrt(area / 64) a side, upright cells), at most 36.
+      const std::vector<Eigen::Vector2d> points = cell_middles(solid_angle * p.fx_px * p.fy_px, 64.0, 8);
       for (const Eigen::Vector2d& w : points) {
         const assets::Vertex v = vertex_between(prim.vertices[a], prim.vertices[b], prim.vertices[c], w.x(), w.y());
         SurfaceSample s;
@@ -192,12 +194,7 @@ std::vector<Eigen::Vector2d> spread_over(const Eigen::Vector3d (&x)[3], const co
     px[k] = q.z() > 0.1 ? camera.project(q) : Eigen::Vector2d::Zero();
   }
   const Eigen::Vector2d a = px[1] - px[0], b = px[2] - px[0];
-  const double area_px = 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
-  const int m = std::clamp(static_cast<int>(std::ceil(std::sqrt(area_px / 8.0))), 1, 16);
-  std::vector<Eigen::Vector2d> out;
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; i + j < m; ++j) out.emplace_back((i + 1.0 / 3.0) / m, (j + 1.0 / 3.0) / m);
-  return out;
+  return cell_middles(0.5 * std::abs(a.x() * b.y() - a.y() * b.x()), 8.0, 16);
 }
 
 }  // namespace

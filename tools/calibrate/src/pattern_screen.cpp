@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -52,6 +53,14 @@ assets::Model pattern_quad(const config::ProjectorConfig& p, const cv::Mat& patt
       px[3] = 255;
     }
   return screen_quad(p, std::move(img), "gray-code pattern");
+}
+
+// Shows what `draw` draws into the projector's window until it is on screen: drawn twice, so that both
+// swapchain images hold it.
+void present(engine::Renderer& renderer, engine::RenderTarget& window, const std::function<void()>& draw) {
+  for (int k = 0; k < 2; ++k) draw();
+  renderer.finish(window);
+  window.poll_close();
 }
 
 // The first colour frame `camera` took at least `lag_s` after `shown_s` (host steady clock); frames taken
@@ -112,9 +121,7 @@ class DeviceRig final : public CaptureRig {
 
  private:
   void show(std::size_t index) {
-    for (int k = 0; k < 2; ++k) screen_.draw(window_, index);  // both swapchain images hold it
-    renderer_.finish(window_);
-    window_.poll_close();
+    present(renderer_, window_, [&] { screen_.draw(window_, index); });
   }
 
   PatternScreen& screen_;
@@ -154,9 +161,7 @@ class DevicePhotometricRig final : public PhotometricRig {
   assets::Image take(const Eigen::Vector3d& input) {
     std::array<std::uint8_t, 3> rgb{};
     for (int ch = 0; ch < 3; ++ch) rgb[ch] = static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(input[ch], 0.0, 1.0)));
-    for (int k = 0; k < 2; ++k) screen_.draw(window_, rgb);  // both swapchain images hold it
-    renderer_.finish(window_);
-    window_.poll_close();
+    present(renderer_, window_, [&] { screen_.draw(window_, rgb); });
     const double shown = config::steady_now_s();
     std::this_thread::sleep_for(std::chrono::duration<double>(settle_s_ + lag_s_));
     assets::Image image = colour_after(camera_, shown, lag_s_, "calibrate photometric");
