@@ -127,3 +127,23 @@ TEST(PhotometricRig, RefusesACameraThatDoesNotSeeTheLightOrSaturates) {
   bright.gain *= 3.0;
   expect_refused(bright, "the camera saturates under input 255 255 255");
 }
+
+// Ctrl-C during a session (stop() true from the fifth capture on): SessionStopped, before the next image is
+// taken, and no result.
+TEST(PhotometricRig, StopsAtTheNextCaptureWhenAsked) {
+  Bench b;
+  auto window = b.renderer.make_offscreen(b.projector.width_px, b.projector.height_px);
+  WallCamera camera(*window, b.truth, 300.0, 20.0);
+  projbot::calibrate::ColourScreen screen(b.renderer, b.projector);
+  int asked = 0;
+  const auto rig = projbot::calibrate::make_device_photometric_rig(screen, b.renderer, *window, camera, 120.0, 0.0,
+                                                                   [&asked] { return ++asked > 8; });
+  try {
+    projbot::calibrate::calibrate_photometric(*rig, b.truth.black_level, 2.2);
+    ADD_FAILURE() << "a stopped session was fitted";
+  } catch (const projbot::calibrate::SessionStopped& e) {
+    EXPECT_NE(std::string(e.what()).find("while measuring the projector's colours"), std::string::npos) << e.what();
+  }
+  EXPECT_GE(asked, 9);
+  EXPECT_LE(camera.stale_frames, 12);  // a few captures' frames taken, not the session's 26
+}

@@ -7,6 +7,7 @@
 
 #include "calibrate_devices.hpp"
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "projbot/calibrate/calibrate.hpp"
 #include "projbot/calibrate/pattern_screen.hpp"
 #include "projbot/calibrate/photometric.hpp"
@@ -76,15 +77,20 @@ int photometric_on_devices(const cli::Args& args, const std::string& out) {
     std::cout << "camera: its exposure is not held (" << hold.detail
               << "): switch its automatic exposure and white balance off yourself, or the values follow them\n";
   calibrate::ColourScreen screen(*d.renderer, scene.projector);
+  catch_interrupts();  // Ctrl-C: stops at the next capture; nothing is written (the fit needs them all)
   const auto rig = calibrate::make_device_photometric_rig(screen, *d.renderer, *d.window, *d.devices.camera, settle_ms,
-                                                          scene.projector.input_lag_ms);
+                                                          scene.projector.input_lag_ms, interrupted);
   std::printf(
       "the projector shows black, white, its primaries and their ramps, %.0f ms each; the camera's response is taken as "
       "gamma %.2f (--camera-gamma: its exposure time cannot be bracketed to measure it)\n",
       settle_ms + scene.projector.input_lag_ms, camera_gamma);
   std::fflush(stdout);
-  const calibrate::PhotometricResult r =
-      calibrate::calibrate_photometric(*rig, scene.projector.photometry.black_level, camera_gamma);
+  calibrate::PhotometricResult r;
+  try {
+    r = calibrate::calibrate_photometric(*rig, scene.projector.photometry.black_level, camera_gamma);
+  } catch (const calibrate::SessionStopped& e) {
+    return nothing_written(e.what());
+  }
   print_result(r);
   calibrate::write_photometric(r, out, "projbot calibrate photometric on the camera and projector of " + path);
   std::cout << "wrote " << out << " (paste its photometry: section into the calibration file the scene names)\n";
@@ -127,7 +133,7 @@ const Command kCalibratePhotometric{
     "off yourself. Each colour is shown for --settle-ms plus the projector's input lag before the camera's\n"
     "image is taken; the values are averaged over the pixels the projector's white lights. projbot cannot set\n"
     "the cameras' exposure time to bracket it, so the camera's response is taken as --camera-gamma (2.2, an\n"
-    "sRGB camera's, unless told).\n\n"
+    "sRGB camera's, unless told). Ctrl-C stops at the next capture and writes nothing (exit 130).\n\n"
     "With --sim, the twin's projector (the scene's lumens, gammas, mixing (a DLP's few percent of crosstalk\n"
     "where the scene has none) and room light) and an 8-bit camera whose response is measured first, from\n"
     "white at six exposures; the result is compared with that truth.\n\n"

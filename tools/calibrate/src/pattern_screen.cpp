@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "projbot/calibrate/procam.hpp"
@@ -137,13 +138,14 @@ class DeviceRig final : public CaptureRig {
 class DevicePhotometricRig final : public PhotometricRig {
  public:
   DevicePhotometricRig(ColourScreen& screen, engine::Renderer& renderer, engine::RenderTarget& window,
-                       alignment::RgbdCamera& camera, double settle_ms, double lag_ms)
+                       alignment::RgbdCamera& camera, double settle_ms, double lag_ms, std::function<bool()> stop)
       : screen_(screen),
         renderer_(renderer),
         window_(window),
         camera_(camera),
         settle_s_(settle_ms / 1000.0),
-        lag_s_(lag_ms / 1000.0) {}
+        lag_s_(lag_ms / 1000.0),
+        stop_(std::move(stop)) {}
 
   bool brackets() const override { return false; }
 
@@ -163,7 +165,11 @@ class DevicePhotometricRig final : public PhotometricRig {
     for (int ch = 0; ch < 3; ++ch) rgb[ch] = static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(input[ch], 0.0, 1.0)));
     present(renderer_, window_, [&] { screen_.draw(window_, rgb); });
     const double shown = config::steady_now_s();
-    std::this_thread::sleep_for(std::chrono::duration<double>(settle_s_ + lag_s_));
+    for (double left = settle_s_ + lag_s_; left > 0.0; left -= 0.05) {  // settling, stopped within 50 ms
+      if (stop_ && stop_()) throw SessionStopped("while measuring the projector's colours");
+      std::this_thread::sleep_for(std::chrono::duration<double>(std::min(left, 0.05)));
+    }
+    if (stop_ && stop_()) throw SessionStopped("while measuring the projector's colours");
     assets::Image image = colour_after(camera_, shown, lag_s_, "calibrate photometric");
     if (size_ != 0 && image.rgba.size() != size_)
       throw CalibrationError("the camera's colour images changed size during the session");
@@ -201,6 +207,7 @@ class DevicePhotometricRig final : public PhotometricRig {
   engine::RenderTarget& window_;
   alignment::RgbdCamera& camera_;
   double settle_s_, lag_s_;
+  std::function<bool()> stop_;
   std::vector<std::size_t> patch_;  // indices of the pixels the projector lights
   std::size_t size_ = 0;
 };
@@ -269,8 +276,8 @@ void ColourScreen::draw(engine::RenderTarget& target, const std::array<std::uint
 
 std::unique_ptr<PhotometricRig> make_device_photometric_rig(ColourScreen& screen, engine::Renderer& renderer,
                                                             engine::RenderTarget& window, alignment::RgbdCamera& camera,
-                                                            double settle_ms, double input_lag_ms) {
-  return std::make_unique<DevicePhotometricRig>(screen, renderer, window, camera, settle_ms, input_lag_ms);
+                                                            double settle_ms, double input_lag_ms, std::function<bool()> stop) {
+  return std::make_unique<DevicePhotometricRig>(screen, renderer, window, camera, settle_ms, input_lag_ms, std::move(stop));
 }
 
 }  // namespace projbot::calibrate

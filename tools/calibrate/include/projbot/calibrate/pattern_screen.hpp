@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <istream>
 #include <map>
 #include <memory>
@@ -66,9 +67,11 @@ class ColourScreen {
 /// over the patch the projector lights: the first measurement takes the camera under black and white and
 /// keeps the pixels whose light rose by at least half as much as the most lit ones' (a CalibrationError
 /// when fewer than 100 did: the projector's light is not in the camera's view). The camera's exposure is
-/// not set (brackets() is false): its response is given.
+/// not set (brackets() is false): its response is given. When `stop()` says so (Ctrl-C), the next capture
+/// throws SessionStopped instead (within 50 ms of a settling wait).
 std::unique_ptr<PhotometricRig> make_device_photometric_rig(ColourScreen& screen, engine::Renderer& renderer,
                                                             engine::RenderTarget& window, alignment::RgbdCamera& camera,
-                                                            double settle_ms, double input_lag_ms);
+                                                            double settle_ms, double input_lag_ms,
+                                                            std::function<bool()> stop = {});
 
 }  // namespace projbot::calibrate

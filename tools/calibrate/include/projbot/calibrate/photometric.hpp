@@ -10,11 +10,18 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "projbot/config/scene.hpp"
 
 namespace projbot::calibrate {
+
+/// A session stopped on request (Ctrl-C) before it had every capture: nothing to fit.
+class SessionStopped : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 /// What a photometric session drives: the projector showing one colour over its whole image (each channel
 /// 0..1; a device shows the nearest 8-bit level), and the colour camera's mean R, G, B (8-bit levels,
