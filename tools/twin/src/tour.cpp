@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -31,7 +32,11 @@ using namespace detail;  // the tour's frame measurement (tour_frames.hpp)
 
 using Clock = std::chrono::steady_clock;
 
-constexpr double kConvergedMm = 3.0;  // the goal for a visit's mean error
+constexpr double kConvergedMm = 3.0;    // the goal for a visit's mean error
+constexpr double kMovingSampleS = 0.1;  // TourOptions::appearance: a moving target's frames scored this far apart
+// ... and the first this long of a motion scored apart: a 30 Hz camera's frames, tracked, reach the
+// projector 50-67 ms after they are taken, and the prediction needs two of them to see the new speed.
+constexpr double kStartingS = 0.2;
 
 // Where --frames writes one of a visit's pictures: DIR/visitNN_TARGET<suffix>.png.
 std::filesystem::path frame_path(const TourOptions& options, const VisitReport& r, const char* suffix) {
@@ -161,8 +166,9 @@ class TourStop final : public session::StopObserver {
   void at_arrival(const session::Stop& at, const alignment::RgbdFrame& f);
   // compensate: the plan's compensation (TourOptions::compensation unless said otherwise).
   assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate = {});
-  void measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target,
-                          const Eigen::Matrix4d* T_projector_still = nullptr);
+  std::array<AppearanceSample, 2> measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target,
+                                                     const Eigen::Matrix4d* T_projector_still = nullptr);
+  void sample_motion(const TimelineSample& s, const session::DrawnPose* visited);
   void measure_reflectance();
   assets::Image spectator_picture(const assets::Image& projector);
   void write_pictures(const assets::Image& colour);
@@ -193,7 +199,10 @@ class TourStop final : public session::StopObserver {
   double motion_end_s_ = 0.0;
   double back_under_ = -1.0;  // when the error went back under the goal for good, -1 while it is not
   bool ever_over_ = false;
-  bool moving_measured_ = false;  // TourOptions::appearance: the middle of the motion was measured
+  // TourOptions::appearance: the frames scored while the target moves (starting: off, on; then: off, on),
+  // and when the next is due.
+  std::array<std::vector<AppearanceSample>, 4> moving_samples_;
+  double next_moving_sample_s_ = 0.0;
 };
 
 alignment::RgbdCamera& TourStop::arrived(const session::Stop& at) {
@@ -267,7 +276,9 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
     lights_.push_back(neighbour_light(tour_.twin, tour_.trackers[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, tour_.models));
   if (!tour_.options.frames_dir.empty()) write_pictures(f.colour);
   if (tour_.options.measure_reflectance && report.projected) measure_reflectance();
-  if (tour_.options.appearance) measure_appearance(false, report.projected, report.T_projector_target_estimated);
+  if (tour_.options.appearance)
+    for (const AppearanceSample& sample : measure_appearance(false, report.projected, report.T_projector_target_estimated))
+      report.appearance.push_back(sample);
 
   dwell_.emplace(DwellContext{tour_.twin, target_index_, tour_.models, truth_, tour_.options, lights_});
   start_projection();
@@ -355,8 +366,8 @@ void TourStop::measure_reflectance() {
 // What a visitor sees of the visited target drawn at T_projector_target, compensation off and on, against
 // its content under the reference light scaled by the visit's gain; with --frames both pictures. With
 // T_projector_still (moving), each also drawn there: the target tracked exactly, as if it stood still.
-void TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target,
-                                  const Eigen::Matrix4d* T_projector_still) {
+std::array<AppearanceSample, 2> TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target,
+                                                             const Eigen::Matrix4d* T_projector_still) {
   const TwinTarget& target = tour_.twin.targets()[target_index_];
   const Eigen::Matrix4d T_world_spectator =
       spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
@@ -368,17 +379,37 @@ void TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& 
   const auto score = [&](const SpectatorPicture& seen) {
     return score_appearance(seen, view, gain, tour_.scene.room.ambient_lux, tour_.models.truth.photometry);
   };
+  std::array<AppearanceSample, 2> samples;
   for (const bool on : {false, true}) {
     const auto t0 = Clock::now();
     const auto image = projector_image(lit, T_projector_target, on);
     const double ms = ms_since(t0);
     const SpectatorPicture seen = tour_.spectator->light(scene, image);
-    AppearanceSample sample{on, moving, gain, ms, score(seen)};
+    AppearanceSample sample{.compensation = on, .moving = moving, .gain = gain, .ms_per_frame = ms, .score = score(seen)};
     if (T_projector_still)
       sample.still_psnr_db = score(tour_.spectator->light(scene, projector_image(true, *T_projector_still, on))).psnr_db;
-    report.appearance.push_back(sample);
+    samples[on ? 1 : 0] = sample;
     if (!moving && !tour_.options.frames_dir.empty())
       assets::write_png(frame_path(tour_.options, report, on ? "_spectator_on" : "_spectator_off"), seen.image);
+  }
+  return samples;
+}
+
+// While the visited target moves: its frames scored every kMovingSampleS of display time, from the first
+// frame of the motion on (the sudden start included), each beside itself drawn at the true pose.
+void TourStop::sample_motion(const TimelineSample& s, const session::DrawnPose* visited) {
+  if (!tour_.options.appearance || !s.moving || s.t_s < next_moving_sample_s_) return;
+  next_moving_sample_s_ = s.t_s + kMovingSampleS - 1e-9;
+  const Eigen::Matrix4d T_camera_target = light_pose(visited, drawn_, s.t_s, tour_.options.predict);
+  const Eigen::Matrix4d T_camera_true =
+      alignment::rigid_inverse(truth_.T_world_camera.matrix()) * tour_.twin.targets()[target_index_].T_world_target_true;
+  const Eigen::Matrix4d T_projector_still = tour_.models.projector_from_target(T_camera_true);
+  const auto samples = measure_appearance(true, shown_, tour_.models.projector_from_target(T_camera_target), &T_projector_still);
+  const config::TargetMotion* motion = tour_.twin.targets()[target_index_].config.motion_on(report.target_visit);
+  const bool starting = motion && s.t_s < motion->start_s + kStartingS;
+  for (AppearanceSample a : samples) {
+    a.starting = starting;
+    moving_samples_[(starting ? 0 : 2) + (a.compensation ? 1 : 0)].push_back(a);
   }
 }
 
@@ -424,15 +455,7 @@ void TourStop::project(double start_s) {
   if (visited && tour_.options.compensation)  // the gain follows the pose, as run's loop has it do
     tour_.plan.at(target_index_, visit_, tour_.models.believed, visited->T_projector_target, frame.display_s);
   const TimelineSample s = measure_frame(c, report, frame.display_s, visited, drawn_);
-  const config::TargetMotion* motion = tour_.twin.targets()[target_index_].config.motion_on(report.target_visit);
-  if (tour_.options.appearance && s.moving && !moving_measured_ && s.t_s >= motion->start_s + motion->duration_s / 2) {
-    moving_measured_ = true;
-    const Eigen::Matrix4d T_camera_target = light_pose(visited, drawn_, s.t_s, tour_.options.predict);
-    const Eigen::Matrix4d T_camera_true =
-        alignment::rigid_inverse(truth_.T_world_camera.matrix()) * tour_.twin.targets()[target_index_].T_world_target_true;
-    const Eigen::Matrix4d T_projector_still = tour_.models.projector_from_target(T_camera_true);
-    measure_appearance(true, shown_, tour_.models.projector_from_target(T_camera_target), &T_projector_still);
-  }
+  sample_motion(s, visited);
   for (std::size_t k = 1; k < lit_.size(); ++k) measure_neighbour(c, lights_[k - 1], drawn_of(static_cast<int>(k)));
   report.timeline.push_back(s);
   report.lit_frames += shown_ ? 1 : 0;
@@ -472,6 +495,8 @@ void TourStop::end_dwell() {
 
 void TourStop::finish() {
   for (const NeighbourLight& l : lights_) report.neighbours.push_back(finished(l));
+  for (const auto& samples : moving_samples_)
+    if (!samples.empty()) report.appearance.push_back(mean_appearance(samples));
   if (!tour_.options.frames_dir.empty() && report.moved && !interrupted) {
     // A moved target: what the visitor sees at the end of the dwell, where the target went and where
     // the light went (followed, or left where the target was).

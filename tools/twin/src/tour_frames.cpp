@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 
 #include "projbot/alignment/equations.hpp"
@@ -123,6 +124,37 @@ NeighbourLight neighbour_light(const Twin& twin, const Acquired& a, std::size_t 
   r.max_mm = e.max_mm;
   count_frame(l, e.mean_mm);  // the arrival's frame
   return l;
+}
+
+// A motion's scored frames as one: the mean of each figure over the frames that saw the target (all of
+// them, if none did: a row that says so).
+AppearanceSample mean_appearance(const std::vector<AppearanceSample>& samples) {
+  AppearanceSample m = samples.front();
+  std::vector<const AppearanceSample*> seen;
+  for (const AppearanceSample& a : samples)
+    if (a.score.pixels > 0) seen.push_back(&a);
+  m.frames = static_cast<int>(samples.size());
+  if (seen.empty()) return m;
+  const double n = static_cast<double>(seen.size());
+  const auto mean = [&](auto field) {
+    double sum = 0.0;
+    for (const AppearanceSample* a : seen) sum += field(*a);
+    return sum / n;
+  };
+  m.gain = mean([](const AppearanceSample& a) { return a.gain; });
+  m.ms_per_frame = mean([](const AppearanceSample& a) { return a.ms_per_frame; });
+  m.still_psnr_db = mean([](const AppearanceSample& a) { return a.still_psnr_db; });
+  AppearanceScore& s = m.score;
+  s.pixels = static_cast<std::size_t>(std::lround(mean([](const AppearanceSample& a) { return double(a.score.pixels); })));
+  s.psnr_db = mean([](const AppearanceSample& a) { return a.score.psnr_db; });
+  s.ssim = mean([](const AppearanceSample& a) { return a.score.ssim; });
+  s.de2000_median = mean([](const AppearanceSample& a) { return a.score.de2000_median; });
+  s.de2000_p95 = mean([](const AppearanceSample& a) { return a.score.de2000_p95; });
+  s.clipped_share = mean([](const AppearanceSample& a) { return a.score.clipped_share; });
+  s.unreachable_share = mean([](const AppearanceSample& a) { return a.score.unreachable_share; });
+  m.worst_psnr_db = std::numeric_limits<double>::infinity();
+  for (const AppearanceSample* a : seen) m.worst_psnr_db = std::min(m.worst_psnr_db, a->score.psnr_db);
+  return m;
 }
 
 }  // namespace projbot::twin::detail

@@ -69,4 +69,8 @@ void summarise_timeline(VisitReport& r);
 NeighbourLight neighbour_light(const Twin& twin, const Acquired& a, std::size_t target, const session::LitTarget& n,
                                const robot::HeadPoses& truth, const ProjectorModels& models);
 
+// A motion's scored frames as one (TourOptions::appearance): each figure the mean over the frames that
+// saw the target, the worst frame's PSNR, how many were scored.
+AppearanceSample mean_appearance(const std::vector<AppearanceSample>& samples);
+
 }  // namespace projbot::twin::detail

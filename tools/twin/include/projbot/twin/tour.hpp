@@ -65,21 +65,29 @@ struct TourOptions {
   /// With measure_reflectance: measured into each target's texture space (engine::ReflectanceMap, refined
   /// over its visits) and bound as its surface, so a printed surface is learnt; false: one colour.
   bool reflectance_map = false;
-  /// Issue 43: at each arrival (and once in the middle of a scripted motion) the visited target's frame is
-  /// drawn with compensation off and on, and what a visitor sees of it scored (VisitReport::appearance).
+  /// Issue 43: at each arrival (and through a scripted motion) the visited target's frame is drawn with
+  /// compensation off and on, and what a visitor sees of it scored (VisitReport::appearance).
   bool appearance = false;
 };
 
-/// What a visitor saw of the visited target in one projector frame (TourOptions::appearance).
+/// What a visitor saw of the visited target in a projector frame (TourOptions::appearance): at arrival
+/// one frame; while a scripted motion goes on, the mean over its frames scored 0.1 s apart (display time),
+/// each drawn at the pose predicted for its display time: its first 0.2 s (starting: the camera's frames
+/// reach the projector 50-67 ms after they are taken and the prediction needs two to see the new speed)
+/// and the rest apart.
 struct AppearanceSample {
   bool compensation = false;
-  bool moving = false;        ///< in the middle of a scripted motion, the pose predicted for its display time
-  double gain = 1.0;          ///< the target's k for this visit (the same off and on)
+  bool moving = false;
+  bool starting = false;      ///< moving, in the first 0.2 s of the motion
+  int frames = 1;             ///< the frames scored (moving: those that saw the target, each figure their mean)
+  double gain = 1.0;          ///< the target's k (the same off and on)
   double ms_per_frame = 0.0;  ///< wall time to draw the projector's frame and read it back
   AppearanceScore score;
-  /// Moving: the PSNR of the same frame drawn at the target's true pose (tracked exactly: what it shows
+  /// Moving: the PSNR of the same frames drawn at the target's true pose (tracked exactly: what they show
   /// standing still there, the same gain); NaN otherwise. Against `score`, what the motion costs.
   double still_psnr_db = std::numeric_limits<double>::quiet_NaN();
+  /// Moving: the worst frame's PSNR; NaN otherwise.
+  double worst_psnr_db = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The projection error of one projector frame while projecting, at its display time.
