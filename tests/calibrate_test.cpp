@@ -398,3 +398,42 @@ TEST(Photometric, RecoversEachChannelsGammaAndTheMixing) {
     EXPECT_NE(std::string(e.what()).find("do not follow its exposure"), std::string::npos) << e.what();
   }
 }
+
+// The camera's response from the same captures (issue 43, item 2): where the camera cannot bracket its
+// exposure, the grey ramp is shown too, and the camera's gamma is the one under which grey's light is the
+// sum of the primaries'. Recovered within the goals with a DLP's few percent of crosstalk; a projector
+// whose light does not add up (a white segment adding 30 % of white) and one whose primaries the camera
+// sees in one channel each are refused by name, as is a camera that cannot bracket given no other way.
+TEST(Photometric, MeasuresTheCamerasResponseFromTheColoursAddingUp) {
+  projbot::calibrate::PhotometricSim sim;
+  sim.projector.photometry.gamma_rgb = {2.0, 2.3, 2.5};
+  sim.projector.photometry.mixing = projbot::calibrate::typical_mixing();
+  sim.camera_gamma = 1.8;
+  sim.ambient_lux = 50.0;
+  sim.seed = 7;
+  sim.brackets = false;
+  const auto& truth = sim.projector.photometry;
+  const auto r = projbot::calibrate::calibrate_photometric(*projbot::calibrate::make_twin_photometric_rig(sim), truth.black_level,
+                                                           {.from_colours = true});
+  EXPECT_EQ(r.camera_response, projbot::calibrate::CameraResponse::colours_adding_up);
+  EXPECT_NEAR(r.camera_gamma, 1.8, 0.02 * 1.8);  // measured 1.796
+  for (std::size_t j = 0; j < 3; ++j) EXPECT_NEAR(r.projector.gamma_rgb[j], truth.gamma_rgb[j], 0.02 * truth.gamma_rgb[j]) << j;
+  EXPECT_LT((r.projector.mixing - truth.mixing).cwiseAbs().maxCoeff(), 0.02) << r.projector.mixing;
+  EXPECT_EQ(r.captures, 2 + 3 * 8 + 7);
+  const auto refused = [&](const projbot::calibrate::PhotometricSim& s, projbot::calibrate::CameraResponseOptions how,
+                           const std::string& why) {
+    try {
+      projbot::calibrate::calibrate_photometric(*projbot::calibrate::make_twin_photometric_rig(s), 0.0005, how);
+      ADD_FAILURE() << "fitted; expected: " << why;
+    } catch (const projbot::calibrate::CalibrationError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  };
+  projbot::calibrate::PhotometricSim white_segment = sim;
+  white_segment.white_segment = 0.3;
+  refused(white_segment, {.from_colours = true}, "colours do not add up to its grey and white");
+  projbot::calibrate::PhotometricSim pure = sim;
+  pure.projector.photometry.mixing = Eigen::Matrix3d::Identity();
+  refused(pure, {.from_colours = true}, "sees each of the projector's primaries in one channel only");
+  refused(sim, {}, "cannot set its exposure");
+}

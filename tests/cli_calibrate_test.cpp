@@ -119,6 +119,27 @@ TEST_F(CliTest, CalibratePhotometricRecoversTheTwinsResponse) {
   text << in.rdbuf();
   EXPECT_NE(text.str().find("photometry:\n  gamma: 2."), std::string::npos) << text.str();
   EXPECT_NE(text.str().find("  mixing: [0.9"), std::string::npos) << text.str();
+  // The camera's response from the same session (the colours adding up) instead of exposure brackets.
+  r = run_projbot("calibrate photometric --sim --camera-response colours --camera-gamma 1.8 --out " + (dir_ / "c.yaml").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("33 captures: "), std::string::npos) << r.output;  // 26, and the grey ramp's 7
+  const std::size_t measured = r.output.find("(from the colours adding up)");
+  ASSERT_NE(measured, std::string::npos) << r.output;
+  double camera_gamma = 0.0, truth = 0.0;
+  const std::size_t against = r.output.find("against the twin's truth: ");
+  ASSERT_NE(against, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + r.output.find("camera gamma ", against), "camera gamma %lf (truth %lf)", &camera_gamma,
+                        &truth),
+            2)
+      << r.output;
+  EXPECT_NEAR(camera_gamma, 1.8, 0.02 * 1.8) << r.output;  // measured 1.791
+  EXPECT_DOUBLE_EQ(truth, 1.8);
+  ASSERT_EQ(std::sscanf(r.output.c_str() + against,
+                        "against the twin's truth: gamma within %lf %% (worst channel), mixing within %lf", &gamma_pct, &mixing),
+            2)
+      << r.output;
+  EXPECT_LT(gamma_pct, 2.0) << r.output;
+  EXPECT_LT(mixing, 0.02) << r.output;
   r = run_projbot("calibrate photometric --out " + (dir_ / "real.yaml").string());
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("give --config site.yaml (its devices.camera and devices.projector) or --sim"), std::string::npos)

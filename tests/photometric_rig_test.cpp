@@ -98,13 +98,21 @@ TEST(PhotometricRig, RecoversTheProjectorsResponseFromWhatTheRendererDrew) {
   } catch (const CalibrationError& e) {
     EXPECT_NE(std::string(e.what()).find("cannot set its exposure"), std::string::npos) << e.what();
   }
-  const auto r = projbot::calibrate::calibrate_photometric(*rig, b.truth.black_level, 2.2);
+  const auto r = projbot::calibrate::calibrate_photometric(*rig, b.truth.black_level, {.gamma = 2.2});
   for (std::size_t j = 0; j < 3; ++j)
     EXPECT_NEAR(r.projector.gamma_rgb[j], b.truth.gamma_rgb[j], 0.02 * b.truth.gamma_rgb[j]) << j;
   EXPECT_LT((r.projector.mixing - b.truth.mixing).cwiseAbs().maxCoeff(), 0.02) << r.projector.mixing;
-  EXPECT_FALSE(r.camera_gamma_measured);
+  EXPECT_EQ(r.camera_response, projbot::calibrate::CameraResponse::given);
   EXPECT_EQ(r.captures, 2 + 3 * 8);
   EXPECT_GE(camera.stale_frames, r.captures);  // each capture met an old frame first, and dropped it
+  // Its response measured from the same session instead: the colours adding up (a grey ramp more).
+  const auto m = projbot::calibrate::calibrate_photometric(*rig, b.truth.black_level, {.from_colours = true});
+  EXPECT_EQ(m.camera_response, projbot::calibrate::CameraResponse::colours_adding_up);
+  EXPECT_NEAR(m.camera_gamma, 2.2, 0.02 * 2.2);
+  for (std::size_t j = 0; j < 3; ++j)
+    EXPECT_NEAR(m.projector.gamma_rgb[j], b.truth.gamma_rgb[j], 0.02 * b.truth.gamma_rgb[j]) << j;
+  EXPECT_LT((m.projector.mixing - b.truth.mixing).cwiseAbs().maxCoeff(), 0.02) << m.projector.mixing;
+  EXPECT_EQ(m.captures, 2 + 3 * 8 + 7);
 }
 
 TEST(PhotometricRig, RefusesACameraThatDoesNotSeeTheLightOrSaturates) {
@@ -114,7 +122,7 @@ TEST(PhotometricRig, RefusesACameraThatDoesNotSeeTheLightOrSaturates) {
   const auto expect_refused = [&](WallCamera& camera, const std::string& why) {
     const auto rig = projbot::calibrate::make_device_photometric_rig(screen, b.renderer, *window, camera, 0.0, 0.0);
     try {
-      projbot::calibrate::calibrate_photometric(*rig, b.truth.black_level, 2.2);
+      projbot::calibrate::calibrate_photometric(*rig, b.truth.black_level, {.gamma = 2.2});
       ADD_FAILURE() << "fitted: " << why;
     } catch (const CalibrationError& e) {
       EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
@@ -139,7 +147,7 @@ TEST(PhotometricRig, StopsAtTheNextCaptureWhenAsked) {
   const auto rig = projbot::calibrate::make_device_photometric_rig(screen, b.renderer, *window, camera, 120.0, 0.0,
                                                                    [&asked] { return ++asked > 8; });
   try {
-    projbot::calibrate::calibrate_photometric(*rig, b.truth.black_level, 2.2);
+    projbot::calibrate::calibrate_photometric(*rig, b.truth.black_level, {.gamma = 2.2});
     ADD_FAILURE() << "a stopped session was fitted";
   } catch (const projbot::calibrate::SessionStopped& e) {
     EXPECT_NE(std::string(e.what()).find("while measuring the projector's colours"), std::string::npos) << e.what();

@@ -1,5 +1,6 @@
 // projbot calibrate photometric: the projector's response per channel and colour mixing (issue 43), on a
-// site's projector and colour camera or in the twin (there the camera's response from exposure brackets first).
+// site's projector and colour camera or in the twin (there the camera's response from exposure brackets
+// first, unless measured from the colours adding up).
 
 #include <cmath>
 #include <cstdio>
@@ -29,9 +30,17 @@ void print_result(const calibrate::PhotometricResult& r) {
   const auto& p = r.projector;
   std::printf(
       "%d captures: gamma R %.3f G %.3f B %.3f; camera gamma %.3f (%s)\nmixing (column j: channel j's light in R, G, B):\n",
-      r.captures, p.gamma_rgb[0], p.gamma_rgb[1], p.gamma_rgb[2], r.camera_gamma,
-      r.camera_gamma_measured ? "from exposure brackets" : "as given");
+      r.captures, p.gamma_rgb[0], p.gamma_rgb[1], p.gamma_rgb[2], r.camera_gamma, calibrate::to_string(r.camera_response));
   for (int i = 0; i < 3; ++i) std::printf("  %.4f %.4f %.4f\n", p.mixing(i, 0), p.mixing(i, 1), p.mixing(i, 2));
+}
+
+// --camera-response colours; nothing else is a way this command has.
+bool from_colours(const cli::Args& args) {
+  const auto response = args.get("camera-response");
+  if (response && *response != "colours")
+    throw cli::UsageError("--camera-response can only be 'colours' (from the projector's colours adding up), not '" + *response +
+                          "'");
+  return response.has_value();
 }
 
 double camera_gamma_option(const cli::Args& args) {
@@ -52,7 +61,8 @@ int photometric_in_twin(const cli::Args& args, const std::string& out) {
   if (!(sim.noise_levels >= 0.0 && sim.noise_levels <= 50.0)) throw cli::UsageError("--noise must be 0..50 levels");
   sim.camera_gamma = camera_gamma_option(args);
   const auto rig = calibrate::make_twin_photometric_rig(sim);
-  const calibrate::PhotometricResult r = calibrate::calibrate_photometric(*rig, sim.projector.photometry.black_level);
+  const calibrate::PhotometricResult r =
+      calibrate::calibrate_photometric(*rig, sim.projector.photometry.black_level, {.from_colours = from_colours(args)});
   print_result(r);
   print_against_truth(r, sim);
   calibrate::write_photometric(r, out, "projbot calibrate photometric --sim (the twin of " + scene.source.string() + ")");
@@ -68,7 +78,8 @@ int photometric_on_devices(const cli::Args& args, const std::string& out) {
     throw cli::UsageError(path +
                           " configures no camera (devices.camera): the session needs the projector and a colour camera; "
                           "--sim runs it in the twin");
-  const double camera_gamma = camera_gamma_option(args), settle_ms = settle_ms_option(args);
+  const bool measured = from_colours(args);
+  const double camera_gamma = measured ? 0.0 : camera_gamma_option(args), settle_ms = settle_ms_option(args);
   CalibrationDevices d = open_calibration_devices(args, scene, "projbot calibrate photometric");
   const alignment::ExposureHold hold = d.devices.camera->hold_colour_exposure();
   if (hold.held)
@@ -80,14 +91,21 @@ int photometric_on_devices(const cli::Args& args, const std::string& out) {
   catch_interrupts();  // Ctrl-C: stops at the next capture; nothing is written (the fit needs them all)
   const auto rig = calibrate::make_device_photometric_rig(screen, *d.renderer, *d.window, *d.devices.camera, settle_ms,
                                                           scene.projector.input_lag_ms, interrupted);
-  std::printf(
-      "the projector shows black, white, its primaries and their ramps, %.0f ms each; the camera's response is taken as "
-      "gamma %.2f (--camera-gamma: its exposure time cannot be bracketed to measure it)\n",
-      settle_ms + scene.projector.input_lag_ms, camera_gamma);
+  if (measured)
+    std::printf(
+        "the projector shows black, white, its primaries, their ramps and a grey ramp, %.0f ms each; the camera's response "
+        "is measured from the colours adding up\n",
+        settle_ms + scene.projector.input_lag_ms);
+  else
+    std::printf(
+        "the projector shows black, white, its primaries and their ramps, %.0f ms each; the camera's response is taken as "
+        "gamma %.2f (--camera-gamma: its exposure time cannot be bracketed to measure it)\n",
+        settle_ms + scene.projector.input_lag_ms, camera_gamma);
   std::fflush(stdout);
   calibrate::PhotometricResult r;
   try {
-    r = calibrate::calibrate_photometric(*rig, scene.projector.photometry.black_level, camera_gamma);
+    r = calibrate::calibrate_photometric(*rig, scene.projector.photometry.black_level,
+                                         {.gamma = camera_gamma, .from_colours = measured});
   } catch (const calibrate::SessionStopped& e) {
     return nothing_written(e.what());
   }
@@ -104,6 +122,8 @@ int run_photometric(const cli::Args& args) {
   if (sim && args.get("config")) throw cli::UsageError("--sim and --config: give one (the twin's devices, or the config's)");
   if (!sim && !args.get("config"))
     throw cli::UsageError("give --config site.yaml (its devices.camera and devices.projector) or --sim for the twin's");
+  if (!sim && from_colours(args) && args.get("camera-gamma"))
+    throw cli::UsageError("--camera-gamma and --camera-response colours: give the camera's gamma or have it measured, not both");
   for (const char* twin_only : {"scene", "seed", "noise"})
     if (!sim && args.flag(twin_only))
       throw cli::UsageError(std::string("--") + twin_only + " is the twin's (--sim); a site's devices come with --config");
@@ -118,9 +138,10 @@ int run_photometric(const cli::Args& args) {
 const Command kCalibratePhotometric{
     "calibrate photometric",
     "the projector's response per channel and colour mixing, from its colours on a surface",
-    "projbot calibrate photometric --config site.yaml --out photo.yaml [--camera-gamma G] [--settle-ms MS]\n"
-    "       projbot calibrate photometric --sim --out photo.yaml [--scene FILE] [--seed K] [--noise LEVELS] [--camera-gamma "
-    "G]\n\n"
+    "projbot calibrate photometric --config site.yaml --out photo.yaml [--camera-gamma G | --camera-response colours]\n"
+    "                              [--settle-ms MS]\n"
+    "       projbot calibrate photometric --sim --out photo.yaml [--scene FILE] [--seed K] [--noise LEVELS]\n"
+    "                              [--camera-gamma G] [--camera-response colours]\n\n"
     "The projector shows uniform colours on a light surface and the colour camera measures them: black, white,\n"
     "each primary and an eight-step ramp per channel (each step the nearest 8-bit level). From the linearised\n"
     "values: each channel's gamma (its ramp's share of its full light, log against log) and the colour mixing\n"
@@ -133,10 +154,17 @@ const Command kCalibratePhotometric{
     "off yourself. Each colour is shown for --settle-ms plus the projector's input lag before the camera's\n"
     "image is taken; the values are averaged over the pixels the projector's white lights. projbot cannot set\n"
     "the cameras' exposure time to bracket it, so the camera's response is taken as --camera-gamma (2.2, an\n"
-    "sRGB camera's, unless told). Ctrl-C stops at the next capture and writes nothing (exit 130).\n\n"
+    "sRGB camera's, unless told), or with --camera-response colours measured from the same session: a grey\n"
+    "ramp is shown too, and the camera's gamma is the one under which grey's light is the sum of the\n"
+    "primaries' at the same input. That holds for a projector whose light adds up (LCD, LCoS, three-chip DLP,\n"
+    "a colour wheel without a white segment: often a DLP's sRGB mode); a white segment adding a few percent\n"
+    "to white passes unseen and biases the camera's gamma (2 % of white: 8 % in the twin), a large one is\n"
+    "refused, as is a projector whose primaries the camera sees each in one channel only.\n"
+    "Ctrl-C stops at the next capture and writes nothing (exit 130).\n\n"
     "With --sim, the twin's projector (the scene's lumens, gammas, mixing (a DLP's few percent of crosstalk\n"
-    "where the scene has none) and room light) and an 8-bit camera whose response is measured first, from\n"
-    "white at six exposures; the result is compared with that truth.\n\n"
+    "where the scene has none) and room light) and an 8-bit camera whose response (--camera-gamma, its truth)\n"
+    "is measured first, from white at six exposures, or with --camera-response colours as above; the result\n"
+    "is compared with that truth.\n\n"
     "Paste the written photometry: section into the calibration file a scene names (`calibration:`) to\n"
     "project with it.\n",
     {{"config", "FILE", "site config with devices.camera and devices.projector", cli::PathRole::input_file},
@@ -144,6 +172,8 @@ const Command kCalibratePhotometric{
      {"out", "FILE", "the photometry to write (YAML, `photometry:` as a calibration file carries it)",
       cli::PathRole::output_file},
      {"camera-gamma", "G", "the camera's response exponent: --config, taken as given; --sim, the twin's truth (default 2.2)"},
+     {"camera-response", "colours",
+      "measure the camera's response from the projector's colours adding up (a projector whose light adds up: see above)"},
      {"settle-ms", "MS",
       "--config: wait after a colour is presented before taking the image (default 150; plus projector.input_lag_ms)"},
      {"fullscreen", "", "--config: full screen on the projector (the config's devices.projector says so too)"},

@@ -1,6 +1,7 @@
 #include "projbot/calibrate/photometric.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -15,6 +16,11 @@ namespace projbot::calibrate {
 namespace {
 
 constexpr double kExposures[] = {1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125};
+constexpr double kMostCameraGamma = 3.5;
+// The camera's gamma from the colours adding up: at the best gamma they must add up within this share of
+// white (RMS), and 10 % off that gamma they must fail by this much more.
+constexpr double kMostAdditivityRms = 0.01;
+constexpr double kLeastAdditivityRise = 0.002;
 
 // The camera's gamma from white at the bracketed exposures: value = 255 (e L)^(1 / g) per channel, so
 // log(value) against log(e) has slope 1 / g; values near black or saturation are left out.
@@ -43,47 +49,135 @@ std::string levels(const Eigen::Vector3d& v) {
   return text;
 }
 
-}  // namespace
+// The ramps' inputs: step k of 8 as the 8-bit level nearest k/8 (what a device shows).
+double ramp_level(int step) { return std::round(255.0 * step / 8.0) / 255.0; }
 
-PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level, double given_camera_gamma) {
-  PhotometricResult r;
-  if (given_camera_gamma > 0.0) {
-    r.camera_gamma = given_camera_gamma;
-  } else if (!rig.brackets()) {
-    throw CalibrationError("photometric: this camera cannot set its exposure, so its response cannot be measured: give it");
-  } else {
-    r.camera_gamma = camera_gamma(rig, r.captures);
-    r.camera_gamma_measured = true;
-  }
-  const auto linear = [&](const Eigen::Vector3d& input) {
-    ++r.captures;
+// What the fit reads: the camera's mean values (8-bit levels) under each colour the projector showed.
+struct Captures {
+  Eigen::Vector3d black, white;
+  std::array<Eigen::Vector3d, 3> full;                 // each primary at full
+  std::array<std::array<Eigen::Vector3d, 7>, 3> ramp;  // each primary at ramp_level(1..7)
+  std::array<Eigen::Vector3d, 7> grey;                 // all three at ramp_level(1..7): only to measure the camera
+};
+
+// Black and white first (a projector out of the camera's view is refused before the rest), each primary
+// at full and its ramp, and with `grey` the grey ramp; every capture checked for saturation.
+Captures capture(PhotometricRig& rig, bool grey, int& captures) {
+  const auto take = [&](const Eigen::Vector3d& input) {
+    ++captures;
     const Eigen::Vector3d v = rig.show_and_measure(input, 1.0);
     if (v.maxCoeff() > 250.0)
       throw CalibrationError("photometric: the camera saturates under input " + levels(input * 255.0) + " (it reads " +
                              levels(v) + "): lower its exposure, or aim the projector at a darker surface");
-    Eigen::Vector3d l;
-    for (int ch = 0; ch < 3; ++ch) l[ch] = std::pow(std::clamp(v[ch], 0.0, 255.0) / 255.0, r.camera_gamma);
-    return l;
+    return v;
   };
-  const Eigen::Vector3d black = linear(Eigen::Vector3d::Zero());
-  const Eigen::Vector3d white = linear(Eigen::Vector3d::Ones()) - black;
+  Captures c;
+  c.black = take(Eigen::Vector3d::Zero());
+  c.white = take(Eigen::Vector3d::Ones());
+  if (!((c.white - c.black).minCoeff() >= 1.0))
+    throw CalibrationError("photometric: the projector's white is no brighter than its black in the camera (" + levels(c.white) +
+                           " against " + levels(c.black) + "): is its light in the camera's view?");
+  for (int j = 0; j < 3; ++j) {
+    c.full[j] = take(Eigen::Vector3d::Unit(j));
+    for (int step = 1; step < 8; ++step) c.ramp[j][step - 1] = take(ramp_level(step) * Eigen::Vector3d::Unit(j));
+  }
+  if (grey)
+    for (int step = 1; step < 8; ++step) c.grey[step - 1] = take(Eigen::Vector3d::Constant(ramp_level(step)));
+  return c;
+}
+
+Eigen::Vector3d linear(const Eigen::Vector3d& v, double camera_gamma) {
+  Eigen::Vector3d l;
+  for (int ch = 0; ch < 3; ++ch) l[ch] = std::pow(std::clamp(v[ch], 0.0, 255.0) / 255.0, camera_gamma);
+  return l;
+}
+
+// How far light fails to add up at camera gamma g: at each ramp level and full, in each camera channel,
+// the grey's light above black less the three primaries' at that level, as a share of white's; the RMS.
+double additivity_rms(const Captures& c, double g) {
+  const Eigen::Vector3d black = linear(c.black, g), white = linear(c.white, g) - black;
+  double sum = 0.0;
+  for (int step = 1; step <= 8; ++step) {
+    Eigen::Vector3d rest = linear(step == 8 ? c.white : c.grey[step - 1], g) - black;
+    for (int j = 0; j < 3; ++j) rest -= linear(step == 8 ? c.full[j] : c.ramp[j][step - 1], g) - black;
+    sum += rest.cwiseQuotient(white).squaredNorm();
+  }
+  return std::sqrt(sum / 24.0);
+}
+
+// The camera's gamma from the same captures: the projector's light adds up (grey = red + green + blue
+// at the same input, in light), and only the right gamma makes the camera's values add up too. Its
+// primaries' crosstalk into the camera's other channels is what tells: a projector whose primaries the
+// camera sees each in one channel only cannot. Refused when light does not add up at any gamma (a
+// colour wheel's white segment; exposure or white balance moving) or the fit cannot tell.
+double camera_gamma_from_colours(const Captures& c) {
+  double best = 1.0, best_rms = additivity_rms(c, 1.0);
+  for (double g = 1.01; g <= kMostCameraGamma + 1e-9; g += 0.01)
+    if (const double rms = additivity_rms(c, g); rms < best_rms) best = g, best_rms = rms;
+  double lo = std::max(1.0, best - 0.01), hi = std::min(kMostCameraGamma, best + 0.01);
+  for (int i = 0; i < 40; ++i) {  // golden section on the scan's bracket
+    const double a = hi - 0.618 * (hi - lo), b = lo + 0.618 * (hi - lo);
+    if (additivity_rms(c, a) < additivity_rms(c, b))
+      hi = b;
+    else
+      lo = a;
+  }
+  best = 0.5 * (lo + hi), best_rms = additivity_rms(c, best);
+  char said[96];
+  std::snprintf(said, sizeof said, " (at best %.2f %% of white off, at gamma %.2f)", 100.0 * best_rms, best);
+  if (best_rms > kMostAdditivityRms)
+    throw CalibrationError(std::string("photometric: the projector's colours do not add up to its grey and white in the camera") +
+                           said +
+                           ": a colour wheel with a white segment, or the camera's exposure or white balance moving; give the "
+                           "camera's gamma");
+  const double rise = std::min(additivity_rms(c, 0.9 * best), additivity_rms(c, 1.1 * best)) - best_rms;
+  if (!(rise > kLeastAdditivityRise))
+    throw CalibrationError(std::string("photometric: the camera sees each of the projector's primaries in one channel only, so "
+                                       "how its colours add up cannot tell the camera's response") +
+                           said + ": give the camera's gamma");
+  return best;
+}
+
+}  // namespace
+
+PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level, const CameraResponseOptions& camera) {
+  PhotometricResult r;
+  if (camera.from_colours) {
+    if (camera.gamma > 0.0) throw std::invalid_argument("calibrate_photometric: a camera gamma given and to be measured");
+  } else if (camera.gamma > 0.0) {
+    r.camera_gamma = camera.gamma;
+  } else if (rig.brackets()) {
+    r.camera_gamma = camera_gamma(rig, r.captures);
+    r.camera_response = CameraResponse::exposure_brackets;
+  } else {
+    throw CalibrationError(
+        "photometric: this camera cannot set its exposure, so its response cannot be measured from brackets: give it, or "
+        "measure it from the projector's colours adding up");
+  }
+  const Captures c = capture(rig, camera.from_colours, r.captures);
+  if (camera.from_colours) {
+    r.camera_gamma = camera_gamma_from_colours(c);
+    r.camera_response = CameraResponse::colours_adding_up;
+  }
+  const Eigen::Vector3d black = linear(c.black, r.camera_gamma);
+  const Eigen::Vector3d white = linear(c.white, r.camera_gamma) - black;
   if (!(white.minCoeff() > 1e-3))
     throw CalibrationError("photometric: the projector's white is no brighter than its black in the camera (light " +
                            levels(255.0 * white) + " above black): is its light in the camera's view?");
   r.projector.black_level = black_level;
   for (int j = 0; j < 3; ++j) {
     // Mixing: channel j's light in each camera channel, as a share of white's there (rows sum to 1).
-    const Eigen::Vector3d full = linear(Eigen::Vector3d::Unit(j)) - black;
+    const Eigen::Vector3d full = linear(c.full[j], r.camera_gamma) - black;
     r.projector.mixing.col(j) = full.cwiseQuotient(white);
     // Gamma: the ramp in the channel's own camera channel, log(share) = gamma log(c), through the origin.
     double num = 0.0, den = 0.0;
     for (int step = 1; step < 8; ++step) {
-      const double c = std::round(255.0 * step / 8.0) / 255.0;  // what an 8-bit projector input shows
-      const double share = (linear(c * Eigen::Vector3d::Unit(j)) - black)[j] / full[j];
+      const double level = ramp_level(step);
+      const double share = (linear(c.ramp[j][step - 1], r.camera_gamma) - black)[j] / full[j];
       if (!(share > 1e-3)) continue;
       // The response's black offset: share = (c^gamma (1 - black) ) / (1 - black) exactly, since black's
       // light is subtracted with the black capture.
-      num += std::log(share) * std::log(c), den += std::log(c) * std::log(c);
+      num += std::log(share) * std::log(level), den += std::log(level) * std::log(level);
     }
     if (!(den > 0.0) || !(num / den > 0.5 && num / den < 5.0))
       throw CalibrationError("photometric: channel " + std::to_string(j) + "'s ramp gives no response to fit");
@@ -91,6 +185,18 @@ PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level,
   }
   r.projector.gamma = (r.projector.gamma_rgb[0] + r.projector.gamma_rgb[1] + r.projector.gamma_rgb[2]) / 3.0;
   return r;
+}
+
+const char* to_string(CameraResponse from) {
+  switch (from) {
+    case CameraResponse::given:
+      return "as given";
+    case CameraResponse::exposure_brackets:
+      return "from exposure brackets";
+    case CameraResponse::colours_adding_up:
+      return "from the colours adding up";
+  }
+  return "?";
 }
 
 Eigen::Matrix3d typical_mixing() {
@@ -107,11 +213,17 @@ class TwinPhotometricRig final : public PhotometricRig {
     // The patch on the projector's axis 1.5 m away, facing it: full white's lux there; the camera exposed
     // so that white fills 90 % of its range at exposure 1.
     white_lux_ = engine::white_lux(sim.projector, {0.0, 0.0, 1.5}, {0.0, 0.0, -1.0});
-    scale_ = 0.9 / (kAlbedo * (sim.ambient_lux + white_lux_));
+    scale_ = 0.9 / (kAlbedo * (sim.ambient_lux + white_lux_ * (1.0 + sim.white_segment)));
   }
+  bool brackets() const override { return sim_.brackets; }
   Eigen::Vector3d show_and_measure(const Eigen::Vector3d& input, double exposure) override {
+    const config::Photometry& truth = sim_.projector.photometry;
+    double dimmest = 1.0;  // a white segment's light: as much as the dimmest channel asks for
+    for (int ch = 0; ch < 3; ++ch)
+      dimmest = std::min(dimmest, std::pow(input[ch], truth.gamma_rgb[static_cast<std::size_t>(ch)]));
     const Eigen::Vector3d lux =
-        Eigen::Vector3d::Constant(sim_.ambient_lux) + white_lux_ * engine::light(sim_.projector.photometry, input);
+        Eigen::Vector3d::Constant(sim_.ambient_lux) +
+        white_lux_ * (engine::light(truth, input) + Eigen::Vector3d::Constant(sim_.white_segment * dimmest));
     std::normal_distribution<double> noise(0.0, sim_.noise_levels);
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     constexpr int kPixels = 32 * 32;

@@ -1,9 +1,9 @@
 #pragma once
 // Photometric calibration (issue 43): the projector's response per channel and its colour mixing, from
 // uniform colours it shows on a light surface and the colour camera's images of them. The camera's own
-// response comes first, from exposure brackets of the projector's white, so that its values can be
-// linearised. Black level and the room's light cannot be told apart with the projector on: the scene's
-// black_level stays.
+// response comes from exposure brackets of the projector's white, or where the camera cannot bracket from
+// the same captures (its values must add up as light does), so that its values can be linearised. Black level and the room's
+// light cannot be told apart with the projector on: the scene's black_level stays.
 
 #include <Eigen/Core>
 #include <array>
@@ -35,21 +35,43 @@ class PhotometricRig {
   virtual bool brackets() const { return true; }
 };
 
+/// Where the camera's response came from.
+enum class CameraResponse {
+  given,
+  exposure_brackets,  ///< white at six exposures
+  colours_adding_up,  ///< the grey ramp against the sum of the primaries' at the same inputs
+};
+const char* to_string(CameraResponse from);
+
 /// The projector's colour is a config::Photometry: each channel's gamma (`gamma_rgb`), its black level and
 /// its `mixing` (column j: channel j's light in the camera's R, G, B; rows sum to 1, so white is white).
 struct PhotometricResult {
-  config::Photometry projector;        ///< gamma_rgb (gamma their mean) and mixing measured; black_level as given
-  double camera_gamma = 0.0;           ///< the camera's response: value = 255 (exposure x light)^(1 / camera_gamma)
-  bool camera_gamma_measured = false;  ///< from exposure brackets; false: as given
+  config::Photometry projector;  ///< gamma_rgb (gamma their mean) and mixing measured; black_level as given
+  double camera_gamma = 0.0;     ///< the camera's response: value = 255 (exposure x light)^(1 / camera_gamma)
+  CameraResponse camera_response = CameraResponse::given;
   int captures = 0;
 };
 
-/// The session: white at six exposures (the camera's response; skipped when `camera_gamma` is given, which
-/// a rig that cannot bracket needs), black, white and each primary, and an eight-step ramp per channel
-/// (each step the 8-bit level nearest k/8). `black_level`: the projector's, from its scene (not
-/// measurable here). Throws CalibrationError when the captures cannot be fitted (saturated, too dark, not
-/// monotonic) or a rig that cannot bracket gets no camera gamma.
-PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level, double camera_gamma = 0.0);
+/// How the camera's response is had: `gamma` given (> 0); else from the colours adding up when
+/// `from_colours`; else from exposure brackets (a rig that cannot bracket is refused).
+struct CameraResponseOptions {
+  double gamma = 0.0;
+  /// The grey ramp is shown too: the projector's light adds up (grey = red + green + blue at the same
+  /// input), and the camera's gamma is the one that makes its values add up as well (within 1 % of white;
+  /// the primaries' crosstalk into the camera's other channels is what tells). Only for a projector whose
+  /// light adds up: LCD, LCoS, three-chip DLP, a colour wheel without a white segment (often a DLP's sRGB
+  /// mode). A white segment adding 2 % of white passes unseen and biases the camera's gamma by 8 %
+  /// (the twin's, with a typical DLP's crosstalk); from about 10 % it is refused.
+  bool from_colours = false;
+};
+
+/// The session: white at six exposures (the camera's response from brackets), black, white and each
+/// primary, an eight-step ramp per channel (each step the 8-bit level nearest k/8), and with
+/// `camera.from_colours` the grey ramp at the same steps. `black_level`: the projector's, from its scene
+/// (not measurable here). Throws CalibrationError when the captures cannot be fitted (saturated, too dark,
+/// not monotonic; light that does not add up, or too little crosstalk to tell the camera's response), or
+/// a rig that cannot bracket has no other way to the camera's response.
+PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level, const CameraResponseOptions& camera = {});
 
 /// The twin's rig: a light grey patch (reflectance 0.8) facing the projector 1.5 m away, lit by the
 /// room's `ambient_lux` and the projector (its lumens and photometry, the truth), seen by an 8-bit camera whose response
@@ -61,6 +83,8 @@ struct PhotometricSim {
   double camera_gamma = 2.2;
   double noise_levels = 2.0;
   std::uint64_t seed = 1;
+  bool brackets = true;        ///< the camera's exposure can be set; false: its response from the colours adding up
+  double white_segment = 0.0;  ///< a colour wheel's white segment: this share of white's light more, times the dimmest channel's
 };
 std::unique_ptr<PhotometricRig> make_twin_photometric_rig(const PhotometricSim& sim);
 /// A result against the twin's truth: the worst channel's gamma off by this share (0.01: 1 %), and the
