@@ -331,3 +331,20 @@ TEST_F(ShopDuckStop, TheVisitorSeesReflectanceTimesLight) {
 }
 
 }  // namespace
+
+// The projector's saturated share (issue 43, bench appearance's "projector saturated"): of the target's
+// pixels (lit in the compensated frame or in the content as stored) those at 254 or more in a channel.
+TEST(Appearance, TheSaturatedShareCountsTheTargetsPixelsAtFull) {
+  projbot::assets::Image on, off;
+  on.width = off.width = 4, on.height = off.height = 1;
+  on.rgba = {255, 10, 10, 255, /**/ 0, 0, 0, 255, /**/ 100, 254, 0, 255, /**/ 0, 0, 0, 255};
+  off.rgba = {9, 9, 9, 255, /**/ 40, 0, 0, 255, /**/ 100, 100, 0, 255, /**/ 0, 0, 0, 255};
+  // Three target pixels (the second black when compensated: content darker than the room), two saturated;
+  // the fourth is not the target.
+  EXPECT_NEAR(projbot::twin::saturated_share(on, off), 2.0 / 3.0, 1e-12);
+  on.rgba[0] = 253, on.rgba[9] = 253;
+  EXPECT_DOUBLE_EQ(projbot::twin::saturated_share(on, off), 0.0);
+  EXPECT_DOUBLE_EQ(projbot::twin::saturated_share(off, off), 0.0);
+  off.width = 2, off.rgba.resize(8);
+  EXPECT_THROW(projbot::twin::saturated_share(on, off), std::invalid_argument);
+}

@@ -21,23 +21,25 @@ namespace {
 void print_table(const twin::TourReport& report) {
   std::printf(
       "\n| # | target | moving | k | compensation | PSNR dB | SSIM | dE2000 median / p95 | clipped %% | unreachable %% | "
-      "ms per frame | PSNR still there dB |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "projector saturated %% | ms per frame | PSNR still there dB |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& v : report.visits)
     for (const auto& a : v.appearance) {
       const auto& s = a.score;
       if (s.pixels == 0) {
-        std::printf("| %d | %s | %s | %.2f | %s | no lit pixel of the target in view | | | | | %.1f | |\n", v.visit,
+        std::printf("| %d | %s | %s | %.2f | %s | no lit pixel of the target in view | | | | | | %.1f | |\n", v.visit,
                     v.target.c_str(), a.moving ? "yes" : "no", a.gain, a.compensation ? "on" : "off", a.ms_per_frame);
         continue;
       }
-      char still[32] = "", moving[64] = "no";
+      char still[32] = "", moving[64] = "no", saturated[32] = "";
       if (std::isfinite(a.still_psnr_db)) std::snprintf(still, sizeof still, "%.1f", a.still_psnr_db);
+      if (std::isfinite(a.projector_saturated_share))
+        std::snprintf(saturated, sizeof saturated, "%.1f", 100.0 * a.projector_saturated_share);
       if (a.moving)
         std::snprintf(moving, sizeof moving, "%s, %d frames, worst %.1f dB", a.starting ? "starting" : "yes", a.frames,
                       a.worst_psnr_db);
-      std::printf("| %d | %s | %s | %.2f | %s | %.1f | %.3f | %.1f / %.1f | %.1f | %.1f | %.1f | %s |\n", v.visit,
+      std::printf("| %d | %s | %s | %.2f | %s | %.1f | %.3f | %.1f / %.1f | %.1f | %.1f | %s | %.1f | %s |\n", v.visit,
                   v.target.c_str(), moving, a.gain, a.compensation ? "on" : "off", s.psnr_db, s.ssim, s.de2000_median,
-                  s.de2000_p95, 100.0 * s.clipped_share, 100.0 * s.unreachable_share, a.ms_per_frame, still);
+                  s.de2000_p95, 100.0 * s.clipped_share, 100.0 * s.unreachable_share, saturated, a.ms_per_frame, still);
     }
 }
 
@@ -88,6 +90,7 @@ void write_report(const std::filesystem::path& file, const twin::TourReport& rep
            {"ms_per_frame", a.ms_per_frame},
            {"still_psnr_db", number(a.still_psnr_db)},
            {"worst_psnr_db", number(a.worst_psnr_db)},
+           {"projector_saturated_share", number(a.projector_saturated_share)},
            {"albedo_measured", v.measured_albedo
                                    ? nlohmann::json({v.measured_albedo->x(), v.measured_albedo->y(), v.measured_albedo->z()})
                                    : nlohmann::json(nullptr)}});
@@ -112,15 +115,17 @@ const Command kBenchAppearance{
     "(1000 lux), scaled by the target's gain k (chosen at arrival so that about 2 % of the projector's\n"
     "pixels on it would need more than full white, at most 1, and followed as the target moves): PSNR and\n"
     "SSIM over all of them, CIEDE2000 over those the projector can reach (where even the best input stays\n"
-    "more than 2 off, a pixel counts as unreachable). ms per frame: drawing the projector's frame and\n"
-    "reading it back on this machine. A moving row is the mean over the motion's frames (how many, and the\n"
-    "worst frame's PSNR, in its moving column): 'starting' its first 0.2 s (the camera's frames reach the\n"
-    "projector 50-67 ms after they are taken, and the prediction needs two to see the new speed), 'yes' the\n"
-    "rest. Its last column: the same frames drawn at the target's true pose (tracked exactly: what they\n"
-    "show standing still there, with the same k): the motion's cost is the difference; the arrival's row\n"
-    "differs in the pose as well.\n"
-    "Without --scene, assets/scenes/shop.yaml\n"
-    "runs. With --frames, DIR/visitNN_TARGET_spectator_off.png and _spectator_on.png at each arrival.\n"
+    "more than 2 off, a pixel counts as unreachable; clipped: it needs more than full white). Projector\n"
+    "saturated: of the target's pixels in its compensated frame (drawn alone) those at full in some channel,\n"
+    "what the gain holds to about 2 %; a visitor off the projector's axis may see faces lit edge-on, so more\n"
+    "of their pixels clip. ms per frame: drawing the projector's frame and reading it back on this machine.\n"
+    "A moving row is the mean over the motion's frames (how many, and the worst frame's PSNR, in its moving\n"
+    "column): 'starting' its first 0.2 s (the camera's frames reach the projector 50-67 ms after they are\n"
+    "taken, and the prediction needs two to see the new speed), 'yes' the rest. Its last column: the same\n"
+    "frames drawn at the target's true pose (tracked exactly: what they show standing still there, with the\n"
+    "same k): the motion's cost is the difference; the arrival's row differs in the pose as well. Without\n"
+    "--scene, assets/scenes/shop.yaml runs. With --frames, DIR/visitNN_TARGET_spectator_off.png and\n"
+    "_spectator_on.png at each arrival.\n"
     "With --reflectance measured, each target's reflectance is measured at its stop (the colour camera under\n"
     "the projector's black and mid grey, read at the estimated pose) instead of taken from the scene, and\n"
     "printed beside the scene's (the twin's truth). With --reflectance mapped, it is measured into the\n"

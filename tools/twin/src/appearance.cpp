@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/engine/photometry.hpp"
@@ -151,6 +152,19 @@ AppearanceScore score_appearance(const SpectatorPicture& seen, const ContentView
   s.clipped_share = static_cast<double>(clipped) / static_cast<double>(s.pixels);
   s.unreachable_share = static_cast<double>(unreachable) / static_cast<double>(s.pixels);
   return s;
+}
+
+double saturated_share(const assets::Image& on, const assets::Image& off) {
+  if (on.rgba.size() != off.rgba.size()) throw std::invalid_argument("saturated_share: frames of different sizes");
+  std::size_t target = 0, saturated = 0;
+  for (std::size_t i = 0; i + 3 < on.rgba.size(); i += 4) {
+    const std::uint8_t* a = on.rgba.data() + i;
+    const std::uint8_t* b = off.rgba.data() + i;
+    if (!(a[0] | a[1] | a[2] | b[0] | b[1] | b[2])) continue;
+    ++target;
+    saturated += std::max({a[0], a[1], a[2]}) >= 254 ? 1 : 0;
+  }
+  return target ? static_cast<double>(saturated) / static_cast<double>(target) : 0.0;
 }
 
 std::vector<engine::ReflectancePoint> measured_reflectance(SpectatorView& camera, Twin& twin, std::size_t target,

@@ -165,7 +165,9 @@ class TourStop final : public session::StopObserver {
  private:
   void at_arrival(const session::Stop& at, const alignment::RgbdFrame& f);
   // compensate: the plan's compensation (TourOptions::compensation unless said otherwise).
-  assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate = {});
+  // neighbours: the stop's lit neighbours drawn too (false: the visited target alone).
+  assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate = {},
+                                bool neighbours = true);
   std::array<AppearanceSample, 2> measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target,
                                                      const Eigen::Matrix4d* T_projector_still = nullptr);
   void sample_motion(const TimelineSample& s, const session::DrawnPose* visited);
@@ -319,7 +321,8 @@ void TourStop::start_projection() {
 
 // The projector's frame: the target drawn at T_projector_target when lit, its neighbours where lit, else
 // all black.
-assets::Image TourStop::projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate) {
+assets::Image TourStop::projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate,
+                                        bool neighbours) {
   std::vector<engine::DrawItem> items;
   const bool on = compensate.value_or(tour_.options.compensation);
   // The estimator's side: the scene's surfaces and room light, the believed projector, the drawn poses.
@@ -329,7 +332,7 @@ assets::Image TourStop::projector_image(bool lit, const Eigen::Matrix4d& T_proje
   };
   if (lit) item(target_index_, T_projector_target);
   for (const NeighbourLight& n : lights_)
-    if (n.shown) item(n.target, tour_.models.projector_from_target(n.drawn.T_camera_target));
+    if (n.shown && neighbours) item(n.target, tour_.models.projector_from_target(n.drawn.T_camera_target));
   tour_.renderer.draw_frame(*tour_.projector_frame, tour_.models.believed, items);
   return tour_.projector_frame->read_back();
 }
@@ -392,6 +395,9 @@ std::array<AppearanceSample, 2> TourStop::measure_appearance(bool moving, bool l
     if (!moving && !tour_.options.frames_dir.empty())
       assets::write_png(frame_path(tour_.options, report, on ? "_spectator_on" : "_spectator_off"), seen.image);
   }
+  if (!moving && lit)  // the gain's own measure: the projector's pixels on the target alone
+    samples[1].projector_saturated_share = saturated_share(projector_image(true, T_projector_target, true, false),
+                                                           projector_image(true, T_projector_target, false, false));
   return samples;
 }
 

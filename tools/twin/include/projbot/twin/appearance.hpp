@@ -37,6 +37,11 @@ struct AppearanceScore {
 AppearanceScore score_appearance(const SpectatorPicture& seen, const ContentView& view, double k, double ambient_lux,
                                  const config::Photometry& photometry);
 
+/// Of a projector frame drawn with compensation (`on`) the share of the target's pixels at 254 or more in
+/// some channel: clipped where the projector sends it. The target's pixels: those lit in `on` or in
+/// `off`, the same frame drawn with the content as stored (drawn alone, without neighbours). 0 when none.
+double saturated_share(const assets::Image& on, const assets::Image& off);
+
 /// A target's reflectance as a session measures it at a stop (issue 43): the colour camera (`camera`, a
 /// SpectatorView through the RGB-D camera's pinhole) takes it under the projector's black and mid grey,
 /// lit by the twin from the true frames; engine::reflectance_points reads the pictures at the estimated

@@ -88,6 +88,9 @@ struct AppearanceSample {
   double still_psnr_db = std::numeric_limits<double>::quiet_NaN();
   /// Moving: the worst frame's PSNR; NaN otherwise.
   double worst_psnr_db = std::numeric_limits<double>::quiet_NaN();
+  /// At arrival, compensated: the share of the projector's pixels on the target at full in some channel
+  /// (saturated_share; what the gain choice holds to about 2 %); NaN otherwise.
+  double projector_saturated_share = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The projection error of one projector frame while projecting, at its display time.
