@@ -126,15 +126,15 @@ NeighbourLight neighbour_light(const Twin& twin, const Acquired& a, std::size_t 
   return l;
 }
 
-// A motion's scored frames as one: the mean of each figure over the frames that saw the target (all of
-// them, if none did: a row that says so).
+// A motion's scored frames as one: the mean of each figure over the frames that saw the target, and how
+// many did (none: the first frame's row, which says so).
 AppearanceSample mean_appearance(const std::vector<AppearanceSample>& samples) {
   AppearanceSample m = samples.front();
   std::vector<const AppearanceSample*> seen;
   for (const AppearanceSample& a : samples)
     if (a.score.pixels > 0) seen.push_back(&a);
-  m.frames = static_cast<int>(samples.size());
-  if (seen.empty()) return m;
+  m.frames = static_cast<int>(seen.size());
+  if (seen.empty()) return m;  // pixels 0: "no lit pixel of the target in view"
   const double n = static_cast<double>(seen.size());
   const auto mean = [&](auto field) {
     double sum = 0.0;

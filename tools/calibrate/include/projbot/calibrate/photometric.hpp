@@ -1,9 +1,9 @@
 #pragma once
 // Photometric calibration (issue 43): the projector's response per channel and its colour mixing, from
 // uniform colours it shows on a light surface and the colour camera's images of them. The camera's own
-// response comes from exposure brackets of the projector's white, or where the camera cannot bracket from
-// the same captures (its values must add up as light does), so that its values can be linearised. Black level and the room's
-// light cannot be told apart with the projector on: the scene's black_level stays.
+// response comes from exposure brackets of the projector's white, or from the same captures (its values
+// must add up as light does), or is given, so that its values can be linearised. Black level and the
+// room's light cannot be told apart with the projector on: the scene's black_level stays.
 
 #include <Eigen/Core>
 #include <array>
