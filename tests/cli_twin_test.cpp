@@ -68,10 +68,15 @@ TEST_F(CliTest, BenchAppearanceKeepsThePrintedBoxUnclipped) {
 // it moved away from the projector's axis (chosen again as it goes, dimming no faster than the plan's rate).
 TEST_F(CliTest, BenchAppearanceScoresAMovingTargetBesideItselfStandingStill) {
   const fs::path report = dir_ / "moving.json";
-  const CliRun r = run_projbot("bench appearance --scene " + std::string(PROJBOT_ASSET_DIR) +
-                               "/scenes/motion.yaml --visits 2 --report " + report.string());
+  const CliRun r =
+      run_projbot("bench appearance --scene " + std::string(PROJBOT_ASSET_DIR) + "/scenes/motion.yaml --visits 2 --report " +
+                  report.string() + " --frames " + (dir_ / "frames").string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("PSNR still there dB"), std::string::npos) << r.output;
+  for (const char* part : {"starting", "moving"}) {  // the visitor's picture of each part's worst frame
+    const fs::path picture = dir_ / "frames" / ("visit02_box_spectator_" + std::string(part) + "_worst.png");
+    EXPECT_GT(fs::exists(picture) ? fs::file_size(picture) : 0, 1000U) << picture;
+  }
   EXPECT_NE(r.output.find("| starting, 2 frames, worst "), std::string::npos) << r.output;
   std::ifstream in(report);
   const auto rows = nlohmann::json::parse(in).at("visits");

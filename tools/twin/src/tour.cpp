@@ -168,8 +168,10 @@ class TourStop final : public session::StopObserver {
   // neighbours: the stop's lit neighbours drawn too (false: the visited target alone).
   assets::Image projector_image(bool lit, const Eigen::Matrix4d& T_projector_target, std::optional<bool> compensate = {},
                                 bool neighbours = true);
+  // on_picture: the visitor's picture with compensation on, kept there.
   std::array<AppearanceSample, 2> measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target,
-                                                     const Eigen::Matrix4d* T_projector_still = nullptr);
+                                                     const Eigen::Matrix4d* T_projector_still = nullptr,
+                                                     assets::Image* on_picture = nullptr);
   void sample_motion(const TimelineSample& s, const session::DrawnPose* visited);
   void measure_reflectance();
   assets::Image spectator_picture(const assets::Image& projector);
@@ -205,6 +207,8 @@ class TourStop final : public session::StopObserver {
   // and when the next is due.
   std::array<std::vector<AppearanceSample>, 4> moving_samples_;
   double next_moving_sample_s_ = 0.0;
+  // --frames: the worst compensated frame of each part of the motion (starting, then), for the pictures.
+  std::array<std::pair<double, assets::Image>, 2> worst_moving_{};
 };
 
 alignment::RgbdCamera& TourStop::arrived(const session::Stop& at) {
@@ -370,7 +374,8 @@ void TourStop::measure_reflectance() {
 // its content under the reference light scaled by the visit's gain; with --frames both pictures. With
 // T_projector_still (moving), each also drawn there: the target tracked exactly, as if it stood still.
 std::array<AppearanceSample, 2> TourStop::measure_appearance(bool moving, bool lit, const Eigen::Matrix4d& T_projector_target,
-                                                             const Eigen::Matrix4d* T_projector_still) {
+                                                             const Eigen::Matrix4d* T_projector_still,
+                                                             assets::Image* on_picture) {
   const TwinTarget& target = tour_.twin.targets()[target_index_];
   const Eigen::Matrix4d T_world_spectator =
       spectator_pose(truth_.T_world_camera.translation(), model_middle(target, target.T_world_target_true));
@@ -392,6 +397,7 @@ std::array<AppearanceSample, 2> TourStop::measure_appearance(bool moving, bool l
     if (T_projector_still)
       sample.still_psnr_db = score(tour_.spectator->light(scene, projector_image(true, *T_projector_still, on))).psnr_db;
     samples[on ? 1 : 0] = sample;
+    if (on && on_picture) *on_picture = seen.image;
     if (!moving && !tour_.options.frames_dir.empty())
       assets::write_png(frame_path(tour_.options, report, on ? "_spectator_on" : "_spectator_off"), seen.image);
   }
@@ -410,9 +416,15 @@ void TourStop::sample_motion(const TimelineSample& s, const session::DrawnPose* 
   const Eigen::Matrix4d T_camera_true =
       alignment::rigid_inverse(truth_.T_world_camera.matrix()) * tour_.twin.targets()[target_index_].T_world_target_true;
   const Eigen::Matrix4d T_projector_still = tour_.models.projector_from_target(T_camera_true);
-  const auto samples = measure_appearance(true, shown_, tour_.models.projector_from_target(T_camera_target), &T_projector_still);
+  assets::Image picture;
+  const auto samples = measure_appearance(true, shown_, tour_.models.projector_from_target(T_camera_target), &T_projector_still,
+                                          tour_.options.frames_dir.empty() ? nullptr : &picture);
   const config::TargetMotion* motion = tour_.twin.targets()[target_index_].config.motion_on(report.target_visit);
   const bool starting = motion && s.t_s < motion->start_s + kStartingS;
+  auto& worst = worst_moving_[starting ? 0 : 1];
+  const AppearanceScore& on = samples[1].score;
+  if (!picture.rgba.empty() && on.pixels > 0 && (worst.second.rgba.empty() || on.psnr_db < worst.first))
+    worst = {on.psnr_db, std::move(picture)};
   for (AppearanceSample a : samples) {
     a.starting = starting;
     moving_samples_[(starting ? 0 : 2) + (a.compensation ? 1 : 0)].push_back(a);
@@ -503,6 +515,10 @@ void TourStop::finish() {
   for (const NeighbourLight& l : lights_) report.neighbours.push_back(finished(l));
   for (const auto& samples : moving_samples_)
     if (!samples.empty()) report.appearance.push_back(mean_appearance(samples));
+  for (std::size_t part = 0; part < worst_moving_.size(); ++part)
+    if (!worst_moving_[part].second.rgba.empty())
+      assets::write_png(frame_path(tour_.options, report, part == 0 ? "_spectator_starting_worst" : "_spectator_moving_worst"),
+                        worst_moving_[part].second);
   if (!tour_.options.frames_dir.empty() && report.moved && !interrupted) {
     // A moved target: what the visitor sees at the end of the dwell, where the target went and where
     // the light went (followed, or left where the target was).
