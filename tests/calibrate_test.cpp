@@ -374,13 +374,23 @@ TEST(Capture, RefusesABadPoseOnTheSpotAndKeepsTheRest) {
 // Photometric calibration (issue 43) on the twin's patch: three different channel gammas, a DLP's
 // crosstalk and a camera of its own response, recovered within the issue's goals; a rig whose camera
 // does not follow its exposure is refused by name.
-TEST(Photometric, RecoversEachChannelsGammaAndTheMixing) {
+namespace {
+
+// The twin's patch under a DLP with three channel gammas and its crosstalk, seen by a camera of gamma 1.8.
+projbot::calibrate::PhotometricSim dlp_patch() {
   projbot::calibrate::PhotometricSim sim;
   sim.projector.photometry.gamma_rgb = {2.0, 2.3, 2.5};
   sim.projector.photometry.mixing = projbot::calibrate::typical_mixing();
   sim.camera_gamma = 1.8;
   sim.ambient_lux = 50.0;
   sim.seed = 7;
+  return sim;
+}
+
+}  // namespace
+
+TEST(Photometric, RecoversEachChannelsGammaAndTheMixing) {
+  const projbot::calibrate::PhotometricSim sim = dlp_patch();
   const auto rig = projbot::calibrate::make_twin_photometric_rig(sim);
   const auto& truth = sim.projector.photometry;
   const auto r = projbot::calibrate::calibrate_photometric(*rig, truth.black_level);
@@ -405,12 +415,7 @@ TEST(Photometric, RecoversEachChannelsGammaAndTheMixing) {
 // whose light does not add up (a white segment adding 30 % of white) and one whose primaries the camera
 // sees in one channel each are refused by name, as is a camera that cannot bracket given no other way.
 TEST(Photometric, MeasuresTheCamerasResponseFromTheColoursAddingUp) {
-  projbot::calibrate::PhotometricSim sim;
-  sim.projector.photometry.gamma_rgb = {2.0, 2.3, 2.5};
-  sim.projector.photometry.mixing = projbot::calibrate::typical_mixing();
-  sim.camera_gamma = 1.8;
-  sim.ambient_lux = 50.0;
-  sim.seed = 7;
+  projbot::calibrate::PhotometricSim sim = dlp_patch();
   sim.brackets = false;
   const auto& truth = sim.projector.photometry;
   const auto r = projbot::calibrate::calibrate_photometric(*projbot::calibrate::make_twin_photometric_rig(sim), truth.black_level,
