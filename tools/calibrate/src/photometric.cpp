@@ -16,7 +16,7 @@ namespace projbot::calibrate {
 namespace {
 
 constexpr double kExposures[] = {1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125};
-constexpr double kMostCameraGamma = 3.5;
+constexpr double kLeastCameraGamma = 0.5, kMostCameraGamma = 3.5;  // the colours' search
 // The camera's gamma from the colours adding up: at the best gamma they must add up within this share of
 // white (RMS), and 10 % off that gamma they must fail by this much more.
 constexpr double kMostAdditivityRms = 0.01;
@@ -111,10 +111,18 @@ double additivity_rms(const Captures& c, double g) {
 // camera sees each in one channel only cannot. Refused when light does not add up at any gamma (a
 // colour wheel's white segment; exposure or white balance moving) or the fit cannot tell.
 double camera_gamma_from_colours(const Captures& c) {
-  double best = 1.0, best_rms = additivity_rms(c, 1.0);
-  for (double g = 1.01; g <= kMostCameraGamma + 1e-9; g += 0.01)
+  double best = kLeastCameraGamma, best_rms = additivity_rms(c, best);
+  for (double g = kLeastCameraGamma + 0.01; g <= kMostCameraGamma + 1e-9; g += 0.01)
     if (const double rms = additivity_rms(c, g); rms < best_rms) best = g, best_rms = rms;
-  double lo = std::max(1.0, best - 0.01), hi = std::min(kMostCameraGamma, best + 0.01);
+  if (best < kLeastCameraGamma + 0.005 || best > kMostCameraGamma - 0.005) {
+    char edge[160];
+    std::snprintf(edge, sizeof edge,
+                  "photometric: the camera's values add up best at gamma %.2f, the edge of what a camera's response can "
+                  "be: give the camera's gamma",
+                  best);
+    throw CalibrationError(edge);
+  }
+  double lo = best - 0.01, hi = best + 0.01;
   for (int i = 0; i < 40; ++i) {  // golden section on the scan's bracket
     const double a = hi - 0.618 * (hi - lo), b = lo + 0.618 * (hi - lo);
     if (additivity_rms(c, a) < additivity_rms(c, b))
@@ -128,8 +136,8 @@ double camera_gamma_from_colours(const Captures& c) {
   if (best_rms > kMostAdditivityRms)
     throw CalibrationError(std::string("photometric: the projector's colours do not add up to its grey and white in the camera") +
                            said +
-                           ": a colour wheel with a white segment, or the camera's exposure or white balance moving; give the "
-                           "camera's gamma");
+                           ": a colour wheel with a white segment, the camera's exposure or white balance moving, or a "
+                           "camera too noisy; give the camera's gamma");
   const double rise = std::min(additivity_rms(c, 0.9 * best), additivity_rms(c, 1.1 * best)) - best_rms;
   if (!(rise > kLeastAdditivityRise))
     throw CalibrationError(std::string("photometric: the camera sees each of the projector's primaries in one channel only, so "
