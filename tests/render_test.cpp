@@ -187,6 +187,27 @@ TEST_F(RenderTest, BaseColorFactorAndVertexColourMultiply) {
   EXPECT_EQ(img.pixel(2, 2)[0], 0);  // background is black
 }
 
+// A background (issue 43: the projector's uniform grey while a target's reflectance is measured): where
+// no model is, and nowhere else; black again once set back. Through a lens too (its canvas is cleared to it).
+TEST_F(RenderTest, TheBackgroundFillsWhereNoModelIs) {
+  Model m = quad({Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1), Eigen::Vector3d(0.5, 0.5, 1),
+                  Eigen::Vector3d(-0.5, 0.5, 1)},
+                 {1.0F, 1.0F, 1.0F, 1.0F}, projbot::assets::Material{});
+  const std::size_t white = renderer_->add_model(m);
+  ProjectorConfig p = projector(100, 100, 80, 80, 49.5, 49.5);
+  renderer_->set_background({128, 64, 0});
+  Image img = render(p, {{white, Eigen::Matrix4d::Identity()}});
+  EXPECT_EQ(img.pixel(50, 50)[0], 255);
+  EXPECT_EQ(img.pixel(2, 2)[0], 128);
+  EXPECT_EQ(img.pixel(2, 2)[1], 64);
+  EXPECT_EQ(img.pixel(2, 2)[2], 0);
+  EXPECT_EQ(render(p, {}).pixel(97, 97)[0], 128);  // no model: the whole image
+  p.distortion[0] = 0.05;                          // k1
+  EXPECT_EQ(render(p, {}).pixel(50, 50)[1], 64);
+  renderer_->set_background({0, 0, 0});
+  EXPECT_EQ(render(p, {}).pixel(50, 50)[1], 0);
+}
+
 TEST_F(RenderTest, AlphaModes) {
   const std::array<Eigen::Vector3d, 4> c{Eigen::Vector3d(-0.5, -0.5, 1), Eigen::Vector3d(0.5, -0.5, 1),
                                          Eigen::Vector3d(0.5, 0.5, 1), Eigen::Vector3d(-0.5, 0.5, 1)};

@@ -198,10 +198,9 @@ void Renderer::Impl::transition_depth(const vk::raii::CommandBuffer& cmd, vk::Im
 }
 
 void Renderer::Impl::begin_pass(const vk::raii::CommandBuffer& cmd, vk::ImageView color, vk::ImageView depth, vk::Extent2D extent,
-                                float clear_alpha) {
+                                const std::array<float, 4>& clear) {
   vk::RenderingAttachmentInfo color_att(color, vk::ImageLayout::eColorAttachmentOptimal, {}, {}, {}, vk::AttachmentLoadOp::eClear,
-                                        vk::AttachmentStoreOp::eStore,
-                                        vk::ClearColorValue(std::array<float, 4>{0.0F, 0.0F, 0.0F, clear_alpha}));
+                                        vk::AttachmentStoreOp::eStore, vk::ClearColorValue(clear));
   vk::RenderingAttachmentInfo depth_att(depth, vk::ImageLayout::eDepthAttachmentOptimal, {}, {}, {}, vk::AttachmentLoadOp::eClear,
                                         vk::AttachmentStoreOp::eDontCare, vk::ClearDepthStencilValue(1.0F, 0));
   cmd.beginRendering(vk::RenderingInfo({}, vk::Rect2D({0, 0}, extent), 1, 0, color_att, depth ? &depth_att : nullptr));
@@ -216,7 +215,7 @@ void Renderer::Impl::record_canvas(const vk::raii::CommandBuffer& cmd, detail::T
                      vk::AccessFlagBits2::eShaderSampledRead, vk::PipelineStageFlagBits2::eColorAttachmentOutput,
                      vk::AccessFlagBits2::eColorAttachmentWrite);
   transition_depth(cmd, *c.depth.image);
-  begin_pass(cmd, *c.color.view, *c.depth.view, c.color.extent, 1.0F);
+  begin_pass(cmd, *c.color.view, *c.depth.view, c.color.extent, background);
   record_draws(cmd, t.color_format(), c.lens.pinhole, false, c.projector, slot, 0);
   cmd.endRendering();
   detail::transition(cmd, *c.color.image, vk::ImageAspectFlagBits::eColor, vk::ImageLayout::eColorAttachmentOptimal,
@@ -226,7 +225,7 @@ void Renderer::Impl::record_canvas(const vk::raii::CommandBuffer& cmd, detail::T
 }
 
 void Renderer::Impl::record_lens(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, vk::ImageView color) {
-  begin_pass(cmd, color, nullptr, t.extent(), 1.0F);
+  begin_pass(cmd, color, nullptr, t.extent(), background);
   cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *lens_pipeline(t.color_format()));
   cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *lens_layout, 0, *t.canvas->set, {});
   cmd.draw(3, 1, 0, 0);
@@ -282,7 +281,8 @@ bool Renderer::Impl::draw_frame(detail::TargetBackend& t, const config::Projecto
     record_lens(cmd, t, frame->color_view);
   } else {
     transition_depth(cmd, *t.depth().image);
-    begin_pass(cmd, frame->color_view, *t.depth().view, t.extent(), t.depth_output() ? 0.0F : 1.0F);
+    begin_pass(cmd, frame->color_view, *t.depth().view, t.extent(),
+               t.depth_output() ? std::array<float, 4>{0.0F, 0.0F, 0.0F, 0.0F} : background);
     // The projector image (width x height of the intrinsics) is stretched onto the target.
     record_draws(cmd, t.color_format(), projector, t.depth_output(), projector, slot, 0);
     cmd.endRendering();
@@ -330,6 +330,9 @@ const DeviceInfo& Renderer::device_info() const { return impl_->gpu->info; }
 std::size_t Renderer::add_model(const assets::Model& model) { return impl_->add_model(model); }
 void Renderer::replace_model(std::size_t model, const assets::Model& fresh) { impl_->replace_model(model, fresh); }
 void Renderer::set_surface(std::size_t model, const assets::Image& reflectance) { impl_->set_surface(model, reflectance); }
+void Renderer::set_background(const std::array<std::uint8_t, 3>& rgb) {
+  for (std::size_t ch = 0; ch < 3; ++ch) impl_->background[ch] = static_cast<float>(rgb[ch]) / 255.0F;
+}
 std::size_t Renderer::add_streamed_texture(std::size_t model, int material, int width_px, int height_px) {
   return impl_->add_streamed_texture(model, material, width_px, height_px);
 }

@@ -267,7 +267,8 @@ struct Renderer::Impl {
 
   // Dynamic rendering into `color` (and `depth`, when given) over the whole of `extent`, cleared to black.
   static void begin_pass(const vk::raii::CommandBuffer& cmd, vk::ImageView color, vk::ImageView depth, vk::Extent2D extent,
-                         float clear_alpha);
+                         const std::array<float, 4>& clear);
+  std::array<float, 4> background{0.0F, 0.0F, 0.0F, 1.0F};  // set_background's, for a projector's frames
 
   // The lens pass's first half: the models through the canvas's pinhole, left ready to sample. One canvas
   // serves both frames in flight: the barriers order this frame's drawing after the last frame's sampling.

@@ -171,7 +171,12 @@ class Renderer {
   /// A window with a swapchain. Needs RendererOptions::windowing.
   std::unique_ptr<RenderTarget> make_window(const WindowOptions& options);
 
-  /// Draws one frame: black background, depth-tested, unlit textured models placed by their poses and
+  /// The background of the frames drawn from now on, 8-bit levels per channel as the target stores them
+  /// (black until set): what a projector shows where no model is, and over its whole image with none
+  /// (a reflectance measurement's uniform grey). Depth cameras' frames are unaffected.
+  void set_background(const std::array<std::uint8_t, 3>& rgb);
+
+  /// Draws one frame: the background (black unless set), depth-tested, unlit textured models placed by their poses and
   /// projected through `projector` (whose size is stretched onto the target; its photometry sets the
   /// white gain). Returns false if the frame was skipped (window minimised or swapchain rebuilt). Records
   /// timing into `profiler` if given.
