@@ -73,8 +73,10 @@ class LiveLoopTest : public ::testing::Test {
 
   // The loop over `seconds` of fake time at 60 Hz; the pose of target 0 is `pose(t)` (nullopt: none yet,
   // or lost); the meter measures against `truth(t)`.
+  using Uniform = std::optional<std::array<std::uint8_t, 3>>;
   session::LiveFigures run(double seconds, const std::function<std::optional<alignment::PoseSample>(double)>& pose,
-                           const std::function<Eigen::Matrix4d(double)>& truth, bool predict, assets::Image* last = nullptr) {
+                           const std::function<Eigen::Matrix4d(double)>& truth, bool predict, assets::Image* last = nullptr,
+                           const std::function<Uniform(double)>& uniform = {}) {
     session::LiveLoopConfig c;
     c.projection.T_projector_camera = at(0.1, 0.0, 0.0);
     c.projection.refresh_hz = 60.0;
@@ -92,6 +94,7 @@ class LiveLoopTest : public ::testing::Test {
     };
     in.camera_last_s = [this] { return clock_.t_s; };
     in.keep_going = [] { return true; };
+    if (uniform) in.uniform = [&] { return uniform(clock_.t_s); };
     in.meter = [&](const session::DrawnPose& d) {
       const Eigen::Vector3d error = d.T_camera_target.topRightCorner<3, 1>() - truth(d.display_s).topRightCorner<3, 1>();
       return session::DisplayError{1000.0 * error.norm(), d.display_s > 10.25};
@@ -138,6 +141,33 @@ TEST_F(LiveLoopTest, PacesItsFramesAndBlanksATargetNotFoundOrLost) {
   EXPECT_EQ(f.blank + drawn, f.rows.size());
   EXPECT_EQ(f.ages_ms.size(), drawn);
   EXPECT_EQ(last.lit_pixels(), 0U);  // the last frame, the target lost: black
+}
+
+// A uniform colour asked for (a reflectance measured at a stop) replaces the targets over the whole image
+// for as long as it is asked, counted apart from blank frames; then the target is drawn again.
+TEST_F(LiveLoopTest, ShowsAUniformColourInsteadOfTheTargetsWhileAsked) {
+  const auto pose = [&](double) -> std::optional<alignment::PoseSample> {
+    return seen(at(0, 0, 1), 10.0, Eigen::Vector3d::Zero());
+  };
+  const auto truth = [](double) { return at(0, 0, 1); };
+  const auto grey_until = [](double end_s) {
+    return [end_s](double t) -> Uniform {
+      if (t >= 10.2 && t < end_s) return std::array<std::uint8_t, 3>{128, 128, 128};
+      return std::nullopt;
+    };
+  };
+  assets::Image last;
+  session::LiveFigures f = run(0.5, pose, truth, false, &last, grey_until(10.3));
+  EXPECT_NEAR(static_cast<double>(f.uniform), 6.0, 1.0);  // 0.1 s at 60 Hz
+  EXPECT_EQ(f.blank, 0U);
+  std::size_t drawn = 0;
+  for (const session::LiveRow& r : f.rows) drawn += r.target == 0 ? 1 : 0;
+  EXPECT_EQ(drawn + f.uniform, f.rows.size());
+  EXPECT_GT(last.lit_pixels(), 0U);                                                  // the square again...
+  EXPECT_EQ(last.pixel(0, 0)[0], 0);                                                 // ...on black
+  f = run(0.5, pose, truth, false, &last, grey_until(99.0));                         // grey to the end
+  EXPECT_EQ(last.pixel(0, 0)[0], 128);                                               // the whole image
+  EXPECT_EQ(last.pixel(projector_.width_px / 2, projector_.height_px / 2)[1], 128);  // the target not drawn
 }
 
 TEST_F(LiveLoopTest, DrawsAMovingTargetWhereItWillBeAtDisplayTimeAndMeasuresIt) {

@@ -54,11 +54,12 @@ void LiveLoop::compose(const LiveStop& stop, const LiveInputs& in, std::vector<e
 
 // Each drawn target's error against the truth at its display time; the row (and the pose's age, capture
 // to the expected display time) is the first drawn one's.
-void LiveLoop::measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s) {
+void LiveLoop::measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s,
+                       bool uniform) {
   const double nan = std::nan("");
   const double clock_s = start_s - t0_s_;
   if (drawn.empty()) {
-    ++figures_.blank;
+    ++(uniform ? figures_.uniform : figures_.blank);
     figures_.rows.push_back({start_ms, -1.0, nan, nan, nan, -1, clock_s, nan, nan, Eigen::Vector3d::Constant(nan)});
     return;
   }
@@ -90,15 +91,25 @@ std::optional<LiveFrame> LiveLoop::frame(engine::RenderTarget* target, const Liv
   const double start_ms = profiler ? profiler->now_ms() : 1000.0 * (f.start_s - t0_s_);
   frames_.frame_started(f.start_s);
   first_content_ = {std::nan(""), std::nan(""), false};
+  const std::optional<std::array<std::uint8_t, 3>> uniform = in.uniform ? in.uniform() : std::nullopt;
+  if (uniform) decided_s_ = f.start_s;  // nothing decided: no target drawn
   if (target) {
-    const auto read = [&](std::vector<engine::DrawItem>& out) { compose(stop, in, out, f.drawn); };
-    if (!renderer_.draw_frame(*target, projector_, read, profiler)) return std::nullopt;
-  } else {
+    const auto read = [&](std::vector<engine::DrawItem>& out) {
+      if (uniform)
+        out.clear();
+      else
+        compose(stop, in, out, f.drawn);
+    };
+    if (uniform) renderer_.set_background(*uniform);
+    const bool drawn = renderer_.draw_frame(*target, projector_, read, profiler);
+    if (uniform) renderer_.set_background({0, 0, 0});
+    if (!drawn) return std::nullopt;
+  } else if (!uniform) {
     f.drawn = decide(stop, in, f.start_s);
   }
   f.display_s = frames_.display_time_s(decided_s_);
   if (in.after_frame) in.after_frame();
-  measure(f.drawn, in.meter, start_ms, f.start_s);
+  measure(f.drawn, in.meter, start_ms, f.start_s, uniform.has_value());
   return f;
 }
 

@@ -7,7 +7,9 @@
 // without drawing. Times are seconds on the loop's clock; rows' times are the frame profiler's ms (the
 // clock's, from the start, without one). The robot's state, the poses and the truth come in through callbacks.
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -55,7 +57,8 @@ struct LiveFigures {
   std::vector<double> ages_ms;              ///< pose age at display, frames with a target
   std::vector<double> moving_mm, still_mm;  ///< display errors, per drawn target and frame, where measured
   std::vector<double> content_offsets_ms;   ///< per target-frame with video: its content time less the shown frame's
-  std::size_t blank = 0;                    ///< frames with no target drawn
+  std::size_t blank = 0;                    ///< frames with no target drawn (not counting `uniform` ones)
+  std::size_t uniform = 0;                  ///< frames that showed LiveInputs::uniform's colour instead
   std::size_t with_neighbours = 0;          ///< frames that drew more than one target
 };
 
@@ -80,6 +83,9 @@ struct LiveInputs {
   std::function<bool()> keep_going;       ///< asked before each frame
   DisplayMeter meter;                     ///< empty: nothing measured against a truth
   std::function<void()> after_frame;      ///< after each frame (the content's messages)
+  /// A colour (8-bit levels) to show over the whole image instead of the targets (a reflectance measured
+  /// at a stop: the projector's black, then its mid grey); nullopt or empty: the targets. Read once per frame.
+  std::function<std::optional<std::array<std::uint8_t, 3>>()> uniform;
 };
 
 /// The render thread's loop. Not thread-safe: one owner, the thread that owns the renderer.
@@ -106,7 +112,7 @@ class LiveLoop {
  private:
   std::vector<DrawnPose> decide(const LiveStop& stop, const LiveInputs& in, double now_s);
   void compose(const LiveStop& stop, const LiveInputs& in, std::vector<engine::DrawItem>& out, std::vector<DrawnPose>& drawn);
-  void measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s);
+  void measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s, bool uniform);
   engine::SceneContent::Sample first_content_;  // the first drawn target's, this frame
 
   engine::Renderer& renderer_;
