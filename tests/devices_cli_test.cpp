@@ -276,6 +276,17 @@ TEST_F(DevicesCli, RunTracksThroughAConfiguredKinect) {
   // Measured: 148 of 171 frames lit, 0.1 mm (the twin's own camera: 147, 0.1 mm).
   EXPECT_GT(number_after(r.output, "pose age at display (depth capture to expected display), "), 90.0) << r.output;
   EXPECT_LT(number_after(r.output, "still mean "), 1.0) << r.output;
+  // --learn-reflectance on a camera that does not see the projector (a dump's colour stays as recorded): the
+  // projector shows black and grey, the two images agree, and nothing is learnt (a black surface would
+  // make every compensated pixel saturate).
+  const CliRun learn =
+      run_projbot("run --headless --visits 1 --dwell 2 --learn-reflectance --config " + (dir_ / "site.yaml").string(), 120);
+  ASSERT_EQ(learn.code, 0) << learn.output;
+  EXPECT_NE(learn.output.find("reflectance of duck not measured: read as 0.000 0.000 0.000, no brighter under grey than black"),
+            std::string::npos)
+      << learn.output;
+  EXPECT_NE(learn.output.find(" frames black or grey while 0 target reflectance(s) were measured"), std::string::npos)
+      << learn.output;
 
   // The camera goes quiet for 1.5 s in the middle of the dwell (the dump's next frame is 1.5 s later):
   // within 100 ms the projection is blanked, and it is lit again when frames come back.

@@ -67,6 +67,7 @@ live::RunOptions run_options(const cli::Args& args) {
   args.get_int("monitor", 0, 0, 64);                  // so is a bad monitor
   o.compensate = on_off(args, "compensation", true);
   o.predict = !args.flag("no-predict");
+  o.learn_reflectance = args.flag("learn-reflectance");
   return o;
 }
 
@@ -91,6 +92,9 @@ void print_frames(std::ostream& out, const live::RunResult& r) {
       << " ms, p99 " << engine::percentile(f.ages_ms, 0.99) << " ms, max " << engine::percentile(f.ages_ms, 1.0) << " ms; "
       << f.blank << " frames blank (driving, acquiring or lost)";
   if (f.with_neighbours > 0) out << "; " << f.with_neighbours << " frames lit a neighbour too";
+  if (f.uniform > 0)
+    out << "; " << f.uniform << " frames black or grey while " << r.reflectance_measured
+        << " target reflectance(s) were measured";
   if (r.silent_frames > 0)
     out << "; " << r.silent_frames << " frames blanked because the camera had handed over no frame for "
         << std::lround(1000.0 * r.silent_camera_s) << " ms";
@@ -149,7 +153,7 @@ const Command kRun{
     "the live engine: project onto the tracked targets while the robot tours (the twin with --sim)",
     "projbot run [--config C.yaml] [--sim | --replay DIR] [--fullscreen] [--monitor N] [--headless] [--profile p.csv]\n"
     "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n"
-    "            [--no-predict]\n\n"
+    "            [--no-predict] [--compensation on|off] [--learn-reflectance]\n\n"
     "Opens the projector output and draws, every frame, each target the robot is projecting onto (the\n"
     "visited one and the others it expects in the projector's view at that stop) at the\n"
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
@@ -183,6 +187,13 @@ const Command kRun{
     "poses and content every time (--profile shows them), as fast as the machine tracks and draws. Targets\n"
     "whose reflectance the recording learnt (recording.yaml's `reflectance:`) are compensated with it in place\n"
     "of the scene's `surface:`.\n"
+    "With --learn-reflectance, at each stop, once the visited target's pose is accepted, the projector shows\n"
+    "black and then mid grey over its whole image, each until the camera has taken a frame under it (three\n"
+    "refreshes, the input lag and a camera frame: about 0.1 s each), and the target's reflectance is read\n"
+    "from the two colour images at the tracked pose (the light's distance and angle divided out, the room's\n"
+    "light subtracted) into a map over its model's texture coordinates, refined over its visits; it\n"
+    "replaces the scene's `surface:` in the compensation from then on. The camera's colour must be\n"
+    "registered to its depth and sRGB-coded. In the twin its camera sees the projector's black and grey.\n"
     "Targets with `content:` (a video, a timeline) or animated materials play them on each frame's display\n"
     "time; a video, model or texture file that changes on disk is loaded again and swapped in at a later\n"
     "frame (tracking goes on; a model of another shape is not), and one that fails to load leaves the old\n"
@@ -206,9 +217,16 @@ const Command kRun{
      {"seed", "K", "seed of the twin's noise (default 1)"},
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time"},
      {"compensation", "on|off",
-      "radiometric compensation of each target's surface and the room's light (default on; off: the content as stored)"}},
+      "radiometric compensation of each target's surface and the room's light (default on; off: the content as stored)"},
+     {"learn-reflectance", "",
+      "measure each visited target's reflectance at its stop (the projector black, then grey, a moment each) and "
+      "compensate with it"}},
     [](const cli::Args& args) {
       catch_interrupts();  // Ctrl-C / SIGTERM: leave the frame loop at the next frame, then write what was measured
+      if (args.flag("learn-reflectance") && args.get("replay"))
+        throw cli::UsageError(
+            "--learn-reflectance and --replay: a recording's frames were taken without the projector's "
+            "black and grey (record learns in the twin; a replay compensates with what it learnt)");
       const std::optional<config::Recording> recording = replay_of(args);
       const std::string scene_path =
           args.get_or("config", recording ? recording->scene.string() : (asset_dir() / "scenes" / "tour.yaml").string());

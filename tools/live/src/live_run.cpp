@@ -10,6 +10,7 @@
 #include "projbot/alignment/latest_value.hpp"
 #include "projbot/config/clock.hpp"
 #include "projbot/engine/content.hpp"
+#include "projbot/live/reflectance_probe.hpp"
 #include "projbot/live/rig.hpp"
 #include "projbot/session/trackers.hpp"
 #include "projbot/twin/display_error.hpp"
@@ -61,9 +62,12 @@ class RunObserver final : public session::StopObserver {
   RunObserver(const config::Scene& scene, alignment::LatestValue<RobotState>& state, Handoffs& handoffs, twin::Twin* twin,
               session::PoseCheck* check, std::ostream& log, config::Clock clock)
       : scene_(scene), state_(state), handoffs_(handoffs), twin_(twin), check_(check), log_(log), clock_(std::move(clock)) {}
+  /// Each stop's visited target's reflectance measured by `probe` from the trackers' poses.
+  void learn(ReflectanceProbe* probe, session::PoseSource poses) { probe_ = probe, poses_ = std::move(poses); }
   void driving(int visit) override { state_.publish({.lit = {}, .since_s = clock_.now_s(), .visit = visit + 1}); }
   void lit(const session::Stop& stop, double since_s) override {
     say_lit(stop);
+    if (probe_) probe_->lit(stop, since_s);
     std::vector<DrawnTarget> lit;
     for (const session::LitTarget& l : stop.lit)
       lit.push_back({l.target, l.target == stop.target ? stop.target_visit : 0, twin_ ? twin_index(l.target) : 0});
@@ -81,10 +85,13 @@ class RunObserver final : public session::StopObserver {
       handoffs_.from_capture_ms.push_back(1000.0 * (now - f.depth.capture_time_s));
       handoffs_.in_session_ms.push_back(1000.0 * (now - f.delivered_s));
       handoffs_.last_s = now;
+      if (probe_)
+        if (const std::string said = probe_->frame(f, now, poses_); !said.empty()) log_ << said << std::endl;
     }
     if (check_) check_->compare(scene_, stop, k, samples);
   }
   void left(const session::Stop& stop) override {
+    if (probe_) probe_->left();
     if (twin_) twin_->end_visit(twin_index(stop.target), stop.target_visit);  // back home, or left where it was moved
   }
 
@@ -108,6 +115,8 @@ class RunObserver final : public session::StopObserver {
   session::PoseCheck* check_;
   std::ostream& log_;
   config::Clock clock_;  // the session's
+  ReflectanceProbe* probe_ = nullptr;
+  session::PoseSource poses_;
 };
 
 // The robot thread of a run: the session at each stop (the rig built on this thread: the twin renders on
@@ -116,8 +125,8 @@ class RunObserver final : public session::StopObserver {
 class RobotThread {
  public:
   RobotThread(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers, const RunSources& sources,
-              session::ReplayClock* replay_clock)
-      : replay_clock_(replay_clock), thread_([this, &scene, &o, &trackers, &sources](std::stop_token cancel) {
+              session::ReplayClock* replay_clock, ReflectanceProbe* probe)
+      : replay_clock_(replay_clock), probe_(probe), thread_([this, &scene, &o, &trackers, &sources](std::stop_token cancel) {
           try {
             drive(scene, o, trackers, sources, cancel);
           } catch (...) {
@@ -138,6 +147,7 @@ class RobotThread {
   void drive(const config::Scene& scene, const RunOptions& o, session::SceneTrackers& trackers, const RunSources& sources,
              const std::stop_token& cancel);
   session::ReplayClock* replay_clock_;
+  ReflectanceProbe* probe_;  // null: no reflectance measured
   alignment::LatestValue<RobotState> state_;
   Handoffs handoffs_;
   std::exception_ptr error_;
@@ -153,6 +163,12 @@ void RobotThread::drive(const config::Scene& scene, const RunOptions& o, session
            .replay_clock = replay_clock_ ? replay_clock_->robot() : config::Clock{}});
   const config::Clock& clock = rig.session().clock();
   RunObserver observer(scene, state_, handoffs_, rig.twin(), sources.check, *sources.log, clock);
+  if (probe_) {
+    observer.learn(probe_, [&trackers](int index, alignment::PoseSample& pose) {
+      return trackers.owned[static_cast<std::size_t>(index)]->latest(pose);
+    });
+    rig.projector_shows([probe = probe_] { return probe->showing(); });
+  }
   const int visits = rig.visits(o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size()));
   const session::Dwell dwell = rig.dwell(o.dwell_s);
   for (int v = 0; v < visits && !cancel.stop_requested(); ++v) rig.session().visit(v, trackers.workers, dwell, observer, cancel);
@@ -238,6 +254,39 @@ session::LiveInputs live_inputs(const config::Scene& scene, RobotThread& robot, 
   return in;
 }
 
+// RunOptions::learn_reflectance (not in a replay: its frames were taken without the probe's light): the
+// probe over the scene's models, each image taken once the projector has shown its colour for three
+// refreshes and its input lag, and the camera has exposed a frame under it.
+std::unique_ptr<ReflectanceProbe> reflectance_probe(const config::Scene& scene, const RunOptions& o,
+                                                    const std::vector<assets::Model>& models, bool replay) {
+  if (!o.learn_reflectance || replay) return nullptr;
+  std::vector<const assets::Model*> pointers;
+  for (const assets::Model& m : models) pointers.push_back(&m);
+  const double refresh_hz = scene.projector.refresh_hz > 0.0 ? scene.projector.refresh_hz : 60.0;
+  return std::make_unique<ReflectanceProbe>(scene, std::move(pointers),
+                                            3.0 / refresh_hz + scene.projector.input_lag_ms / 1000.0 + 1.0 / 30.0);
+}
+
+// The render thread's side of the probe: its colour shown instead of the targets while it asks, and what it
+// learnt bound to the target's model and compensation after each frame.
+void learn_in_loop(session::LiveInputs& in, ReflectanceProbe& probe, engine::Renderer& renderer, Output& out,
+                   std::size_t& measured) {
+  in.uniform = [&probe] { return probe.showing(); };
+  in.after_frame = [after = in.after_frame, &probe, &renderer, &out, &measured] {
+    if (after) after();
+    for (ReflectanceProbe::Learnt& l : probe.take_learnt()) {
+      const auto target = static_cast<std::size_t>(l.target);
+      if (l.map) {
+        renderer.set_surface(out.items.at(target).model, *l.map);
+        out.plan.set_surface(target, std::move(l.map));
+      } else {
+        out.plan.add_measured_albedo(target, l.albedo);
+      }
+      ++measured;
+    }
+  };
+}
+
 }  // namespace
 
 RunResult run(engine::Renderer& renderer, const config::Scene& scene, const RunOptions& options, const RunSources& sources) {
@@ -258,11 +307,14 @@ RunResult run(engine::Renderer& renderer, const config::Scene& scene, const RunO
   // One tracker worker per target on the map.
   session::SceneTrackers trackers =
       session::make_trackers(scene, session::worker_config(options.predict, sources.replay != nullptr));
-  RobotThread robot(scene, options, trackers, sources, replay_clock.get());
+  std::unique_ptr<ReflectanceProbe> probe = reflectance_probe(scene, options, out.models, sources.replay != nullptr);
+  RobotThread robot(scene, options, trackers, sources, replay_clock.get(), probe.get());
   RobotState seen;  // as the render thread last read it
   engine::FrameProfiler profiler;
   RunResult r;
-  r.figures = loop.run(*out.target, live_inputs(scene, robot, seen, trackers, out.content, sources), profiler);
+  session::LiveInputs in = live_inputs(scene, robot, seen, trackers, out.content, sources);
+  if (probe) learn_in_loop(in, *probe, renderer, out, r.reflectance_measured);
+  r.figures = loop.run(*out.target, in, profiler);
   r.failure = robot.finish(renderer, *out.target, scene.projector);
   for (const auto& w : trackers.owned)
     if (w && w->error()) std::rethrow_exception(w->error());

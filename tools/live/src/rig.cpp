@@ -41,6 +41,10 @@ std::unique_ptr<twin::ReflectanceSurvey> Rig::reflectance_survey() {
   return std::make_unique<twin::ReflectanceSurvey>(twin_->twin(), twin_->renderer());
 }
 
+void Rig::projector_shows(twin::TwinCamera::UniformLight shown) {
+  if (twin_ && twin_camera_) twin_->see_projector(std::move(shown));
+}
+
 int Rig::visits(int asked) const { return replay_ ? static_cast<int>(replay_->stops.size()) : asked; }
 
 void Rig::on_scan(ScanListener listener) {

@@ -1,5 +1,6 @@
 #include "projbot/twin/camera.hpp"
 
+#include <algorithm>
 #include <thread>
 
 #include "projbot/config/clock.hpp"
@@ -18,6 +19,11 @@ void TwinCamera::at_stop(std::size_t target, int target_visit, int visit, double
   tick_ = Clock::now();
 }
 
+void TwinCamera::see_projector(engine::Renderer& renderer, UniformLight shown) {
+  shown_ = std::move(shown);
+  colour_camera_ = std::make_unique<SpectatorView>(renderer, twin_.scene().projector, twin_.camera_pinhole());
+}
+
 alignment::RgbdFrame TwinCamera::next() {
   if (frame_ > 0) {  // 30 Hz, like the Kinect; one that fell behind does not burst
     tick_ += std::chrono::microseconds(33333);
@@ -29,8 +35,17 @@ alignment::RgbdFrame TwinCamera::next() {
   const Eigen::Matrix4d T_world_camera = twin_.true_head().T_world_camera.matrix();
   alignment::RgbdFrame f;
   f.depth = twin_.capture(T_world_camera, static_cast<std::uint32_t>(seed_ * 7919 + frame_));
-  if (frame_ == 0 || colour_every_frame_)
+  const std::optional<std::array<std::uint8_t, 3>> uniform = shown_ ? shown_() : std::nullopt;
+  if (uniform) {  // the scene under the projector's one colour, as the colour camera sees it
+    const config::ProjectorConfig& p = twin_.scene().projector;
+    assets::Image frame;
+    frame.width = p.width_px, frame.height = p.height_px;
+    frame.rgba.resize(static_cast<std::size_t>(p.width_px) * p.height_px * 4, 255);
+    for (std::size_t i = 0; i < frame.rgba.size(); i += 4) std::copy(uniform->begin(), uniform->end(), frame.rgba.begin() + i);
+    f.colour = colour_camera_->draw(twin_, T_world_camera, twin_.true_head().T_world_projector.matrix(), frame);
+  } else if (frame_ == 0 || colour_every_frame_) {
     f.colour = twin_.capture_colour(T_world_camera, static_cast<std::uint32_t>(seed_ * 7919 + visit_ * 1009 + frame_));
+  }
   f.depth.capture_time_s = captured;
   f.depth_timestamp = f.colour_timestamp = frame_++;
   last_capture_ms_ = 1000.0 * (config::steady_now_s() - captured);

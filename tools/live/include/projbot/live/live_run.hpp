@@ -30,6 +30,9 @@ struct RunOptions {
   bool headless = false;   ///< offscreen, paced like a 60 Hz projector
   bool predict = true;     ///< each pose moved on to its frame's display time
   bool compensate = true;  ///< radiometric compensation of each target's surface and the room's light
+  /// At each stop, once the visited target's pose is accepted, its reflectance is measured (ReflectanceProbe:
+  /// the projector black, then mid grey, for a moment each) and compensated for from then on.
+  bool learn_reflectance = false;
 };
 
 /// What serves the session and how it talks: what run() needs besides the scene.
@@ -49,7 +52,8 @@ struct RunResult {
   engine::FrameSummary summary;
   std::size_t silent_frames = 0;  ///< blanked because the camera had handed over nothing for silent_camera_s
   double silent_camera_s = 0.0;
-  int visits = 0;  ///< visits begun
+  int visits = 0;                        ///< visits begun
+  std::size_t reflectance_measured = 0;  ///< stops whose target's reflectance was measured (learn_reflectance)
   /// Per live camera frame: from its capture stamp, and from the camera's next() returning, to the frame
   /// handed to every lit worker (ms).
   std::vector<double> handoff_from_capture_ms, handoff_in_session_ms;

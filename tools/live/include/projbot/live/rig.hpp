@@ -51,6 +51,9 @@ class Rig {
   /// A survey of the targets' reflectance when the twin serves the camera too (its colour camera sees the
   /// twin's projector light); null otherwise: a configured camera's session drives no projector here.
   std::unique_ptr<twin::ReflectanceSurvey> reflectance_survey();
+  /// When the twin serves the camera, it sees the projector's light while `shown` says it shows one colour
+  /// (a reflectance measured at a stop); a configured camera sees the real projector's.
+  void projector_shows(twin::TwinCamera::UniformLight shown);
   /// The visits a tour of `asked` makes: a recording plays its own stops.
   int visits(int asked) const;
   /// Each laser scan while driving and settling: the twin's, or the configured laser's; a recording has none.

@@ -5,10 +5,15 @@
 // the capture instant, so a live run sees it move as a real one would. Not thread-safe: the twin's owner
 // thread reads it.
 
+#include <array>
 #include <chrono>
 #include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
 
 #include "projbot/alignment/rgbd_camera.hpp"
+#include "projbot/twin/spectator.hpp"
 #include "projbot/twin/world.hpp"
 
 namespace projbot::twin {
@@ -28,6 +33,11 @@ class TwinCamera final : public alignment::RgbdCamera {
   alignment::RgbdFrame next() override;
   /// Wall time of the last capture (render and noise), ms.
   double last_capture_ms() const { return last_capture_ms_; }
+  /// What the projector shows over its whole image, when it shows one colour (a reflectance measured at a
+  /// stop; nullopt: the content): while it does, every frame carries colour, the scene lit by it as the
+  /// colour camera sees it (SpectatorView through the camera's pinhole, drawn with `renderer`).
+  using UniformLight = std::function<std::optional<std::array<std::uint8_t, 3>>()>;
+  void see_projector(engine::Renderer& renderer, UniformLight shown);
 
  private:
   Twin& twin_;
@@ -39,6 +49,8 @@ class TwinCamera final : public alignment::RgbdCamera {
   std::uint32_t frame_ = 0;  // frames at this stop
   std::chrono::steady_clock::time_point tick_{};
   double last_capture_ms_ = 0.0;
+  UniformLight shown_;
+  std::unique_ptr<SpectatorView> colour_camera_;  // see_projector's
 };
 
 }  // namespace projbot::twin

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "projbot/engine/renderer.hpp"
@@ -27,6 +28,8 @@ class TwinSession {
   engine::Renderer& renderer() { return renderer_; }
   /// The dwell: `dwell_s` at each stop, the camera the configured one or the twin's.
   session::Dwell dwell(double dwell_s, bool lockstep);
+  /// The twin's camera sees the projector's light when it shows one colour (TwinCamera::see_projector).
+  void see_projector(TwinCamera::UniformLight shown) { twin_camera_.see_projector(renderer_, std::move(shown)); }
 
  private:
   engine::Renderer renderer_;
