@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <sstream>
 
+#include "projbot/live/reflectance_probe.hpp"
+
 namespace {
 
 projbot::live::RunSources twin_sources(projbot::hardware::Devices& devices, const projbot::config::Scene& scene,
@@ -77,3 +79,46 @@ TEST(LiveRun, MissingSourcesAreRefused) {
 }
 
 }  // namespace
+
+// The reflectance probe's steps at a stop (run --learn-reflectance; the measurement itself through the
+// executable: CliTest.RunLearnsEachTargetsReflectanceAtItsStop): nothing until the visited target's pose
+// is accepted at this stop, then black until a frame taken `settle` later, then grey; a stop left midway
+// shows the targets again, and a camera whose frames carry no colour is said.
+TEST(ReflectanceProbe, StepsThroughBlackAndGreyOnceThePoseIsAccepted) {
+  const auto scene = projbot::config::load_scene(std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml");
+  projbot::live::ReflectanceProbe probe(scene, std::vector<const projbot::assets::Model*>(scene.targets.size(), nullptr), 0.1);
+  projbot::session::Stop stop;
+  stop.target = 0;
+  projbot::alignment::PoseSample pose;
+  pose.lost = false;
+  pose.capture_time_s = 9.9;  // the last stop's
+  const projbot::session::PoseSource poses = [&](int, projbot::alignment::PoseSample& out) { return (out = pose), true; };
+  const auto frame = [](double captured_s, bool colour) {
+    projbot::alignment::RgbdFrame f;
+    f.depth.capture_time_s = captured_s;
+    if (colour) f.colour.width = 4, f.colour.height = 3, f.colour.rgba.assign(48, 9);
+    return f;
+  };
+  EXPECT_FALSE(probe.showing());  // no stop yet
+  probe.lit(stop, 10.0);
+  EXPECT_EQ(probe.frame(frame(10.0, true), 10.0, poses), "");
+  EXPECT_FALSE(probe.showing());  // a pose from before the stop
+  pose.capture_time_s = 10.05;
+  EXPECT_EQ(probe.frame(frame(10.06, true), 10.06, poses), "");
+  ASSERT_TRUE(probe.showing());
+  EXPECT_EQ((*probe.showing())[0], 0);  // black
+  EXPECT_EQ(probe.frame(frame(10.10, true), 10.10, poses), "");
+  EXPECT_EQ((*probe.showing())[0], 0);  // taken before black was surely shown
+  EXPECT_EQ(probe.frame(frame(10.17, true), 10.17, poses), "");
+  EXPECT_EQ((*probe.showing())[0], 128);  // grey
+  probe.left();
+  EXPECT_FALSE(probe.showing());  // the targets again
+  probe.lit(stop, 11.0);
+  pose.capture_time_s = 11.1;
+  probe.frame(frame(11.1, false), 11.1, poses);
+  EXPECT_EQ((*probe.showing())[0], 0);
+  const std::string said = probe.frame(frame(11.3, false), 11.3, poses);
+  EXPECT_NE(said.find("the camera's frames carry no colour"), std::string::npos) << said;
+  EXPECT_FALSE(probe.showing());
+  EXPECT_TRUE(probe.take_learnt().empty());
+}
