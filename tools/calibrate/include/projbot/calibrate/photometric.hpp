@@ -60,8 +60,8 @@ struct CameraResponseOptions {
   /// input), and the camera's gamma is the one that makes its values add up as well (within 1 % of white;
   /// the primaries' crosstalk into the camera's other channels is what tells). Only for a projector whose
   /// light adds up: LCD, LCoS, three-chip DLP, a colour wheel without a white segment (often a DLP's sRGB
-  /// mode). A white segment adding 2 % of white passes unseen and biases the camera's gamma by 8 %
-  /// (the twin's, with a typical DLP's crosstalk); from about 10 % it is refused.
+  /// mode). A white segment adding 2 % of white passes unseen and biases the camera's gamma by 8 % (10 %:
+  /// 28 %; the twin's, with a typical DLP's crosstalk); one of 30 % is refused.
   bool from_colours = false;
 };
 
