@@ -360,8 +360,9 @@ TEST_F(CliTest, RunPlacesTheShopTargetsWithFootingAndColour) {
 // tracked pose is the scene's surface within 3 % (measured within 0.6 %), learnt as a map over the duck's and
 // the box's texture coordinates, and the frames shown black or grey are counted apart. Tracking is as good.
 TEST_F(CliTest, RunLearnsEachTargetsReflectanceAtItsStop) {
-  const CliRun r = run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) +
-                               "/scenes/shop.yaml --visits 3 --dwell 2 --learn-reflectance");
+  const CliRun r =
+      run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) +
+                  "/scenes/shop.yaml --visits 3 --dwell 2 --learn-reflectance --reflectance-out " + (dir_ / "learnt").string());
   ASSERT_EQ(r.code, 0) << r.output;
   const std::map<std::string, Eigen::Vector3d> scene{
       {"figure", {0.72, 0.58, 0.44}}, {"duck", {0.78, 0.62, 0.08}}, {"box", {0.55, 0.42, 0.30}}};
@@ -379,6 +380,17 @@ TEST_F(CliTest, RunLearnsEachTargetsReflectanceAtItsStop) {
   }
   EXPECT_NE(r.output.find(" frames black or grey while 3 target reflectance(s) were measured"), std::string::npos) << r.output;
   EXPECT_LT(number_after(r.output, "still mean "), 0.8) << r.output;
+  // Saved as learnt: a surface: line per target for the scene, the maps as PNGs beside it.
+  std::ifstream in(dir_ / "learnt" / "surfaces.yaml");
+  const std::string saved{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  EXPECT_NE(saved.find("- name: figure\n  surface: {albedo: [0.72"), std::string::npos) << saved;
+  for (const char* mapped : {"duck", "box"}) {
+    const std::size_t at = saved.find(std::string("- name: ") + mapped + "\n  surface: {texture: ");
+    ASSERT_NE(at, std::string::npos) << saved;
+    const std::size_t from = saved.find("texture: ", at) + 9;
+    const fs::path png = saved.substr(from, saved.find('}', from) - from);
+    EXPECT_GT(fs::exists(png) ? fs::file_size(png) : 0, 100U) << png;
+  }
   EXPECT_EQ(run_projbot("run --headless --learn-reflectance --replay " + dir_.string()).code, 2);
 }
 

@@ -3,6 +3,7 @@
 // initial guess (Eq. 1) to the worker and, in the twin, plays the depth camera at 30 Hz.
 
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -68,6 +69,13 @@ live::RunOptions run_options(const cli::Args& args) {
   o.compensate = on_off(args, "compensation", true);
   o.predict = !args.flag("no-predict");
   o.learn_reflectance = args.flag("learn-reflectance");
+  if (const auto out = args.get("reflectance-out")) {
+    if (!o.learn_reflectance) throw cli::UsageError("--reflectance-out saves what --learn-reflectance learns: give both");
+    std::error_code ec;
+    if (std::filesystem::exists(*out, ec) && !std::filesystem::is_empty(*out, ec))
+      throw cli::UsageError(*out + ": not empty; the learnt surfaces need a new folder");
+    o.reflectance_out = *out;
+  }
   return o;
 }
 
@@ -153,7 +161,7 @@ const Command kRun{
     "the live engine: project onto the tracked targets while the robot tours (the twin with --sim)",
     "projbot run [--config C.yaml] [--sim | --replay DIR] [--fullscreen] [--monitor N] [--headless] [--profile p.csv]\n"
     "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n"
-    "            [--no-predict] [--compensation on|off] [--learn-reflectance]\n\n"
+    "            [--no-predict] [--compensation on|off] [--learn-reflectance [--reflectance-out DIR]]\n\n"
     "Opens the projector output and draws, every frame, each target the robot is projecting onto (the\n"
     "visited one and the others it expects in the projector's view at that stop) at the\n"
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
@@ -194,6 +202,8 @@ const Command kRun{
     "light subtracted) into a map over its model's texture coordinates, refined over its visits; it\n"
     "replaces the scene's `surface:` in the compensation from then on. The camera's colour must be\n"
     "registered to its depth and sRGB-coded. In the twin its camera sees the projector's black and grey.\n"
+    "With --reflectance-out DIR (a new folder), what was learnt is written after each measurement: each map\n"
+    "as a PNG and surfaces.yaml, each target's `surface:` line to put into the scene.\n"
     "Targets with `content:` (a video, a timeline) or animated materials play them on each frame's display\n"
     "time; a video, model or texture file that changes on disk is loaded again and swapped in at a later\n"
     "frame (tracking goes on; a model of another shape is not), and one that fails to load leaves the old\n"
@@ -220,7 +230,10 @@ const Command kRun{
       "radiometric compensation of each target's surface and the room's light (default on; off: the content as stored)"},
      {"learn-reflectance", "",
       "measure each visited target's reflectance at its stop (the projector black, then grey, a moment each) and "
-      "compensate with it"}},
+      "compensate with it"},
+     {"reflectance-out", "DIR",
+      "with --learn-reflectance: save what is learnt (each map as a PNG, surfaces.yaml) in this new folder",
+      cli::PathRole::output_folder}},
     [](const cli::Args& args) {
       catch_interrupts();  // Ctrl-C / SIGTERM: leave the frame loop at the next frame, then write what was measured
       if (args.flag("learn-reflectance") && args.get("replay"))

@@ -263,8 +263,10 @@ std::unique_ptr<ReflectanceProbe> reflectance_probe(const config::Scene& scene, 
   std::vector<const assets::Model*> pointers;
   for (const assets::Model& m : models) pointers.push_back(&m);
   const double refresh_hz = scene.projector.refresh_hz > 0.0 ? scene.projector.refresh_hz : 60.0;
-  return std::make_unique<ReflectanceProbe>(scene, std::move(pointers),
-                                            3.0 / refresh_hz + scene.projector.input_lag_ms / 1000.0 + 1.0 / 30.0);
+  auto probe = std::make_unique<ReflectanceProbe>(scene, std::move(pointers),
+                                                  3.0 / refresh_hz + scene.projector.input_lag_ms / 1000.0 + 1.0 / 30.0);
+  if (!o.reflectance_out.empty()) probe->save_to(o.reflectance_out);
+  return probe;
 }
 
 // The render thread's side of the probe: its colour shown instead of the targets while it asks, and what it

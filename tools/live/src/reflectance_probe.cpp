@@ -1,10 +1,12 @@
 #include "projbot/live/reflectance_probe.hpp"
 
+#include <cctype>
 #include <cstdio>
 #include <stdexcept>
 #include <utility>
 
 #include "projbot/alignment/equations.hpp"
+#include "projbot/config/output_file.hpp"
 
 namespace projbot::live {
 namespace {
@@ -94,9 +96,40 @@ std::string ReflectanceProbe::measure(const alignment::RgbdFrame& grey, const al
   char said[160];
   std::snprintf(said, sizeof said, "reflectance of %s measured: %zu points, median %.3f %.3f %.3f%s", name.c_str(), l.points,
                 l.albedo.x(), l.albedo.y(), l.albedo.z(), l.map ? " (a map over its texture coordinates)" : "");
+  const std::string saved = save(l);
   const std::lock_guard lock(mutex_);
   learnt_.push_back(std::move(l));
-  return said;
+  return said + saved;
+}
+
+// save_to's files after a measurement; what to add to its log line.
+std::string ReflectanceProbe::save(const Learnt& l) {
+  if (save_dir_.empty()) return "";
+  const std::string& name = scene_.targets[static_cast<std::size_t>(l.target)].name;
+  try {
+    std::filesystem::create_directories(save_dir_);
+    char line[160];
+    if (l.map) {
+      std::string stem = name;  // letters, digits, - and _ kept
+      for (char& c : stem)
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+      const std::filesystem::path png = std::filesystem::absolute(save_dir_ / (stem + "_" + std::to_string(l.target) + ".png"));
+      assets::write_png(png, *l.map);
+      surfaces_[l.target] = "  surface: {texture: " + png.string() + "}";
+    } else {
+      std::snprintf(line, sizeof line, "  surface: {albedo: [%.3f, %.3f, %.3f]}", l.albedo.x(), l.albedo.y(), l.albedo.z());
+      surfaces_[l.target] = line;
+    }
+    std::string yaml =
+        "# projbot run --learn-reflectance: each target's surface as measured at its stops so far. Put a\n"
+        "# target's surface: line into its entry in the scene (targets:) to compensate with it from the start.\n";
+    for (const auto& [target, surface] : surfaces_)
+      yaml += "- name: " + scene_.targets[static_cast<std::size_t>(target)].name + "\n" + surface + "\n";
+    config::write_file_atomically(save_dir_ / "surfaces.yaml", yaml);
+    return "; saved in " + save_dir_.string();
+  } catch (const std::exception& e) {
+    return std::string("; not saved: ") + e.what();
+  }
 }
 
 std::optional<std::array<std::uint8_t, 3>> ReflectanceProbe::showing() const {

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <ostream>
@@ -33,6 +34,8 @@ struct RunOptions {
   /// At each stop, once the visited target's pose is accepted, its reflectance is measured (ReflectanceProbe:
   /// the projector black, then mid grey, for a moment each) and compensated for from then on.
   bool learn_reflectance = false;
+  /// With learn_reflectance: what was learnt written here after each measurement (ReflectanceProbe::save_to).
+  std::filesystem::path reflectance_out;
 };
 
 /// What serves the session and how it talks: what run() needs besides the scene.

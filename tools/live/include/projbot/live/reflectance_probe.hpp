@@ -10,6 +10,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -41,6 +42,10 @@ class ReflectanceProbe {
   /// camera's frames were captured `settle_s` after the colour was asked for (the projector's refresh and
   /// input lag, and the camera's exposure, must fit in it).
   ReflectanceProbe(const config::Scene& scene, std::vector<const assets::Model*> models, double settle_s);
+  /// After each measurement, what was learnt so far written into `dir` (made then): each map as NAME.png
+  /// and surfaces.yaml, each learnt target's `surface:` as a scene takes it (a map by its absolute path),
+  /// both written whole and renamed. A failure to write is said, and the session goes on.
+  void save_to(std::filesystem::path dir) { save_dir_ = std::move(dir); }
 
   // The robot thread, as a StopObserver's calls come.
   void lit(const session::Stop& stop, double since_s);
@@ -58,6 +63,7 @@ class ReflectanceProbe {
  private:
   enum class Phase { idle, black, grey, done };
   std::string measure(const alignment::RgbdFrame& grey, const alignment::PoseSample& pose);
+  std::string save(const Learnt& l);
   void show(int level) { showing_.store(level); }
 
   const config::Scene& scene_;
@@ -70,6 +76,8 @@ class ReflectanceProbe {
   Phase phase_ = Phase::done;
   assets::Image black_;
   std::map<int, engine::ReflectanceMap> maps_;
+  std::filesystem::path save_dir_;
+  std::map<int, std::string> surfaces_;  // each learnt target's surface: line, as saved
   // Handed to the render thread.
   std::mutex mutex_;
   std::vector<Learnt> learnt_;
