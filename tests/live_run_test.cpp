@@ -120,5 +120,21 @@ TEST(ReflectanceProbe, StepsThroughBlackAndGreyOnceThePoseIsAccepted) {
   const std::string said = probe.frame(frame(11.3, false), 11.3, poses);
   EXPECT_NE(said.find("the camera's frames carry no colour"), std::string::npos) << said;
   EXPECT_FALSE(probe.showing());
+  // Moved between the two images (a visitor picks it up): the two do not show the same points.
+  const auto measured = [&](double lit_s, const Eigen::Vector3d& moved) {
+    probe.lit(stop, lit_s);
+    pose.capture_time_s = lit_s + 0.05;
+    pose.T_camera_target = Eigen::Matrix4d::Identity();
+    probe.frame(frame(lit_s + 0.06, true), lit_s + 0.06, poses);
+    probe.frame(frame(lit_s + 0.2, true), lit_s + 0.2, poses);
+    EXPECT_EQ((*probe.showing())[0], 128);
+    pose.T_camera_target.topRightCorner<3, 1>() = moved;
+    return probe.frame(frame(lit_s + 0.4, true), lit_s + 0.4, poses);
+  };
+  EXPECT_NE(measured(12.0, {0.01, 0.0, 0.0}).find("it moved between the black and the grey image"), std::string::npos);
+  // Still, but colour of another size than the depth camera's: not registered to it, so not read.
+  EXPECT_NE(measured(13.0, {0.001, 0.0, 0.0}).find("its colour images are 4x3, not the depth camera's 640x480"),
+            std::string::npos);
+  EXPECT_FALSE(probe.showing());
   EXPECT_TRUE(probe.take_learnt().empty());
 }

@@ -1,6 +1,8 @@
 #include "projbot/live/reflectance_probe.hpp"
 
+#include <Eigen/Geometry>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <utility>
@@ -15,6 +17,8 @@ constexpr int kGrey = 128;  // the projector's input under which the surface is 
 // (a real surface reflects some of one); one at 1 is whiter than white: the camera changed between the
 // images, or saturated.
 constexpr double kLeastAlbedo = 0.02, kMostAlbedo = 0.995;
+// Moved further than this between the black and the grey image, the two do not show the same points.
+constexpr double kStillM = 0.003, kStillDeg = 1.0;
 }  // namespace
 
 ReflectanceProbe::ReflectanceProbe(const config::Scene& scene, std::vector<const assets::Model*> models, double settle_s)
@@ -48,6 +52,7 @@ std::string ReflectanceProbe::frame(const alignment::RgbdFrame& f, double now_s,
   if (f.depth.capture_time_s < phase_s_ + settle_s_) return "";  // taken before the colour was surely shown
   if (phase_ == Phase::black && !f.colour.rgba.empty()) {        // (the twin's camera gives colour under one colour only)
     black_ = f.colour;
+    black_pose_ = pose.T_camera_target;
     phase_ = Phase::grey, phase_s_ = now_s;
     show(kGrey);
     return "";
@@ -56,6 +61,10 @@ std::string ReflectanceProbe::frame(const alignment::RgbdFrame& f, double now_s,
   show(-1);
   if (f.colour.rgba.empty()) return "reflectance of " + name + " not measured: the camera's frames carry no colour";
   if (!found) return "reflectance of " + name + " not measured: its pose was lost while measuring";
+  const Eigen::Matrix4d moved = black_pose_.inverse() * pose.T_camera_target;
+  const double moved_deg = Eigen::AngleAxisd(Eigen::Matrix3d(moved.topLeftCorner<3, 3>())).angle() * 180.0 / M_PI;
+  if (moved.topRightCorner<3, 1>().norm() > kStillM || moved_deg > kStillDeg)
+    return "reflectance of " + name + " not measured: it moved between the black and the grey image";
   return measure(f, pose);
 }
 
@@ -64,6 +73,12 @@ std::string ReflectanceProbe::measure(const alignment::RgbdFrame& grey, const al
   const std::string& name = scene_.targets[static_cast<std::size_t>(target_)].name;
   const Eigen::Matrix4d T_projector_target =
       alignment::projector_from_target(scene_.pan_tilt.T_projector_camera, pose.T_camera_target);
+  const config::Camera& camera = scene_.depth_camera;
+  if (black_.width != camera.width_px || black_.height != camera.height_px || grey.colour.width != camera.width_px ||
+      grey.colour.height != camera.height_px)
+    return "reflectance of " + name + " not measured: its colour images are " + std::to_string(grey.colour.width) + "x" +
+           std::to_string(grey.colour.height) + ", not the depth camera's " + std::to_string(camera.width_px) + "x" +
+           std::to_string(camera.height_px) + " (colour registered to depth is needed)";
   std::vector<engine::ReflectancePoint> points;
   try {
     points = engine::reflectance_points(*models_[static_cast<std::size_t>(target_)], scene_.depth_camera, pose.T_camera_target,

@@ -75,6 +75,7 @@ class ReflectanceProbe {
   double since_s_ = 0.0, phase_s_ = 0.0;
   Phase phase_ = Phase::done;
   assets::Image black_;
+  Eigen::Matrix4d black_pose_ = Eigen::Matrix4d::Identity();  // the target's when black_ was taken
   std::map<int, engine::ReflectanceMap> maps_;
   std::filesystem::path save_dir_;
   std::map<int, std::string> surfaces_;  // each learnt target's surface: line, as saved
