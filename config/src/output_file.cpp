@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <string>
@@ -81,6 +82,12 @@ void check_writable(const std::filesystem::path& path) {
   } catch (const OutputError& e) {
     throw OutputError(path.string() + ": " + e.what());
   }
+}
+
+std::string file_stem(std::string name) {
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  return name;
 }
 
 }  // namespace projbot::config

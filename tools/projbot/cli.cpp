@@ -161,6 +161,12 @@ double Args::get_double(const std::string& name, double fallback) const {
   return out;
 }
 
+void check_new_folder(const std::string& folder, const std::string& needs) {
+  std::error_code ec;
+  if (std::filesystem::exists(folder, ec) && !std::filesystem::is_empty(folder, ec))
+    throw UsageError(folder + ": not empty; " + needs);
+}
+
 std::vector<double> spaced_numbers(const std::string& text, std::size_t count, const std::string& what) {
   static const std::regex separator(R"(\s*,\s*|\s+)");
   const std::size_t first = text.find_first_not_of(" \t"), last = text.find_last_not_of(" \t");

@@ -78,6 +78,10 @@ std::pair<double, double> parse_distance_angle(const std::string& text, const st
 /// checks and errors naming `what`.
 std::vector<double> spaced_numbers(const std::string& text, std::size_t count, const std::string& what);
 
+/// An output folder that must be new or empty (a recording, learnt surfaces): one holding anything is a
+/// UsageError "FOLDER: not empty; `needs`".
+void check_new_folder(const std::string& folder, const std::string& needs);
+
 /// "  --scene FILE     help" lines for a subcommand's help text.
 std::string format_options(const std::vector<OptionSpec>& specs);
 

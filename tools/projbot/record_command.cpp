@@ -65,9 +65,7 @@ const Command kRecord{
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot record` needs a 'tour: {visits: [...]}' section");
       const int visits = args.get_int("visits", static_cast<int>(scene.visits.size()), 1, 1000);
-      std::error_code ec;
-      if (fs::exists(*out, ec) && !fs::is_empty(*out, ec))
-        throw cli::UsageError(*out + ": not empty; a recording needs a new folder");
+      cli::check_new_folder(*out, "a recording needs a new folder");
       catch_interrupts();  // Ctrl-C: during set-up nothing is written; later, end the stop in progress, keep every stop
 
       Progress progress("frame", static_cast<int>(std::ceil(visits * dwell_s * 30.0)));

@@ -71,9 +71,7 @@ live::RunOptions run_options(const cli::Args& args) {
   o.learn_reflectance = args.flag("learn-reflectance");
   if (const auto out = args.get("reflectance-out")) {
     if (!o.learn_reflectance) throw cli::UsageError("--reflectance-out saves what --learn-reflectance learns: give both");
-    std::error_code ec;
-    if (std::filesystem::exists(*out, ec) && !std::filesystem::is_empty(*out, ec))
-      throw cli::UsageError(*out + ": not empty; the learnt surfaces need a new folder");
+    cli::check_new_folder(*out, "the learnt surfaces need a new folder");
     o.reflectance_out = *out;
   }
   return o;

@@ -1,7 +1,6 @@
 #include "projbot/live/recorder.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -127,9 +126,7 @@ class RecordObserver final : public session::StopObserver {
   // reflectance/NAME.png, NAME's characters other than letters, digits, - and _ made _, and a number added
   // where that names another target's file.
   std::string map_file(const std::string& name) const {
-    std::string stem = name;
-    for (char& c : stem)
-      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+    const std::string stem = config::file_stem(name);
     const auto taken = [&](const std::string& file) {
       return std::any_of(rec_.reflectance.begin(), rec_.reflectance.end(),
                          [&](const auto& r) { return r.second.texture == file; });

@@ -1,7 +1,6 @@
 #include "projbot/live/reflectance_probe.hpp"
 
 #include <Eigen/Geometry>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -83,7 +82,7 @@ std::string ReflectanceProbe::measure(const alignment::RgbdFrame& grey, const al
   try {
     points = engine::reflectance_points(*models_[static_cast<std::size_t>(target_)], scene_.depth_camera, pose.T_camera_target,
                                         scene_.projector, T_projector_target, black_, grey.colour, kGrey / 255.0);
-  } catch (const std::exception& e) {  // pictures it cannot read (another size than the camera's)
+  } catch (const std::exception& e) {  // a model it cannot read (an index past its vertices)
     return "reflectance of " + name + " not measured: " + e.what();
   }
   if (points.empty())
@@ -125,10 +124,8 @@ std::string ReflectanceProbe::save(const Learnt& l) {
     std::filesystem::create_directories(save_dir_);
     char line[160];
     if (l.map) {
-      std::string stem = name;  // letters, digits, - and _ kept
-      for (char& c : stem)
-        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-      const std::filesystem::path png = std::filesystem::absolute(save_dir_ / (stem + "_" + std::to_string(l.target) + ".png"));
+      const std::filesystem::path png =
+          std::filesystem::absolute(save_dir_ / (config::file_stem(name) + "_" + std::to_string(l.target) + ".png"));
       assets::write_png(png, *l.map);
       surfaces_[l.target] = "  surface: {texture: " + png.string() + "}";
     } else {

@@ -175,13 +175,9 @@ std::vector<engine::ReflectancePoint> measured_reflectance(SpectatorView& camera
                                                            const Eigen::Matrix4d& T_projector_target) {
   constexpr std::uint8_t kGrey = 128;
   const config::ProjectorConfig& p = twin.scene().projector;
-  assets::Image frame;
-  frame.width = p.width_px, frame.height = p.height_px;
-  frame.rgba.assign(static_cast<std::size_t>(p.width_px) * p.height_px * 4, 0);
   const SpectatorScene seen = camera.look(twin, T_world_camera, T_world_projector);
-  const assets::Image black = camera.light(seen, frame).image;
-  std::fill(frame.rgba.begin(), frame.rgba.end(), kGrey);
-  const assets::Image grey = camera.light(seen, frame).image;
+  const assets::Image black = camera.light(seen, uniform_frame(p, {0, 0, 0})).image;
+  const assets::Image grey = camera.light(seen, uniform_frame(p, {kGrey, kGrey, kGrey})).image;
   return engine::reflectance_points(twin.targets().at(target).model, twin.camera_pinhole(), T_camera_target, believed,
                                     T_projector_target, black, grey, kGrey / 255.0);
 }

@@ -1,6 +1,5 @@
 #include "projbot/twin/camera.hpp"
 
-#include <algorithm>
 #include <thread>
 
 #include "projbot/config/clock.hpp"
@@ -37,12 +36,8 @@ alignment::RgbdFrame TwinCamera::next() {
   f.depth = twin_.capture(T_world_camera, static_cast<std::uint32_t>(seed_ * 7919 + frame_));
   const std::optional<std::array<std::uint8_t, 3>> uniform = shown_ ? shown_() : std::nullopt;
   if (uniform) {  // the scene under the projector's one colour, as the colour camera sees it
-    const config::ProjectorConfig& p = twin_.scene().projector;
-    assets::Image frame;
-    frame.width = p.width_px, frame.height = p.height_px;
-    frame.rgba.resize(static_cast<std::size_t>(p.width_px) * p.height_px * 4, 255);
-    for (std::size_t i = 0; i < frame.rgba.size(); i += 4) std::copy(uniform->begin(), uniform->end(), frame.rgba.begin() + i);
-    f.colour = colour_camera_->draw(twin_, T_world_camera, twin_.true_head().T_world_projector.matrix(), frame);
+    f.colour = colour_camera_->draw(twin_, T_world_camera, twin_.true_head().T_world_projector.matrix(),
+                                    uniform_frame(twin_.scene().projector, *uniform));
   } else if (frame_ == 0 || colour_every_frame_) {
     f.colour = twin_.capture_colour(T_world_camera, static_cast<std::uint32_t>(seed_ * 7919 + visit_ * 1009 + frame_));
   }

@@ -154,6 +154,15 @@ SpectatorScene SpectatorView::look(Twin& twin, const Eigen::Matrix4d& T_world_sp
   return out;
 }
 
+assets::Image uniform_frame(const config::ProjectorConfig& projector, const std::array<std::uint8_t, 3>& rgb) {
+  assets::Image frame;
+  frame.width = projector.width_px, frame.height = projector.height_px;
+  frame.rgba.resize(static_cast<std::size_t>(frame.width) * frame.height * 4, 255);
+  for (std::size_t i = 0; i < frame.rgba.size(); i += 4)
+    std::copy(rgb.begin(), rgb.end(), frame.rgba.begin() + static_cast<std::ptrdiff_t>(i));
+  return frame;
+}
+
 SpectatorPicture SpectatorView::light(const SpectatorScene& scene, const assets::Image& projector_frame) const {
   if (projector_frame.width != projector_.width_px || projector_frame.height != projector_.height_px ||
       projector_frame.rgba.size() != static_cast<std::size_t>(projector_frame.width) * projector_frame.height * 4)

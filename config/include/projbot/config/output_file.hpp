@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <stdexcept>
+#include <string>
 #include <string_view>
 
 namespace projbot::config {
@@ -27,5 +28,8 @@ inline void write_file_atomically(const std::filesystem::path& path, std::string
 void check_writable(const std::filesystem::path& path);
 /// Checks that files can be created in `folder` (by creating and removing one). Throws OutputError.
 void check_folder_writable(const std::filesystem::path& folder);
+
+/// A name (a target's) as part of a file's name: its characters other than letters, digits, - and _ made _.
+std::string file_stem(std::string name);
 
 }  // namespace projbot::config

@@ -5,6 +5,7 @@
 // (issue 43: engine/photometry.hpp's light, each surface's own reflectance).
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -48,6 +49,10 @@ struct ContentView {
   assets::Image content;
   std::vector<std::uint8_t> mask;  ///< 1 where the spectator sees the target
 };
+
+/// A projector frame of one colour (8-bit levels) over its whole image: what it shows while a target's
+/// reflectance is measured (black, then mid grey).
+assets::Image uniform_frame(const config::ProjectorConfig& projector, const std::array<std::uint8_t, 3>& rgb);
 
 class SpectatorView {
  public:
