@@ -3,7 +3,9 @@
 #   tools/fuzz.sh TARGET [SECONDS]     TARGET: gltf scene pcd ply depth_png depth_tiff oni rawlog ini mesh bop video, or all
 # Seeds: tests/fuzz/corpus/TARGET (committed) plus, for gltf, the shared models. The growing corpus is
 # build/fuzz/corpus/TARGET; a finding (crash, ASan report, allocation over 512 MB, 10 s on one input) is
-# saved under build/fuzz/findings/TARGET/ and the script exits 1: make it a regression test.
+# saved under build/fuzz/findings/TARGET/ and the script exits 1: make it a regression test. A failure of the
+# harness itself (its own file writes: exit 86, "HARNESS FAILURE") is said as such, saves no finding, and exits 3.
+# With "all", every target runs and the last line counts the targets with findings and with harness failures.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 targets=(gltf scene pcd ply depth_png depth_tiff oni rawlog ini mesh bop video)
@@ -13,7 +15,14 @@ target=$1
 seconds=${2:-60}
 [[ $seconds =~ ^[0-9]+$ && $seconds -gt 0 ]] || { echo "fuzz: SECONDS must be a whole number > 0, not '$seconds'"; exit 2; }
 if [[ $target == all ]]; then
-  for t in "${targets[@]}"; do bash "$0" "$t" "$seconds"; done
+  found=() broken=()
+  for t in "${targets[@]}"; do
+    rc=0
+    bash "$0" "$t" "$seconds" || rc=$?
+    ((rc == 0)) || { ((rc == 3)) && broken+=("$t") || found+=("$t"); }
+  done
+  echo "fuzz: ${#targets[@]} targets, findings in ${#found[@]}${found:+ (${found[*]})}, harness failures in ${#broken[@]}${broken:+ (${broken[*]})}"
+  ((${#found[@]} + ${#broken[@]} == 0)) || exit 1
   exit 0
 fi
 [[ " ${targets[*]} " == *" $target "* ]] || { echo "fuzz: unknown target '$target'"; usage; }
@@ -49,6 +58,11 @@ elapsed=$(($(date +%s) - start))
 set -e
 runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1 || echo 0)
 echo "fuzz $target: $runs inputs in $elapsed s ($((runs / elapsed)) per second), corpus $(ls "$corpus" | wc -l) files, exit $status (log: $log)"
+if [[ $status -eq 86 ]] || grep -q 'projbot-fuzz: HARNESS FAILURE' "$log"; then
+  grep -m1 'projbot-fuzz: HARNESS FAILURE' "$log" || echo "fuzz $target: the harness exited 86 without saying why"
+  echo "fuzz $target: a failure of the harness, not a finding in the reader; nothing saved under $findings"
+  exit 3
+fi
 if [[ $status -ne 0 ]]; then
   grep -E 'ERROR|SUMMARY|Test unit written' "$log" | head -5
   exit 1
