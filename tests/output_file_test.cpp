@@ -5,10 +5,15 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/time.h>
+#include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <csignal>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "projbot/assets/image.hpp"
 #include "projbot/config/paths.hpp"
@@ -49,6 +54,42 @@ void expect_error(F&& f, const std::string& needle) {
   } catch (const std::runtime_error& e) {  // OutputError, or AssetError from write_png
     EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
   }
+}
+
+// A SIGALRM every 200 us whose handler has no SA_RESTART (as libFuzzer's timer has): every blocking call
+// it lands in fails with EINTR unless the caller tries it again. Restores the old handler when it ends.
+class SignalStorm {
+ public:
+  SignalStorm() {
+    count() = 0;
+    struct sigaction sa {};
+    sa.sa_handler = [](int) { count().fetch_add(1, std::memory_order_relaxed); };
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0;
+    sigaction(SIGALRM, &sa, &old_);
+    itimerval every{{0, 200}, {0, 200}};
+    setitimer(ITIMER_REAL, &every, nullptr);
+  }
+  ~SignalStorm() {
+    itimerval off{};
+    setitimer(ITIMER_REAL, &off, nullptr);
+    sigaction(SIGALRM, &old_, nullptr);
+  }
+  SignalStorm(const SignalStorm&) = delete;
+  SignalStorm& operator=(const SignalStorm&) = delete;
+  static std::atomic<long>& count() {
+    static std::atomic<long> n{0};
+    return n;
+  }
+
+ private:
+  struct sigaction old_ {};
+};
+
+std::string pattern(std::size_t size) {
+  std::string s(size, '\0');
+  for (std::size_t i = 0; i < size; ++i) s[i] = static_cast<char>('a' + (i * 7919) % 26);
+  return s;
 }
 
 }  // namespace
@@ -176,3 +217,44 @@ TEST_F(AtomicFile, InputsAreNamedByKind) {
 }
 
 }  // namespace
+
+// Issue 73: a signal without SA_RESTART during a write. Into a FIFO whose reader is slow, open() blocks
+// and every write() blocks on the full pipe, so the signals land inside them: each must be tried again,
+// and the reader gets every byte in order. The same for a file written atomically and a copy.
+TEST_F(AtomicFile, SignalsDuringWritesAreRetriedNotErrors) {
+  const fs::path fifo = dir_ / "out.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string data = pattern(4 << 20);
+  std::string got;
+  SignalStorm storm;
+  std::thread reader([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the writer's open() waits for this
+    std::ifstream in(fifo, std::ios::binary);
+    char buf[4096];
+    while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+      got.append(buf, static_cast<std::size_t>(in.gcount()));
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+  });
+  EXPECT_NO_THROW(projbot::config::write_file_atomically(fifo, data));
+  reader.join();
+  EXPECT_EQ(got.size(), data.size());
+  EXPECT_TRUE(got == data) << "the FIFO's reader got other bytes than were written";
+
+  const fs::path file = dir_ / "big.bin", copy = dir_ / "copy.bin";
+  EXPECT_NO_THROW(projbot::config::write_file_atomically(file, data));
+  EXPECT_NO_THROW(projbot::config::copy_file(file, copy));
+  EXPECT_TRUE(read(file) == data);
+  EXPECT_TRUE(read(copy) == data);
+  EXPECT_GT(SignalStorm::count().load(), 100) << "the signals did not land during the writes";
+}
+
+TEST_F(AtomicFile, CopyNamesTheFileThatFailed) {
+  expect_error([&] { projbot::config::copy_file(dir_ / "none.oni", dir_ / "copy.oni"); }, "none.oni");
+  projbot::config::write_file_atomically(dir_ / "a.oni", "abc");
+  expect_error([&] { projbot::config::copy_file(dir_ / "a.oni", dir_ / "no" / "copy.oni"); }, "copy.oni");
+  expect_error([&] { projbot::config::copy_file(dir_ / "a.oni", "/dev/full"); }, "/dev/full: cannot write the copy");
+  struct stat st {};
+  ASSERT_EQ(::stat("/dev/full", &st), 0) << "the device named as the copy was removed";
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << "the device named as the copy was replaced";
+}

@@ -11,6 +11,7 @@
 #include <cstdio>
 
 #include "projbot/config/clock.hpp"
+#include "projbot/config/output_file.hpp"
 #include "projbot/config/paths.hpp"
 
 namespace projbot::alignment {
@@ -97,7 +98,11 @@ OpenNi2Source::OpenNi2Source(const OpenNi2Options& options) : impl_(std::make_un
     static std::atomic<int> copies{0};
     m.repaired_copy.path = std::filesystem::temp_directory_path() /
                            ("projbot_playback_" + std::to_string(::getpid()) + "_" + std::to_string(copies++) + ".oni");
-    std::filesystem::copy_file(options.uri, m.repaired_copy.path, std::filesystem::copy_options::overwrite_existing);
+    try {
+      config::copy_file(options.uri, m.repaired_copy.path);  // through EINTR: a Ctrl-C mid-copy is a stop request
+    } catch (const config::OutputError& e) {
+      throw AlignmentError(e.what());
+    }
     try {
       add_oni_cropping_property(m.repaired_copy.path);
     } catch (const AlignmentError& e) {  // named as the user named it, not as our temporary copy

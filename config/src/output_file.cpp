@@ -26,6 +26,18 @@ std::filesystem::path temporary_beside(const std::filesystem::path& path) {
   return path.parent_path() / name;
 }
 
+// `in` to its end into `out`, through short reads and writes and EINTR: 0, -errno of a failed read, or
+// the errno of a failed write.
+int copy_bytes(int in, int out) {
+  char buf[1 << 16];
+  for (;;) {
+    const ssize_t n = detail::read_retrying(in, buf, sizeof buf);
+    if (n == 0) return 0;
+    if (n < 0) return -errno;
+    if (const int err = detail::write_all(out, buf, static_cast<std::size_t>(n)); err != 0) return err;
+  }
+}
+
 }  // namespace
 
 void write_file_atomically(const std::filesystem::path& path, const void* data, std::size_t size) {
@@ -33,7 +45,7 @@ void write_file_atomically(const std::filesystem::path& path, const void* data, 
   const auto st = std::filesystem::status(path, ec);
   if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
     if (std::filesystem::is_directory(st)) throw OutputError(path.string() + ": cannot write: it is a folder");
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);  // a device or FIFO: in place
+    const int fd = detail::open_retrying(path.c_str(), O_WRONLY | O_CLOEXEC);  // a device or FIFO: in place
     if (fd < 0) throw OutputError(path.string() + ": cannot write: " + reason(errno));
     const int err = detail::write_all(fd, data, size);
     const int close_err = ::close(fd) == 0 ? 0 : errno;
@@ -41,7 +53,7 @@ void write_file_atomically(const std::filesystem::path& path, const void* data, 
     return;
   }
   const std::filesystem::path tmp = temporary_beside(path);
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  const int fd = detail::open_retrying(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0)
     throw OutputError(path.string() + ": cannot write: " + reason(errno) + " (does the folder exist and is it writable?)");
   int err = detail::write_all(fd, data, size);
@@ -52,6 +64,31 @@ void write_file_atomically(const std::filesystem::path& path, const void* data, 
     ::unlink(tmp.c_str());
     throw OutputError(path.string() + ": cannot write: " + reason(err) + " (the previous file, if any, is unchanged)");
   }
+}
+
+void copy_file(const std::filesystem::path& from, const std::filesystem::path& to) {
+  // Only a regular file (or none) is replaced, and only what this call wrote is removed on failure:
+  // a device named as the copy (/dev/full) is refused, never unlinked.
+  std::error_code ec;
+  const auto st = std::filesystem::symlink_status(to, ec);
+  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+    throw OutputError(to.string() + ": cannot write the copy of " + from.string() + " there: it is not a regular file");
+  const int in = detail::open_retrying(from.c_str(), O_RDONLY | O_CLOEXEC);
+  if (in < 0) throw OutputError(from.string() + ": cannot copy it: " + reason(errno));
+  const int out = detail::open_retrying(to.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0600);
+  if (out < 0) {
+    const int err = errno;
+    ::close(in);
+    throw OutputError(to.string() + ": cannot write the copy of " + from.string() + ": " + reason(err));
+  }
+  const int err = copy_bytes(in, out);
+  ::close(in);
+  const int close_err = ::close(out) == 0 ? 0 : errno;
+  if (err == 0 && close_err == 0) return;
+  ::unlink(to.c_str());
+  throw OutputError(err < 0 ? from.string() + ": cannot copy it: " + reason(-err)
+                            : to.string() + ": cannot write the copy of " + from.string() + ": " +
+                                  reason(err != 0 ? err : close_err));
 }
 
 void check_folder_writable(const std::filesystem::path& folder) {

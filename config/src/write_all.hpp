@@ -1,6 +1,9 @@
 #pragma once
 // Writing a whole buffer to a file descriptor, through short writes and signals (EINTR): for the
-// atomic outputs and for the isolated reader's reply to its parent.
+// atomic outputs and for the isolated reader's reply to its parent. A handler installed without
+// SA_RESTART (a library's timer, a test harness's) makes open() of a FIFO and every blocking write or
+// read fail with EINTR: each is tried again.
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -21,6 +24,22 @@ inline int write_all(int fd, const void* data, std::size_t size) {
     size -= static_cast<std::size_t>(n);
   }
   return 0;
+}
+
+/// open(2), tried again while a signal interrupts it (a FIFO's open blocks until its other end opens).
+inline int open_retrying(const char* path, int flags, mode_t mode = 0) {
+  int fd;
+  do fd = ::open(path, flags, mode);
+  while (fd < 0 && errno == EINTR);
+  return fd;
+}
+
+/// read(2), tried again while a signal interrupts it.
+inline ssize_t read_retrying(int fd, void* buf, std::size_t size) {
+  ssize_t n;
+  do n = ::read(fd, buf, size);
+  while (n < 0 && errno == EINTR);
+  return n;
 }
 
 }  // namespace projbot::config::detail

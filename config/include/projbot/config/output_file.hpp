@@ -23,6 +23,12 @@ inline void write_file_atomically(const std::filesystem::path& path, std::string
   write_file_atomically(path, text.data(), text.size());
 }
 
+/// Copies the regular file `from` to `to` (a new file or a regular one replaced, not atomically: for
+/// temporary copies; anything else at `to` is refused and left alone),
+/// through short reads and writes and signals (EINTR), unlike std::filesystem::copy_file. Throws
+/// OutputError naming the file that failed; a partial copy is removed.
+void copy_file(const std::filesystem::path& from, const std::filesystem::path& to);
+
 /// Checks before long work that `path` can be written later: its folder exists and is writable, and it
 /// is not a folder itself. Throws OutputError naming the file and what is wrong.
 void check_writable(const std::filesystem::path& path);
