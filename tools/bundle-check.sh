@@ -2,24 +2,58 @@
 # Checks tools/bundle.sh the way the bundle is used: made into a new folder, under 64 MiB, then run in a root
 # that holds nothing but the base the bundle assumes (glibc; no libstdc++, no Debian libraries) and, for the
 # commands that draw, a Vulkan driver (here lavapipe and what it needs, standing in for the GPU's driver).
-#   bash tools/bundle-check.sh
-# Needs root (chroot) or unprivileged user namespaces (unshare -r); says so and fails without either.
+#   bash tools/bundle-check.sh [--enter auto|namespaces|chroot]
+# The root is entered through new mount and pid namespaces with their own /proc where the kernel gives them
+# (as root, or unprivileged through unshare -r); else, as root, by plain chroot with /proc mounted in the root
+# (or, where mounting is refused too, as in a container without CAP_SYS_ADMIN, without /proc: the bundle's
+# libraries are found through LD_LIBRARY_PATH, not $ORIGIN). --enter forces one way (to check the other).
+# Where no way works (not root, no user namespaces, or chroot refused) it says "bundle-check: SKIPPED: why"
+# and exits 77, which tools/test.sh reports as skipped, not failed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-fail() { echo "bundle-check: FAILED: $*" >&2; exit 1; }
-work=$(mktemp -d /tmp/projbot-bundle-check.XXXXXX)
-trap 'rm -rf "$work"' EXIT
+enter_how=auto
+case "${1:-}" in
+  "") ;;
+  --enter) enter_how=${2:-}; [[ $enter_how =~ ^(auto|namespaces|chroot)$ ]] || { echo "bundle-check: --enter takes auto, namespaces or chroot, not '$enter_how'" >&2; exit 2; } ;;
+  -h | --help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  *) echo "bundle-check: unknown argument '$1' (usage: bash tools/bundle-check.sh [--enter auto|namespaces|chroot])" >&2; exit 2 ;;
+esac
 
-# Into the root with its own /proc (the loader and $ORIGIN read /proc/self/exe), in a mount namespace that
-# ends with the command.
+fail() { echo "bundle-check: FAILED: $*" >&2; exit 1; }
+skip() { echo "bundle-check: SKIPPED: $*"; exit 77; }
+work=$(mktemp -d /tmp/projbot-bundle-check.XXXXXX)
 root="$work/root"
-chroot=$(command -v chroot) || fail "no chroot (coreutils)"
-unshare=$(command -v unshare) || fail "no unshare (util-linux)"
-enter=("$unshare" -m -p -f --mount-proc="$root/proc" "$chroot")
-[[ $(id -u) -eq 0 ]] || enter=("$unshare" -r -m -p -f --mount-proc="$root/proc" "$chroot")
+proc_mounted=0
+cleanup() {
+  ((proc_mounted == 0)) || umount -l "$root/proc" 2>/dev/null || true
+  rm -rf --one-file-system "$work"
+}
+trap cleanup EXIT
+
+chroot=$(command -v chroot) || skip "no chroot (coreutils) to run the bundle in a bare root"
 mkdir -p "$root/proc"
-"${enter[@]}" / true 2>/dev/null || fail "needs root or user namespaces (unshare -r) to run the bundle in a bare root"
+# Namespaces: the root's own /proc (the loader and $ORIGIN read /proc/self/exe) in a mount namespace that
+# ends with the command.
+enter=()
+if [[ $enter_how != chroot ]] && unshare=$(command -v unshare); then
+  enter=("$unshare" -m -p -f --mount-proc="$root/proc" "$chroot")
+  [[ $(id -u) -eq 0 ]] || enter=("$unshare" -r -m -p -f --mount-proc="$root/proc" "$chroot")
+  if "${enter[@]}" / true 2>/dev/null; then how="namespaces (unshare), the root's own /proc"; else enter=(); fi
+fi
+if ((${#enter[@]} == 0)); then
+  [[ $enter_how != namespaces ]] || skip "--enter namespaces: unshare -m -p is refused here"
+  [[ $(id -u) -eq 0 ]] || skip "not root and no user namespaces (unshare -r): cannot enter a bare root"
+  "$chroot" / true 2>/dev/null || skip "chroot is refused here (no CAP_SYS_CHROOT), and so are namespaces"
+  enter=("$chroot")
+  if mount -t proc proc "$root/proc" 2>/dev/null; then
+    proc_mounted=1
+    how="plain chroot (no namespaces here), /proc mounted in the root"
+  else
+    how="plain chroot (no namespaces here), without /proc (mounting it is refused)"
+  fi
+fi
+echo "bundle-check: entering the bare root by $how"
 
 bash tools/bundle.sh "$work/bundle" | tee "$work/bundle.log"
 size=$(tail -1 "$work/bundle.log" | sed -n 's/^bundle: \([0-9.]*\) MiB in .*/\1/p')
