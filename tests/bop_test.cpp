@@ -131,6 +131,10 @@ TEST_F(BopCopy, MalformedJsonNamesTheFile) {
   spill(scene() / "scene_gt.json", slurp(scene() / "scene_gt.json").substr(0, 500));
   const std::string e = error();
   EXPECT_NE(e.find("scene_gt.json: malformed JSON"), std::string::npos) << e;
+  EXPECT_EQ(e.find("json.exception"), std::string::npos) << "the JSON library's tag reaches the user: " << e;
+  spill(scene() / "scene_gt.json", R"({"1": [{"obj_id": 1e400}]})");  // issue 72's number overflow
+  const std::string overflow = error();
+  EXPECT_NE(overflow.find("scene_gt.json: malformed JSON (number overflow parsing '1e400'"), std::string::npos) << overflow;
 }
 
 TEST_F(BopCopy, AMissingDepthImageIsNamed) {
@@ -164,6 +168,70 @@ TEST_F(BopCopy, ARotationThatIsNoneIsRefused) {
   spill(scene() / "scene_gt.json", scaled);
   const std::string e = error();
   EXPECT_NE(e.find("scene_gt.json: image 1, instance 0: pose's rotation is not a proper rotation"), std::string::npos) << e;
+}
+
+// The first instance's rotation (or anything else of it) replaced by `with`.
+std::string replace_first(const std::string& text, const std::string& pattern, const std::string& with) {
+  return std::regex_replace(text, std::regex(pattern), with, std::regex_constants::format_first_only);
+}
+
+// Issue 68: LM-O publishes rotations rounded to 0.0019 of orthonormal. Within 0.01 one is made a rotation
+// (SVD), counted and said; beyond, the error names the file, the image and the instance.
+TEST_F(BopCopy, ARoundedRotationIsMadeOrthonormalAndCounted) {
+  // 30 degrees about z, its first column 1.00095 long: R^T R - I has 0.0019 on its diagonal.
+  const std::string gt = slurp(scene() / "scene_gt.json");
+  spill(scene() / "scene_gt.json", replace_first(gt, R"("cam_R_m2c": \[[^\]]*\])",
+                                                 R"("cam_R_m2c": [0.86684813, -0.5, 0, 0.500475, 0.8660254, 0, 0, 0, 1])"));
+  const auto data = read_bop_dataset(dir_);
+  EXPECT_EQ(data.rotations_orthonormalised, 1);
+  EXPECT_NEAR(data.worst_orthonormality_error, 0.0019, 2e-5);
+  const Eigen::Matrix3d R = data.scenes[0].images[0].instances[0].T_camera_model.topLeftCorner<3, 3>();
+  EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
+  EXPECT_NEAR(std::atan2(R(1, 0), R(0, 0)) * 180.0 / M_PI, 30.0, 0.05);
+  const std::string note = projbot::alignment::rounded_rotations_note(data);
+  EXPECT_NE(note.find("1 rotation rounded off orthonormal (worst 0.0019"), std::string::npos) << note;
+  EXPECT_EQ(projbot::alignment::rounded_rotations_note(read_bop_dataset(kYcbv)), "") << "float32 rotations are not rounded";
+
+  spill(scene() / "scene_gt.json",
+        replace_first(gt, R"("cam_R_m2c": \[[^\]]*\])", R"("cam_R_m2c": [0.8747, -0.5, 0, 0.505, 0.8660254, 0, 0, 0, 1])"));
+  const std::string e = error();
+  EXPECT_NE(e.find("scene_gt.json: image 1, instance 0: pose's rotation is not a proper rotation"), std::string::npos) << e;
+  EXPECT_NE(e.find("allowed 0.01"), std::string::npos) << e;
+}
+
+TEST_F(BopCopy, ACameraRotationIsCheckedTheSameWay) {
+  const std::string cams = slurp(scene() / "scene_camera.json");
+  const std::string rounded =
+      replace_first(cams, R"("depth_scale")", R"("cam_R_w2c": [1.0019, 0, 0, 0, 1, 0, 0, 0, 1], "depth_scale")");
+  ASSERT_NE(rounded, cams);
+  spill(scene() / "scene_camera.json", rounded);
+  EXPECT_EQ(read_bop_dataset(dir_).rotations_orthonormalised, 1);
+  spill(scene() / "scene_camera.json",
+        replace_first(cams, R"("depth_scale")", R"("cam_R_w2c": [1.5, 0, 0, 0, 1, 0, 0, 0, 1], "depth_scale")"));
+  const std::string e = error();
+  EXPECT_NE(e.find("scene_camera.json: image 1: cam_R_w2c: pose's rotation is not a proper rotation"), std::string::npos) << e;
+}
+
+// Issue 72: a translation behind the camera or past 100 m, a depth scale out of 0.001..1000, refused by name.
+TEST_F(BopCopy, TranslationsAndDepthScalesOutOfTheirDomainAreRefused) {
+  const std::string gt = slurp(scene() / "scene_gt.json");
+  spill(scene() / "scene_gt.json", replace_first(gt, R"("cam_t_m2c": \[[^\]]*\])", R"("cam_t_m2c": [0, 0, -900])"));
+  std::string e = error();
+  EXPECT_NE(e.find("scene_gt.json: image 1, instance 0: cam_t_m2c puts the object behind the camera"), std::string::npos) << e;
+  spill(scene() / "scene_gt.json", replace_first(gt, R"("cam_t_m2c": \[[^\]]*\])", R"("cam_t_m2c": [0, 0, 1e300])"));
+  e = error();
+  EXPECT_NE(e.find("image 1, instance 0: cam_t_m2c puts the object"), std::string::npos) << e;
+  EXPECT_NE(e.find("at most 100 m"), std::string::npos) << e;
+  spill(scene() / "scene_gt.json", gt);
+  const std::string cams = slurp(scene() / "scene_camera.json");
+  for (const char* bad : {"1e300", "0.0000001", "-1"}) {
+    spill(scene() / "scene_camera.json",
+          std::regex_replace(cams, std::regex(R"("depth_scale": [0-9.e+-]+)"), std::string(R"("depth_scale": )") + bad));
+    e = error();
+    EXPECT_NE(e.find("scene_camera.json: image 1: depth_scale must be a number within 0.001..1000"), std::string::npos)
+        << bad << ": " << e;
+  }
 }
 
 TEST_F(BopCopy, AFolderWithoutTheSplitIsNamed) {

@@ -41,6 +41,16 @@ struct Hostile {
   std::vector<std::string> must_contain;
 };
 
+// A one-image, one-instance BOP dataset under bop/ with the camera `camera` and the translation `t_mm`.
+inline Files bop_files(const std::string& camera, const std::string& t_mm) {
+  return Files{{"bop/models/models_info.json", R"({"1": {"diameter": 100}})"},
+               {"bop/models/obj_000001.ply", "ply\n"},
+               {"bop/test/000000/depth/000001.png", "png"},
+               {"bop/test/000000/scene_camera.json", R"({"1": )" + camera + "}"},
+               {"bop/test/000000/scene_gt.json",
+                R"({"1": [{"obj_id": 1, "cam_R_m2c": [1, 0, 0, 0, 1, 0, 0, 0, 1], "cam_t_m2c": )" + t_mm + "}]}"}};
+}
+
 // A PNG whose header claims `w` x `h` pixels (an IHDR, no data: the size is refused before any decoding).
 inline std::string png_claiming(std::uint32_t w, std::uint32_t h) {
   std::string s("\x89PNG\r\n\x1a\n", 8);

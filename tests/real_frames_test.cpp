@@ -4,11 +4,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <vector>
 
@@ -67,7 +69,29 @@ TEST_F(RealFrames, BenchDatasetReportsEachEstimateAndAlignAgreesWithIt) {
     EXPECT_EQ(row.at("mode"), "acquire");
     EXPECT_EQ(row.at("T_est").size(), 16U);
     EXPECT_EQ(row.at("perturbation"), nlohmann::json::array({20.0, 5.0}));
+    EXPECT_LE(row.at("adds_mm").get<double>(), row.at("add_mm").get<double>() + 1e-9) << "ADD-S never exceeds ADD";
   }
+  // Issue 68: YCB-Video's AUCs over 0-10 cm, printed beside ours; recomputed here from the report's rows.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      r.output, m,
+      std::regex(R"(\| 20 mm, 5 deg \| projbot \| (\d+) of 3 \| ([0-9.]+) \| ([0-9.]+) \| ([0-9.]+) \| ([0-9.]+) \|)")))
+      << r.output;
+  double add_lit = 0, adds_lit = 0;
+  int lit = 0;
+  for (const auto& row : rows)
+    if (row.at("method") == "projbot" && row.at("accepted").get<bool>()) {
+      ++lit;
+      add_lit += 1.0 - std::min(row.at("add_mm").get<double>(), 100.0) / 100.0;
+      adds_lit += 1.0 - std::min(row.at("adds_mm").get<double>(), 100.0) / 100.0;
+    }
+  EXPECT_EQ(std::stoi(m[1].str()), lit);
+  if (lit > 0) {
+    EXPECT_NEAR(std::stod(m[2].str()), 100.0 * add_lit / lit, 0.051);
+    EXPECT_NEAR(std::stod(m[3].str()), 100.0 * adds_lit / lit, 0.051);
+  }
+  EXPECT_NEAR(std::stod(m[4].str()), 100.0 * add_lit / 3, 0.051) << "a blank counts as a miss";
+  EXPECT_NEAR(std::stod(m[5].str()), 100.0 * adds_lit / 3, 0.051);
   // The first row: ours on scene 000000, image 1, instance 0 (the gelatin box, obj 8).
   const auto& first = rows[0];
   ASSERT_EQ(first.at("method"), "projbot");

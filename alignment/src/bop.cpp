@@ -22,6 +22,37 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr std::uintmax_t kMaxJsonBytes = 256ULL << 20;
+// Published ground truth is rounded (LM-O's rotations to 0.0019 of orthonormal): within this it is a
+// rotation and is made exactly one (SVD); beyond it, it is something else (a scale, a mistake).
+constexpr double kRoundedRotation = 0.01;
+constexpr double kFloat32Rotation = 1e-4;       // what float32 storage alone leaves: not counted as rounded
+constexpr double kMaxTranslationMm = 100000.0;  // 100 m: no camera sees an object farther
+
+// The rotations read that were rounded past float32's precision, and the worst of them.
+struct Rounding {
+  int count = 0;
+  double worst = 0.0;
+};
+
+double orthonormality_error(const Eigen::Matrix3d& R) {
+  return (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+}
+
+// `R` (row-major, 9 numbers) and `t_m` as a rigid transform whose rotation is made orthonormal.
+Eigen::Matrix4d read_rotation(const fs::path& file, const std::vector<double>& R, const Eigen::Vector3d& t_m,
+                              const std::string& where, Rounding& rounding) {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  for (int i = 0; i < 9; ++i) T(i / 3, i % 3) = R[static_cast<std::size_t>(i)];
+  T.topRightCorner<3, 1>() = t_m;
+  const double error = orthonormality_error(T.topLeftCorner<3, 3>());
+  try {
+    T = config::orthonormalised_rigid(T, file.string() + ": " + where, kRoundedRotation);
+  } catch (const std::exception& e) {
+    throw AlignmentError(e.what());
+  }
+  if (error > kFloat32Rotation) ++rounding.count, rounding.worst = std::max(rounding.worst, error);
+  return T;
+}
 
 [[noreturn]] void fail(const fs::path& file, const std::string& why) { throw AlignmentError(file.string() + ": " + why); }
 
@@ -37,7 +68,9 @@ json read_json(const fs::path& file) {
     if (!j.is_object()) fail(file, "must hold a JSON object");
     return j;
   } catch (const json::exception& e) {
-    fail(file, std::string("malformed JSON (") + e.what() + ")");
+    const std::string what = e.what();  // without the library's tag, "[json.exception.parse_error.101] "
+    const auto tag = what.rfind("[json.exception.", 0) == 0 ? what.find("] ") : std::string::npos;
+    fail(file, "malformed JSON (" + (tag == std::string::npos ? what : what.substr(tag + 2)) + ")");
   }
 }
 
@@ -99,7 +132,7 @@ std::vector<BopObject> read_objects(const fs::path& root) {
   return objects;
 }
 
-BopImage read_camera(const fs::path& file, const fs::path& folder, int id, const json& cam) {
+BopImage read_camera(const fs::path& file, const fs::path& folder, int id, const json& cam, Rounding& rounding) {
   const std::string where = "image " + std::to_string(id);
   BopImage image;
   image.id = id;
@@ -107,8 +140,11 @@ BopImage read_camera(const fs::path& file, const fs::path& folder, int id, const
   if (!(K[0] > 0.0) || !(K[4] > 0.0)) fail(file, where + ": cam_K's focal lengths must be > 0");
   image.k.fx_px = K[0], image.k.fy_px = K[4], image.k.cx_px = K[2], image.k.cy_px = K[5];
   const json& scale = member(file, cam, "depth_scale", where);
-  if (!scale.is_number() || !(scale.get<double>() > 0.0) || !std::isfinite(scale.get<double>()))
-    fail(file, where + ": depth_scale must be a finite number > 0 (mm per stored unit)");
+  if (!scale.is_number() || !(scale.get<double>() >= 1e-3 && scale.get<double>() <= 1e3))
+    fail(file, where + ": depth_scale must be a number within 0.001..1000 (mm per stored unit)");
+  if (cam.contains("cam_R_w2c"))  // checked like the ground truth's rotations; the reader uses no world frame
+    read_rotation(file, numbers(file, cam.at("cam_R_w2c"), 9, where + ": cam_R_w2c"), Eigen::Vector3d::Zero(),
+                  where + ": cam_R_w2c", rounding);
   image.depth_units_per_m = 1000.0 / scale.get<double>();
   image.depth = folder / "depth" / image_name(id, ".png");
   std::error_code ec;
@@ -119,7 +155,7 @@ BopImage read_camera(const fs::path& file, const fs::path& folder, int id, const
   return image;
 }
 
-BopInstance read_instance(const fs::path& file, const json& gt, const std::string& where) {
+BopInstance read_instance(const fs::path& file, const json& gt, const std::string& where, Rounding& rounding) {
   BopInstance inst;
   const json& obj = member(file, gt, "obj_id", where);
   if (!obj.is_number_integer() || obj.get<long long>() < 0 || obj.get<long long>() > 1000000)
@@ -127,18 +163,16 @@ BopInstance read_instance(const fs::path& file, const json& gt, const std::strin
   inst.obj_id = obj.get<int>();
   const auto R = numbers(file, member(file, gt, "cam_R_m2c", where), 9, where + ": cam_R_m2c");
   const auto t = numbers(file, member(file, gt, "cam_t_m2c", where), 3, where + ": cam_t_m2c");
-  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  for (int i = 0; i < 9; ++i) T(i / 3, i % 3) = R[static_cast<std::size_t>(i)];
-  for (int i = 0; i < 3; ++i) T(i, 3) = t[static_cast<std::size_t>(i)] / 1000.0;
-  try {
-    inst.T_camera_model = config::orthonormalised_rigid(T, file.string() + ": " + where);
-  } catch (const std::exception& e) {
-    throw AlignmentError(e.what());
-  }
+  const Eigen::Vector3d t_mm(t[0], t[1], t[2]);
+  if (!(t_mm.z() > 0.0))
+    fail(file, where + ": cam_t_m2c puts the object behind the camera (z " + std::to_string(t_mm.z()) + " mm, must be > 0)");
+  if (!(t_mm.norm() <= kMaxTranslationMm))
+    fail(file, where + ": cam_t_m2c puts the object " + std::to_string(t_mm.norm() / 1000.0) + " m away (at most 100 m)");
+  inst.T_camera_model = read_rotation(file, R, t_mm / 1000.0, where, rounding);
   return inst;
 }
 
-void read_instances(const fs::path& folder, std::map<int, BopImage>& images) {
+void read_instances(const fs::path& folder, std::map<int, BopImage>& images, Rounding& rounding) {
   const fs::path gt_file = folder / "scene_gt.json", info_file = folder / "scene_gt_info.json";
   const json gt = read_json(gt_file);
   std::error_code ec;
@@ -158,7 +192,7 @@ void read_instances(const fs::path& folder, std::map<int, BopImage>& images) {
     }
     for (std::size_t i = 0; i < list.size(); ++i) {
       const std::string where = "image " + key + ", instance " + std::to_string(i);
-      BopInstance inst = read_instance(gt_file, list[i], where);
+      BopInstance inst = read_instance(gt_file, list[i], where, rounding);
       inst.gt_index = static_cast<int>(i);
       if (visib) {
         const json& px = member(info_file, (*visib)[i], "px_count_visib", where);
@@ -171,7 +205,7 @@ void read_instances(const fs::path& folder, std::map<int, BopImage>& images) {
   }
 }
 
-BopScene read_scene(const fs::path& folder) {
+BopScene read_scene(const fs::path& folder, Rounding& rounding) {
   BopScene scene;
   scene.name = folder.filename().string();
   scene.folder = folder;
@@ -180,10 +214,10 @@ BopScene read_scene(const fs::path& folder) {
   std::map<int, BopImage> images;
   for (const auto& [key, cam] : cams.items()) {
     const int id = parse_id(cam_file, key);
-    images.emplace(id, read_camera(cam_file, folder, id, cam));
+    images.emplace(id, read_camera(cam_file, folder, id, cam, rounding));
   }
   if (images.empty()) fail(cam_file, "lists no images");
-  read_instances(folder, images);
+  read_instances(folder, images, rounding);
   for (auto& [id, image] : images) scene.images.push_back(std::move(image));
   return scene;
 }
@@ -212,7 +246,10 @@ BopDataset read_bop_dataset(const fs::path& root, const std::vector<std::string>
     if (!fs::is_directory(split_dir / s, ec)) fail(split_dir / s, "no such scene");
   if (folders.empty()) fail(split_dir, "holds no scene folders");
   std::sort(folders.begin(), folders.end());
-  for (const fs::path& f : folders) out.scenes.push_back(read_scene(f));
+  Rounding rounding;
+  for (const fs::path& f : folders) out.scenes.push_back(read_scene(f, rounding));
+  out.rotations_orthonormalised = rounding.count;
+  out.worst_orthonormality_error = rounding.worst;
   // Every object an instance names is in models_info.json and has its model file (each looked up once).
   std::set<int> checked;
   for (const BopScene& s : out.scenes)
@@ -225,6 +262,15 @@ BopDataset read_bop_dataset(const fs::path& root, const std::vector<std::string>
           fail(o->model, "missing (object " + std::to_string(inst.obj_id) + " has instances)");
       }
   return out;
+}
+
+std::string rounded_rotations_note(const BopDataset& data) {
+  if (data.rotations_orthonormalised == 0) return "";
+  char worst[32];
+  std::snprintf(worst, sizeof worst, "%.2g", data.worst_orthonormality_error);
+  const int n = data.rotations_orthonormalised;
+  return data.root.string() + ": " + std::to_string(n) + (n == 1 ? " rotation" : " rotations") +
+         " rounded off orthonormal (worst " + worst + ", within 0.01) made orthonormal (SVD)";
 }
 
 DepthImage read_bop_depth(const BopImage& image) {

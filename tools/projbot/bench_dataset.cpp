@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iostream>
+#include <limits>
 #include <set>
 
 #include "commands.hpp"
@@ -71,6 +73,30 @@ void print_tables(const std::vector<DatasetEstimate>& rows, const std::vector<Pe
     }
 }
 
+// YCB-Video's measure beside ours: ADD and ADD-S AUC over 0-10 cm, over the estimates shown (lit) and over
+// every instance with a blank one counted as a miss (a projector shows nothing there).
+void print_auc(const std::vector<DatasetEstimate>& rows, const std::vector<Perturbation>& perturbations,
+               const std::vector<std::string>& methods) {
+  std::printf(
+      "\n| start | method | lit | ADD AUC, lit | ADD-S AUC, lit | ADD AUC, blank = miss | ADD-S AUC, blank = miss |\n"
+      "|---|---|---|---|---|---|---|\n");
+  const double miss = std::numeric_limits<double>::infinity();
+  for (const Perturbation& p : perturbations)
+    for (const std::string& method : methods) {
+      std::vector<double> add_lit, adds_lit, add_all, adds_all;
+      for (const DatasetEstimate& r : rows) {
+        if (r.method != method || r.perturbation.mm != p.mm || r.perturbation.deg != p.deg) continue;
+        if (r.accepted) add_lit.push_back(r.add_mm), adds_lit.push_back(r.adds_mm);
+        add_all.push_back(r.accepted ? r.add_mm : miss);
+        adds_all.push_back(r.accepted ? r.adds_mm : miss);
+      }
+      if (add_all.empty()) continue;
+      std::printf("| %.0f mm, %.0f deg | %s | %zu of %zu | %.1f | %.1f | %.1f | %.1f |\n", p.mm, p.deg, method.c_str(),
+                  add_lit.size(), add_all.size(), bench::auc_10cm(add_lit), bench::auc_10cm(adds_lit), bench::auc_10cm(add_all),
+                  bench::auc_10cm(adds_all));
+    }
+}
+
 // --report may not name a file inside the dataset it reads.
 void check_report_apart(const cli::Args& args, const fs::path& dir) {
   const auto report = args.get("report");
@@ -92,6 +118,7 @@ int run_bench_dataset(const cli::Args& args) {
   const double scale = model_scale_option(args, 0.001);
   check_report_apart(args, dir);
   const alignment::BopDataset data = alignment::read_bop_dataset(dir, args.get_list("scenes"));
+  if (const std::string note = alignment::rounded_rotations_note(data); !note.empty()) std::cout << note << "\n";
   catch_interrupts();
   bench::DatasetBench bench(data, scale, perturbations, seed, [] { return interrupted(); });
   std::vector<DatasetEstimate> rows;
@@ -109,6 +136,7 @@ int run_bench_dataset(const cli::Args& args) {
       progress.step(++done);
     }
     print_tables(rows, perturbations, {"projbot"});
+    print_auc(rows, perturbations, {"projbot"});
     if (const auto report = args.get("report")) bench::write_dataset_report(*report, rows, interrupted());
     if (interrupted()) return benchmark_interrupted("after " + std::to_string(done) + " scenes");
     return 0;
@@ -123,6 +151,7 @@ int run_bench_dataset(const cli::Args& args) {
       progress.step(std::min(instances, total));
     }
   print_tables(rows, perturbations, {"projbot", "pcl"});
+  print_auc(rows, perturbations, {"projbot", "pcl"});
   if (const auto report = args.get("report")) bench::write_dataset_report(*report, rows, interrupted());
   if (interrupted()) return benchmark_interrupted("after " + std::to_string(instances) + " instances");
   return 0;

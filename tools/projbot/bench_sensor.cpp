@@ -125,6 +125,7 @@ int run_bench_sensor(const cli::Args& args) {
   const auto seed = static_cast<std::uint32_t>(args.get_int("seed", 1, 0, 1 << 30));
   const double scale = model_scale_option(args, 0.001);
   const alignment::BopDataset data = alignment::read_bop_dataset(args.positional().front(), args.get_list("scenes"));
+  if (const std::string note = alignment::rounded_rotations_note(data); !note.empty()) std::cout << note << "\n";
   bench::SensorBench sensor(data, scale);
   catch_interrupts();
   int total = 0;

@@ -1,6 +1,7 @@
 #include "projbot/bench/dataset.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -47,9 +48,11 @@ std::uint32_t start_seed(std::uint64_t seed, const std::string& scene, int image
   return static_cast<std::uint32_t>(h ^ (h >> 32));
 }
 
-double error_mm(const alignment::BopModel& m, const Eigen::Matrix4d& T_est, const Eigen::Matrix4d& T_true) {
-  return 1000.0 * (m.info->symmetric ? alignment::adds_error_m(m.vertices, T_est, T_true)
-                                     : alignment::add_error_m(m.vertices, T_est, T_true));
+// The row's estimate against the truth: ADD and ADD-S both (for the AUCs), and the one its shape calls for.
+void score(DatasetEstimate& row, const alignment::BopModel& m, const Eigen::Matrix4d& T_true) {
+  row.add_mm = 1000.0 * alignment::add_error_m(m.vertices, row.T_est, T_true);
+  row.adds_mm = 1000.0 * alignment::adds_error_m(m.vertices, row.T_est, T_true);
+  row.error_mm = m.info->symmetric ? row.adds_mm : row.add_mm;
 }
 
 bool same_camera(const alignment::CameraIntrinsics& a, const alignment::CameraIntrinsics& b) {
@@ -116,7 +119,7 @@ void DatasetBench::image(const alignment::BopScene& scene, const alignment::BopI
       });
       row.inlier_ratio = r.inlier_ratio, row.rmse_mm = r.rmse_mm;
       row.T_est = r.T_scan_model;
-      row.error_mm = error_mm(m, row.T_est, inst.T_camera_model);
+      score(row, m, inst.T_camera_model);
       rows.push_back(row);
       rows.push_back(pcl_estimate(row, e.pcl, depth, k, m, inst));
     }
@@ -162,7 +165,7 @@ void DatasetBench::follow(const alignment::BopScene& scene, const std::vector<al
     for (const alignment::BopInstance& inst : scene.images[f].instances)
       if (inst.obj_id == m.info->id) {
         row.gt_index = inst.gt_index;
-        row.error_mm = error_mm(m, row.T_est, inst.T_camera_model);
+        score(row, m, inst.T_camera_model);
       }
     if (row.gt_index >= 0) rows.push_back(row);
   }
@@ -182,7 +185,7 @@ DatasetEstimate DatasetBench::pcl_estimate(DatasetEstimate row, const alignment:
   });
   row.accepted = r.converged;
   row.T_est = r.T_scan_model;
-  row.error_mm = error_mm(m, row.T_est, inst.T_camera_model);
+  score(row, m, inst.T_camera_model);
   return row;
 }
 
@@ -204,6 +207,13 @@ DatasetBench::Estimators& DatasetBench::estimators(const alignment::BopModel& m,
   return it->second.second;
 }
 
+double auc_10cm(const std::vector<double>& errors_mm) {
+  if (errors_mm.empty()) return 0.0;
+  double sum = 0.0;
+  for (const double e : errors_mm) sum += 1.0 - std::min(e, 100.0) / 100.0;  // the integral of [e < t] over t in 0..10 cm
+  return 100.0 * sum / static_cast<double>(errors_mm.size());
+}
+
 void write_dataset_report(const std::filesystem::path& file, const std::vector<DatasetEstimate>& rows, bool interrupted_run) {
   nlohmann::json out = {{"instances", nlohmann::json::array()}, {"interrupted", interrupted_run}};
   for (const DatasetEstimate& r : rows)
@@ -218,6 +228,8 @@ void write_dataset_report(const std::filesystem::path& file, const std::vector<D
                                 {"T_est", matrix_json(r.T_est)},
                                 {"accepted", r.accepted},
                                 {"error_mm", r.error_mm},
+                                {"add_mm", r.add_mm},
+                                {"adds_mm", r.adds_mm},
                                 {"inlier_ratio", r.inlier_ratio},
                                 {"rmse_mm", std::isfinite(r.rmse_mm) ? nlohmann::json(r.rmse_mm) : nlohmann::json(nullptr)},
                                 {"behind_ratio", r.behind_ratio},

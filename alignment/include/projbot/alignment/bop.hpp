@@ -53,15 +53,24 @@ struct BopDataset {
   std::filesystem::path root;
   std::vector<BopObject> objects;  ///< by id
   std::vector<BopScene> scenes;    ///< by name
+  /// Rotations (ground truth, and cameras' cam_R_w2c) rounded beyond float32's precision (1e-4) but within
+  /// 0.01 of orthonormal, as published datasets round them: made orthonormal (SVD) and used. The worst error.
+  int rotations_orthonormalised = 0;
+  double worst_orthonormality_error = 0.0;
   const BopObject* object(int id) const;
 };
+
+/// The one line saying how many rotations were made orthonormal, or "" where none was.
+std::string rounded_rotations_note(const BopDataset& data);
 
 /// The ids YCB-V's own evaluation scores as symmetric (cans, bowl, wood block, marker, clamps, foam brick).
 inline const std::vector<int> kYcbvSymmetricIds{1, 4, 6, 13, 16, 18, 19, 20, 21};
 
 /// Reads the dataset at `root` (holding models/ and `split`/), only the scenes named in `scenes` when it
 /// is not empty. Checks every JSON file, that each image's depth image exists, that scene_gt_info.json
-/// lists as many instances as scene_gt.json, that every obj_id has a model, and that poses are rigid.
+/// lists as many instances as scene_gt.json, that every obj_id has a model, and that poses are rigid
+/// (a rotation within 0.01 of orthonormal is made orthonormal; beyond, an error naming image and instance),
+/// in front of the camera and within 100 m, and depth scales within 0.001..1000 mm per unit.
 /// Images are not decoded here: read_bop_depth does that.
 BopDataset read_bop_dataset(const std::filesystem::path& root, const std::vector<std::string>& scenes = {},
                             const std::string& split = "test");

@@ -31,13 +31,18 @@ struct DatasetEstimate {
   int image = 0, gt_index = 0, obj_id = 0;
   Perturbation perturbation;
   Eigen::Matrix4d T_start = Eigen::Matrix4d::Identity(), T_est = Eigen::Matrix4d::Identity();
-  bool accepted = false;      ///< lit: converged and through the gate and the free-space check
-  double time_ms = 0.0;       ///< wall time of the estimate
-  double error_mm = 0.0;      ///< ADD (ADD-S for symmetric objects) against the ground truth
-  double inlier_ratio = 0.0;  ///< what the gate saw
-  double rmse_mm = 0.0;       ///< likewise (may be infinite)
+  bool accepted = false;               ///< lit: converged and through the gate and the free-space check
+  double time_ms = 0.0;                ///< wall time of the estimate
+  double error_mm = 0.0;               ///< ADD (ADD-S for symmetric objects) against the ground truth
+  double add_mm = 0.0, adds_mm = 0.0;  ///< ADD and ADD-S whatever the shape (YCB-Video's AUCs take each for all)
+  double inlier_ratio = 0.0;           ///< what the gate saw
+  double rmse_mm = 0.0;                ///< likewise (may be infinite)
   double behind_ratio = 0.0, agree_ratio = 0.0, flush_ratio = 0.0;  ///< what the free-space check saw
 };
+
+/// YCB-Video's area under the accuracy-threshold curve over 0-10 cm, in percent: 100 x the mean of
+/// 1 - min(e, 10 cm) / 10 cm over `errors_mm` (an infinite error, a miss, adds 0). 0 for none.
+double auc_10cm(const std::vector<double>& errors_mm);
 
 /// The benchmark over one dataset: estimators and models made when first needed and kept.
 /// Not thread-safe.
