@@ -310,6 +310,13 @@ TEST_F(CorruptBox, BadAlphaMode) {
   expect_contains(error(), "alphaMode");
 }
 
+// Issue 72: glTF's factors lie within 0..1; [1e30, -5, 1, 1] was drawn.
+TEST_F(CorruptBox, ABaseColourFactorOutsideGltfsRangeIsRefused) {
+  json_["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1e30, -5.0, 1.0, 1.0};
+  save();
+  expect_contains(error(), "material 0: baseColorFactor must be four numbers within 0..1");
+}
+
 TEST_F(CorruptBox, AlphaModesAndDoubleSidedAreRead) {
   json_["materials"][0]["alphaMode"] = "MASK";
   json_["materials"][0]["alphaCutoff"] = 0.3;

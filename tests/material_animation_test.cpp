@@ -176,6 +176,8 @@ TEST_F(AnimatedBox, MalformedChannelsAreRefusedNamingThem) {
   json& ch = json_["animations"][0]["channels"][0];
   ch["sampler"] = 9;
   EXPECT_NE(error().find("animation 0 channel 0: sampler index 9 is out of range"), std::string::npos);
+  ch["sampler"] = 4294967296LL;  // issue 72: read as int it wrapped to 0 and was then used as 2^32
+  EXPECT_NE(error().find("animation 0 channel 0: sampler index 4294967296 is out of range"), std::string::npos);
   ch["sampler"] = 1;  // the emissive strength's scalars for the base colour's four numbers
   EXPECT_NE(error().find("animation 0 channel 0: its output must be 4 float"), std::string::npos);
   ch["sampler"] = 0;

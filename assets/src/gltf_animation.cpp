@@ -96,8 +96,9 @@ std::optional<MaterialChannel> read_channel(const GltfReader& r, const json& c, 
   r.check_index(property->first, g.materials, what + ": material");
   if (!c.contains("sampler") || !c["sampler"].is_number_integer()) r.fail(what + ": has no sampler index");
   const auto& samplers = g.animations[a].samplers;
-  r.check_index(c["sampler"].get<int>(), samplers, what + ": sampler");
-  const tinygltf::AnimationSampler& s = samplers[c["sampler"].get<std::size_t>()];
+  const long long sampler = c["sampler"].get<long long>();  // glTF's indices are unsigned 32-bit: never read as int
+  r.check_index(sampler, samplers, what + ": sampler");
+  const tinygltf::AnimationSampler& s = samplers[static_cast<std::size_t>(sampler)];
   MaterialChannel ch;
   ch.material = property->first;
   ch.property = property->second;
@@ -131,7 +132,9 @@ void read_material_animations(const GltfReader& r, const std::string& json_text,
     r.warn_once("its " + std::to_string(node_channels) +
                 " node animation channel(s) are not played (the object does not move with them)");
 } catch (const json::exception& e) {  // a channel's parts of the wrong JSON type
-  r.fail(std::string("an animation channel is malformed: ") + e.what());
+  const std::string what = e.what();  // without the library's tag, "[json.exception.type_error.302] "
+  const auto tag = what.rfind("[json.exception.", 0) == 0 ? what.find("] ") : std::string::npos;
+  r.fail("an animation channel is malformed: " + (tag == std::string::npos ? what : what.substr(tag + 2)));
 }
 
 }  // namespace projbot::assets::detail

@@ -121,7 +121,8 @@ void read_materials(const GltfReader& r, Model& out) {
     const auto& f = gm.pbrMetallicRoughness.baseColorFactor;
     if (f.size() == 4)
       for (std::size_t k = 0; k < 4; ++k) {
-        if (!std::isfinite(f[k])) r.fail(name + ": baseColorFactor is not finite");
+        if (!(f[k] >= 0.0 && f[k] <= 1.0))  // NaN too; glTF's range, which the renderer and compensation assume
+          r.fail(name + ": baseColorFactor must be four numbers within 0..1 (glTF's range), not " + std::to_string(f[k]));
         m.base_color_factor[k] = static_cast<float>(f[k]);
       }
     const auto& base = gm.pbrMetallicRoughness.baseColorTexture;

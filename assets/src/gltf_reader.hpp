@@ -21,8 +21,9 @@ class GltfReader {
   [[noreturn]] void fail(const std::string& why) const { throw AssetError(file_ + ": " + why); }
 
   template <typename T>
-  void check_index(int index, const std::vector<T>& items, const std::string& what) const {
-    if (index < 0 || static_cast<std::size_t>(index) >= items.size())
+  // 64-bit: an index read from JSON past int's range (4294967296) must not wrap into range.
+  void check_index(long long index, const std::vector<T>& items, const std::string& what) const {
+    if (index < 0 || static_cast<unsigned long long>(index) >= items.size())
       fail(what + " index " + std::to_string(index) + " is out of range (have " + std::to_string(items.size()) + ")");
   }
 
