@@ -159,6 +159,11 @@ TEST_F(PcdReader, PlyBodiesMustMatchTheirHeaders) {
   refused(ply_cloud("binary_little_endian", 40, 30), "more than the file holds");
   refused(ply_cloud("ascii", 30, 40), "the body holds 40 lines");
   refused(ply_cloud("binary_little_endian", 40, 40).replace(4, 27, "format binary_middle_endian"), "binary_middle_endian");
+  // Issue 72: without x, y and z PCL read points at the origin and align said "NOT converged".
+  refused(
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float a\nproperty float b\nproperty float c\nend_header\n"
+      "0 0 1\n1 0 1\n",
+      "its vertex element has no x, y and z properties");
 }
 
 // The shared real models (binary, with normals and face lists) pass the same walk.

@@ -84,7 +84,10 @@ PointCloud read_cloud(const std::filesystem::path& path) {
         throw AlignmentError(path.string() + ": read " + std::to_string(cloud.size()) + " points, the header claims " +
                              std::to_string(header.points) + " (malformed data section?)");
     } else if (ext == ".ply") {
-      const std::uint64_t vertices = detail::check_ply_body(path).vertices;  // PCL reads the declared counts, ignores the rest
+      const detail::PlyCounts counts = detail::check_ply_body(path);  // PCL reads the declared counts, ignores the rest
+      if (!counts.vertex_xyz)  // PCL reads such a file as points at the origin, and the alignment then fails
+        throw AlignmentError(path.string() + ": its vertex element has no x, y and z properties (not a point cloud)");
+      const std::uint64_t vertices = counts.vertices;
       rc = load_isolated(
           path, "PLY file", [&](Cloud& c) { return pcl::io::loadPLYFile(path.string(), c); }, cloud);
       if (rc >= 0 && cloud.size() != vertices)

@@ -1,4 +1,4 @@
-#include "ply_body.hpp"
+#include "projbot/config/ply_body.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -7,13 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "projbot/alignment/depth.hpp"
-
-namespace projbot::alignment::detail {
+namespace projbot::config {
 
 namespace {
 
 struct Property {
+  std::string name;
   int size = 0;        ///< bytes of a scalar, or of a list's items
   int count_size = 0;  ///< bytes of a list's count; 0 for a scalar
 };
@@ -42,9 +41,7 @@ Header read_header(std::ifstream& in, const std::string& file) {
   Header h;
   std::string line;
   int number = 0;
-  const auto fail = [&](const std::string& why) {
-    throw AlignmentError(file + ":" + std::to_string(number) + ": PLY header: " + why);
-  };
+  const auto fail = [&](const std::string& why) { throw PlyError(file + ":" + std::to_string(number) + ": PLY header: " + why); };
   while (std::getline(in, line)) {
     ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -80,10 +77,11 @@ Header read_header(std::ifstream& in, const std::string& file) {
       } else if ((p.size = type_size(type)) == 0) {
         fail("'" + line + "' has an unknown type");
       }
+      words >> p.name;
       h.elements.back().properties.push_back(p);
     }
   }
-  throw AlignmentError(file + ": PLY header: no end_header");
+  throw PlyError(file + ": PLY header: no end_header");
 }
 
 std::uint64_t list_count(const char* bytes, int size, bool big_endian) {
@@ -127,16 +125,25 @@ std::uint64_t binary_body_bytes(std::ifstream& in, const Header& h, std::uint64_
   return at;
 }
 
+bool has_xyz(const Element& e) {
+  int found = 0;
+  for (const char* axis : {"x", "y", "z"})
+    found += std::count_if(e.properties.begin(), e.properties.end(),
+                           [&](const Property& p) { return p.name == axis && p.count_size == 0; }) > 0;
+  return found == 3;
+}
+
 }  // namespace
 
 PlyCounts check_ply_body(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw AlignmentError(file + ": cannot open");
+  if (!in) throw PlyError(file + ": cannot open");
   Header h = read_header(in, file);
   std::uint64_t vertices = 0, faces = 0, total = 0;
+  bool xyz = false;
   for (const Element& e : h.elements) {
-    if (e.name == "vertex") vertices = e.count;
+    if (e.name == "vertex") vertices = e.count, xyz = has_xyz(e);
     if (e.name == "face") faces = e.count;
     total += e.count;
   }
@@ -150,19 +157,19 @@ PlyCounts check_ply_body(const std::filesystem::path& path) {
     for (std::string line; std::getline(in, line);)
       if (line.find_first_not_of(" \t\r") != std::string::npos) ++lines;
     if (lines != total)
-      throw AlignmentError(file + ": the header declares " + std::to_string(total) + " elements (" + std::to_string(vertices) +
-                           " vertices), the body holds " + std::to_string(lines) + " lines");
-    return {vertices, faces};
+      throw PlyError(file + ": the header declares " + std::to_string(total) + " elements (" + std::to_string(vertices) +
+                     " vertices), the body holds " + std::to_string(lines) + " lines");
+    return {vertices, faces, xyz};
   }
   if (h.format != "binary_little_endian" && h.format != "binary_big_endian")
-    throw AlignmentError(file + ": PLY format '" + h.format + "' is none of ascii, binary_little_endian, binary_big_endian");
+    throw PlyError(file + ": PLY format '" + h.format + "' is none of ascii, binary_little_endian, binary_big_endian");
   const std::uint64_t end = binary_body_bytes(in, h, size);
   if (end != size)
-    throw AlignmentError(file + ": the header declares " + std::to_string(vertices) + " vertices and " +
-                         std::to_string(total - vertices) + " other elements, " +
-                         (end > size ? "more than the file holds" : "but " + std::to_string(size - end) + " bytes follow them") +
-                         " (truncated, or more data than declared)");
-  return {vertices, faces};
+    throw PlyError(file + ": the header declares " + std::to_string(vertices) + " vertices and " +
+                   std::to_string(total - vertices) + " other elements, " +
+                   (end > size ? "more than the file holds" : "but " + std::to_string(size - end) + " bytes follow them") +
+                   " (truncated, or more data than declared)");
+  return {vertices, faces, xyz};
 }
 
-}  // namespace projbot::alignment::detail
+}  // namespace projbot::config
