@@ -278,6 +278,11 @@ std::vector<Hostile> clash_cases() {
                     {"f.glb", "@fifo"}},
               1,
               {"f.glb: is a FIFO, not a regular file"}},
+      Hostile{"obj_material_library_is_a_fifo",  // issue 72: Assimp blocked on it until its time limit, blaming the OBJ
+              "render --model {dir}/m.obj --out {dir}/x.png",
+              Files{{"m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n"}, {"m.mtl", "@fifo"}},
+              1,
+              {"m.mtl: is a FIFO, not a regular file (the material library {dir}/m.obj names)"}},
       Hostile{"render_scene_is_dev_zero",
               "render --scene /dev/zero --out {dir}/x.png",
               "",

@@ -2,6 +2,7 @@
 // files written here for what those do not cover.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <fstream>
@@ -109,6 +110,23 @@ TEST_F(MeshFiles, AnObjsFilesAreItselfItsMaterialLibraryAndItsTextures) {
   EXPECT_EQ(load_model(write("t.ply", kTetraPly)).files, std::vector<fs::path>{dir_ / "t.ply"});
 }
 
+// Issue 72: a texture that is a FIFO blocked the load (and every command) forever; now it is not opened,
+// said by kind, and the material keeps its colour.
+TEST_F(MeshFiles, ATextureThatIsAFifoIsNotOpened) {
+  ASSERT_EQ(::mkfifo((dir_ / "f.png").c_str(), 0600), 0);
+  write("f.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd f.png\n");
+  const fs::path obj =
+      write("f.obj", "mtllib f.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n");
+  testing::internal::CaptureStderr();
+  const auto model = load_model(obj);
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_NE(said.find((dir_ / "f.png").string() + " not used (" + (dir_ / "f.png").string() + ": is a FIFO, not a regular file"),
+            std::string::npos)
+      << said;
+  EXPECT_TRUE(model.images.empty());
+  for (const auto& m : model.materials) EXPECT_LT(m.base_color_image, 0);
+}
+
 TEST_F(MeshFiles, ReadsAnAsciiStl) {
   const auto stl =
       load_model(write("t.stl",
@@ -143,6 +161,13 @@ TEST_F(MeshFiles, BadMeshesAreNamedErrors) {
   const fs::path beyond = write("beyond.ply", bad);
   m = message(beyond);
   EXPECT_EQ(m.rfind(beyond.string() + ": ", 0), 0U) << m;
+  // Issue 72: a header declaring 2 of the 4 faces it holds was drawn in half; align refused the same file.
+  std::string half = kTetraPly;
+  half.replace(half.find("element face 4"), 14, "element face 2");
+  const fs::path halved = write("half.ply", half);
+  m = message(halved);
+  EXPECT_NE(m.find(halved.string() + ": the header declares 6 elements (4 vertices), the body holds 8 lines"), std::string::npos)
+      << m;
   m = message(dir_ / "none.obj");
   EXPECT_EQ(m, (dir_ / "none.obj").string() + ": no such file");
   m = message(write("x.fbx2", "x"));

@@ -33,6 +33,7 @@
 
 #include "image_info.hpp"
 #include "projbot/config/output_file.hpp"
+#include "projbot/config/paths.hpp"
 
 namespace projbot::assets {
 
@@ -77,6 +78,9 @@ void check_claimed_size(const std::filesystem::path& path, int w, int h, int byt
 // stb allocates what a PNG chunk's length claims before reading it (a 73-byte file claiming a 553 MB
 // IDAT): every chunk must fit in the file. Files that are not PNG are left to stb.
 void check_png_chunks(const std::filesystem::path& path) {
+  // Before any open: a FIFO's open blocks until a writer comes (a texture named by a scene or an .mtl).
+  if (const std::string problem = config::input_file_problem(path); !problem.empty())
+    throw AssetError(path.string() + ": " + (problem == "does not exist" ? std::string("no such image file") : problem));
   std::error_code ec;
   const std::uint64_t size = std::filesystem::file_size(path, ec);
   if (!ec && size == 0) throw AssetError(path.string() + ": the file is empty (0 bytes), not an image");

@@ -19,6 +19,8 @@
 #include "default_material.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/isolated_read.hpp"
+#include "projbot/config/paths.hpp"
+#include "projbot/config/ply_body.hpp"
 
 namespace projbot::assets {
 namespace {
@@ -185,12 +187,27 @@ Model model_from_bytes(const std::string& bytes, const std::filesystem::path& pa
   return out;
 }
 
+// Assimp, like PCL, reads the counts a PLY header declares and ignores what follows: the body is checked first.
+void check_ply(const std::filesystem::path& path) {
+  try {
+    config::check_ply_body(path);
+  } catch (const config::PlyError& e) {
+    throw AssetError(e.what());
+  }
+}
+
 }  // namespace
 
 Model load_mesh(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw AssetError(path.string() + (std::filesystem::exists(path, ec) ? ": not a regular file" : ": no such file"));
+  if (detail::lowercase_extension(path) == ".ply") check_ply(path);
+  for (const std::string& library : obj_material_libraries(path))  // Assimp would block on a FIFO until its time limit
+    if (const auto problem = config::input_file_problem(path.parent_path() / library);
+        !problem.empty() && problem != "does not exist")
+      throw AssetError((path.parent_path() / library).string() + ": " + problem + " (the material library " + path.string() +
+                       " names)");
   std::string bytes;
   try {
     bytes = config::read_isolated(path, {"mesh file", "Assimp"}, [&](config::ReadProgress&) { return import_in_child(path); });
