@@ -418,6 +418,11 @@ std::vector<Hostile> usage_cases() {
               {"--projector '0x800'"}},
       Hostile{"calibrate_solve_out_in_missing_folder", "calibrate solve {dir}/goodmap --out {dir}/no/c.yaml", "", 2, {"--out"}},
       Hostile{"calibrate_simulate_over_a_file", "calibrate simulate --out {dir}/prev.txt --poses 1", "", 2, {"--out"}},
+      Hostile{"calibrate_simulate_out_not_empty",  // issue 72: exited 1 without naming --out
+              "calibrate simulate --out {dir}/cap --poses 1",
+              Files{{"cap/mine.txt", "the user's"}},
+              2,
+              {"cap: not empty; --out needs a new or empty folder"}},
       Hostile{"calibrate_simulate_bad_poses", "calibrate simulate --out {dir}/cap --poses 0", "", 2, {"--poses"}},
       Hostile{"calibrate_simulate_board_too_big",
               "calibrate simulate --out {dir}/cap --poses 1 --board charuco:30x20:0.1:0.08:DICT_4X4_1000",

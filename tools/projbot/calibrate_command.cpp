@@ -58,6 +58,7 @@ calibrate::SimulationConfig simulation_config(const cli::Args& args, const confi
 int run_simulate(const cli::Args& args) {
   const auto out = args.get("out");
   if (!out) throw cli::UsageError("--out DIR is required");
+  cli::check_new_folder(*out, "--out needs a new or empty folder for the capture");
   const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
   args.check_clashes({{"the default scene", scene_path, false}});
   const config::Scene scene = config::load_scene(scene_path);
@@ -170,6 +171,7 @@ calibrate::CaptureSummary capture_on_devices(const cli::Args& args, const config
 int run_capture(const cli::Args& args) {
   const auto out = args.get("out");
   if (!out) throw cli::UsageError("--out DIR is required");
+  cli::check_new_folder(*out, "--out needs a new or empty folder for the capture");
   const std::string scene_path = args.get_or("config", (asset_dir() / "scenes" / "shop.yaml").string());
   args.check_clashes({{"the default scene", scene_path, false}});
   const config::Scene scene = config::load_scene(scene_path);
