@@ -32,8 +32,8 @@ TEST_F(CliTest, CalibrateCaptureRefusesABadPoseAndWritesWhatSolveReads) {
   EXPECT_NE(r.output.find("shop.yaml configures no camera (devices.camera)"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "cap2"));
   r = run_projbot("calibrate capture --sim --out " + cap.string());  // refused before any pattern is shown
-  EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_NE(r.output.find("cap' exists and is not an empty folder; name a new one"), std::string::npos) << r.output;
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("cap: not empty; --out needs a new or empty folder for the capture"), std::string::npos) << r.output;
 }
 
 TEST_F(CliTest, CalibrateSimulateThenSolveFeedsAScene) {
@@ -94,7 +94,9 @@ TEST_F(CliTest, CalibrateSimulateThenSolveFeedsAScene) {
   EXPECT_EQ(run_projbot("calibrate solve --out " + calib.string()).code, 2);
   EXPECT_EQ(run_projbot("calibrate solve " + cap.string() + " --out " + calib.string() + " --projector 1280by800").code, 2);
   EXPECT_EQ(run_projbot("calibrate capture").code, 2);
-  EXPECT_EQ(run_projbot("calibrate simulate --out " + cap.string()).code, 1);  // not empty
+  r = run_projbot("calibrate simulate --out " + cap.string());  // not empty: a usage error naming --out (issue 72)
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--out needs a new or empty folder"), std::string::npos) << r.output;
 }
 
 // calibrate photometric --sim (issue 43): the twin's projector response and mixing recovered within the
