@@ -5,6 +5,8 @@
 # paper's Table 1; report and projector, camera and spectator pictures in out/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# ccache keys without this checkout's absolute path, as tools/test.sh does, so another clone reuses compiles.
+export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
 bash tools/setup-debian.sh
 cmake --preset release >/dev/null
 cmake --build --preset release --target projbot
