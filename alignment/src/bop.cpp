@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "projbot/assets/image.hpp"
+#include "projbot/config/json_message.hpp"
 #include "projbot/config/rigid.hpp"
 
 namespace projbot::alignment {
@@ -68,9 +69,7 @@ json read_json(const fs::path& file) {
     if (!j.is_object()) fail(file, "must hold a JSON object");
     return j;
   } catch (const json::exception& e) {
-    const std::string what = e.what();  // without the library's tag, "[json.exception.parse_error.101] "
-    const auto tag = what.rfind("[json.exception.", 0) == 0 ? what.find("] ") : std::string::npos;
-    fail(file, "malformed JSON (" + (tag == std::string::npos ? what : what.substr(tag + 2)) + ")");
+    fail(file, "malformed JSON (" + config::without_json_tag(e.what()) + ")");
   }
 }
 

@@ -8,6 +8,7 @@
 #include <regex>
 
 #include "gltf_reader.hpp"
+#include "projbot/config/json_message.hpp"
 
 namespace projbot::assets::detail {
 namespace {
@@ -132,9 +133,7 @@ void read_material_animations(const GltfReader& r, const std::string& json_text,
     r.warn_once("its " + std::to_string(node_channels) +
                 " node animation channel(s) are not played (the object does not move with them)");
 } catch (const json::exception& e) {  // a channel's parts of the wrong JSON type
-  const std::string what = e.what();  // without the library's tag, "[json.exception.type_error.302] "
-  const auto tag = what.rfind("[json.exception.", 0) == 0 ? what.find("] ") : std::string::npos;
-  r.fail("an animation channel is malformed: " + (tag == std::string::npos ? what : what.substr(tag + 2)));
+  r.fail("an animation channel is malformed: " + config::without_json_tag(e.what()));
 }
 
 }  // namespace projbot::assets::detail
