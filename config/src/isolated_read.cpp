@@ -16,7 +16,7 @@
 #include <new>
 
 #include "projbot/config/paths.hpp"
-#include "write_all.hpp"
+#include "projbot/config/write_all.hpp"
 
 // A fuzzer's or sanitizer's report-and-exit hook, present only in such builds.
 extern "C" __attribute__((weak)) void __sanitizer_set_death_callback(void (*callback)());
@@ -106,7 +106,7 @@ void default_action(int sig) {
   } catch (...) {
     reply = "Eunknown error";
   }
-  _exit(detail::write_all(fd, reply.data(), reply.size()) == 0 ? 0 : 3);
+  _exit(write_all(fd, reply.data(), reply.size()) == 0 ? 0 : 3);
 }
 
 // ", after N objects, at byte B", or "" where the reader kept no count.

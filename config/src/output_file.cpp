@@ -9,7 +9,7 @@
 #include <cstring>
 #include <string>
 
-#include "write_all.hpp"
+#include "projbot/config/write_all.hpp"
 
 namespace projbot::config {
 
@@ -31,10 +31,10 @@ std::filesystem::path temporary_beside(const std::filesystem::path& path) {
 int copy_bytes(int in, int out) {
   char buf[1 << 16];
   for (;;) {
-    const ssize_t n = detail::read_retrying(in, buf, sizeof buf);
+    const ssize_t n = read_retrying(in, buf, sizeof buf);
     if (n == 0) return 0;
     if (n < 0) return -errno;
-    if (const int err = detail::write_all(out, buf, static_cast<std::size_t>(n)); err != 0) return err;
+    if (const int err = write_all(out, buf, static_cast<std::size_t>(n)); err != 0) return err;
   }
 }
 
@@ -45,18 +45,18 @@ void write_file_atomically(const std::filesystem::path& path, const void* data, 
   const auto st = std::filesystem::status(path, ec);
   if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
     if (std::filesystem::is_directory(st)) throw OutputError(path.string() + ": cannot write: it is a folder");
-    const int fd = detail::open_retrying(path.c_str(), O_WRONLY | O_CLOEXEC);  // a device or FIFO: in place
+    const int fd = open_retrying(path.c_str(), O_WRONLY | O_CLOEXEC);  // a device or FIFO: in place
     if (fd < 0) throw OutputError(path.string() + ": cannot write: " + reason(errno));
-    const int err = detail::write_all(fd, data, size);
+    const int err = write_all(fd, data, size);
     const int close_err = ::close(fd) == 0 ? 0 : errno;
     if (err != 0 || close_err != 0) throw OutputError(path.string() + ": cannot write: " + reason(err != 0 ? err : close_err));
     return;
   }
   const std::filesystem::path tmp = temporary_beside(path);
-  const int fd = detail::open_retrying(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  const int fd = open_retrying(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0)
     throw OutputError(path.string() + ": cannot write: " + reason(errno) + " (does the folder exist and is it writable?)");
-  int err = detail::write_all(fd, data, size);
+  int err = write_all(fd, data, size);
   if (err == 0 && ::fsync(fd) != 0 && errno != EINVAL) err = errno;
   if (::close(fd) != 0 && err == 0) err = errno;
   if (err == 0 && std::rename(tmp.c_str(), path.c_str()) != 0) err = errno;
@@ -73,9 +73,9 @@ void copy_file(const std::filesystem::path& from, const std::filesystem::path& t
   const auto st = std::filesystem::symlink_status(to, ec);
   if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
     throw OutputError(to.string() + ": cannot write the copy of " + from.string() + " there: it is not a regular file");
-  const int in = detail::open_retrying(from.c_str(), O_RDONLY | O_CLOEXEC);
+  const int in = open_retrying(from.c_str(), O_RDONLY | O_CLOEXEC);
   if (in < 0) throw OutputError(from.string() + ": cannot copy it: " + reason(errno));
-  const int out = detail::open_retrying(to.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0600);
+  const int out = open_retrying(to.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0600);
   if (out < 0) {
     const int err = errno;
     ::close(in);

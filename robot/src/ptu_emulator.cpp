@@ -11,6 +11,7 @@
 #include <mutex>
 #include <thread>
 
+#include "projbot/config/write_all.hpp"
 #include "projbot/robot/ptu_d46.hpp"
 #include "pseudo_terminal.hpp"
 
@@ -110,7 +111,8 @@ struct PtuD46Emulator::Impl {
           const std::string reply = answer(pending);
           pending.clear();
           if (!silent.load() && !reply.empty()) {
-            [[maybe_unused]] const ssize_t w = ::write(pty.master, reply.data(), reply.size());
+            // Whole, through short writes and signals; a driver that has closed its end hears nothing.
+            [[maybe_unused]] const int err = config::write_all(pty.master, reply.data(), reply.size());
           }
         } else if (pending.size() < 64) {
           pending.push_back(c);

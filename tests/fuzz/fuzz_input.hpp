@@ -19,6 +19,8 @@
 #include <string_view>
 #include <system_error>
 
+#include "projbot/config/write_all.hpp"
+
 namespace projbot::fuzz {
 
 inline constexpr int kHarnessFailure = 86;  // tools/fuzz.sh: "harness failure, not a finding"
@@ -66,19 +68,10 @@ inline Scratch& scratch() {
 
 // `bytes` as the whole of `file`, through short writes and EINTR.
 inline void write_file(const std::filesystem::path& file, std::string_view bytes) {
-  int fd;
-  do fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-  while (fd < 0 && errno == EINTR);
+  const int fd = config::open_retrying(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
   if (fd < 0) harness_failure("cannot create " + file.string() + ": " + std::strerror(errno));
-  const char* p = bytes.data();
-  std::size_t left = bytes.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd, p, left);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) harness_failure("cannot write " + file.string() + ": " + std::strerror(errno));
-    p += n;
-    left -= static_cast<std::size_t>(n);
-  }
+  if (const int err = config::write_all(fd, bytes.data(), bytes.size()); err != 0)
+    harness_failure("cannot write " + file.string() + ": " + std::strerror(err));
   if (::close(fd) != 0 && errno != EINTR) harness_failure("cannot close " + file.string() + ": " + std::strerror(errno));
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 // Writing a whole buffer to a file descriptor, through short writes and signals (EINTR): for the
-// atomic outputs and for the isolated reader's reply to its parent. A handler installed without
+// atomic outputs, the isolated reader's reply to its parent and the fuzz harnesses' inputs. A handler installed without
 // SA_RESTART (a library's timer, a test harness's) makes open() of a FIFO and every blocking write or
 // read fail with EINTR: each is tried again.
 #include <fcntl.h>
@@ -9,7 +9,7 @@
 #include <cerrno>
 #include <cstddef>
 
-namespace projbot::config::detail {
+namespace projbot::config {
 
 /// Writes all `size` bytes to `fd`; returns 0, or the errno of the first failure.
 inline int write_all(int fd, const void* data, std::size_t size) {
@@ -42,4 +42,4 @@ inline ssize_t read_retrying(int fd, void* buf, std::size_t size) {
   return n;
 }
 
-}  // namespace projbot::config::detail
+}  // namespace projbot::config
