@@ -362,8 +362,8 @@ TEST(StrongStepTest, AFaceMovesOnlyAlongItsNormalACornerMovesFreely) {
   EXPECT_TRUE(few.T.isIdentity());
 }
 
-// Searching for a target that is not there: one attempt per due frame, escalating and spaced out, the
-// model's features computed once however often the global search runs.
+// Searching for a target that is not there: one attempt per due frame, spaced out, each the acquisition
+// from the guess (it has not been found at this stop), so no global search and no model features.
 TEST(TargetFollowerTest, AnAbsentTargetCostsABoundedNumberOfAttempts) {
 #if defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "the global search's FPFH runs OpenMP threads, outside ThreadSanitizer's view";
@@ -386,9 +386,51 @@ TEST(TargetFollowerTest, AnAbsentTargetCostsABoundedNumberOfAttempts) {
   EXPECT_GE(stats.attempts, 3);
   EXPECT_LE(stats.attempts, 6);
   EXPECT_EQ(stats.attempts + stats.frames_waited, 90);
-  // The wide global search (every third attempt) sees the wall: the model's features are computed then,
-  // once, however many global attempts follow.
+  EXPECT_EQ(follower.aligner().model_feature_computations(), 0);
+  // Found once and then gone, the search escalates: the wide global search (every third attempt) sees the
+  // wall, and the model's features are computed then, once, however many global attempts follow.
+  follower.set_pose(projbot::config::pose_from_xyz_rpy({0.0, 0.0, 1.2}, {20, 30, 10}));
+  for (int frame = 90; frame < 180; ++frame) {
+    wall->capture_time_s = frame / 30.0;
+    follower.step(*wall);
+  }
+  EXPECT_GE(follower.search_stats().attempts, 3);
   EXPECT_EQ(follower.aligner().model_feature_computations(), 1);
+}
+
+// Until a target is first found from its guess, every search attempt is the acquisition itself, held to
+// the guess's stated error: a cube 45 cm from a guess said to be within 2 cm / 5 deg is something else
+// that fits and stays blank (the bounded global attempts used to light it), and a cube absent from the
+// first frame and at its guess from then on is found by the next attempt.
+TEST(TargetFollowerTest, UntilFoundEverySearchIsTheBoundedAcquisition) {
+#if defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "the global search's FPFH runs OpenMP threads, outside ThreadSanitizer's view";
+#endif
+  const CameraIntrinsics k = CameraIntrinsics::kinect_v1();
+  WorkerConfig cfg;
+  cfg.guess_bounds_estimate = true;
+  cfg.guess_uncertainty_m = 0.02, cfg.guess_uncertainty_deg = 5.0;
+  cfg.search_spacing_frames = {0};
+  cfg.search_duty = 1.0;  // an attempt on every frame
+  const Eigen::Matrix4d guess = projbot::config::pose_from_xyz_rpy({0.0, 0.0, 1.1}, {20, 30, 10});
+  const Eigen::Matrix4d elsewhere = projbot::config::pose_from_xyz_rpy({0.45, 0.0, 1.1}, {20, 30, 10});
+  TargetFollower far(cube_model(), k, cfg);
+  far.set_initial_guess(guess);
+  int lit = 0;
+  for (int frame = 0; frame < 8; ++frame)
+    if (const auto s = far.step(*cube_depth(elsewhere, k, frame / 30.0)); s && !s->lost) ++lit;
+  EXPECT_EQ(lit, 0) << "a pose 45 cm from a guess bounded to 2 cm was lit";
+  EXPECT_GE(far.search_stats().attempts, 8);
+
+  TargetFollower late(cube_model(), k, cfg);
+  late.set_initial_guess(guess);
+  auto empty = cube_depth(guess, k, 0.0);
+  std::fill(empty->depth_m.begin(), empty->depth_m.end(), 0.0F);
+  EXPECT_FALSE(late.step(*empty) && !late.last_pose().isApprox(guess));
+  const auto s = late.step(*cube_depth(projbot::config::pose_from_xyz_rpy({0.01, 0.0, 1.1}, {22, 30, 10}), k, 1 / 30.0));
+  ASSERT_TRUE(s && !s->lost) << "the cube at its guess on the second frame was not found there";
+  EXPECT_NEAR(s->T_camera_target(0, 3), 0.01, 0.003);
+  EXPECT_EQ(late.search_stats().attempts, 2);
 }
 
 // The worker was busy (an acquisition) while the target moved on: the next frame it takes is a second

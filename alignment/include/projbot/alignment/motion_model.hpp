@@ -88,6 +88,8 @@ class MotionFilter {
   /// The state to extrapolate from: still (the newest measured pose, zero velocity) until min_poses
   /// poses are in and the target has moved more than noise over the stillness window.
   MotionState state() const;
+  /// No pose since the last reset: state() and predict() know nothing yet.
+  bool empty() const { return count_ == 0; }
   Eigen::Matrix4d predict(double t_s) const { return predict_pose(state(), t_s); }
   /// Velocity restarts since the last reset (starts and stops detected), for tests and statistics.
   int maneuvers() const { return maneuvers_; }

@@ -36,8 +36,10 @@ struct WorkerConfig {
   /// ...and long enough that searching takes at most this share of the worker's time (an attempt of t
   /// ms is followed by t (1 / search_duty - 1) ms of frames at camera_hz without one).
   double search_duty = 0.25;
-  /// The first search from a new guess is the acquisition itself (acquire()); later ones are the bounded
-  /// attempts above. False: every attempt is a bounded one.
+  /// Until the target is first found from a new guess, every search attempt is the acquisition itself
+  /// (acquire(), spaced as above): a target the acquisition finds on some frame is found on it. Once
+  /// found and then lost, the first attempt acquires and later ones are the bounded attempts above.
+  /// False: every attempt is a bounded one.
   bool first_search_acquires = true;
   double camera_hz = 30.0;
   /// A pose whose predicted silhouette is seen through (check_free_space) over more than this share is
@@ -302,7 +304,8 @@ class TargetFollower {
   bool lost_reported_ = false;
   int wait_ = 0;  // frames until the next search attempt
   SearchStats stats_;
-  int search_attempts_ = 0;  // attempts since this search began (a new guess, or the target lost)
+  int search_attempts_ = 0;     // attempts since this search began (a new guess, or the target lost)
+  bool found_at_stop_ = false;  // a pose was found since the last guess
   std::optional<AlignmentResult> last_attempt_;
   FreeSpaceCheck check_;
   Known known_;                   // this stop's floor and footing
