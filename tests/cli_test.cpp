@@ -353,3 +353,30 @@ TEST_F(CliTest, TourRunsWithTheDepthModelFittedToRealFrames) {
   ASSERT_EQ(report.at("visits").size(), 1U);
   EXPECT_TRUE(std::isfinite(report.at("visits")[0].at("mean_mm").get<double>()));
 }
+
+// A command's default scene is an input like a --scene (issue 72): an output naming it is refused before
+// any work, and the shipped file stays as it was. Run on a copy of the assets (PROJBOT_ASSETS).
+TEST_F(CliTest, NoOutputReplacesACommandsDefaultScene) {
+  const fs::path assets = dir_ / "assets";
+  fs::create_directories(assets);
+  for (const char* part : {"scenes", "models", "videos", "sites"})
+    if (fs::exists(fs::path(PROJBOT_ASSET_DIR) / part))
+      fs::copy(fs::path(PROJBOT_ASSET_DIR) / part, assets / part, fs::copy_options::recursive);
+  ASSERT_EQ(::setenv("PROJBOT_ASSETS", assets.c_str(), 1), 0);
+  const std::map<std::string, std::string> cases{
+      {"bench content --report ", "content.yaml"},
+      {"bench appearance --report ", "shop.yaml"},
+      {"calibrate photometric --sim --out ", "shop.yaml"},
+  };
+  for (const auto& [command, scene] : cases) {
+    const fs::path file = assets / "scenes" / scene;
+    std::ifstream before_in(file);
+    const std::string before((std::istreambuf_iterator<char>(before_in)), std::istreambuf_iterator<char>());
+    const CliRun r = run_projbot(command + file.string(), 120);
+    EXPECT_EQ(r.code, 2) << command << r.output;
+    EXPECT_NE(r.output.find("is also the input the scene " + file.string()), std::string::npos) << command << r.output;
+    std::ifstream after_in(file);
+    EXPECT_EQ(std::string((std::istreambuf_iterator<char>(after_in)), std::istreambuf_iterator<char>()), before) << command;
+  }
+  ::unsetenv("PROJBOT_ASSETS");
+}

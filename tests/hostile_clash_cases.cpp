@@ -4,6 +4,26 @@
 
 namespace hostile {
 
+namespace {
+
+// BoxTextured (a .gltf with its .bin and texture) copied under box/, and a scene s.yaml drawing it as
+// target 'box' (`scene`), with `more` files beside.
+const std::string kBoxScene =
+    "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\n"
+    "targets:\n  - name: box\n    model: box/BoxTextured.gltf\n    pose: {translation: [0, 0, 1]}\n";
+
+Files box_files(const std::string& scene = kBoxScene, std::vector<std::pair<std::string, std::string>> more = {}) {
+  const std::string from = "@head:10000000:{data}/gltf/BoxTextured/glTF/";
+  Files f{{"box/BoxTextured.gltf", from + "BoxTextured.gltf"},
+          {"box/BoxTextured0.bin", from + "BoxTextured0.bin"},
+          {"box/CesiumLogoFlat.png", from + "CesiumLogoFlat.png"},
+          {"s.yaml", scene}};
+  for (auto& m : more) f.list.push_back(std::move(m));
+  return f;
+}
+
+}  // namespace
+
 // Outputs that would destroy an input (issue 47): refused before any work, exit 2, naming both; inputs that
 // are not regular files refused by kind, exit 1, before anything opens them (a FIFO would block).
 std::vector<Hostile> clash_cases() {
@@ -74,6 +94,35 @@ std::vector<Hostile> clash_cases() {
               Files{{"chain.gltf", chain}},
               1,
               {"chain.gltf: node 256: the node hierarchy is deeper than 256 levels"}},
+      // The files a scene and its models name are inputs too (issue 72): a model's texture and buffer, a
+      // target's model and surface print, a content video.
+      Hostile{"render_out_over_the_models_texture",
+              "render --model {dir}/box/BoxTextured.gltf --out {dir}/box/CesiumLogoFlat.png",
+              box_files(),
+              2,
+              {"--out {dir}/box/CesiumLogoFlat.png is also the input part of the model of target 'model' "
+               "{dir}/box/CesiumLogoFlat.png"}},
+      Hostile{"render_profile_over_the_models_buffer",
+              "render --model {dir}/box/BoxTextured.gltf --out {dir}/x.png --profile {dir}/box/BoxTextured0.bin",
+              box_files(),
+              2,
+              {"--profile {dir}/box/BoxTextured0.bin is also the input part of the model of target 'model'"}},
+      Hostile{"render_out_over_a_targets_surface_print",
+              "render --scene {dir}/s.yaml --out {dir}/print.png",
+              box_files(kBoxScene + "    surface: {texture: print.png}\n",
+                        {{"print.png", "@head:100000:{data}/gltf/BoxTextured/glTF/CesiumLogoFlat.png"}}),
+              2,
+              {"--out {dir}/print.png is also the input the surface texture of target 'box'"}},
+      Hostile{"tour_report_over_a_targets_model",
+              "tour --scene {dir}/s.yaml --report {dir}/box/BoxTextured.gltf",
+              box_files(kBoxScene),
+              2,
+              {"--report {dir}/box/BoxTextured.gltf is also the input the model of target 'box'"}},
+      Hostile{"bench_content_report_over_the_video",
+              "bench content --scene {dir}/s.yaml --report {dir}/clip.mp4",
+              box_files(kBoxScene + "    content: {video: clip.mp4}\n", {{"clip.mp4", "not a video, and must stay as it is"}}),
+              2,
+              {"--report {dir}/clip.mp4 is also the input the video of target 'box'"}},
       Hostile{"slam_out_map_holds_the_rawlog",
               "slam --rawlog {dir}/rec/laser.rawlog --out-map {dir}/rec --out-trajectory {dir}/t.txt",
               Files{{"rec/laser.rawlog", whole_rawlog}},

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "default_material.hpp"
+#include "obj_files.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/isolated_read.hpp"
 #include "projbot/config/paths.hpp"
@@ -140,20 +141,6 @@ int load_texture(const std::filesystem::path& model, const std::string& name, Mo
   }
 }
 
-// The material libraries an OBJ file names (`mtllib a.mtl b.mtl`), declared before its faces: what it
-// is drawn with besides itself. None for other formats.
-std::vector<std::string> obj_material_libraries(const std::filesystem::path& path) {
-  std::vector<std::string> out;
-  if (detail::lowercase_extension(path) != ".obj") return out;
-  std::ifstream in(path);
-  for (std::string line; std::getline(in, line) && line.rfind("f ", 0) != 0;) {
-    if (line.rfind("mtllib", 0) != 0) continue;
-    std::istringstream names(line.substr(6));
-    for (std::string name; names >> name;) out.push_back(name);
-  }
-  return out;
-}
-
 Model model_from_bytes(const std::string& bytes, const std::filesystem::path& path) {
   const std::string file = path.string();
   config::BytesReader in(bytes);
@@ -203,7 +190,7 @@ Model load_mesh(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path, ec))
     throw AssetError(path.string() + (std::filesystem::exists(path, ec) ? ": not a regular file" : ": no such file"));
   if (detail::lowercase_extension(path) == ".ply") check_ply(path);
-  for (const std::string& library : obj_material_libraries(path))  // Assimp would block on a FIFO until its time limit
+  for (const std::string& library : detail::obj_material_libraries(path))  // Assimp would block on a FIFO until its time limit
     if (const auto problem = config::input_file_problem(path.parent_path() / library);
         !problem.empty() && problem != "does not exist")
       throw AssetError((path.parent_path() / library).string() + ": " + problem + " (the material library " + path.string() +
@@ -217,7 +204,7 @@ Model load_mesh(const std::filesystem::path& path) {
   }
   Model model = model_from_bytes(bytes, path);
   model.files.insert(model.files.begin(), path);
-  for (const std::string& library : obj_material_libraries(path)) model.files.push_back(path.parent_path() / library);
+  for (const std::string& library : detail::obj_material_libraries(path)) model.files.push_back(path.parent_path() / library);
   return model;
 }
 

@@ -55,6 +55,7 @@ const Command kBenchAcquire{
       const auto [cm, deg] = cli::parse_distance_angle(args.get_or("guess-error", "5,10"), "guess-error", "cm", 100);
       const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
+      check_scene_outputs(args, scene);
       catch_interrupts();
       engine::Renderer renderer(engine::RendererOptions{});
       bench::AcquireBench bench(scene, {trials, cm, deg, seed}, renderer);

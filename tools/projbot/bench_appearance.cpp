@@ -157,6 +157,7 @@ const Command kBenchAppearance{
       o.measure_reflectance = reflectance != "scene";
       o.reflectance_map = reflectance == "mapped";
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
+      check_scene_outputs(args, scene);
       catch_interrupts();
       o.stop_requested = [] { return interrupted(); };
       const int visits = o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size());

@@ -78,6 +78,7 @@ const Command kBenchContent{
       const double seconds = args.get_double("seconds", 10.0);
       if (!(seconds >= 0.1 && seconds <= 86400.0)) throw cli::UsageError("--seconds must be 0.1..86400");
       const config::Scene scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "content.yaml").string()));
+      check_scene_outputs(args, scene);
       if (std::none_of(scene.targets.begin(), scene.targets.end(), [](const auto& t) { return t.content.has_value(); }))
         throw config::ConfigError(scene.source.string() + ": no target has `content:` to play");
       engine::RendererOptions ro;

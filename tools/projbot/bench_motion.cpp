@@ -85,6 +85,7 @@ const Command kBenchMotion{
         if (!(*o.processing_ms >= 0.0 && *o.processing_ms <= 1000.0)) throw cli::UsageError("--processing-ms must be 0..1000");
       }
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "motion.yaml").string()));
+      check_scene_outputs(args, scene);
       catch_interrupts();
       o.stop_requested = [] { return interrupted(); };
       twin::TourReport runs[2];

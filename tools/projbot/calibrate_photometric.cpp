@@ -51,6 +51,7 @@ double camera_gamma_option(const cli::Args& args) {
 
 int photometric_in_twin(const cli::Args& args, const std::string& out) {
   const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string()));
+  check_scene_outputs(args, scene);
   calibrate::PhotometricSim sim;
   sim.projector = scene.projector;
   // The scene's projector is the truth; one without crosstalk gets a DLP's, so there is mixing to find.
@@ -74,6 +75,7 @@ int photometric_in_twin(const cli::Args& args, const std::string& out) {
 int photometric_on_devices(const cli::Args& args, const std::string& out) {
   const std::string path = *args.get("config");
   const config::Scene scene = config::load_scene(path);
+  check_scene_outputs(args, scene);
   if (!scene.devices.camera)
     throw cli::UsageError(path +
                           " configures no camera (devices.camera): the session needs the projector and a colour camera; "

@@ -62,6 +62,7 @@ const Command kRecord{
       const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
       args.check_clashes({{"the default scene", (asset_dir() / "scenes" / "tour.yaml"), false}});
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
+      check_scene_outputs(args, scene);
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot record` needs a 'tour: {visits: [...]}' section");
       const int visits = args.get_int("visits", static_cast<int>(scene.visits.size()), 1, 1000);

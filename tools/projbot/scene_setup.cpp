@@ -52,6 +52,34 @@ Eigen::Matrix4d framing_pose(const config::ProjectorConfig& p, double radius_m) 
   return T;
 }
 
+namespace {
+
+void add_model_inputs(const std::filesystem::path& model, const std::string& whose, std::vector<config::NamedPath>& out) {
+  if (model.empty()) return;
+  const auto files = assets::model_files(model);
+  out.push_back({"the model of " + whose, files.front(), false});
+  for (std::size_t i = 1; i < files.size(); ++i) out.push_back({"part of the model of " + whose, files[i], false});
+}
+
+}  // namespace
+
+std::vector<config::NamedPath> scene_inputs(const config::Scene& scene) {
+  std::vector<config::NamedPath> out;
+  if (!scene.source.empty()) out.push_back({"the scene", scene.source, false});
+  for (const auto& t : scene.targets) {
+    const std::string whose = "target '" + t.name + "'";
+    add_model_inputs(t.model, whose, out);
+    if (!t.surface.texture.empty()) out.push_back({"the surface texture of " + whose, t.surface.texture, false});
+    if (t.content && !t.content->video.empty()) out.push_back({"the video of " + whose, t.content->video, false});
+  }
+  for (const auto& p : scene.props) add_model_inputs(p.model, "prop '" + p.name + "'", out);
+  if (scene.devices.laser && !scene.devices.laser->map.empty())
+    out.push_back({"the laser's map", scene.devices.laser->map, true});
+  return out;
+}
+
+void check_scene_outputs(const cli::Args& args, const config::Scene& scene) { args.check_clashes(scene_inputs(scene)); }
+
 config::Scene scene_from_args(const cli::Args& args) {
   const auto scene_path = args.get("scene");
   config::Scene scene;
@@ -75,6 +103,7 @@ config::Scene scene_from_args(const cli::Args& args) {
                             std::to_string(scene.targets.size()));
     scene.targets[0].model = *model;
   }
+  check_scene_outputs(args, scene);
   auto& p = scene.projector;
   if (const auto size = args.get("size")) {
     const auto x = size->find('x');

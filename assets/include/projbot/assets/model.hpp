@@ -157,6 +157,11 @@ Model load_mesh(const std::filesystem::path& path);
 /// load_gltf for .gltf / .glb, load_mesh for .ply / .obj / .stl; any other extension is an AssetError.
 Model load_model(const std::filesystem::path& path);
 
+/// The files loading `path` reads, listed without loading it (a command checks its outputs against them
+/// before any work): the file itself, a glTF's external buffers and images, an OBJ's material libraries
+/// and the texture maps they name. What cannot be read is left out: the loader names it when it loads.
+std::vector<std::filesystem::path> model_files(const std::filesystem::path& path);
+
 /// Scales the model frame uniformly, then (if recenter) moves the origin to the surface centroid.
 void scale_and_recenter(Model& model, double scale, bool recenter);
 
