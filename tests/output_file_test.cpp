@@ -228,6 +228,12 @@ TEST_F(AtomicFile, SignalsDuringWritesAreRetriedNotErrors) {
   std::string got;
   SignalStorm storm;
   std::thread reader([&] {
+    // The signals are for the writer's calls: a reader interrupted in its own open() gave up, and the
+    // writer's open() then waited for a reader forever (seen in a fresh root beside a build).
+    sigset_t alarm;
+    sigemptyset(&alarm);
+    sigaddset(&alarm, SIGALRM);
+    pthread_sigmask(SIG_BLOCK, &alarm, nullptr);
     std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the writer's open() waits for this
     std::ifstream in(fifo, std::ios::binary);
     char buf[4096];
