@@ -280,25 +280,18 @@ TEST_F(CliTest, HostilePcdFilesAreRefused) {
       {"header_only.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 5\nHEIGHT 1\n"},
       {"random.pcd", std::string("\x89\x01\xfe\x00garbage\x7f\x10", 14) + std::string(3000, '\x9c')},
       {"huge.pcd", header + std::string(4800, '\x01')}};
-  double empty_s = 0.0;  // refusing an empty file: the executable's start (about 0.9 s here: 388 libraries)
   for (const auto& [name, bytes] : files) {
     std::ofstream(dir_ / name, std::ios::binary) << bytes;
     for (const std::string role : {"--model", "--scan"}) {
       const std::string other = role == "--model" ? " --scan " + (dir_ / "empty.pcd").string() : " --model " + kDuck;
-      const auto t0 = std::chrono::steady_clock::now();
       const CliRun r = run_projbot("align " + role + " " + (dir_ / name).string() + other);
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (name == "empty.pcd" && role == "--model") empty_s = seconds;
       EXPECT_EQ(r.code, 1) << name << ' ' << role << ": " << r.output;
       EXPECT_NE(r.output.find(name), std::string::npos) << r.output;
       EXPECT_NE(r.output.find("malformed PCD file"), std::string::npos) << r.output;
-      // The 2e9 points claimed are refused from the header, not read: no longer than the empty file's
-      // refusal, give or take half a second.
-      if (name == "huge.pcd" && role == "--model") {
-        EXPECT_LT(seconds, empty_s + 0.5) << "empty.pcd: " << empty_s << " s";
-      }
     }
   }
+  // The 2e9 points claimed are refused from the header, not read: the run's peak memory says so (a timed
+  // comparison with the empty file's refusal failed on a loaded machine).
   const long kib = peak_rss_kib({"align", "--model", (dir_ / "huge.pcd").string(), "--scan", (dir_ / "empty.pcd").string()});
   EXPECT_GT(kib, 0);
   EXPECT_LT(kib, 200 * 1024) << "peak resident KiB of the run refusing a 2e9-point claim";

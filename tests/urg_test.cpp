@@ -33,7 +33,8 @@ TEST(UrgLaser, MrptsHokuyoDriverReadsTheScansTheUnitSends) {
   const auto served = ramp(0);
   UrgEmulator unit(served);
   MrptLaser laser("CHokuyoURG", {{"COM_port_LIN", unit.port()}});
-  const LaserScan scan = laser.next(2.0);
+  // A generous wait: it returns with the first scan; MRPT's start-up took over 2 s in a fresh root beside a build.
+  const LaserScan scan = laser.next(10.0);
   // The UTM-30LX's steps 0..1080 as PP reported them: 1081 rays, 1440 to the turn (270.25 degrees), 60 m.
   ASSERT_EQ(scan.ranges_m.size(), 1081U);
   EXPECT_NEAR(scan.aperture_rad, 1081 * 2 * std::numbers::pi / 1440, 1e-6);
