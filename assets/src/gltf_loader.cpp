@@ -19,6 +19,7 @@
 #include "image_info.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/paths.hpp"
+#include "referenced_files.hpp"
 
 namespace projbot::assets {
 namespace {
@@ -364,20 +365,6 @@ bool read_regular_file(std::vector<unsigned char>* out, std::string* err, const 
   return tinygltf::ReadWholeFile(out, err, file, user);
 }
 
-// The document's JSON: a .gltf file's text, or a .glb's first chunk (already read whole by tinygltf, so
-// its header is sound; checked again all the same).
-std::string document_json(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!is_glb(path)) return bytes;
-  std::uint32_t length = 0, type = 0;
-  if (bytes.size() < 20) return {};
-  std::memcpy(&length, bytes.data() + 12, 4);
-  std::memcpy(&type, bytes.data() + 16, 4);
-  if (type != 0x4E4F534AU || length > bytes.size() - 20) return {};  // 'JSON'
-  return bytes.substr(20, length);
-}
-
 }  // namespace
 
 Model load_gltf(const std::filesystem::path& path) {
@@ -405,7 +392,7 @@ Model load_gltf(const std::filesystem::path& path) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     throw AssetError(file + ": " + (err.empty() ? std::string("tinygltf could not parse the file") : err));
   }
-  Model model = Loader(gltf, file).build(gltf.animations.empty() ? std::string() : document_json(path));
+  Model model = Loader(gltf, file).build(gltf.animations.empty() ? std::string() : detail::gltf_document_json(path));
   model.files = {path};
   const auto external = [&](const std::string& uri) {
     if (!uri.empty() && uri.rfind("data:", 0) != 0) model.files.push_back(path.parent_path() / uri);

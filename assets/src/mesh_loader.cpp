@@ -17,11 +17,11 @@
 #include <vector>
 
 #include "default_material.hpp"
-#include "obj_files.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/isolated_read.hpp"
 #include "projbot/config/paths.hpp"
 #include "projbot/config/ply_body.hpp"
+#include "referenced_files.hpp"
 
 namespace projbot::assets {
 namespace {
@@ -190,7 +190,8 @@ Model load_mesh(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path, ec))
     throw AssetError(path.string() + (std::filesystem::exists(path, ec) ? ": not a regular file" : ": no such file"));
   if (detail::lowercase_extension(path) == ".ply") check_ply(path);
-  for (const std::string& library : detail::obj_material_libraries(path))  // Assimp would block on a FIFO until its time limit
+  const std::vector<std::string> libraries = detail::obj_material_libraries(path);
+  for (const std::string& library : libraries)  // Assimp would block on a FIFO until its time limit
     if (const auto problem = config::input_file_problem(path.parent_path() / library);
         !problem.empty() && problem != "does not exist")
       throw AssetError((path.parent_path() / library).string() + ": " + problem + " (the material library " + path.string() +
@@ -204,7 +205,7 @@ Model load_mesh(const std::filesystem::path& path) {
   }
   Model model = model_from_bytes(bytes, path);
   model.files.insert(model.files.begin(), path);
-  for (const std::string& library : detail::obj_material_libraries(path)) model.files.push_back(path.parent_path() / library);
+  for (const std::string& library : libraries) model.files.push_back(path.parent_path() / library);
   return model;
 }
 

@@ -9,36 +9,22 @@
 #include <string>
 
 #include "default_material.hpp"
-#include "obj_files.hpp"
 #include "projbot/assets/model.hpp"
 #include "projbot/config/paths.hpp"
+#include "referenced_files.hpp"
 
 namespace projbot::assets {
 namespace {
 
-constexpr std::uintmax_t kMaxDocumentBytes = 256u << 20;  // a glTF's JSON or a .mtl beyond this is not read here
+constexpr std::uintmax_t kMaxDocumentBytes = 256u << 20;  // a glTF, OBJ or .mtl beyond this is not read here
 
 bool readable(const std::filesystem::path& file) {
   std::error_code ec;
   return config::input_file_problem(file).empty() && std::filesystem::file_size(file, ec) <= kMaxDocumentBytes && !ec;
 }
 
-// A .gltf's text, or a .glb's JSON chunk; empty where it cannot be had.
-std::string gltf_json(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (detail::lowercase_extension(file) == ".gltf") return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  char header[20];
-  if (!in.read(header, sizeof header) || std::memcmp(header, "glTF", 4) != 0 || std::memcmp(header + 16, "JSON", 4) != 0)
-    return {};
-  std::uint32_t length = 0;
-  std::memcpy(&length, header + 12, 4);
-  if (length > kMaxDocumentBytes) return {};
-  std::string json(length, '\0');
-  return in.read(json.data(), length) ? json : std::string();
-}
-
 void add_gltf_uris(const std::filesystem::path& file, std::vector<std::filesystem::path>& out) {
-  const nlohmann::json doc = nlohmann::json::parse(gltf_json(file), nullptr, false);
+  const nlohmann::json doc = nlohmann::json::parse(detail::gltf_document_json(file), nullptr, false);
   if (!doc.is_object()) return;  // malformed: the loader says so
   for (const char* key : {"buffers", "images"}) {
     if (!doc.contains(key) || !doc[key].is_array()) continue;
@@ -68,6 +54,24 @@ void add_obj_files(const std::filesystem::path& file, std::vector<std::filesyste
 }
 
 }  // namespace
+
+std::string detail::gltf_document_json(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char header[20] = {};
+  in.read(header, sizeof header);
+  if (in.gcount() < 4 || std::memcmp(header, "glTF", 4) != 0) {  // a .gltf: the text is the document
+    in.clear();
+    in.seekg(0);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+  std::uint32_t length = 0;
+  std::memcpy(&length, header + 12, 4);
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (in.gcount() < 20 || std::memcmp(header + 16, "JSON", 4) != 0 || ec || length > size - 20) return {};
+  std::string json(length, '\0');
+  return in.read(json.data(), length) ? json : std::string();
+}
 
 std::vector<std::filesystem::path> model_files(const std::filesystem::path& path) {
   std::vector<std::filesystem::path> out{path};

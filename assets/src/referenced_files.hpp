@@ -1,5 +1,6 @@
 #pragma once
-// What an OBJ file names besides itself, for the mesh loader and model_files.
+// What a model file names besides itself, for the loaders and model_files: an OBJ's material libraries,
+// and a glTF's JSON document (where its buffers, images and animations are named).
 
 #include <filesystem>
 #include <fstream>
@@ -24,5 +25,10 @@ inline std::vector<std::string> obj_material_libraries(const std::filesystem::pa
   }
   return out;
 }
+
+/// The JSON document of a glTF file: a .gltf's whole text, or a .glb's JSON chunk (told apart by the
+/// .glb's magic bytes); empty where a .glb's header is not sound. The caller has checked that `path` is a
+/// regular file (model_files.cpp).
+std::string gltf_document_json(const std::filesystem::path& path);
 
 }  // namespace projbot::assets::detail
