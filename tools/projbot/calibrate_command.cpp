@@ -60,9 +60,8 @@ int run_simulate(const cli::Args& args) {
   if (!out) throw cli::UsageError("--out DIR is required");
   cli::check_new_folder(*out, "--out needs a new or empty folder for the capture");
   const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
-  args.check_clashes({{"the default scene", scene_path, false}});
   const config::Scene scene = config::load_scene(scene_path);
-  check_scene_outputs(args, scene);
+  check_scene_outputs(args, scene, "the default scene");
   const calibrate::SimulationConfig c = simulation_config(args, scene);
   Progress progress("pose", c.poses);
   catch_interrupts();  // Ctrl-C: the poses rendered so far are written as the capture
@@ -174,9 +173,8 @@ int run_capture(const cli::Args& args) {
   if (!out) throw cli::UsageError("--out DIR is required");
   cli::check_new_folder(*out, "--out needs a new or empty folder for the capture");
   const std::string scene_path = args.get_or("config", (asset_dir() / "scenes" / "shop.yaml").string());
-  args.check_clashes({{"the default scene", scene_path, false}});
   const config::Scene scene = config::load_scene(scene_path);
-  check_scene_outputs(args, scene);
+  check_scene_outputs(args, scene, "the default scene");
   const bool sim = args.flag("sim");
   if (!sim && !scene.devices.camera)
     throw cli::UsageError(scene_path +

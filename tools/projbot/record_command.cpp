@@ -60,9 +60,8 @@ const Command kRecord{
       const double dwell_s = args.get_double("dwell", 2.0);
       if (!(dwell_s > 0.0 && dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
       const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
-      args.check_clashes({{"the default scene", (asset_dir() / "scenes" / "tour.yaml"), false}});
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
-      check_scene_outputs(args, scene);
+      check_scene_outputs(args, scene, "the default scene");
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot record` needs a 'tour: {visits: [...]}' section");
       const int visits = args.get_int("visits", static_cast<int>(scene.visits.size()), 1, 1000);

@@ -241,9 +241,8 @@ const Command kRun{
       const std::optional<config::Recording> recording = replay_of(args);
       const std::string scene_path =
           args.get_or("config", recording ? recording->scene.string() : (asset_dir() / "scenes" / "tour.yaml").string());
-      args.check_clashes({{recording ? "the recording's scene" : "the default scene", scene_path, false}});
       config::Scene scene = config::load_scene(scene_path);
-      check_scene_outputs(args, scene);
+      check_scene_outputs(args, scene, recording ? "the recording's scene" : "the default scene");
       if (recording) config::use_learnt_reflectance(scene, *recording);  // compensated as the session learnt it
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");

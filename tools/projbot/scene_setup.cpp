@@ -63,9 +63,9 @@ void add_model_inputs(const std::filesystem::path& model, const std::string& who
 
 }  // namespace
 
-std::vector<config::NamedPath> scene_inputs(const config::Scene& scene) {
+std::vector<config::NamedPath> scene_inputs(const config::Scene& scene, const std::string& scene_name) {
   std::vector<config::NamedPath> out;
-  if (!scene.source.empty()) out.push_back({"the scene", scene.source, false});
+  if (!scene.source.empty()) out.push_back({scene_name, scene.source, false});
   for (const auto& t : scene.targets) {
     const std::string whose = "target '" + t.name + "'";
     add_model_inputs(t.model, whose, out);
@@ -78,7 +78,9 @@ std::vector<config::NamedPath> scene_inputs(const config::Scene& scene) {
   return out;
 }
 
-void check_scene_outputs(const cli::Args& args, const config::Scene& scene) { args.check_clashes(scene_inputs(scene)); }
+void check_scene_outputs(const cli::Args& args, const config::Scene& scene, const std::string& scene_name) {
+  args.check_clashes(scene_inputs(scene, scene_name));
+}
 
 config::Scene scene_from_args(const cli::Args& args) {
   const auto scene_path = args.get("scene");
@@ -93,7 +95,6 @@ config::Scene scene_from_args(const cli::Args& args) {
     scene.targets.push_back(target);
     frame_model = !args.get("pose-matrix");
   } else {
-    args.check_clashes({{"the default scene", asset_dir() / "scenes" / "demo.yaml", false}});
     scene = config::load_scene(asset_dir() / "scenes" / "demo.yaml");
   }
 
@@ -103,7 +104,7 @@ config::Scene scene_from_args(const cli::Args& args) {
                             std::to_string(scene.targets.size()));
     scene.targets[0].model = *model;
   }
-  check_scene_outputs(args, scene);
+  check_scene_outputs(args, scene, scene_path ? "the scene" : "the default scene");
   auto& p = scene.projector;
   if (const auto size = args.get("size")) {
     const auto x = size->find('x');

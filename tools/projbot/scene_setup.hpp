@@ -33,13 +33,14 @@ double model_scale_option(const cli::Args& args, double fallback);
 /// config::ConfigError or cli::UsageError.
 config::Scene scene_from_args(const cli::Args& args);
 
-/// The files a scene makes a command read, named for messages: the scene file, each target's and prop's
-/// model with the files it reads (assets::model_files), surface textures, content videos, the laser's map.
-std::vector<config::NamedPath> scene_inputs(const config::Scene& scene);
+/// The files a scene makes a command read, named for messages: the scene file (as `scene_name`: "the
+/// default scene" where the command chose it), each target's and prop's model with the files it reads
+/// (assets::model_files), surface textures, content videos, the laser's map.
+std::vector<config::NamedPath> scene_inputs(const config::Scene& scene, const std::string& scene_name = "the scene");
 
-/// Before any work: no output option of `args` is one of scene_inputs(scene), or holds one (UsageError
-/// naming both).
-void check_scene_outputs(const cli::Args& args, const config::Scene& scene);
+/// Before any work: no output option of `args` is one of scene_inputs(scene, scene_name), or holds one
+/// (UsageError naming both).
+void check_scene_outputs(const cli::Args& args, const config::Scene& scene, const std::string& scene_name = "the scene");
 
 /// A pose that frames a model of bounding radius r in the projector's view: model +y up in the image,
 /// model front (+z) towards the projector.

@@ -109,9 +109,8 @@ const Command kTour{
       }
       o.compensation = on_off(args, "compensation", true);
       const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
-      args.check_clashes({{"the default scene", scene_path, false}});
       const auto scene = config::load_scene(scene_path);
-      check_scene_outputs(args, scene);
+      check_scene_outputs(args, scene, "the default scene");
       if (const auto calibration = args.get("calibration")) {
         o.calibration = config::load_calibration(*calibration);
         if (o.calibration->projector.width_px != scene.projector.width_px ||
