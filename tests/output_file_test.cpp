@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "projbot/assets/image.hpp"
+#include "projbot/assets/model.hpp"
 #include "projbot/config/paths.hpp"
 
 namespace fs = std::filesystem;
@@ -146,6 +147,29 @@ TEST_F(AtomicFile, PngRoundTripAndFailedPngWrite) {
   ASSERT_EQ(back.height, 2);
   EXPECT_EQ(back.pixel(2, 1)[0], 200);
   expect_error([&] { projbot::assets::write_png("/dev/full", img); }, "/dev/full");
+}
+
+// A depth image written as 16-bit PNG reads back value for value (stb writes 8 bits only; ours packs the
+// rows with its deflate), and a mesh written as PLY loads back with its triangles and its scale.
+TEST_F(AtomicFile, Gray16PngAndPlyMeshRoundTrip) {
+  projbot::assets::Gray16Image depth{5, 3, {}};
+  for (int i = 0; i < 15; ++i) depth.values.push_back(static_cast<std::uint16_t>(i * 4369));  // 0 .. 61166
+  depth.values[7] = 65535;
+  const fs::path png = dir_ / "depth.png";
+  projbot::assets::write_png_gray16(png, depth);
+  const auto back = projbot::assets::read_png_gray16(png);
+  ASSERT_EQ(back.width, 5);
+  ASSERT_EQ(back.height, 3);
+  EXPECT_EQ(back.values, depth.values);
+  expect_error([&] { projbot::assets::write_png_gray16("/dev/full", depth); }, "/dev/full");
+  expect_error([&] { projbot::assets::write_png_gray16(dir_ / "empty.png", {0, 0, {}}); }, "empty");
+  const projbot::assets::Model box = projbot::assets::make_box({-0.1, -0.2, 0.0}, {0.1, 0.2, 0.05}, {1.0F, 1.0F, 1.0F, 1.0F});
+  const fs::path ply = dir_ / "box.ply";
+  projbot::assets::write_ply(ply, box, 1000.0);
+  const projbot::assets::Model mesh = projbot::assets::load_mesh(ply);
+  EXPECT_EQ(mesh.triangle_count(), box.triangle_count());
+  EXPECT_NEAR(mesh.bounds().max().y(), 200.0, 1e-3);  // millimetres, as written
+  EXPECT_NEAR(mesh.bounds().min().z(), 0.0, 1e-3);
 }
 
 // A command's inputs against its outputs (issue 47): what would destroy an input is found, through links

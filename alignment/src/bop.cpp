@@ -104,8 +104,10 @@ std::string image_name(int id, const char* ext) {
 
 bool has_symmetries(const json& info) { return info.contains("symmetries_discrete") || info.contains("symmetries_continuous"); }
 
-std::vector<BopObject> read_objects(const fs::path& root) {
-  const fs::path file = root / "models" / "models_info.json";
+}  // namespace
+
+std::vector<BopObject> read_bop_models(const fs::path& models) {
+  const fs::path file = models / "models_info.json", root = models.parent_path();
   const json info = read_json(file);
   bool any_symmetry = false;
   for (const auto& [key, value] : info.items()) any_symmetry = any_symmetry || has_symmetries(value);
@@ -121,7 +123,7 @@ std::vector<BopObject> read_objects(const fs::path& root) {
     if (!d.is_number() || !(d.get<double>() > 0.0) || !std::isfinite(d.get<double>()))
       fail(file, "object " + key + ": diameter must be a finite number > 0 (mm)");
     o.diameter_m = d.get<double>() / 1000.0;
-    o.model = root / "models" / ("obj_" + image_name(o.id, ".ply"));
+    o.model = models / ("obj_" + image_name(o.id, ".ply"));
     o.symmetric =
         any_symmetry ? has_symmetries(value) : ycbv && std::count(kYcbvSymmetricIds.begin(), kYcbvSymmetricIds.end(), o.id) > 0;
     objects.push_back(o);
@@ -130,6 +132,8 @@ std::vector<BopObject> read_objects(const fs::path& root) {
   std::sort(objects.begin(), objects.end(), [](const BopObject& a, const BopObject& b) { return a.id < b.id; });
   return objects;
 }
+
+namespace {
 
 BopImage read_camera(const fs::path& file, const fs::path& folder, int id, const json& cam, Rounding& rounding) {
   const std::string where = "image " + std::to_string(id);
@@ -234,7 +238,7 @@ BopDataset read_bop_dataset(const fs::path& root, const std::vector<std::string>
   if (!fs::is_directory(root, ec)) fail(root, "no such folder (a BOP dataset: models/ and " + split + "/)");
   BopDataset out;
   out.root = root;
-  out.objects = read_objects(root);
+  out.objects = read_bop_models(root / "models");
   const fs::path split_dir = root / split;
   if (!fs::is_directory(split_dir, ec)) fail(split_dir, "no such folder (the dataset's " + split + " split)");
   std::vector<fs::path> folders;

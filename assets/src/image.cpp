@@ -27,6 +27,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <memory>
@@ -53,6 +54,56 @@ void write_png(const std::filesystem::path& path, const Image& image) {
   std::vector<std::uint8_t> png;
   if (stbi_write_png_to_func(append_bytes, &png, image.width, image.height, 4, image.rgba.data(), image.width * 4) == 0)
     throw AssetError(path.string() + ": cannot encode PNG");
+  try {
+    config::write_file_atomically(path, png.data(), png.size());
+  } catch (const config::OutputError& e) {
+    throw AssetError(e.what());
+  }
+}
+
+namespace {
+
+void append_be32(std::vector<std::uint8_t>& out, std::uint32_t v) {
+  for (const int shift : {24, 16, 8, 0}) out.push_back(static_cast<std::uint8_t>(v >> shift));
+}
+
+// One PNG chunk: length, type, data and the CRC of type and data (stb's).
+void append_chunk(std::vector<std::uint8_t>& png, const char* type, const std::uint8_t* data, std::size_t size) {
+  append_be32(png, static_cast<std::uint32_t>(size));
+  const std::size_t start = png.size();
+  png.insert(png.end(), type, type + 4);
+  png.insert(png.end(), data, data + size);
+  append_be32(png, stbiw__crc32(png.data() + start, static_cast<int>(size + 4)));
+}
+
+}  // namespace
+
+// stb writes 8-bit PNGs only; its deflate and CRC make the 16-bit one (rows unfiltered, big-endian samples).
+void write_png_gray16(const std::filesystem::path& path, const Gray16Image& image) {
+  if (image.width <= 0 || image.height <= 0 || image.values.size() != static_cast<std::size_t>(image.width) * image.height)
+    throw AssetError(path.string() + ": refusing to write an empty or inconsistent image");
+  const std::size_t row = 1 + 2 * static_cast<std::size_t>(image.width);
+  std::vector<std::uint8_t> raw(row * image.height);
+  for (int y = 0; y < image.height; ++y) {
+    std::uint8_t* out = raw.data() + row * y;
+    *out++ = 0;  // filter: none
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint16_t v = image.values[static_cast<std::size_t>(y) * image.width + x];
+      *out++ = static_cast<std::uint8_t>(v >> 8);
+      *out++ = static_cast<std::uint8_t>(v & 0xFF);
+    }
+  }
+  int packed_size = 0;
+  std::unique_ptr<unsigned char, void (*)(void*)> packed(
+      stbi_zlib_compress(raw.data(), static_cast<int>(raw.size()), &packed_size, 6), std::free);
+  if (!packed) throw AssetError(path.string() + ": cannot encode PNG");
+  std::vector<std::uint8_t> png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'}, header;
+  append_be32(header, static_cast<std::uint32_t>(image.width));
+  append_be32(header, static_cast<std::uint32_t>(image.height));
+  header.insert(header.end(), {16, 0, 0, 0, 0});  // 16 bits, grey, deflate, adaptive filtering, not interlaced
+  append_chunk(png, "IHDR", header.data(), header.size());
+  append_chunk(png, "IDAT", packed.get(), static_cast<std::size_t>(packed_size));
+  append_chunk(png, "IEND", nullptr, 0);
   try {
     config::write_file_atomically(path, png.data(), png.size());
   } catch (const config::OutputError& e) {

@@ -35,6 +35,7 @@ extern const Command kBenchContent;
 extern const Command kBenchAcquire;
 extern const Command kBenchDataset;
 extern const Command kBenchSensor;
+extern const Command kTwinDataset;
 extern const Command kSlam;
 extern const Command kLocalize;
 extern const Command kBenchLocalize;

@@ -37,6 +37,7 @@ const std::vector<const Command*>& commands() {
                                                &projbot::tools::kBenchAcquire,
                                                &projbot::tools::kBenchDataset,
                                                &projbot::tools::kBenchSensor,
+                                               &projbot::tools::kTwinDataset,
                                                &projbot::tools::kSlam,
                                                &projbot::tools::kLocalize,
                                                &projbot::tools::kBenchLocalize,

@@ -66,6 +66,11 @@ std::string rounded_rotations_note(const BopDataset& data);
 /// The ids YCB-V's own evaluation scores as symmetric (cans, bowl, wood block, marker, clamps, foam brick).
 inline const std::vector<int> kYcbvSymmetricIds{1, 4, 6, 13, 16, 18, 19, 20, 21};
 
+/// The objects of a BOP models folder (`models_info.json` and obj_IIIIII.ply beside it), checked as
+/// read_bop_dataset checks them; a folder of YCB-V (its own or its parent's name says so) without
+/// symmetry entries gets kYcbvSymmetricIds. Throws AlignmentError naming the file.
+std::vector<BopObject> read_bop_models(const std::filesystem::path& models);
+
 /// Reads the dataset at `root` (holding models/ and `split`/), only the scenes named in `scenes` when it
 /// is not empty. Checks every JSON file, that each image's depth image exists, that scene_gt_info.json
 /// lists as many instances as scene_gt.json, that every obj_id has a model, and that poses are rigid

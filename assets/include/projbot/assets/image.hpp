@@ -41,6 +41,9 @@ struct Gray16Image {
 /// leaves any previous file unchanged. Throws AssetError naming the file.
 void write_png(const std::filesystem::path& path, const Image& image);
 
+/// Writes a 16-bit single-channel PNG (a depth image) atomically, as write_png does. Throws AssetError.
+void write_png_gray16(const std::filesystem::path& path, const Gray16Image& image);
+
 /// Reads a PNG or JPEG into RGBA8. Throws AssetError naming the file.
 Image read_image(const std::filesystem::path& path);
 

@@ -162,6 +162,10 @@ Model load_model(const std::filesystem::path& path);
 /// and the texture maps they name. What cannot be read is left out: the loader names it when it loads.
 std::vector<std::filesystem::path> model_files(const std::filesystem::path& path);
 
+/// Writes the model's triangles as one binary PLY mesh (vertices with normals; no materials), positions
+/// times `units_per_metre` (1000: BOP's millimetres), atomically. Throws AssetError naming the file.
+void write_ply(const std::filesystem::path& path, const Model& model, double units_per_metre);
+
 /// Scales the model frame uniformly, then (if recenter) moves the origin to the surface centroid.
 void scale_and_recenter(Model& model, double scale, bool recenter);
 
