@@ -72,7 +72,7 @@ int run_twin_dataset(const cli::Args& args) {
             << s.objects << " objects in " << *out << " (sensor: " << args.get_or("sensor", "fitted") << ")\n"
             << "measure on it: projbot bench dataset " << *out << "\n";
   if (s.interrupted) {
-    std::cout << "interrupted: the scenes written are whole\n";
+    std::cout << "interrupted: the last scene holds the images written before the stop; every scene's files are complete\n";
     return interrupt_exit_code();
   }
   return 0;
@@ -98,8 +98,8 @@ const Command kTwinDataset{
     "scene_gt_info.json (px_count_visib ...) and cam_R_w2c / cam_t_w2c come from the exact render. Symmetries in\n"
     "models_info.json: each procedural body of revolution's axis; a folder's symmetric object (YCB-V's list)\n"
     "the half turn about its most distinct principal axis. The same seed writes the same dataset. Ctrl-C\n"
-    "stops after the image being written; the scenes written are whole (a scene is renamed into place when\n"
-    "done).\n",
+    "stops after the image being written: the last scene keeps the images written so far, its files complete\n"
+    "(each scene is written beside its place and renamed into it when done: an error leaves no half scene).\n",
     {{"out", "DIR", "the dataset's folder (new or empty)", cli::PathRole::output_folder},
      {"models", "DIR", "a BOP models folder to take objects from (repeatable; default: the shared YCB-Video meshes)",
       cli::PathRole::input_folder},

@@ -34,14 +34,14 @@ struct DatasetOptions {
 
 struct DatasetSummary {
   int objects = 0, scenes = 0, images = 0, instances = 0;
-  bool interrupted = false;  ///< stop_requested ended it: the scenes written are whole
+  bool interrupted = false;  ///< stop_requested ended it: the last scene holds the images written before
 };
 
 /// Writes the dataset into `out` (an empty or new folder): models/ (each object's PLY and
 /// models_info.json) and test/SCENE/ (depth/, rgb/, mask_visib/, scene_camera.json, scene_gt.json,
-/// scene_gt_info.json). Each scene is written beside its place and renamed into it when whole, so an
-/// error or a stop never leaves half a scene. Throws config::OutputError, assets::AssetError or
-/// alignment::AlignmentError naming the file; a repeated object id across `model_folders` is an error.
+/// scene_gt_info.json). Each scene is written beside its place and renamed into it when done, so an
+/// error never leaves half a scene; a stop ends the last scene after the images written. Throws config::OutputError,
+/// assets::AssetError or alignment::AlignmentError naming the file; a repeated object id across `model_folders` is an error.
 DatasetSummary write_twin_dataset(const std::filesystem::path& out, const DatasetOptions& options, engine::Renderer& renderer);
 
 }  // namespace projbot::twin
