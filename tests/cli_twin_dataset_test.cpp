@@ -1,7 +1,10 @@
 // projbot twin-dataset through the executable (issue 68): a BOP dataset that the readers take as they take
 // real ones, whose depth agrees with its own ground truth, reproducible for a seed, and its refusals.
 
+#include <Eigen/Geometry>
+
 #include "cli_fixture.hpp"
+#include "projbot/assets/model.hpp"
 
 using cli_fixture::CliTest;
 
@@ -35,7 +38,65 @@ double median_depth_mm(const fs::path& depth_png, const fs::path& mask_png, doub
   return z[z.size() / 2];
 }
 
+// The lowest point (mm, world z: the table top is 0) of `mesh` placed by an instance's ground truth and
+// its image's camera pose.
+double lowest_in_world_mm(const projbot::assets::Model& mesh, const nlohmann::json& gt, const nlohmann::json& camera) {
+  Eigen::Matrix3d R_m2c, R_w2c;
+  for (int i = 0; i < 9; ++i) {
+    R_m2c(i / 3, i % 3) = gt.at("cam_R_m2c")[i].get<double>();
+    R_w2c(i / 3, i % 3) = camera.at("cam_R_w2c")[i].get<double>();
+  }
+  Eigen::Vector3d t_m2c, t_w2c;
+  for (int i = 0; i < 3; ++i) t_m2c[i] = gt.at("cam_t_m2c")[i].get<double>(), t_w2c[i] = camera.at("cam_t_w2c")[i].get<double>();
+  double lowest = 1e9;
+  for (const auto& p : mesh.primitives)
+    for (const auto& v : p.vertices) {
+      const Eigen::Vector3d camera_point = R_m2c * Eigen::Vector3d(v.position[0], v.position[1], v.position[2]) + t_m2c;
+      lowest = std::min(lowest, (R_w2c.transpose() * (camera_point - t_w2c)).z());
+    }
+  return lowest;
+}
+
+// The enclosed volume (mm^3) of a closed mesh: positive when its faces point outward.
+double signed_volume(const projbot::assets::Model& mesh) {
+  double v = 0.0;
+  for (const auto& p : mesh.primitives)
+    for (std::size_t i = 0; i + 2 < p.indices.size(); i += 3) {
+      const auto at = [&](std::size_t k) {
+        const auto& q = p.vertices[p.indices[i + k]].position;
+        return Eigen::Vector3d(q[0], q[1], q[2]);
+      };
+      v += at(0).dot(at(1).cross(at(2))) / 6.0;
+    }
+  return v;
+}
+
 }  // namespace
+
+// Every object of a scene rests on the table (its lowest point at the table top, z = 0 in the world the
+// cameras' cam_R_w2c / cam_t_w2c give), and the procedural shapes are closed with their faces outward:
+// the cup holds its walls' volume, not its hollow's.
+TEST_F(CliTest, TwinDatasetObjectsRestOnTheTableAndTheShapesAreSolid) {
+  const fs::path out = dir_ / "twin";
+  const CliRun r = run_projbot("twin-dataset --out " + out.string() + " --scenes 1 --images 1 --seed 4");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto gt = read_json(out / "test" / "000000" / "scene_gt.json").at("0");
+  const auto camera = read_json(out / "test" / "000000" / "scene_camera.json").at("0");
+  ASSERT_GE(gt.size(), 1U);
+  for (const auto& instance : gt) {
+    char name[32];
+    std::snprintf(name, sizeof name, "obj_%06d.ply", instance.at("obj_id").get<int>());
+    EXPECT_NEAR(lowest_in_world_mm(projbot::assets::load_mesh(out / "models" / name), instance, camera), 0.0, 0.5) << name;
+  }
+  const double cup = signed_volume(projbot::assets::load_mesh(out / "models" / "obj_000102.ply"));
+  const double walls = M_PI * (40.0 * 40.0 * 95.0 - 37.0 * 37.0 * 89.0);  // outer cylinder less the hollow
+  EXPECT_NEAR(cup, walls, 0.01 * walls);
+  for (const int id : {101, 103, 104, 105}) {
+    char name[32];
+    std::snprintf(name, sizeof name, "obj_%06d.ply", id);
+    EXPECT_GT(signed_volume(projbot::assets::load_mesh(out / "models" / name)), 1000.0) << name;
+  }
+}
 
 TEST_F(CliTest, TwinDatasetIsABopDatasetWhoseDepthAgreesWithItsGroundTruth) {
   const fs::path out = dir_ / "twin";
