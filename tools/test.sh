@@ -2,7 +2,7 @@
 # Quick start, command 2 (and CI): install what is missing, build everything with warnings as errors,
 # check formatting, check the align path and the hostile-input suite for memory errors under
 # AddressSanitizer + UBSan (on every machine; valgrind's memcheck in the main suite is skipped where
-# valgrind cannot run the executable, see the README), run the whole test suite (GPU tests on lavapipe,
+# valgrind cannot run the executable, see docs/building.md), run the whole test suite (GPU tests on lavapipe,
 # window tests under Xvfb), then every fuzz target for a short smoke run (its seeds include every
 # earlier finding), then the portable bundle (tools/bundle-check.sh; skipped, with its reason, where no bare
 # root can be entered).

@@ -1,5 +1,5 @@
 #!/bin/sh
-# The benchmarks of the README's GPU section, run from a bundle (tools/bundle.sh) on the machine it was
+# The benchmarks of the GPU bundle's page (docs/gpu-bundle.md), run from a bundle (tools/bundle.sh) on the machine it was
 # carried to; each one's table goes to OUT/NAME.txt as it prints, and OUT/summary.txt gathers their
 # headline lines with the machine named.
 #   DIR/bench.sh OUT [--quick]
