@@ -17,6 +17,21 @@ TEST_F(CliTest, HelpNamesTheCommands) {
   EXPECT_EQ(group.code, 0) << group.output;
   EXPECT_NE(group.output.find("Usage: projbot calibrate WHAT"), std::string::npos) << group.output;
   EXPECT_NE(group.output.find("  photometric  the projector's response per channel"), std::string::npos) << group.output;
+  // Every command's help names the guide's page that explains it, and the page is there.
+  std::istringstream listed(r.output.substr(r.output.find("Commands:")));
+  int commands = 0;
+  for (std::string line; std::getline(listed, line) && line.rfind("Examples:", 0) != 0;) {
+    if (line.size() < 26 || line.rfind("  ", 0) != 0) continue;
+    std::string name = line.substr(2, 23);
+    name.erase(name.find_last_not_of(' ') + 1);
+    const CliRun help = run_projbot(name + " --help");
+    const auto at = help.output.find("Guide: docs/");
+    ASSERT_NE(at, std::string::npos) << name << ": " << help.output;
+    const std::string page = help.output.substr(at + 7, help.output.find(' ', at + 7) - at - 7);
+    EXPECT_TRUE(fs::exists(fs::path(PROJBOT_SOURCE_DIR) / page)) << name << ": " << page;
+    ++commands;
+  }
+  EXPECT_GE(commands, 24);
   const CliRun bench = run_projbot("bench -h");
   EXPECT_EQ(bench.code, 0) << bench.output;
   EXPECT_NE(bench.output.find("  dataset      pose estimation on a BOP dataset's real frames"), std::string::npos)

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <map>
 #include <new>
 #include <sstream>
 #include <string>
@@ -51,6 +52,36 @@ const std::vector<const Command*>& commands() {
                                                &projbot::tools::kCalibrateSolve,
                                                &projbot::tools::kCalibratePhotometric};
   return all;
+}
+
+// The guide's page (docs/ in the source tree) that explains each command, by the command's first word
+// or its whole name.
+std::string guide_page(const std::string& name) {
+  static const std::map<std::string, std::string> pages{{"render", "using.md"},
+                                                        {"show", "using.md"},
+                                                        {"bench render", "profiling.md"},
+                                                        {"align", "pose-estimation.md"},
+                                                        {"bench track", "pose-estimation.md"},
+                                                        {"bench acquire", "pose-estimation.md"},
+                                                        {"bench dataset", "pose-estimation.md"},
+                                                        {"bench sensor", "pose-estimation.md"},
+                                                        {"twin-dataset", "pose-estimation.md"},
+                                                        {"bench motion", "twin-and-tour.md"},
+                                                        {"bench appearance", "visitor.md"},
+                                                        {"bench content", "content.md"},
+                                                        {"slam", "robot.md"},
+                                                        {"localize", "robot.md"},
+                                                        {"bench localize", "robot.md"},
+                                                        {"tour", "twin-and-tour.md"},
+                                                        {"run", "using.md"},
+                                                        {"record", "using.md"},
+                                                        {"devices", "hardware.md"},
+                                                        {"sim-base", "hardware.md"},
+                                                        {"calibrate photometric", "visitor.md"},
+                                                        {"calibrate", "calibration.md"}};
+  if (const auto at = pages.find(name); at != pages.end()) return at->second;
+  const auto at = pages.find(name.substr(0, name.find(' ')));
+  return at != pages.end() ? at->second : "using.md";
 }
 
 void print_help() {
@@ -206,7 +237,9 @@ static int dispatch(int argc, char** argv, std::string& name) {
   }
   for (int i = first; i < argc; ++i)
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
-      std::cout << "Usage: " << cmd->usage << "\nOptions:\n" << projbot::cli::format_options(cmd->options);
+      std::cout << "Usage: " << cmd->usage << "\nOptions:\n"
+                << projbot::cli::format_options(cmd->options) << "\nGuide: docs/" << guide_page(cmd->name)
+                << " in Projbot's source tree\n";
       return 0;
     }
   return run_command(*cmd, argc, argv, first, name);
