@@ -9,6 +9,7 @@ cd "$(dirname "$0")/.."
 export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
 bash tools/setup-debian.sh
 cmake --preset release >/dev/null
-cmake --build --preset release --target projbot
+# The shipped content scene's video (assets/scenes/content.yaml) comes with it, so `projbot bench content` works next.
+cmake --build --preset release --target projbot projbot_sample_video
 mkdir -p out
 ./build/release/tools/projbot tour --report out/tour.json --frames out/tour "$@"
