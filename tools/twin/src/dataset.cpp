@@ -16,6 +16,8 @@
 #include "projbot/config/lens.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/twin/shapes.hpp"
+#include "projbot/twin/spectator.hpp"
+#include "projbot/twin/world.hpp"
 
 namespace projbot::twin {
 namespace {
@@ -38,9 +40,9 @@ struct Rest {
 
 struct Object {
   int id = 0;
-  std::string name;
-  assets::Model model;  // metres, the dataset's own model frame
-  fs::path source;      // the PLY copied; empty for a procedural shape, written from `model`
+  assets::Model model;                  // metres, the dataset's own model frame
+  std::vector<Eigen::Vector3d> points;  // its vertices, read once: placing an object tries up to 200 poses
+  fs::path source;                      // the PLY copied; empty for a procedural shape, written from `model`
   double diameter_mm = 0.0;
   json symmetries;  // BOP's symmetry entries, or null
   std::vector<Rest> rests;
@@ -98,8 +100,7 @@ Eigen::Matrix3d standing_on(const Eigen::Vector3d& down, const Eigen::Vector3d& 
 // Its stable rests on the faces of its bounding box: standing on a face, the vertices within kContactM of
 // it carry it, and its surface centroid must lie over what they span (a bowl on its rim or its foot, not
 // on its side; a cylinder on its side or its end). None stable (a sphere): all six.
-std::vector<Rest> resting_orientations(const assets::Model& m) {
-  const std::vector<Eigen::Vector3d> v = vertices(m);
+std::vector<Rest> resting_orientations(const assets::Model& m, const std::vector<Eigen::Vector3d>& v) {
   const Eigen::Vector3d c = m.surface_centroid(), size = m.bounds().sizes();
   std::vector<Rest> stable, all;
   for (int k = 0; k < 3; ++k)
@@ -118,8 +119,7 @@ std::vector<Rest> resting_orientations(const assets::Model& m) {
   return stable.empty() ? all : stable;
 }
 
-double diameter_mm(const assets::Model& m) {
-  const std::vector<Eigen::Vector3d> v = vertices(m);
+double diameter_mm(const std::vector<Eigen::Vector3d>& v) {
   double d2 = 0.0;
   for (std::size_t i = 0; i < v.size(); ++i)
     for (std::size_t j = i + 1; j < v.size(); ++j) d2 = std::max(d2, (v[i] - v[j]).squaredNorm());
@@ -129,8 +129,7 @@ double diameter_mm(const assets::Model& m) {
 // A symmetric object of a models folder (its own symmetry entries, or YCB-V's list) keeps a flag the
 // scoring reads: the half turn about its most distinct principal axis through its middle, the one
 // symmetry a can, a marker and a clamp share.
-json half_turn(const assets::Model& m) {
-  const std::vector<Eigen::Vector3d> v = vertices(m);
+json half_turn(const std::vector<Eigen::Vector3d>& v) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const auto& p : v) mean += p;
   mean /= static_cast<double>(v.size());
@@ -183,12 +182,12 @@ std::vector<Object> folder_objects(const std::vector<fs::path>& folders) {
   for (const auto& o : listed) {
     Object obj;
     obj.id = o.id;
-    obj.name = o.model.filename().string();
     obj.source = o.model;
     obj.model = assets::load_model(o.model);
     assets::scale_and_recenter(obj.model, 0.001, false);
+    obj.points = vertices(obj.model);
     obj.diameter_mm = 1000.0 * o.diameter_m;
-    if (o.symmetric) obj.symmetries = json{{"symmetries_discrete", half_turn(obj.model)}};
+    if (o.symmetric) obj.symmetries = json{{"symmetries_discrete", half_turn(obj.points)}};
     out.push_back(std::move(obj));
   }
   return out;
@@ -201,9 +200,9 @@ std::vector<Object> objects_for(const DatasetOptions& options) {
     for (auto& s : procedural_shapes()) {
       Object obj;
       obj.id = id++;
-      obj.name = s.name;
       obj.model = std::move(s.model);
-      obj.diameter_mm = diameter_mm(obj.model);
+      obj.points = vertices(obj.model);
+      obj.diameter_mm = diameter_mm(obj.points);
       if (s.axis)
         obj.symmetries =
             json{{"symmetries_continuous",
@@ -212,7 +211,7 @@ std::vector<Object> objects_for(const DatasetOptions& options) {
     }
   }
   if (out.empty()) throw alignment::AlignmentError("twin dataset: no objects (no models folder and no procedural shapes)");
-  for (auto& o : out) o.rests = resting_orientations(o.model);
+  for (auto& o : out) o.rests = resting_orientations(o.model, o.points);
   return out;
 }
 
@@ -279,7 +278,7 @@ Eigen::Matrix3d yaw(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::Uni
 Placed place(const Object& o, const Rest& rest, double angle, const Eigen::Vector2d& xy) {
   const Eigen::Matrix3d R = yaw(angle) * rest.R;
   Eigen::AlignedBox3d box;
-  for (const auto& v : vertices(o.model)) box.extend(R * v);
+  for (const auto& v : o.points) box.extend(R * v);
   Placed p{&o, Eigen::Matrix4d::Identity(), {}};
   p.T_world_model.topLeftCorner<3, 3>() = R;
   const Eigen::Vector2d middle = box.center().head<2>();
@@ -328,26 +327,21 @@ std::vector<Placed> arrange(const std::vector<Object>& objects, std::mt19937& rn
 // The camera's path through a scene: 0.6-1.5 m from the objects' middle, looking down 20-60 degrees from
 // in front (the wall behind), moving slowly round and in, as a hand-held or robot-held camera does.
 struct CameraPath {
-  Eigen::Vector3d look_at;
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();  // what it looks at
   double distance = 1.0, elevation = 0.6, azimuth = 0.0;
   double d_distance = 0.0, d_elevation = 0.0, d_azimuth = 0.0;  // per image
 
   Eigen::Matrix4d T_world_camera(int image) const {
     const double d = distance + image * d_distance, e = elevation + image * d_elevation, a = azimuth + image * d_azimuth;
-    const Eigen::Vector3d eye = look_at + d * Eigen::Vector3d(std::sin(a) * std::cos(e), -std::cos(a) * std::cos(e), std::sin(e));
-    const Eigen::Vector3d z = (look_at - eye).normalized(), x = z.cross(Eigen::Vector3d::UnitZ()).normalized(), y = z.cross(x);
-    Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-    T.block<3, 1>(0, 0) = x, T.block<3, 1>(0, 1) = y, T.block<3, 1>(0, 2) = z, T.block<3, 1>(0, 3) = eye;
-    return T;
+    return look_at(target + d * Eigen::Vector3d(std::sin(a) * std::cos(e), -std::cos(a) * std::cos(e), std::sin(e)), target);
   }
 };
 
 CameraPath camera_path(const std::vector<Placed>& placed, std::mt19937& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   CameraPath c;
-  c.look_at = Eigen::Vector3d::Zero();
-  for (const auto& p : placed) c.look_at.head<2>() += p.footprint.center() / static_cast<double>(placed.size());
-  c.look_at.z() = 0.04;
+  for (const auto& p : placed) c.target.head<2>() += p.footprint.center() / static_cast<double>(placed.size());
+  c.target.z() = 0.04;
   const double deg = M_PI / 180.0, sign = u(rng) < 0.5 ? -1.0 : 1.0;
   c.distance = 0.6 + 0.9 * u(rng);
   c.elevation = (20.0 + 40.0 * u(rng)) * deg;
@@ -446,7 +440,6 @@ Visibility visibility(const std::vector<float>& alone, const std::vector<float>&
       v.valid += alignment::has_depth(measured[i]) ? 1 : 0;
       v.visible_box.extend(Eigen::Vector2i(x, y));
       std::fill_n(v.mask.rgba.begin() + static_cast<std::ptrdiff_t>(4 * i), 3, std::uint8_t{255});
-      v.mask.rgba[4 * i + 3] = 255;
     }
   for (std::size_t i = 3; i < v.mask.rgba.size(); i += 4) v.mask.rgba[i] = 255;
   return v;
@@ -467,12 +460,6 @@ assets::Gray16Image depth_png(const alignment::DepthImage& d) {
   return png;
 }
 
-void add_colour_noise(assets::Image& image, std::mt19937& rng) {
-  std::normal_distribution<double> noise(0.0, 2.5);  // the twin's colour camera (Twin::kColourNoiseSigma)
-  for (std::size_t i = 0; i < image.rgba.size(); ++i)
-    if (i % 4 != 3) image.rgba[i] = static_cast<std::uint8_t>(std::clamp(std::lround(image.rgba[i] + noise(rng)), 0L, 255L));
-}
-
 struct SceneJson {
   json camera = json::object(), gt = json::object(), info = json::object();
 };
@@ -485,8 +472,7 @@ int write_image(const fs::path& folder, int image, const std::vector<Placed>& pl
   const alignment::DepthImage measured =
       alignment::apply_kinect_v1_noise({k.width_px, k.height_px, r.scene_m, 0.0}, k, options.sensor, seed);
   assets::write_png_gray16(folder / "depth" / numbered(image, ".png"), depth_png(measured));
-  std::mt19937 rng(seed ^ 0x9e3779b9U);
-  add_colour_noise(r.colour, rng);
+  add_colour_noise(r.colour, seed);
   assets::write_png(folder / "rgb" / numbered(image, ".png"), r.colour);
   const Eigen::Matrix4d T_camera_world = T_world_camera.inverse();
   json gt = json::array(), info = json::array();

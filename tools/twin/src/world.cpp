@@ -314,14 +314,17 @@ assets::Image Twin::capture_colour(const Eigen::Matrix4d& T_world_camera, std::u
   if (!colour_target_) colour_target_ = renderer_.make_offscreen(camera_.width_px, camera_.height_px);
   renderer_.draw_frame(*colour_target_, camera_pinhole(), draw_items(T_world_camera));
   assets::Image image = colour_target_->read_back();
-  if (!options_.depth_noise) return image;
-  std::mt19937 rng(noise_seed ^ 0x9e3779b9U);
-  std::normal_distribution<double> noise(0.0, kColourNoiseSigma);
+  if (options_.depth_noise) add_colour_noise(image, noise_seed);
+  return image;
+}
+
+void add_colour_noise(assets::Image& image, std::uint32_t seed) {
+  std::mt19937 rng(seed ^ 0x9e3779b9U);
+  std::normal_distribution<double> noise(0.0, Twin::kColourNoiseSigma);
   for (std::size_t i = 0; i < image.rgba.size(); ++i) {
     if (i % 4 == 3) continue;  // alpha
     image.rgba[i] = static_cast<std::uint8_t>(std::clamp(std::lround(image.rgba[i] + noise(rng)), 0L, 255L));
   }
-  return image;
 }
 
 alignment::DepthImage Twin::capture(const Eigen::Matrix4d& T_world_camera, std::uint32_t noise_seed) {

@@ -167,6 +167,10 @@ class Twin {
   std::unique_ptr<engine::RenderTarget> colour_target_;
 };
 
+/// The colour camera's sensor noise over an RGBA8 image: Gaussian, Twin::kColourNoiseSigma levels per
+/// colour channel (alpha kept), reproducible for a seed.
+void add_colour_noise(assets::Image& image, std::uint32_t seed);
+
 /// The middle of a target's model (its bounding box's centre) placed by T_world_target.
 Eigen::Vector3d model_middle(const TwinTarget& t, const Eigen::Matrix4d& T_world_target);
 
