@@ -1,13 +1,17 @@
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <fstream>
 #include <functional>
 #include <numbers>
+#include <thread>
+#include <vector>
 
 #include "projbot/config/isolated_read.hpp"
 #include "projbot/config/scene.hpp"
@@ -495,5 +499,63 @@ TEST(IsolatedRead, EveryWayTheChildEndsIsNamed) {
   });
   EXPECT_NE(slow.find("projbot_isolated.bin: the test reader took longer than 0.30 s on it"), std::string::npos) << slow;
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  std::filesystem::remove(file);
+}
+
+namespace {
+
+// `seconds` of this process's own CPU time, spent spinning.
+void spin_cpu(double seconds) {
+  timespec t{};
+  const auto cpu = [&] {
+    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  };
+  for (const double start = cpu(); cpu() - start < seconds;) {
+  }
+}
+
+}  // namespace
+
+// The time limit is the reader's own: a reader that loops is stopped by its CPU time, and one that needs
+// a fifth of its limit but gets the core only now and then (at the lowest priority, behind a busy thread
+// per core and one more) reads its file, however long that takes on the wall clock. Judged by the wall
+// clock, a right mesh was called corrupt on a loaded machine ("Assimp took longer than 2.97 s on it").
+TEST(IsolatedRead, TheTimeLimitIsTheReadersOwnNotTheWallClocks) {
+  using namespace projbot::config;
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / ("projbot_isolated_" + std::to_string(::getpid()));
+  std::ofstream(file) << "data";
+  const IsolatedReader what{"test file", "the test reader", std::chrono::milliseconds(300)};
+  try {
+    read_isolated(file, what, [](ReadProgress&) -> std::string {
+      for (;;) spin_cpu(1.0);
+    });
+    ADD_FAILURE() << "a looping reader was not stopped";
+  } catch (const IsolatedReadError& e) {
+    EXPECT_NE(std::string(e.what()).find("the test reader took longer than 0.30 s on it"), std::string::npos) << e.what();
+  }
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> busy;
+  for (unsigned i = 0; i <= std::max(1U, std::thread::hardware_concurrency()); ++i)
+    busy.emplace_back([&] {
+      while (!stop.load(std::memory_order_relaxed)) {
+      }
+    });
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string result;
+  try {
+    result = read_isolated(file, what, [](ReadProgress&) -> std::string {
+      ::setpriority(PRIO_PROCESS, 0, 19);
+      spin_cpu(0.02);
+      return "read";
+    });
+  } catch (const IsolatedReadError& e) {
+    result = e.what();
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stop = true;
+  for (std::thread& t : busy) t.join();
+  EXPECT_EQ(result, "read");
+  EXPECT_GT(wall, 0.3) << "the reader was not held off the core: this test tested nothing";
   std::filesystem::remove(file);
 }

@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -14,6 +15,8 @@
 #include <cstdio>
 #include <fstream>
 #include <new>
+#include <optional>
+#include <string>
 
 #include "projbot/config/paths.hpp"
 #include "projbot/config/write_all.hpp"
@@ -36,17 +39,64 @@ constexpr bool kAddressSanitizer = false;
 constexpr bool kAddressSanitizer = false;
 #endif
 
-// Everything the child writes, until it closes the pipe or `limit` passes (then: false).
-bool read_all(int fd, std::chrono::milliseconds limit, std::string& out) {
-  const auto end = std::chrono::steady_clock::now() + limit;
+// The child's CPU time so far (user and system, all its threads); nothing where the system cannot tell.
+std::optional<std::chrono::milliseconds> cpu_time(pid_t pid) {
+  clockid_t clock{};
+  timespec t{};
+  if (::clock_getcpuclockid(pid, &clock) != 0 || ::clock_gettime(clock, &t) != 0) return std::nullopt;
+  return std::chrono::milliseconds(static_cast<long long>(t.tv_sec) * 1000 + t.tv_nsec / 1000000);
+}
+
+// Whether the child's main thread is waiting to run or running (state R in /proc), as opposed to asleep
+// or blocked; false where /proc cannot tell.
+bool runnable(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  const auto name_end = line.rfind(')');  // the command name may hold spaces and parentheses
+  return name_end != std::string::npos && name_end + 2 < line.size() && line[name_end + 2] == 'R';
+}
+
+// How long the child has spent on its read: its CPU time, plus the time it lay blocked, using none (a
+// reader waiting forever). Not the wall time, which a busy machine stretches: a right file must not be
+// called corrupt because other work held the core. Where the CPU time cannot be read, the wall time.
+class ReadClock {
+ public:
+  explicit ReadClock(pid_t pid) : pid_(pid), last_wall_(std::chrono::steady_clock::now()), last_cpu_(cpu_time(pid)) {}
+
+  std::chrono::milliseconds spent() {
+    using namespace std::chrono;
+    const auto wall = steady_clock::now();
+    const auto cpu = cpu_time(pid_);
+    const auto slice = duration_cast<milliseconds>(wall - last_wall_);
+    if (!cpu || !last_cpu_)
+      blocked_ += slice;
+    else if (*cpu - *last_cpu_ < milliseconds(1) && !runnable(pid_))
+      blocked_ += slice;
+    last_wall_ = wall;
+    if (cpu) last_cpu_ = cpu;
+    return blocked_ + (last_cpu_ ? *last_cpu_ : milliseconds(0));
+  }
+
+ private:
+  pid_t pid_;
+  std::chrono::steady_clock::time_point last_wall_;
+  std::optional<std::chrono::milliseconds> last_cpu_;
+  std::chrono::milliseconds blocked_{0};
+};
+
+// Everything the child writes, until it closes the pipe or it has spent `limit` on the read (then: false).
+bool read_all(int fd, pid_t pid, std::chrono::milliseconds limit, std::string& out) {
+  constexpr int kSliceMs = 50;  // how often the child's clock is looked at
+  ReadClock clock(pid);
   char buf[65536];
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
-    if (left.count() <= 0) return false;
+    if (clock.spent() >= limit) return false;
     pollfd p{fd, POLLIN, 0};
-    const int ready = ::poll(&p, 1, static_cast<int>(left.count()));
+    const int ready = ::poll(&p, 1, kSliceMs);
     if (ready < 0 && errno == EINTR) continue;
-    if (ready <= 0) return ready == 0 ? false : true;
+    if (ready == 0) continue;
+    if (ready < 0) return true;
     const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return true;
@@ -159,7 +209,7 @@ std::string read_isolated(const std::filesystem::path& file, const IsolatedReade
   }
   ::close(fds[1]);
   std::string reply;
-  const bool in_time = pid < 0 || read_all(fds[0], limit, reply);
+  const bool in_time = pid < 0 || read_all(fds[0], pid, limit, reply);
   ::close(fds[0]);
   if (!in_time) ::kill(pid, SIGKILL);
   int status = 0;

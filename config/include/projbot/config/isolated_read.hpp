@@ -38,7 +38,8 @@ struct IsolatedReader {
 
 /// Runs `read` in a forked child and returns the bytes it produced. An exception in `read` comes back
 /// as an IsolatedReadError with the same message; a child that dies (signal, out of its memory limit)
-/// or takes longer than its time limit is killed and named with `file`, `what` and the
+/// or spends longer than its time limit (its CPU time plus the time it lies blocked, not the wall time a
+/// busy machine stretches) is killed and named with `file`, `what` and the
 /// progress. The child's address space is capped at what it has plus 1 GiB plus 64 bytes per byte of
 /// `file` (not under AddressSanitizer, which reserves more; the time limit holds there too).
 std::string read_isolated(const std::filesystem::path& file, const IsolatedReader& what,
