@@ -162,6 +162,11 @@ void DatasetBench::follow(const alignment::BopScene& scene, const std::vector<al
     });
     row.accepted = shown && !shown->lost;
     row.T_est = shown ? shown->T_camera_target : follower.last_pose();
+    if (shown) row.inlier_ratio = shown->inlier_ratio, row.rmse_mm = shown->rmse_mm;
+    // The checks of the pose shown, as the acquisition's rows give them (outside the timing: tracking
+    // itself does not judge the outline).
+    const alignment::FreeSpaceCheck check = follower.verify(frames[f], row.T_est, true);
+    row.behind_ratio = check.behind_ratio(), row.agree_ratio = check.agree_ratio(), row.flush_ratio = check.flush_ratio();
     for (const alignment::BopInstance& inst : scene.images[f].instances)
       if (inst.obj_id == m.info->id) {
         row.gt_index = inst.gt_index;
