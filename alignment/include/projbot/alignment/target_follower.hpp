@@ -289,7 +289,10 @@ class TargetFollower {
   bool map_floor_ = false;     // the floor came from the map (and the camera's pose), not from a frame
   bool colour_contrast_;       // the model's colours can say where it is (has_colour_contrast)
   Aligner aligner_;
-  ProjectiveTracker tracker_;
+  ProjectiveTracker tracker_;  // from a guess, or from a pose frames were dropped since
+  // From the last frame's pose: a descent that has not settled within a frame's motion is sliding along
+  // what the depth leaves free, not arriving (TrackerConfig::extra_descents left out).
+  ProjectiveTracker next_frame_tracker_;
   ProjectiveTracker wide_tracker_;  // the same frame again, with a wider reach, when tracking failed
   // Acquisition's last step: tracking's settings, with the silhouette's edges where the model has no
   // colour contrast.
@@ -320,7 +323,10 @@ class TargetFollower {
   // The model's samples indexed for nearest-sample queries (nearest_look_alike, nearest_unseen_turn):
   // built once (brute force over 50000 samples was 5 % of an acquisition from 50 mm / 15 degree starts).
   NearestPoints samples_;
+  // The free-space check passes at T (check_ holds it) and T does not sink into the known support.
   bool verified(const DepthImage& frame, const Eigen::Matrix4d& T);
+  // Whether the model at T lies deeper in its known footing than acquisition lets it (footing_height_m).
+  bool sunk(const Eigen::Matrix4d& T) const;
   // A guess known to within half the model's size: touching neighbours can be told from the target
   // (clustered apart, and not counted against it by the gate), and the projective tracker goes first.
   bool close_guess(double grow_m) const { return grow_m < 0.5 * model_radius_m_; }
@@ -333,6 +339,9 @@ class TargetFollower {
   PoseSample found(const DepthImage& frame, const Eigen::Matrix4d& T, double inlier_ratio, double rmse_mm);
 
   std::optional<PoseSample> track(const DepthImage& frame);
+  // Whether frames came and went since the target was last found (the worker was busy): it may have
+  // moved farther than between two frames.
+  bool dropped_frames(const DepthImage& frame) const;
   std::optional<PoseSample> search(const DepthImage& frame, const assets::Image* colour);
   // The pose a search found, moved by colour where depth allows (and then held); false when its
   // colours disagree.
