@@ -69,10 +69,8 @@ class ReadClock {
     const auto wall = steady_clock::now();
     const auto cpu = cpu_time(pid_);
     const auto slice = duration_cast<milliseconds>(wall - last_wall_);
-    if (!cpu || !last_cpu_)
-      blocked_ += slice;
-    else if (*cpu - *last_cpu_ < milliseconds(1) && !runnable(pid_))
-      blocked_ += slice;
+    const bool unknown = !cpu || !last_cpu_, idle = !unknown && *cpu - *last_cpu_ < milliseconds(1) && !runnable(pid_);
+    if (unknown || idle) blocked_ += slice;  // the wall time counts where the CPU time cannot say
     last_wall_ = wall;
     if (cpu) last_cpu_ = cpu;
     return blocked_ + (last_cpu_ ? *last_cpu_ : milliseconds(0));
