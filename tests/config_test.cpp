@@ -319,6 +319,9 @@ INSTANTIATE_TEST_SUITE_P(
                 kProj + "targets: []\nrobot:\n  pan_tilt:\n    camera: {matrix: [2,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}\n",
                 {"robot.pan_tilt.camera", "proper rotation"}},
         BadCase{"yaml_syntax", "projector: {width: 640\ntargets: [\n", {"s.yaml:", "YAML syntax error"}},
+        BadCase{"yaml_too_deep",
+                "targets: " + std::string(2000, '[') + std::string(2000, ']') + "\n",
+                {"s.yaml:1:", "nested deeper than the parser reads"}},
         BadCase{"empty", "", {"s.yaml", "empty"}}, BadCase{"root_not_map", "- 1\n- 2\n", {"s.yaml:1:", "mapping"}}),
     [](const ::testing::TestParamInfo<BadCase>& param_info) { return std::string(param_info.param.name); });
 

@@ -135,6 +135,12 @@ std::vector<Hostile> file_cases() {
               {"m.glb"}},
       Hostile{"scene_empty", "render --scene {dir}/bad.yaml --out {dir}/prev.png", Files{{"bad.yaml", ""}}, 1, {"bad.yaml"}},
       Hostile{"scene_syntax", "render --scene {dir}/bad.yaml --out {dir}/prev.png", "projector: {width: 64\n", 1, {"bad.yaml"}},
+      // yaml-cpp stops at 500 levels and calls it "bad file": the message says how deep instead (issue 72).
+      Hostile{"scene_nested_too_deep",
+              "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+              "a: " + std::string(600, '[') + std::string(600, ']') + "\n",
+              1,
+              {"bad.yaml:1:", "stops at 500 levels"}},
       Hostile{"scene_binary",
               "render --scene {dir}/bad.yaml --out {dir}/prev.png",
               Files{{"bad.yaml", "@random:3000"}},

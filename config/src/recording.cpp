@@ -132,6 +132,8 @@ Recording load_recording(const std::filesystem::path& folder) {
     root = YAML::LoadFile(file);
   } catch (const YAML::BadFile&) {
     throw ConfigError(file + ": cannot read (not a recording made by projbot record?)");
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(yaml_error_message(e, file));
   } catch (const YAML::Exception& e) {
     throw ConfigError(file + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) : std::string()) + ": " + e.msg);
   }

@@ -323,7 +323,7 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
   try {
     c = YAML::Load(text.str());
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(file + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    throw ConfigError(yaml_error_message(e, file));
   }
   if (!c || c.IsNull()) throw ConfigError(file + ": the calibration file is empty");
   if (const std::string twice = duplicate_key_message(c, file); !twice.empty()) throw ConfigError(twice);
@@ -495,7 +495,7 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
   try {
     root = YAML::Load(std::string(yaml_text));
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(file + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    throw ConfigError(yaml_error_message(e, file));
   }
   if (!root || root.IsNull()) throw ConfigError(file + ": the scene file is empty");
 

@@ -1,5 +1,7 @@
 #include "projbot/config/yaml_keys.hpp"
 
+#include <yaml-cpp/depthguard.h>
+
 #include <set>
 #include <vector>
 
@@ -28,6 +30,13 @@ std::string duplicate_key_message(const YAML::Node& node, const std::string& fil
   const auto d = find_duplicate_key(node);
   if (!d) return "";
   return file + ":" + std::to_string(d->line) + ": '" + d->key + "' is given twice in one mapping (the second would be ignored)";
+}
+
+std::string yaml_error_message(const YAML::Exception& e, const std::string& file) {
+  const std::string where = file + (e.mark.is_null() ? std::string() : ":" + std::to_string(e.mark.line + 1));
+  if (const auto* deep = dynamic_cast<const YAML::DeepRecursion*>(&e))
+    return where + ": YAML nested deeper than the parser reads (it stops at " + std::to_string(deep->depth()) + " levels)";
+  return where + ": YAML syntax error: " + e.msg;
 }
 
 }  // namespace projbot::config

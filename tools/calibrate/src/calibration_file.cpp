@@ -98,6 +98,8 @@ Calibration read_calibration(const std::filesystem::path& path) {
       c.T_camera_board.push_back(T);
     }
     return c;
+  } catch (const YAML::ParserException& e) {
+    throw CalibrationError(config::yaml_error_message(e, path.string()));
   } catch (const YAML::Exception& e) {
     throw CalibrationError(path.string() + ": not a calibration file: " + e.what());
   }

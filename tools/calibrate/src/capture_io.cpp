@@ -168,6 +168,8 @@ CaptureManifest read_manifest(const fs::path& dir, const SolveOptions& options) 
       m.projector_height = y["projector"]["height"].as<int>();
       m.board = Board::parse(y["board"].as<std::string>());
       for (const auto& p : y["poses"]) m.folders.push_back(p.as<std::string>());
+    } catch (const YAML::ParserException& e) {
+      throw CalibrationError(config::yaml_error_message(e, file.string()));
     } catch (const YAML::Exception& e) {
       throw CalibrationError(file.string() + ": " + e.what());
     }
@@ -216,6 +218,8 @@ std::vector<BoardPose> read_board_poses(const fs::path& path) {
                                ": centre must lie in front of the camera (z > 0.1 m)");
       out.push_back(b);
     }
+  } catch (const YAML::ParserException& e) {
+    throw CalibrationError(config::yaml_error_message(e, path.string()));
   } catch (const YAML::Exception& e) {
     throw CalibrationError(path.string() + ": " + e.what());
   }

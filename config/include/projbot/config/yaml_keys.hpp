@@ -21,4 +21,8 @@ std::optional<DuplicateKey> find_duplicate_key(const YAML::Node& node);
 /// "FILE:LINE: 'key' is given twice in one mapping (the second would be ignored)", or empty.
 std::string duplicate_key_message(const YAML::Node& node, const std::string& file);
 
+/// yaml-cpp's error as the user reads it: "FILE:LINE: YAML syntax error: ...", and for nesting past the
+/// parser's depth (which yaml-cpp calls "bad file") the depth it stops at.
+std::string yaml_error_message(const YAML::Exception& e, const std::string& file);
+
 }  // namespace projbot::config
