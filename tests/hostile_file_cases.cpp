@@ -135,6 +135,19 @@ std::vector<Hostile> file_cases() {
               {"m.glb"}},
       Hostile{"scene_empty", "render --scene {dir}/bad.yaml --out {dir}/prev.png", Files{{"bad.yaml", ""}}, 1, {"bad.yaml"}},
       Hostile{"scene_syntax", "render --scene {dir}/bad.yaml --out {dir}/prev.png", "projector: {width: 64\n", 1, {"bad.yaml"}},
+      // Assimp said only "No meshes remaining" of a mesh with a NaN vertex (issue 72).
+      Hostile{"obj_nan_vertex",
+              "render --model {dir}/nan.obj --out {dir}/prev.png",
+              Files{{"nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"}},
+              1,
+              {"nan.obj", "vertex position is not a finite number"}},
+      Hostile{"stl_nan_vertex",
+              "render --model {dir}/nan.stl --out {dir}/prev.png",
+              Files{{"nan.stl",
+                     "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 inf 0\nvertex 0 1 0\nendloop\nendfacet\n"
+                     "endsolid s\n"}},
+              1,
+              {"nan.stl", "vertex position is not a finite number"}},
       // yaml-cpp stops at 500 levels and calls it "bad file": the message says how deep instead (issue 72).
       Hostile{"scene_nested_too_deep",
               "render --scene {dir}/bad.yaml --out {dir}/prev.png",

@@ -82,12 +82,27 @@ void put_material(const aiMaterial& material, config::Bytes& out) {
   out.put_vector(std::vector<char>(name.begin(), name.end()));
 }
 
+// Assimp drops the meshes FindInvalidData finds a NaN or infinite position in, and then says only "No
+// meshes remaining": read again without that step, and name the value if that was the cause.
+std::string import_error(const std::filesystem::path& path, const std::string& assimp_error) {
+  Assimp::Importer again;
+  const aiScene* raw = again.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_ValidateDataStructure);
+  for (unsigned m = 0; raw != nullptr && m < raw->mNumMeshes; ++m)
+    for (unsigned i = 0; i < raw->mMeshes[m]->mNumVertices; ++i) {
+      const aiVector3D& p = raw->mMeshes[m]->mVertices[i];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        return "a vertex position is not a finite number (" + std::to_string(p.x) + ", " + std::to_string(p.y) + ", " +
+               std::to_string(p.z) + ")";
+    }
+  return "Assimp cannot read it: " + assimp_error;
+}
+
 // Runs in the child: the whole import, as bytes.
 std::string import_in_child(const std::filesystem::path& path) {
   Assimp::Importer importer;
   // A PLY or STL without faces would come back as points; we want surfaces, and say so below.
   const aiScene* scene = importer.ReadFile(path.string(), kImportFlags);
-  if (scene == nullptr) throw AssetError(std::string("Assimp cannot read it: ") + importer.GetErrorString());
+  if (scene == nullptr) throw AssetError(import_error(path, importer.GetErrorString()));
   config::Bytes out;
   std::uint32_t triangle_meshes = 0;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m)
