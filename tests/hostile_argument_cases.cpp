@@ -306,6 +306,10 @@ std::vector<Hostile> usage_cases() {
               {"--init-matrix: pose's rotation is not a proper rotation (orthonormality error 0.01"}},
       Hostile{"bench_dataset_missing", "bench dataset {dir}/none", "", 1, {"none: no such folder"}},
       Hostile{"bench_dataset_no_folder", "bench dataset", "", 2, {"give the BOP dataset's folder"}},
+      // Issue 72: what is there but is no folder is called what it is, not missing.
+      Hostile{"bench_dataset_fifo", "bench dataset {dir}/f", Files{{"f", "@fifo"}}, 1, {"f: is a FIFO, not a folder"}},
+      Hostile{
+          "bench_dataset_file", "bench dataset {dir}/f.json", Files{{"f.json", "{}"}}, 1, {"f.json: is a file, not a folder"}},
       Hostile{"bench_sensor_missing", "bench sensor {dir}/none", "", 1, {"none: no such folder"}},
       Hostile{"bench_sensor_no_folder", "bench sensor", "", 2, {"give the BOP dataset's folder: projbot bench sensor DIR"}},
       // Issue 68: twin-dataset's models folders are input; its --out is a new dataset.

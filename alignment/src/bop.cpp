@@ -14,6 +14,7 @@
 
 #include "projbot/assets/image.hpp"
 #include "projbot/config/json_message.hpp"
+#include "projbot/config/paths.hpp"
 #include "projbot/config/rigid.hpp"
 
 namespace projbot::alignment {
@@ -235,12 +236,14 @@ const BopObject* BopDataset::object(int id) const {
 
 BopDataset read_bop_dataset(const fs::path& root, const std::vector<std::string>& scenes, const std::string& split) {
   std::error_code ec;
-  if (!fs::is_directory(root, ec)) fail(root, "no such folder (a BOP dataset: models/ and " + split + "/)");
+  if (const std::string why = config::input_folder_problem(root); !why.empty())
+    fail(root, why + " (a BOP dataset: models/ and " + split + "/)");
   BopDataset out;
   out.root = root;
   out.objects = read_bop_models(root / "models");
   const fs::path split_dir = root / split;
-  if (!fs::is_directory(split_dir, ec)) fail(split_dir, "no such folder (the dataset's " + split + " split)");
+  if (const std::string why = config::input_folder_problem(split_dir); !why.empty())
+    fail(split_dir, why + " (the dataset's " + split + " split)");
   std::vector<fs::path> folders;
   for (const auto& entry : fs::directory_iterator(split_dir, ec))
     if (entry.is_directory() && (scenes.empty() || std::count(scenes.begin(), scenes.end(), entry.path().filename().string())))

@@ -57,6 +57,22 @@ std::string input_file_problem(const fs::path& path) {
   return kind_of(fs::status(path, ec));
 }
 
+std::string input_folder_problem(const fs::path& path) {
+  std::error_code ec;
+  switch (fs::status(path, ec).type()) {
+    case fs::file_type::directory:
+      return "";
+    case fs::file_type::not_found:
+      return "no such folder";
+    case fs::file_type::regular:
+      return "is a file, not a folder";
+    case fs::file_type::fifo:
+      return "is a FIFO, not a folder";
+    default:
+      return "is not a folder";
+  }
+}
+
 std::optional<std::string> find_path_clash(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs) {
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const NamedPath& out = outputs[i];

@@ -4,6 +4,7 @@
 #include <iomanip>
 
 #include "map_reader.hpp"
+#include "projbot/config/paths.hpp"
 #include "projbot/config/yaml_keys.hpp"
 
 namespace projbot::config {
@@ -124,9 +125,9 @@ std::string recording_yaml(const Recording& r) {
 
 Recording load_recording(const std::filesystem::path& folder) {
   const std::string file = (folder / "recording.yaml").string();
-  std::error_code ec;
-  if (!std::filesystem::is_directory(folder, ec))
-    throw ConfigError(folder.string() + ": no such recording folder (projbot record --out writes one)");
+  if (const std::string why = input_folder_problem(folder); !why.empty())
+    throw ConfigError(folder.string() + ": " + (why == "no such folder" ? "no such recording folder" : why) +
+                      " (projbot record --out writes one)");
   YAML::Node root;
   try {
     root = YAML::LoadFile(file);

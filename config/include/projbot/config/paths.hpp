@@ -22,6 +22,10 @@ struct NamedPath {
 /// regular file", ...), or empty when it is a regular file (links followed).
 std::string input_file_problem(const std::filesystem::path& path);
 
+/// The same for a folder a command reads: "no such folder", "is a file, not a folder", "is a FIFO, not a
+/// folder", ..., or empty when it is a folder (links followed).
+std::string input_folder_problem(const std::filesystem::path& path);
+
 /// The first clash between `inputs` and `outputs`, as one line naming both, or nothing:
 /// - an output on the same file as an input or another output;
 /// - an input inside (or equal to) an output folder, which the output would replace or mix into;
