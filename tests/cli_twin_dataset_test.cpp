@@ -167,12 +167,16 @@ TEST_F(CliTest, TrackingDoesNotRunAwayAlongTheTableWithFlatObjects) {
     ++rows;
     const double error = row.at("error_mm").get<double>();
     const bool lit = row.at("accepted").get<bool>();
-    if (lit) EXPECT_LT(error, 50.0) << "obj " << row.at("obj_id") << " image " << row.at("image");
+    if (lit) {
+      EXPECT_LT(error, 50.0) << "obj " << row.at("obj_id") << " image " << row.at("image");
+    }
     lit_within_10 += lit && error <= 10.0;
     const int obj = row.at("obj_id").get<int>();
     flat += obj == 8 || obj == 17;
     // Tracking's rows carry the checks of the pose shown, as the acquisition's do.
-    if (lit) EXPECT_GT(row.at("agree_ratio").get<double>(), 0.5);
+    if (lit) {
+      EXPECT_GT(row.at("agree_ratio").get<double>(), 0.5);
+    }
   }
   EXPECT_EQ(rows, 50);  // 5 objects over 10 images
   EXPECT_EQ(flat, 20);
