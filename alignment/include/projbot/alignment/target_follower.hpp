@@ -165,7 +165,7 @@ class TargetFollower {
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const std::optional<Plane>& floor = std::nullopt);
   /// ...and with the target's surveyed footing (its floor left out as above), acquisition accepts only
   /// poses that stand as surveyed (AcquisitionConfig::footing_height_m, footing_tilt_deg). Tracking is
-  /// not held to it: a target carried, lifted or tipped is followed, only not re-found so.
+  /// held only to not sinking into it: a target carried, lifted or tipped is followed, only not re-found so.
   void set_initial_guess(const Eigen::Matrix4d& T_camera_target, const Footing& footing);
   /// The target was already acquired at T_camera_target: the next frame tracks from there.
   void set_pose(const Eigen::Matrix4d& T_camera_target);
