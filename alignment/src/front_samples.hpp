@@ -19,16 +19,19 @@ void for_each_front_sample(const ModelCloud& model, const Eigen::Matrix4d& T_cam
   const Eigen::Matrix3d R = T_camera_model.topLeftCorner<3, 3>();
   const Eigen::Vector3d t = T_camera_model.topRightCorner<3, 1>();
   // A back face is told in the model's frame, from the camera's centre there: half the samples are
-  // dropped before they are moved (the free-space check runs this on every tracked frame).
-  const Eigen::Vector3d eye = -R.transpose() * t;
+  // dropped before they are moved (the free-space check runs this on every tracked frame). In the
+  // samples' own float: a micrometre of rounding moves no sample's pixel that matters.
+  const Eigen::Vector3f eye = (-R.transpose() * t).cast<float>();
+  const Eigen::Matrix3f Rf = R.cast<float>();
+  const Eigen::Vector3f tf = t.cast<float>();
   for (std::size_t i = 0; i < model.points.size(); ++i) {
-    const Eigen::Vector3d m = model.points[i].cast<double>();
-    if (model.normals[i].cast<double>().dot(m - eye) >= 0.0) continue;  // a back face
-    const Eigen::Vector3d p = R * m + t;
-    if (!(p.z() > 0.05)) continue;  // behind the camera
+    const Eigen::Vector3f& m = model.points[i];
+    if (model.normals[i].dot(m - eye) >= 0.0F) continue;  // a back face
+    const Eigen::Vector3f p = Rf * m + tf;
+    if (!(p.z() > 0.05F)) continue;  // behind the camera
     int u = 0, v = 0;
-    if (!k.nearest_pixel(p, u, v)) continue;
-    f(static_cast<float>(p.z()), u, v, i);
+    if (!k.nearest_pixel(p.cast<double>(), u, v)) continue;
+    f(p.z(), u, v, i);
   }
 }
 

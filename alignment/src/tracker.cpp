@@ -27,6 +27,15 @@ Eigen::Matrix4d twist_to_transform(const Eigen::Matrix<double, 6, 1>& xi) {
   return T;
 }
 
+// H's upper triangle += w J J^T, written out: Eigen's rankUpdate (and a product assignment) were a
+// library call per correspondence, a sixth of the tracker's time.
+inline void add_weighted_outer(Eigen::Matrix<double, 6, 6>& H, const Eigen::Matrix<double, 6, 1>& J, double w) {
+  for (int c = 0; c < 6; ++c) {
+    const double wj = w * J[c];
+    for (int r = 0; r <= c; ++r) H(r, c) += wj * J[r];
+  }
+}
+
 double sensor_sigma(double z) { return std::max(kKinectV1SigmaZCoeff * z * z, 0.001); }
 
 constexpr int kSplat = 1;           // outline_grid: each model point covers the pixels this far around its own
@@ -208,7 +217,7 @@ bool ProjectiveTracker::add_edge(const Level& lv, const std::vector<float>& outl
   J.tail<3>() = x.cross(j);
   const double delta = 1.5 * scale;  // Huber at 1.5 pixels
   const double w = cfg_.edge_weight * (std::abs(r) <= delta ? 1.0 : delta / std::abs(r));
-  H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
+  add_weighted_outer(H, J, w);
   g += w * r * J;
   return true;
 }
@@ -219,10 +228,14 @@ ProjectiveTracker::Pass ProjectiveTracker::pass(const Level& lv, std::size_t cou
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   const Eigen::Vector3d t = T.topRightCorner<3, 1>();
   const std::size_t n = std::min(count, model_.points.size());
+  // A back face is told in the model's frame, from the camera's centre there, before anything is moved.
+  const Eigen::Vector3d eye = -R.transpose() * t;
   for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d x = R * model_.points[i].cast<double>() + t;
+    const Eigen::Vector3d m = model_.points[i].cast<double>();
+    if (model_.normals[i].cast<double>().dot(m - eye) >= 0.0) continue;  // facing away
+    const Eigen::Vector3d x = R * m + t;
+    if (x.z() <= 0.05) continue;  // behind the camera
     const Eigen::Vector3d nrm = R * model_.normals[i].cast<double>();
-    if (x.z() <= 0.05 || nrm.dot(x) >= 0.0) continue;  // behind the camera, or facing away
     if (outline && -nrm.dot(x) < cfg_.edge_max_cos * x.norm() &&
         add_edge(lv, outline->grid, x,
                  outline->T.topLeftCorner<3, 3>() * model_.points[i].cast<double>() + outline->T.topRightCorner<3, 1>(), nrm, p.H,
@@ -248,7 +261,7 @@ ProjectiveTracker::Pass ProjectiveTracker::pass(const Level& lv, std::size_t cou
     Eigen::Matrix<double, 6, 1> J;
     J.head<3>() = nrm;           // d r / d v
     J.tail<3>() = x.cross(nrm);  // d r / d w, for x -> x + w x x + v
-    p.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
+    add_weighted_outer(p.H, J, w);
     p.g += w * r * J;
     ++p.used;
   }
