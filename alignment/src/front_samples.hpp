@@ -20,7 +20,8 @@ void for_each_front_sample(const ModelCloud& model, const Eigen::Matrix4d& T_cam
   const Eigen::Vector3d t = T_camera_model.topRightCorner<3, 1>();
   // A back face is told in the model's frame, from the camera's centre there: half the samples are
   // dropped before they are moved (the free-space check runs this on every tracked frame). In the
-  // samples' own float: a micrometre of rounding moves no sample's pixel that matters.
+  // samples' own float: its rounding (micrometres) moves a sample only where it lies on a pixel's border
+  // (one estimate of the shared frames' 260 moved, through colour's placing).
   const Eigen::Vector3f eye = (-R.transpose() * t).cast<float>();
   const Eigen::Matrix3f Rf = R.cast<float>();
   const Eigen::Vector3f tf = t.cast<float>();

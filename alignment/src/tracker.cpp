@@ -232,14 +232,13 @@ ProjectiveTracker::Pass ProjectiveTracker::pass(const Level& lv, std::size_t cou
   const Eigen::Vector3d eye = -R.transpose() * t;
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d m = model_.points[i].cast<double>();
-    if (model_.normals[i].cast<double>().dot(m - eye) >= 0.0) continue;  // facing away
+    const Eigen::Vector3d normal = model_.normals[i].cast<double>();
+    if (normal.dot(m - eye) >= 0.0) continue;  // facing away
     const Eigen::Vector3d x = R * m + t;
     if (x.z() <= 0.05) continue;  // behind the camera
-    const Eigen::Vector3d nrm = R * model_.normals[i].cast<double>();
+    const Eigen::Vector3d nrm = R * normal;
     if (outline && -nrm.dot(x) < cfg_.edge_max_cos * x.norm() &&
-        add_edge(lv, outline->grid, x,
-                 outline->T.topLeftCorner<3, 3>() * model_.points[i].cast<double>() + outline->T.topRightCorner<3, 1>(), nrm, p.H,
-                 p.g))
+        add_edge(lv, outline->grid, x, outline->T.topLeftCorner<3, 3>() * m + outline->T.topRightCorner<3, 1>(), nrm, p.H, p.g))
       ++p.edges;
     int u = 0, v = 0;
     if (!lv.k.nearest_pixel(x, u, v)) continue;
