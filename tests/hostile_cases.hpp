@@ -21,8 +21,9 @@ namespace hostile {
 namespace fs = std::filesystem;
 
 // Files written into the scratch folder before a case runs; a plain string is the scene `bad.yaml`.
-// A content "@head:N:PATH" is the first N bytes of PATH, "@random:N" N random bytes; {dir}, {data} and
-// {src} are replaced in paths and contents. "@fifo" makes a FIFO, "@link:TARGET" a symbolic link.
+// A content "@head:N:PATH" is the first N bytes of PATH, "@random:N" N random bytes; {dir}, {data}, {src}
+// and {made} (what the build made for assets/) are replaced in paths and contents. "@fifo" makes a FIFO,
+// "@link:TARGET" a symbolic link.
 struct Files {
   std::vector<std::pair<std::string, std::string>> list;
   Files() = default;

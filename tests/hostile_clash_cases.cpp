@@ -226,7 +226,7 @@ std::vector<Hostile> clash_cases() {
               Files{{"bad.yaml",
                      "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: a, model: {duck}, "
                      "scale: 0.25, pose: {translation: [0, 0, 1]}, content: {video: cut.mp4}}\n"},
-                    {"cut.mp4", "@head:4000:{src}/assets/videos/countdown.mp4"}},
+                    {"cut.mp4", "@head:4000:{made}/videos/countdown.mp4"}},
               1,
               {"cut.mp4: "}},
       Hostile{"bench_content_video_mov_table_713mb",
@@ -244,7 +244,7 @@ std::vector<Hostile> clash_cases() {
       Hostile{"bench_content_material_missing",
               "bench content --scene {dir}/bad.yaml",
               "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: a, model: {duck}, scale: "
-              "0.25, pose: {translation: [0, 0, 1]}, content: {video: {src}/assets/videos/countdown.mp4, material: glass}}\n",
+              "0.25, pose: {translation: [0, 0, 1]}, content: {video: {made}/videos/countdown.mp4, material: glass}}\n",
               1,
               {"no material 'glass' for the content"}},
       Hostile{"bench_content_without_content",

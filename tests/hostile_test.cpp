@@ -23,6 +23,7 @@ std::string expand(std::string s, const fs::path& dir) {
   s = replace_all(s, "{rawlog}", "{data}/mrpt/localization_demo.rawlog");
   s = replace_all(s, "{dir}", dir.string());
   s = replace_all(s, "{data}", PROJBOT_SHARED_DATA);
+  s = replace_all(s, "{made}", PROJBOT_GENERATED_ASSET_DIR);  // what the build made for assets/
   return replace_all(s, "{src}", PROJBOT_SOURCE_DIR);
 }
 

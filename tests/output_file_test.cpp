@@ -240,6 +240,30 @@ TEST_F(AtomicFile, InputsAreNamedByKind) {
   EXPECT_EQ(projbot::config::input_file_problem(dir_ / "ok"), "");
 }
 
+// Issue 71: what the build makes for a shipped scene (the content scene's video) lives in the build tree.
+// A shipped scene's relative name finds it there when it is not beside the scene; a file beside the scene,
+// a name outside the shipped folder and an absolute name are taken as written.
+TEST_F(AtomicFile, AShippedSceneFindsWhatTheBuildMadeForItInTheBuildTree) {
+  using projbot::config::beside_scene;
+  const fs::path shipped = dir_ / "assets", made = dir_ / "build" / "assets", scenes = shipped / "scenes";
+  fs::create_directories(scenes);
+  fs::create_directories(made / "videos");
+  std::ofstream(made / "videos" / "clip.mp4") << "x";
+  std::ofstream(dir_ / "clip.mp4") << "x";
+  projbot::config::set_generated_assets(shipped, made);
+  EXPECT_EQ(beside_scene("../videos/clip.mp4", scenes), made / "videos" / "clip.mp4");
+  EXPECT_EQ(beside_scene("../videos/none.mp4", scenes), scenes / "../videos/none.mp4") << "missing everywhere: as named";
+  EXPECT_EQ(beside_scene("../../clip.mp4", scenes), scenes / "../../clip.mp4") << "outside the shipped folder";
+  EXPECT_EQ(beside_scene((dir_ / "x.mp4").string(), scenes), dir_ / "x.mp4");
+  fs::create_directories(shipped / "videos");
+  std::ofstream(shipped / "videos" / "clip.mp4") << "y";
+  EXPECT_EQ(beside_scene("../videos/clip.mp4", scenes), scenes / "../videos/clip.mp4") << "beside the scene wins";
+  EXPECT_EQ(beside_scene("videos/clip.mp4", dir_ / "elsewhere"), dir_ / "elsewhere" / "videos/clip.mp4");
+  projbot::config::set_generated_assets({}, {});
+  fs::remove(shipped / "videos" / "clip.mp4");
+  EXPECT_EQ(beside_scene("../videos/clip.mp4", scenes), scenes / "../videos/clip.mp4") << "unset: beside the scene only";
+}
+
 }  // namespace
 
 // Issue 73: a signal without SA_RESTART during a write. Into a FIFO whose reader is slow, open() blocks

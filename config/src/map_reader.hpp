@@ -13,6 +13,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "projbot/config/paths.hpp"
 #include "projbot/config/scene.hpp"
 
 namespace projbot::config {
@@ -108,10 +109,5 @@ class MapReader {
   const std::string& file_;
   std::set<std::string> used_;
 };
-
-// A file or folder as the scene names it: absolute, or relative to the scene's folder `base`.
-inline std::filesystem::path beside_scene(const std::string& named, const std::filesystem::path& base) {
-  return std::filesystem::path(named).is_absolute() ? std::filesystem::path(named) : base / named;
-}
 
 }  // namespace projbot::config

@@ -50,7 +50,35 @@ bool inside_or_equal(const fs::path& p, const fs::path& folder) {
 
 std::string quoted(const NamedPath& n) { return n.name + " " + n.path.string(); }
 
+struct GeneratedAssets {
+  fs::path shipped, generated;
+};
+
+GeneratedAssets& generated_assets() {
+  static GeneratedAssets where;
+  return where;
+}
+
 }  // namespace
+
+void set_generated_assets(const fs::path& shipped, const fs::path& generated) {
+  std::error_code ec;
+  const fs::path s = fs::weakly_canonical(shipped, ec);
+  generated_assets() = {ec ? shipped.lexically_normal() : s, generated.lexically_normal()};
+}
+
+fs::path beside_scene(const std::string& named, const fs::path& base) {
+  const fs::path path(named);
+  if (path.is_absolute()) return path;
+  const fs::path here = base / path;
+  const GeneratedAssets& g = generated_assets();
+  std::error_code ec;
+  if (g.generated.empty() || fs::exists(here, ec)) return here;
+  const fs::path rel = fs::weakly_canonical(here, ec).lexically_relative(g.shipped);
+  if (ec || rel.empty() || *rel.begin() == "..") return here;
+  const fs::path made = g.generated / rel;
+  return fs::exists(made, ec) ? made : here;
+}
 
 std::string input_file_problem(const fs::path& path) {
   std::error_code ec;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -54,6 +55,15 @@ void print(const bench::ContentRun& r, const engine::FrameSummary& frames) {
   std::printf("memory (RSS): %.0f MB at the start, %.0f MB at the end\n", r.rss_start_mb, r.rss_end_mb);
 }
 
+// The default scene's video is made by the build, into the build tree: a missing one says how to make it.
+void check_made_video(const config::Scene& scene) {
+  for (const auto& t : scene.targets)
+    if (t.content && !t.content->video.empty() && !std::filesystem::exists(t.content->video))
+      throw config::ConfigError(t.content->video.string() +
+                                ": does not exist; the build makes it, into " PROJBOT_GENERATED_ASSET_DIR
+                                "/videos (cmake --build --preset release --target projbot_sample_video)");
+}
+
 }  // namespace
 
 const Command kBenchContent{
@@ -78,6 +88,7 @@ const Command kBenchContent{
       const double seconds = args.get_double("seconds", 10.0);
       if (!(seconds >= 0.1 && seconds <= 86400.0)) throw cli::UsageError("--seconds must be 0.1..86400");
       const config::Scene scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "content.yaml").string()));
+      if (!args.get("scene")) check_made_video(scene);
       check_scene_outputs(args, scene);
       if (std::none_of(scene.targets.begin(), scene.targets.end(), [](const auto& t) { return t.content.has_value(); }))
         throw config::ConfigError(scene.source.string() + ": no target has `content:` to play");

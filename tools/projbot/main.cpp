@@ -14,7 +14,9 @@
 
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "projbot/config/paths.hpp"
 #include "projbot/robot/error.hpp"
+#include "scene_setup.hpp"
 
 namespace {
 
@@ -242,6 +244,8 @@ static int dispatch(int argc, char** argv, std::string& name) {
                 << " in Projbot's source tree\n";
       return 0;
     }
+  // The shipped scenes find what the build made for them (the content scene's video) in the build tree.
+  projbot::config::set_generated_assets(projbot::tools::asset_dir(), PROJBOT_GENERATED_ASSET_DIR);
   return run_command(*cmd, argc, argv, first, name);
 }
 

@@ -18,6 +18,16 @@ struct NamedPath {
   bool folder = false;  ///< the command reads or writes a folder's contents
 };
 
+/// A file or folder as a scene in folder `base` names it: absolute, or relative to `base`. Files the build
+/// makes for the shipped scenes (the content scene's video) live in the build tree, never beside the
+/// shipped files: a relative name that resolves inside the shipped asset folder and is not there is looked
+/// for at the same place under the generated one (set_generated_assets), and taken from there if it is.
+std::filesystem::path beside_scene(const std::string& named, const std::filesystem::path& base);
+
+/// Where the build puts what it makes for the files under `shipped` (the executable sets this once, at
+/// its start, before any scene is read). Unset, beside_scene() only looks beside the scene.
+void set_generated_assets(const std::filesystem::path& shipped, const std::filesystem::path& generated);
+
 /// Why `path` cannot be read as a file ("does not exist", "is a folder, not a file", "is a FIFO, not a
 /// regular file", ...), or empty when it is a regular file (links followed).
 std::string input_file_problem(const std::filesystem::path& path);
