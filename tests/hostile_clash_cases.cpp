@@ -247,6 +247,23 @@ std::vector<Hostile> clash_cases() {
               "0.25, pose: {translation: [0, 0, 1]}, content: {video: {made}/videos/countdown.mp4, material: glass}}\n",
               1,
               {"no material 'glass' for the content"}},
+      // Issue 72: a mesh without texture coordinates took one pixel of the video everywhere, silently.
+      Hostile{
+          "bench_content_video_on_a_mesh_without_uvs",
+          "bench content --scene {dir}/bad.yaml",
+          "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: can, model: "
+          "{data}/ycbv-bop/models/obj_000001.ply, scale: 0.001, pose: {translation: [0, 0, 1]}, content: {video: "
+          "{made}/videos/countdown.mp4}}\n",
+          1,
+          {"countdown.mp4: target 'can's video needs texture coordinates to lie on, and its model", "obj_000001.ply has none"}},
+      // "(it has 0)" read as no materials where the box has one, unnamed.
+      Hostile{"bench_content_material_missing_on_an_unnamed_one",
+              "bench content --scene {dir}/bad.yaml",
+              "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: box, model: "
+              "{data}/gltf/BoxTextured/glTF/BoxTextured.gltf, pose: {translation: [0, 0, 1]}, content: {video: "
+              "{made}/videos/countdown.mp4, material: nosuch}}\n",
+              1,
+              {"no material 'nosuch' for the content (its 1 material: 0 (unnamed))"}},
       Hostile{"bench_content_without_content",
               "bench content --scene {dir}/bad.yaml",
               "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets: []\n",

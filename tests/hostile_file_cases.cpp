@@ -128,6 +128,13 @@ std::vector<Hostile> file_cases() {
               1,
               {"gltf_accessor_beyond_buffer.gltf"}},
       Hostile{"gltf_folder", "render --model {dir}/goodmap --out {dir}/prev.png", {}, 1, {"goodmap", "folder"}},
+      // Issue 72: the JSON library's own text ("[json.exception.out_of_range.406] ...") reached the user.
+      Hostile{"gltf_number_beyond_a_double",
+              "render --model {dir}/n.gltf --out {dir}/prev.png",
+              Files{{"n.gltf",
+                     R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"translation": [1e400, 0, 0]}]})"}},
+              1,
+              {"n.gltf: not valid JSON: number overflow parsing '1e400'"}},
       Hostile{"gltf_random_as_align_model",
               "align --model {dir}/m.glb --scan {data}/bunny/bun4.pcd",
               Files{{"m.glb", "@random:4000"}},

@@ -95,6 +95,9 @@ TEST_P(HostileTest, ExitsCleanlyNamingTheProblemAndWritesNothing) {
     EXPECT_NE(r.output.find(expand(part, dir_)), std::string::npos) << "'" << part << "' not in: " << r.output;
   for (const char* crash : {"terminate called", "AddressSanitizer", "runtime error:", "Assertion", "core dumped"})
     EXPECT_EQ(r.output.find(crash), std::string::npos) << crash << " in: " << r.output;
+  // A library's own exception text says nothing to someone mending the file (issue 72).
+  for (const char* bare : {"[json.exception.", "std::bad_alloc"})
+    EXPECT_EQ(r.output.find(bare), std::string::npos) << bare << " in: " << r.output;
   const auto after = snapshot(dir_);
   for (const auto& [path, bytes] : after) {
     const auto was = before.find(path);

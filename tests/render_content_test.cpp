@@ -210,7 +210,8 @@ TEST(SceneContentMaterial, ByNameIndexOrFirstTextured) {
     projbot::engine::content_material(m, "glass");
     ADD_FAILURE() << "no throw";
   } catch (const projbot::assets::AssetError& e) {
-    EXPECT_NE(std::string(e.what()).find("m.glb: no material 'glass' for the content (it has 0, 1 'Label', 2)"),
+    EXPECT_NE(std::string(e.what()).find(
+                  "m.glb: no material 'glass' for the content (its 3 materials: 0 (unnamed), 1 'Label', 2 (unnamed))"),
               std::string::npos)
         << e.what();
   }

@@ -6,11 +6,13 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
 #include <iterator>
 #include <mutex>
+#include <new>
 #include <set>
 #include <sstream>
 
@@ -18,6 +20,7 @@
 #include "gltf_reader.hpp"
 #include "image_info.hpp"
 #include "projbot/assets/model.hpp"
+#include "projbot/config/json_message.hpp"
 #include "projbot/config/paths.hpp"
 #include "referenced_files.hpp"
 
@@ -385,12 +388,20 @@ Model load_gltf(const std::filesystem::path& path) {
   bool ok = false;
   try {
     ok = is_glb(path) ? loader.LoadBinaryFromFile(&gltf, &err, &warn, file) : loader.LoadASCIIFromFile(&gltf, &err, &warn, file);
+  } catch (const std::bad_alloc&) {  // a valid file too large for what memory is left (many targets' copies)
+    std::error_code size_ec;
+    const auto bytes = std::filesystem::file_size(path, size_ec);
+    throw AssetError(file + ": out of memory while reading it" + (size_ec ? "" : " (" + std::to_string(bytes) + " bytes)"));
   } catch (const std::exception& e) {  // nlohmann::json throws on some malformed input
-    throw AssetError(file + ": malformed glTF: " + e.what());
+    throw AssetError(file + ": malformed glTF: " + config::without_json_tag(e.what()));
   }
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-    throw AssetError(file + ": " + (err.empty() ? std::string("tinygltf could not parse the file") : err));
+    const bool json = err.find("[json.exception.") != std::string::npos;  // tinygltf passes the JSON library's text on
+    throw AssetError(file + ": " +
+                     (err.empty() ? std::string("tinygltf could not parse the file")
+                      : json      ? "not valid JSON: " + config::without_json_tag(err)
+                                  : err));
   }
   Model model = Loader(gltf, file).build(gltf.animations.empty() ? std::string() : detail::gltf_document_json(path));
   model.files = {path};

@@ -47,9 +47,10 @@ int content_material(const assets::Model& model, const std::string& spec) {
   std::string names;
   for (int i = 0; i < n; ++i) {
     const std::string& name = model.materials[static_cast<std::size_t>(i)].name;
-    names += (i > 0 ? ", " : "") + std::to_string(i) + (name.empty() ? "" : " '" + name + "'");
+    names += (i > 0 ? ", " : "") + std::to_string(i) + (name.empty() ? " (unnamed)" : " '" + name + "'");
   }
-  throw assets::AssetError(model.source + ": no material '" + spec + "' for the content (it has " + names + ")");
+  throw assets::AssetError(model.source + ": no material '" + spec + "' for the content (its " + std::to_string(n) +
+                           (n == 1 ? " material: " : " materials: ") + names + ")");
 }
 
 namespace {
@@ -96,6 +97,11 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
     s.target = static_cast<int>(i);
     s.spec = content.value_or(config::TargetContent{});
     const int material = content_material(models[i], s.spec.material);
+    // A model without texture coordinates would take one pixel of the video everywhere: never the picture.
+    if (!s.spec.video.empty() && !assets::has_texture_coordinates(models[i]))
+      throw assets::AssetError(s.spec.video.string() + ": target '" + scene.targets[i].name +
+                               "'s video needs texture coordinates to lie on, and its model " + scene.targets[i].model.string() +
+                               " has none");
     s.material = material;
     s.model = items[i].model;
     s.materials = std::make_shared<assets::Model>();

@@ -6,10 +6,15 @@
 
 namespace projbot::config {
 
-/// `what` without a leading "[json.exception.KIND.N] " tag (unchanged where it has none).
-inline std::string without_json_tag(const std::string& what) {
-  const auto tag = what.rfind("[json.exception.", 0) == 0 ? what.find("] ") : std::string::npos;
-  return tag == std::string::npos ? what : what.substr(tag + 2);
+/// `what` without its "[json.exception.KIND.N] " tags (unchanged where it has none; a library that passes
+/// the JSON library's message on, as tinygltf does, may put it after its own words).
+inline std::string without_json_tag(std::string what) {
+  for (auto at = what.find("[json.exception."); at != std::string::npos; at = what.find("[json.exception.", at)) {
+    const auto end = what.find("] ", at);
+    if (end == std::string::npos) break;
+    what.erase(at, end + 2 - at);
+  }
+  return what;
 }
 
 }  // namespace projbot::config
