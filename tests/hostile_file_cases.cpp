@@ -166,6 +166,13 @@ std::vector<Hostile> file_cases() {
               Files{{"bad.yaml", "@random:3000"}},
               1,
               {"bad.yaml"}},
+      // Issue 72: yaml-cpp read up to the NUL and the message blamed a key missing after it.
+      Hostile{
+          "scene_nul_byte",
+          "render --scene {dir}/bad.yaml --out {dir}/prev.png",
+          Files{{"bad.yaml", std::string("projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\n# a\0b\n", 73)}},
+          1,
+          {"bad.yaml:2: a NUL byte (byte 70): YAML is text"}},
       Hostile{"scene_wrong_type",
               "render --scene {dir}/bad.yaml --out {dir}/prev.png",
               with(kProj, "width: 64", "width: wide") + "targets: []\n",

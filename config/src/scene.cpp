@@ -319,6 +319,7 @@ ProjectorCalibration load_calibration(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   const std::string file = path.string();
+  if (const std::string problem = yaml_text_problem(text.str(), file); !problem.empty()) throw ConfigError(problem);
   YAML::Node c;
   try {
     c = YAML::Load(text.str());
@@ -491,6 +492,7 @@ void read_tour(MapReader& r, const std::string& file, Scene& scene) {
 
 Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path& source) {
   const std::string file = source.empty() ? std::string("<scene>") : source.string();
+  if (const std::string problem = yaml_text_problem(yaml_text, file); !problem.empty()) throw ConfigError(problem);
   YAML::Node root;
   try {
     root = YAML::Load(std::string(yaml_text));

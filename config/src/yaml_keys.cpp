@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/depthguard.h>
 
+#include <algorithm>
 #include <set>
 #include <vector>
 
@@ -30,6 +31,14 @@ std::string duplicate_key_message(const YAML::Node& node, const std::string& fil
   const auto d = find_duplicate_key(node);
   if (!d) return "";
   return file + ":" + std::to_string(d->line) + ": '" + d->key + "' is given twice in one mapping (the second would be ignored)";
+}
+
+std::string yaml_text_problem(std::string_view text, const std::string& file) {
+  const auto nul = text.find('\0');
+  if (nul == std::string_view::npos) return {};
+  const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(nul), '\n');
+  return file + ":" + std::to_string(line) + ": a NUL byte (byte " + std::to_string(nul) +
+         "): YAML is text, and this file is not (the wrong file, or a damaged one?)";
 }
 
 std::string yaml_error_message(const YAML::Exception& e, const std::string& file) {

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace projbot::config {
 
@@ -20,6 +21,10 @@ std::optional<DuplicateKey> find_duplicate_key(const YAML::Node& node);
 
 /// "FILE:LINE: 'key' is given twice in one mapping (the second would be ignored)", or empty.
 std::string duplicate_key_message(const YAML::Node& node, const std::string& file);
+
+/// "FILE:LINE: a NUL byte (byte N): ..." for YAML text holding one (yaml-cpp reads up to it and reports a
+/// key missing further on), or empty. YAML is text; a NUL says the file is not what was meant.
+std::string yaml_text_problem(std::string_view text, const std::string& file);
 
 /// yaml-cpp's error as the user reads it: "FILE:LINE: YAML syntax error: ...", and for nesting past the
 /// parser's depth (which yaml-cpp calls "bad file") the depth it stops at.
