@@ -244,6 +244,13 @@ std::vector<Hostile> file_cases() {
               kTour + "devices:\n  pan_tilt: {port: /dev/ttyUSB97}\n  base: {domain: 3}\n",
               1,
               {"/dev/ttyUSB97"}},
+      // Issue 72: a junk content video was recorded with exit 0 and failed only at the replay.
+      Hostile{"record_junk_content_video_makes_no_folder",
+              "record --out {dir}/newrec --config {dir}/bad.yaml --sim --visits 1",
+              Files{{"bad.yaml", with(kTour, "stop: [3, 2, 90]}", "stop: [3, 2, 90], content: {video: junk.mp4}}")},
+                    {"junk.mp4", "@random:5000"}},
+              1,
+              {"junk.mp4: "}},
       Hostile{"scene_start_in_obstacle",
               "tour --scene {dir}/bad.yaml --report {dir}/prev.json",
               with(kTour, "start: [2, 2, 0]", "start: [0.5, 0.5, 0]"),

@@ -65,6 +65,7 @@ const Command kRecord{
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot record` needs a 'tour: {visits: [...]}' section");
       const int visits = args.get_int("visits", static_cast<int>(scene.visits.size()), 1, 1000);
+      check_content_videos(scene);  // the recording's replay plays them: a broken one is refused before the drive
       cli::check_new_folder(*out, "a recording needs a new folder");
       catch_interrupts();  // Ctrl-C: during set-up nothing is written; later, end the stop in progress, keep every stop
 

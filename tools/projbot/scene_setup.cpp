@@ -3,9 +3,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <set>
 #include <thread>
 
 #include "projbot/assets/model.hpp"
+#include "projbot/assets/video.hpp"
 #include "projbot/robot/localization.hpp"
 
 namespace projbot::tools {
@@ -30,6 +32,13 @@ std::vector<cli::OptionSpec> with_scene_options(std::vector<cli::OptionSpec> own
 std::filesystem::path asset_dir() {
   if (const char* env = std::getenv("PROJBOT_ASSETS"); env != nullptr && *env != '\0') return env;
   return PROJBOT_ASSET_DIR;
+}
+
+void check_content_videos(const config::Scene& scene) {
+  std::set<std::filesystem::path> opened;
+  for (const auto& t : scene.targets)
+    if (t.content && !t.content->video.empty() && opened.insert(t.content->video).second)
+      assets::VideoDecoder probe(t.content->video);
 }
 
 void note_twin_on_odometry(std::ostream& out) {

@@ -22,6 +22,10 @@ std::vector<cli::OptionSpec> with_scene_options(std::vector<cli::OptionSpec> own
 /// The folder holding the shipped demo assets (PROJBOT_ASSETS overrides the built-in path).
 std::filesystem::path asset_dir();
 
+/// Opens every target's content video once (its header and first frame), before a command that only plays
+/// it later (record: the replay would fail): throws assets::AssetError naming the file.
+void check_content_videos(const config::Scene& scene);
+
 /// In a portable build (no MRPT), a line saying the twin's robot drives on odometry alone; nothing otherwise.
 void note_twin_on_odometry(std::ostream& out);
 
