@@ -184,6 +184,14 @@ std::vector<Hostile> clash_cases() {
               "a: 1\n",
               2,
               {"--out {dir}/bad.yaml is also the input --config {dir}/bad.yaml"}},
+      // Issue 72: a room this bright gave gammas 34 % off the truth with exit 0.
+      Hostile{"calibrate_photometric_room_too_bright",
+              "calibrate photometric --sim --scene {dir}/bad.yaml --out {dir}/p.yaml",
+              kRoomProjector +
+                  "room: {width: 6, depth: 5, ambient_lux: 100000}\ntargets:\n  - {name: duck, model: {duck}, scale: "
+                  "0.25, pose: {translation: [0, 0, 1]}}\n",
+              1,
+              {"the ramps miss their fitted curves by", "(RMS, worst channel; allowed 2 %)", "darken the room"}},
       Hostile{"calibrate_photometric_out_over_scene",
               "calibrate photometric --sim --scene {dir}/bad.yaml --out {dir}/bad.yaml",
               "a: 1\n",

@@ -32,6 +32,7 @@ void print_result(const calibrate::PhotometricResult& r) {
       "%d captures: gamma R %.3f G %.3f B %.3f; camera gamma %.3f (%s)\nmixing (column j: channel j's light in R, G, B):\n",
       r.captures, p.gamma_rgb[0], p.gamma_rgb[1], p.gamma_rgb[2], r.camera_gamma, calibrate::to_string(r.camera_response));
   for (int i = 0; i < 3; ++i) std::printf("  %.4f %.4f %.4f\n", p.mixing(i, 0), p.mixing(i, 1), p.mixing(i, 2));
+  std::printf("ramps against their fitted curves: %.2f %% of full light RMS (worst channel)\n", 100.0 * r.ramp_residual);
 }
 
 // --camera-response colours; nothing else is a way this command has.

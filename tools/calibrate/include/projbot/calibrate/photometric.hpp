@@ -50,6 +50,9 @@ struct PhotometricResult {
   double camera_gamma = 0.0;     ///< the camera's response: value = 255 (exposure x light)^(1 / camera_gamma)
   CameraResponse camera_response = CameraResponse::given;
   int captures = 0;
+  /// How far the ramps lie from the fitted curves: the worst channel's RMS, over its ramp steps, of the
+  /// measured share of full light less level^gamma.
+  double ramp_residual = 0.0;
 };
 
 /// How the camera's response is had: `gamma` given (> 0); else from the colours adding up when
