@@ -451,6 +451,12 @@ std::vector<Hostile> usage_cases() {
               2,
               {"cap: not empty; --out needs a new or empty folder"}},
       Hostile{"calibrate_simulate_bad_poses", "calibrate simulate --out {dir}/cap --poses 0", "", 2, {"--poses"}},
+      // Issue 72: a board this far shrank to a point that "fitted" both views, and its capture was written.
+      Hostile{"calibrate_simulate_board_out_of_sight",
+              "calibrate simulate --out {dir}/cap --poses-file {dir}/poses.yaml",
+              Files{{"poses.yaml", "poses: [{centre: [0, 0, 1e308]}]\n"}},
+              1,
+              {"board pose 1 of 1: at 1e+308 m the board's squares would be", "pixels in the camera (at least 8 are needed)"}},
       Hostile{"calibrate_simulate_board_too_big",
               "calibrate simulate --out {dir}/cap --poses 1 --board charuco:30x20:0.1:0.08:DICT_4X4_1000",
               "",

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -199,6 +200,9 @@ bool pose_fits(const SimulationConfig& c, const Geometry& g, const Eigen::Matrix
 
 }  // namespace
 
+// A scripted board's squares must be at least this big in the camera (the default poses' are 24-40).
+constexpr int kMinSquarePx = 8;
+
 // Pose i of n: the board's centre over a 3 x 3 spread of the projector's image at 0.8-1.3 m, tilted
 // up to 30 degrees about varied axes; pulled nearer face-on and further away until it fits both views.
 // A scripted pose that does not fit is refused by its number, unless `as_held` (the capture session's
@@ -213,9 +217,19 @@ static std::vector<Eigen::Matrix4d> board_poses(const SimulationConfig& c, const
     Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
     T.block<3, 3>(0, 0) = tilt(p.tilt_deg.x(), p.tilt_deg.y(), p.tilt_deg.z()) * g.R0;
     T.block<3, 1>(0, 3) = p.centre_m - T.block<3, 3>(0, 0) * Eigen::Vector3d(g.centre.x(), g.centre.y(), 0.0);
+    const std::string which = "board pose " + std::to_string(i + 1) + " of " + std::to_string(c.scripted.size());
+    // So far away that it shrinks to a point still "fits" the views: its squares must be seen.
+    const double square_px = c.camera.fx_px * c.board.square_m / p.centre_m.z();
+    if (!(square_px >= kMinSquarePx)) {
+      char said[160];
+      std::snprintf(said, sizeof said,
+                    ": at %.3g m the board's squares would be %.2g pixels in the camera (at least %d are needed)", p.centre_m.z(),
+                    square_px, kMinSquarePx);
+      throw CalibrationError(which + said);
+    }
     if (!as_held && !pose_fits(c, g, T))
-      throw CalibrationError("board pose " + std::to_string(i + 1) + " of " + std::to_string(c.scripted.size()) + ": the board " +
-                             c.board.spec() + " is not wholly inside both the camera's and the projector's views");
+      throw CalibrationError(which + ": the board " + c.board.spec() +
+                             " is not wholly inside both the camera's and the projector's views");
     poses.push_back(T);
   }
   if (!c.scripted.empty()) return poses;
