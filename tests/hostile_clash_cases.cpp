@@ -272,6 +272,18 @@ std::vector<Hostile> clash_cases() {
               "{made}/videos/countdown.mp4, material: nosuch}}\n",
               1,
               {"no material 'nosuch' for the content (its 1 material: 0 (unnamed))"}},
+      // Issue 72: 300 targets with videos of their own ended in "Resource temporarily unavailable".
+      Hostile{"bench_content_more_videos_than_decoders",
+              "bench content --scene {dir}/bad.yaml",
+              [] {
+                std::string yaml = "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n";
+                for (int i = 0; i < 65; ++i)
+                  yaml += "  - {name: t" + std::to_string(i) + ", model: {duck}, scale: 0.25, pose: {translation: [0, 0, 1]}, " +
+                          "content: {video: {made}/videos/countdown.mp4, start: " + std::to_string(i) + "}}\n";
+                return yaml;
+              }(),
+              1,
+              {"bad.yaml: 65 videos would play at once, each with its own decoder; at most 64 do"}},
       Hostile{"bench_content_without_content",
               "bench content --scene {dir}/bad.yaml",
               "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets: []\n",

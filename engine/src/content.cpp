@@ -82,6 +82,31 @@ std::vector<DrawItem> upload_scene(Renderer& renderer, const config::Scene& scen
   return items;
 }
 
+namespace {
+
+// Each stream of its own is a decoder thread (and FFmpeg's) with its frames queued and a texture: 300 of
+// them ended in "Resource temporarily unavailable", no thread left and no limit named.
+constexpr std::size_t kMaxStreams = 64;
+
+// Targets showing the same video from the same start share one player (decoded and uploaded once).
+bool same_stream(const config::TargetContent& a, const config::TargetContent& b) {
+  return a.video == b.video && a.loop == b.loop && a.start == b.start && a.at_s == b.at_s;
+}
+
+void check_stream_count(const config::Scene& scene) {
+  std::vector<const config::TargetContent*> streams;
+  for (const auto& t : scene.targets)
+    if (t.content && !t.content->video.empty() &&
+        std::none_of(streams.begin(), streams.end(), [&](const auto* o) { return same_stream(*o, *t.content); }))
+      streams.push_back(&*t.content);
+  if (streams.size() > kMaxStreams)
+    throw assets::AssetError(scene.source.string() + ": " + std::to_string(streams.size()) +
+                             " videos would play at once, each with its own decoder; at most " + std::to_string(kMaxStreams) +
+                             " do (targets with the same video, loop and start share one)");
+}
+
+}  // namespace
+
 std::shared_ptr<assets::VideoPlayer> SceneContent::make_player(std::unique_ptr<assets::VideoDecoder> decoder, bool loop) {
   return std::make_shared<assets::VideoPlayer>(std::move(decoder), loop, 4,
                                                [this](std::size_t bytes) { return renderer_.frame_memory(bytes); });
@@ -90,6 +115,7 @@ std::shared_ptr<assets::VideoPlayer> SceneContent::make_player(std::unique_ptr<a
 SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const std::vector<assets::Model>& models,
                            const std::vector<DrawItem>& items)
     : renderer_(renderer) {
+  check_stream_count(scene);
   for (std::size_t i = 0; i < scene.targets.size() && i < models.size() && i < items.size(); ++i) {
     const auto& content = scene.targets[i].content;
     if (!content && models[i].material_animations.empty()) continue;
@@ -113,10 +139,8 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
     }
     // The same video from the same start on several targets: one player and one texture (decoded and
     // uploaded once, and in step by construction).
-    const auto same = std::find_if(players_.begin(), players_.end(), [&](const Stream& o) {
-      return o.player && o.spec.video == s.spec.video && o.spec.loop == s.spec.loop && o.spec.start == s.spec.start &&
-             o.spec.at_s == s.spec.at_s;
-    });
+    const auto same =
+        std::find_if(players_.begin(), players_.end(), [&](const Stream& o) { return o.player && same_stream(o.spec, s.spec); });
     if (same != players_.end()) {
       s.player = same->player;
       s.texture = same->texture;
