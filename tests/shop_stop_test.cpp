@@ -64,6 +64,10 @@ TEST_F(ShopFigureStop, TheShopFigureIsFoundFromATenDegreeGuessBesideItsShelf) {
   // (AcquisitionConfig::scan_from_origin): found all the same (before the gate judged them, not found).
   once.cluster_neighbours = false;
   once.acquisition.icp_median_factor = 0.0;
+  // Without those two the search takes longer: on its 1.3 s CPU budget it ended 154 mm off in about one
+  // run in three on a quiet machine. The gate is what is tested here, not the budget (AnAcquisitionStops-
+  // AtItsBudgetAndBlanks is), so these run unbounded.
+  once.acquire_budget_ms = 1e6;
   const auto r2 = projbot::alignment::TargetFollower(cloud, twin.camera(), once).acquire(depth, guess, footing, grow_m);
   EXPECT_TRUE(r2.converged) << "inliers " << r2.inlier_ratio;
   EXPECT_LT(projbot::alignment::translation_norm_m(error(r2.T_scan_model)), 0.003);
