@@ -397,7 +397,7 @@ Model load_gltf(const std::filesystem::path& path) {
   }
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-    const bool json = err.find("[json.exception.") != std::string::npos;  // tinygltf passes the JSON library's text on
+    const bool json = config::has_json_tag(err);  // tinygltf passes the JSON library's text on
     throw AssetError(file + ": " +
                      (err.empty() ? std::string("tinygltf could not parse the file")
                       : json      ? "not valid JSON: " + config::without_json_tag(err)

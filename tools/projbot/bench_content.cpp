@@ -55,15 +55,6 @@ void print(const bench::ContentRun& r, const engine::FrameSummary& frames) {
   std::printf("memory (RSS): %.0f MB at the start, %.0f MB at the end\n", r.rss_start_mb, r.rss_end_mb);
 }
 
-// The default scene's video is made by the build, into the build tree: a missing one says how to make it.
-void check_made_video(const config::Scene& scene) {
-  for (const auto& t : scene.targets)
-    if (t.content && !t.content->video.empty() && !std::filesystem::exists(t.content->video))
-      throw config::ConfigError(t.content->video.string() +
-                                ": does not exist; the build makes it, into " PROJBOT_GENERATED_ASSET_DIR
-                                "/videos (cmake --build --preset release --target projbot_sample_video)");
-}
-
 }  // namespace
 
 const Command kBenchContent{

@@ -41,6 +41,14 @@ void check_content_videos(const config::Scene& scene) {
       assets::VideoDecoder probe(t.content->video);
 }
 
+void check_made_video(const config::Scene& scene) {
+  for (const auto& t : scene.targets)
+    if (t.content && !t.content->video.empty() && !std::filesystem::exists(t.content->video))
+      throw config::ConfigError(t.content->video.string() +
+                                ": does not exist; the build makes it, into " PROJBOT_GENERATED_ASSET_DIR
+                                "/videos (cmake --build --preset release --target projbot_sample_video)");
+}
+
 void note_twin_on_odometry(std::ostream& out) {
   if (!robot::built_with_mrpt())
     out << "note: this portable build has no MRPT: the twin's robot closes its loop on odometry alone\n";

@@ -26,6 +26,10 @@ std::filesystem::path asset_dir();
 /// it later (record: the replay would fail): throws assets::AssetError naming the file.
 void check_content_videos(const config::Scene& scene);
 
+/// For a shipped scene, whose video the build makes into the build tree: a missing one is refused saying how
+/// to make it (config::ConfigError).
+void check_made_video(const config::Scene& scene);
+
 /// In a portable build (no MRPT), a line saying the twin's robot drives on odometry alone; nothing otherwise.
 void note_twin_on_odometry(std::ostream& out);
 

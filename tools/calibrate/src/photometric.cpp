@@ -151,6 +151,30 @@ double camera_gamma_from_colours(const Captures& c) {
   return best;
 }
 
+struct RampFit {
+  double gamma = 0.0;
+  double residual = 0.0;  // RMS of share - level^gamma over the ramp's steps, in shares of full light
+};
+
+// Gamma from one channel's ramp, its light as a share of full at each step: log(share) = gamma log(level),
+// through the origin (black's light is subtracted with the black capture, so the curve has no offset).
+RampFit fit_ramp(const std::array<double, 7>& shares, int channel) {
+  double num = 0.0, den = 0.0;
+  for (int step = 1; step < 8; ++step) {
+    const double share = shares[static_cast<std::size_t>(step - 1)];
+    if (!(share > 1e-3)) continue;
+    num += std::log(share) * std::log(ramp_level(step)), den += std::log(ramp_level(step)) * std::log(ramp_level(step));
+  }
+  if (!(den > 0.0) || !(num / den > 0.5 && num / den < 5.0))
+    throw CalibrationError("photometric: channel " + std::to_string(channel) + "'s ramp gives no response to fit");
+  RampFit fit{num / den, 0.0};
+  double sq = 0.0;
+  for (int step = 1; step < 8; ++step)
+    sq += std::pow(shares[static_cast<std::size_t>(step - 1)] - std::pow(ramp_level(step), fit.gamma), 2);
+  fit.residual = std::sqrt(sq / 7.0);
+  return fit;
+}
+
 }  // namespace
 
 PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level, const CameraResponseOptions& camera) {
@@ -182,25 +206,12 @@ PhotometricResult calibrate_photometric(PhotometricRig& rig, double black_level,
     // Mixing: channel j's light in each camera channel, as a share of white's there (rows sum to 1).
     const Eigen::Vector3d full = linear(c.full[j], r.camera_gamma) - black;
     r.projector.mixing.col(j) = full.cwiseQuotient(white);
-    // Gamma: the ramp in the channel's own camera channel, log(share) = gamma log(c), through the origin.
-    double num = 0.0, den = 0.0;
-    for (int step = 1; step < 8; ++step) {
-      const double level = ramp_level(step);
-      const double share = (linear(c.ramp[j][step - 1], r.camera_gamma) - black)[j] / full[j];
-      if (!(share > 1e-3)) continue;
-      // The response's black offset: share = (c^gamma (1 - black) ) / (1 - black) exactly, since black's
-      // light is subtracted with the black capture.
-      num += std::log(share) * std::log(level), den += std::log(level) * std::log(level);
-    }
-    if (!(den > 0.0) || !(num / den > 0.5 && num / den < 5.0))
-      throw CalibrationError("photometric: channel " + std::to_string(j) + "'s ramp gives no response to fit");
-    r.projector.gamma_rgb[static_cast<std::size_t>(j)] = num / den;
-    double sq = 0.0;
-    for (int step = 1; step < 8; ++step) {
-      const double share = (linear(c.ramp[j][step - 1], r.camera_gamma) - black)[j] / full[j];
-      sq += std::pow(share - std::pow(ramp_level(step), num / den), 2);
-    }
-    r.ramp_residual = std::max(r.ramp_residual, std::sqrt(sq / 7.0));
+    std::array<double, 7> shares{};
+    for (int step = 1; step < 8; ++step)
+      shares[static_cast<std::size_t>(step - 1)] = (linear(c.ramp[j][step - 1], r.camera_gamma) - black)[j] / full[j];
+    const RampFit fit = fit_ramp(shares, j);
+    r.projector.gamma_rgb[static_cast<std::size_t>(j)] = fit.gamma;
+    r.ramp_residual = std::max(r.ramp_residual, fit.residual);
   }
   r.projector.gamma = (r.projector.gamma_rgb[0] + r.projector.gamma_rgb[1] + r.projector.gamma_rgb[2]) / 3.0;
   if (r.ramp_residual > kMaxRampResidual) {
