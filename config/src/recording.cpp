@@ -128,17 +128,9 @@ Recording load_recording(const std::filesystem::path& folder) {
   if (const std::string why = input_folder_problem(folder); !why.empty())
     throw ConfigError(folder.string() + ": " + (why == "no such folder" ? "no such recording folder" : why) +
                       " (projbot record --out writes one)");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(file + ": cannot read (not a recording made by projbot record?)");
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(yaml_error_message(e, file));
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(file + (e.mark.line >= 0 ? ":" + std::to_string(e.mark.line + 1) : std::string()) + ": " + e.msg);
-  }
-  if (const std::string twice = duplicate_key_message(root, file); !twice.empty()) throw ConfigError(twice);
+  if (input_file_problem(file) == "does not exist")
+    throw ConfigError(file + ": does not exist (not a recording made by projbot record?)");
+  const YAML::Node root = load_yaml_file(file, 16U << 20, "a recording's manifest");
   MapReader r(root, "", file);
   Recording rec;
   rec.source = file;

@@ -310,24 +310,9 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
 }  // namespace
 
 ProjectorCalibration load_calibration(const std::filesystem::path& path) {
-  if (const std::string problem = input_file_problem(path); !problem.empty()) throw ConfigError(path.string() + ": " + problem);
-  std::error_code ec;
-  if (std::filesystem::file_size(path, ec) > (1U << 20))
-    throw ConfigError(path.string() + ": larger than 1 MB: not a calibration file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path.string() + ": cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
   const std::string file = path.string();
-  if (const std::string problem = yaml_text_problem(text.str(), file); !problem.empty()) throw ConfigError(problem);
-  YAML::Node c;
-  try {
-    c = YAML::Load(text.str());
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(yaml_error_message(e, file));
-  }
+  const YAML::Node c = load_yaml_file(path, 1U << 20, "a calibration file");
   if (!c || c.IsNull()) throw ConfigError(file + ": the calibration file is empty");
-  if (const std::string twice = duplicate_key_message(c, file); !twice.empty()) throw ConfigError(twice);
   MapReader r(c, "", file);
   MapReader p(r.child("projector", true), "projector", file);
   ProjectorCalibration out;
@@ -538,14 +523,7 @@ Scene load_scene(const std::filesystem::path& path) {
   // Checked by kind before it is opened: a FIFO would block open(), /dev/zero never end.
   if (const std::string problem = input_file_problem(path); !problem.empty())
     throw ConfigError(path.string() + ": " + problem + (problem == "is a folder, not a file" ? " (a scene file, .yaml)" : ""));
-  std::error_code ec;
-  if (std::filesystem::file_size(path, ec) > (16U << 20))
-    throw ConfigError(path.string() + ": larger than 16 MB: not a scene file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path.string() + ": cannot open scene file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scene(text.str(), path);
+  return parse_scene(read_yaml_text(path, 16U << 20, "a scene file"), path);
 }
 
 Scene parse_scene(std::string_view yaml_text, const std::filesystem::path& source) {

@@ -3,8 +3,12 @@
 #include <yaml-cpp/depthguard.h>
 
 #include <algorithm>
+#include <fstream>
 #include <set>
 #include <vector>
+
+#include "projbot/config/error.hpp"
+#include "projbot/config/paths.hpp"
 
 namespace projbot::config {
 
@@ -46,6 +50,38 @@ std::string yaml_error_message(const YAML::Exception& e, const std::string& file
   if (const auto* deep = dynamic_cast<const YAML::DeepRecursion*>(&e))
     return where + ": YAML nested deeper than the parser reads (it stops at " + std::to_string(deep->depth()) + " levels)";
   return where + ": YAML syntax error: " + e.msg;
+}
+
+std::string read_yaml_text(const std::filesystem::path& path, std::uintmax_t max_bytes, const std::string& kind) {
+  const std::string file = path.string();
+  if (const std::string problem = input_file_problem(path); !problem.empty()) throw ConfigError(file + ": " + problem);
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > max_bytes)
+    throw ConfigError(file + ": " + std::to_string(bytes) + " bytes, more than the " + std::to_string(max_bytes >> 20) +
+                      " MB " + kind + " may be");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(file + ": cannot open");
+  std::string text;
+  text.resize(static_cast<std::size_t>(max_bytes) + 1);  // one more than allowed: a file that grew is seen
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > max_bytes)
+    throw ConfigError(file + ": more than the " + std::to_string(max_bytes >> 20) + " MB " + kind + " may be");
+  if (const std::string problem = yaml_text_problem(text, file); !problem.empty()) throw ConfigError(problem);
+  return text;
+}
+
+YAML::Node load_yaml_file(const std::filesystem::path& path, std::uintmax_t max_bytes, const std::string& kind) {
+  const std::string text = read_yaml_text(path, max_bytes, kind);
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(yaml_error_message(e, path.string()));
+  }
+  if (const std::string twice = duplicate_key_message(root, path.string()); !twice.empty()) throw ConfigError(twice);
+  return root;
 }
 
 }  // namespace projbot::config

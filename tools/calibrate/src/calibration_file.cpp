@@ -10,6 +10,7 @@
 #include "projbot/calibrate/calibrate.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/config/yaml_keys.hpp"
+#include "yaml_file.hpp"
 
 namespace projbot::calibrate {
 namespace {
@@ -80,8 +81,7 @@ void write_calibration(const Calibration& c, const std::filesystem::path& path, 
 
 Calibration read_calibration(const std::filesystem::path& path) {
   try {
-    const YAML::Node y = YAML::LoadFile(path.string());
-    if (const std::string twice = config::duplicate_key_message(y, path.string()); !twice.empty()) throw CalibrationError(twice);
+    const YAML::Node y = detail::load_yaml(path, "a calibration file");
     Calibration c;
     c.projector = read_lens(y["projector"]);
     c.camera = read_lens(y["camera"]);

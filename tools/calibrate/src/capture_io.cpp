@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -16,10 +17,13 @@
 #include "projbot/calibrate/procam.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/config/yaml_keys.hpp"
+#include "yaml_file.hpp"
 
 namespace projbot::calibrate {
 namespace fs = std::filesystem;
 namespace {
+
+constexpr int kMinProjectorSide = 8, kMaxProjectorSide = 16384;  // pixels
 
 std::string two_digits(int i) { return (i < 10 ? "0" : "") + std::to_string(i); }
 
@@ -134,6 +138,19 @@ std::optional<cv::Size> first_image_size(const fs::path& folder) {
   return img.size();
 }
 
+// A projector side from the manifest, named with its key, line and the range it may take.
+int projector_side(const YAML::Node& y, const char* key, const fs::path& file) {
+  const YAML::Node p = y["projector"];
+  const YAML::Node n = p.IsMap() ? p[key] : YAML::Node();
+  const double v = n && n.IsScalar() ? n.as<double>(std::nan("")) : std::nan("");
+  if (!(v >= kMinProjectorSide && v <= kMaxProjectorSide) || v != std::floor(v))
+    throw CalibrationError(file.string() + (n ? ":" + std::to_string(n.Mark().line + 1) : std::string()) + ": projector." +
+                           key + " must be a whole number of pixels, " + std::to_string(kMinProjectorSide) + ".." +
+                           std::to_string(kMaxProjectorSide) + " (it is " +
+                           (n && n.IsScalar() ? "'" + n.Scalar() + "'" : std::string("not given")) + ")");
+  return static_cast<int>(v);
+}
+
 // Another tool's capture may keep the projected patterns beside the captures (procam-calibration's
 // graycode_pattern/): folders of images at the projector's size are skipped with a note, unless every
 // folder is (a camera as large as the projector: then none can be told apart).
@@ -159,13 +176,11 @@ CaptureManifest read_manifest(const fs::path& dir, const SolveOptions& options) 
   const fs::path file = dir / "capture.yaml";
   if (fs::exists(file, ec)) {
     try {
-      const YAML::Node y = YAML::LoadFile(file.string());
-      if (const std::string twice = config::duplicate_key_message(y, file.string()); !twice.empty())
-        throw CalibrationError(twice);
+      const YAML::Node y = detail::load_yaml(file, "a capture manifest");
       if (!y.IsMap() || y["format"].as<std::string>("") != "projbot-procam-capture-1")
         throw CalibrationError(file.string() + ": not a projbot capture (format: projbot-procam-capture-1)");
-      m.projector_width = y["projector"]["width"].as<int>();
-      m.projector_height = y["projector"]["height"].as<int>();
+      m.projector_width = projector_side(y, "width", file);
+      m.projector_height = projector_side(y, "height", file);
       m.board = Board::parse(y["board"].as<std::string>());
       for (const auto& p : y["poses"]) m.folders.push_back(p.as<std::string>());
     } catch (const YAML::ParserException& e) {
@@ -188,9 +203,11 @@ CaptureManifest read_manifest(const fs::path& dir, const SolveOptions& options) 
     skip_pattern_folders(dir, m);
   }
   if (options.board) m.board = *options.board;
-  if (m.projector_width < 8 || m.projector_height < 8 || m.projector_width > 16384 || m.projector_height > 16384)
+  if (m.projector_width < kMinProjectorSide || m.projector_height < kMinProjectorSide ||
+      m.projector_width > kMaxProjectorSide || m.projector_height > kMaxProjectorSide)
     throw CalibrationError("projector size " + std::to_string(m.projector_width) + "x" + std::to_string(m.projector_height) +
-                           " is out of range");
+                           " is out of range (each side " + std::to_string(kMinProjectorSide) + ".." +
+                           std::to_string(kMaxProjectorSide) + " pixels)");
   if (m.folders.empty()) throw CalibrationError("'" + dir.string() + "' holds no pose folders with images");
   return m;
 }
@@ -198,8 +215,7 @@ CaptureManifest read_manifest(const fs::path& dir, const SolveOptions& options) 
 std::vector<BoardPose> read_board_poses(const fs::path& path) {
   std::vector<BoardPose> out;
   try {
-    const YAML::Node y = YAML::LoadFile(path.string());
-    if (const std::string twice = config::duplicate_key_message(y, path.string()); !twice.empty()) throw CalibrationError(twice);
+    const YAML::Node y = detail::load_yaml(path, "a board-pose file");
     if (!y.IsMap() || !y["poses"] || !y["poses"].IsSequence() || y["poses"].size() == 0)
       throw CalibrationError(path.string() + ": expected 'poses: [{centre: [x, y, z], tilt_deg: [a, b, c]}, ...]'");
     for (const auto& p : y["poses"]) {

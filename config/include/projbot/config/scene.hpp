@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "projbot/config/devices.hpp"
+#include "projbot/config/error.hpp"
 #include "projbot/config/lens.hpp"
 #include "projbot/config/odometry_drift.hpp"
 #include "projbot/config/pinhole.hpp"
@@ -18,12 +19,6 @@
 #include "projbot/config/room.hpp"
 
 namespace projbot::config {
-
-/// A bad scene or value: the message names the file, line and key path ("scene.yaml:7: projector.fx: ...").
-class ConfigError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// How much light the projector gives and how its input becomes light (issue 43): per channel, an input
 /// c in 0..1 gives black + (1 - black) c^gamma of full white, and full white is `brightness_lm` lumens

@@ -4,6 +4,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -29,5 +31,14 @@ std::string yaml_text_problem(std::string_view text, const std::string& file);
 /// yaml-cpp's error as the user reads it: "FILE:LINE: YAML syntax error: ...", and for nesting past the
 /// parser's depth (which yaml-cpp calls "bad file") the depth it stops at.
 std::string yaml_error_message(const YAML::Exception& e, const std::string& file);
+
+/// The text of the YAML file at `path`, read as every YAML reader of the project reads one: a regular file (a
+/// FIFO, device or folder is refused by kind before anything opens it), at most `max_bytes` (the limit said),
+/// with no NUL byte. `kind` names what the file should be in the size message ("a calibration file").
+/// Throws ConfigError naming the file.
+std::string read_yaml_text(const std::filesystem::path& path, std::uintmax_t max_bytes, const std::string& kind);
+
+/// read_yaml_text, parsed: a syntax error as yaml_error_message, a key given twice refused (ConfigError).
+YAML::Node load_yaml_file(const std::filesystem::path& path, std::uintmax_t max_bytes, const std::string& kind);
 
 }  // namespace projbot::config
