@@ -2,6 +2,7 @@
 // a scene using what they wrote, and content at its content time.
 
 #include "cli_fixture.hpp"
+#include "projbot/assets/video.hpp"
 
 using namespace cli_fixture;
 
@@ -225,6 +226,31 @@ TEST_F(CliTest, RenderShowsTheContentOfItsContentTime) {
   for (std::size_t i = 0; i + 3 < a.rgba.size(); i += 4)
     differ += a.rgba[i] != c.rgba[i] || a.rgba[i + 1] != c.rgba[i + 1] || a.rgba[i + 2] != c.rgba[i + 2] ? 1 : 0;
   EXPECT_GT(differ, 5000U);  // frame 15's colour wash and stripes, not frame 75's
+}
+
+// The same frames in MPEG-TS and in MP4 (issue 72): the TS target was drawn black at content time 0 (the
+// decoder's way back to the start landed a second in); both now draw the same picture at 0 and at 1.2 s.
+TEST_F(CliTest, RenderDrawsAnMpegTsVideoAsTheSameFramesInMp4) {
+  for (const char* name : {"count.ts", "count.mp4"}) {
+    projbot::assets::VideoWriter writer(dir_ / name, 320, 240, 30);
+    for (int i = 0; i < 60; ++i) writer.write(projbot::assets::frame_code_image(i, 320, 240));
+    writer.finish();
+  }
+  const auto render_at = [&](const std::string& clip, const std::string& t) {
+    write("v.yaml", "projector: {width: 320, height: 240, fx: 300, fy: 300, cx: 159.5, cy: 119.5}\ntargets:\n  - {name: box, "
+                    "model: " + (fs::path(PROJBOT_SHARED_DATA) / "gltf/BoxTextured/glTF/BoxTextured.gltf").string() +
+                    ", scale: 0.3, pose: {translation: [0, 0, 1], rpy_deg: [200, 35, 0]}, content: {video: " + clip + "}}\n");
+    const fs::path out = dir_ / (clip + "_" + t + ".png");
+    const CliRun r = run_projbot("render --scene " + (dir_ / "v.yaml").string() + " --content-time " + t + " --out " + out.string());
+    EXPECT_EQ(r.code, 0) << clip << " at " << t << ": " << r.output;
+    return projbot::assets::read_image(out);
+  };
+  for (const char* t : {"0", "1.2"}) {
+    const auto ts = render_at("count.ts", t), mp4 = render_at("count.mp4", t);
+    EXPECT_GT(ts.lit_pixels(), 5000U) << t;
+    EXPECT_EQ(ts.rgba, mp4.rgba) << t;
+  }
+  EXPECT_NE(render_at("count.ts", "0").rgba, render_at("count.ts", "1.2").rgba);
 }
 
 // A glTF model's own material animation (KHR_animation_pointer, issue 44) through the executable: BoxTextured

@@ -101,16 +101,33 @@ struct VideoDecoder::Impl {
   std::int64_t decoded = 0;
   bool draining = false;
   double seek_to_s = -1.0;  // after a seek: frames whose time has passed by then are decoded and dropped
+  // MPEG-TS and PS: their timestamp seek is a search that can land a key frame late (back to the start it
+  // skipped the first second of a clip), so they go back by byte, to the start, and decode up to a time.
+  bool seeks_by_byte = false;
 
   [[noreturn]] void fail(const std::string& what) const { throw AssetError(name + ": " + what); }
 
+  // What FFmpeg logged when it failed with `code`, else the code's words; a picture it refuses as too
+  // large is told with this player's limits.
+  std::string ffmpeg_reason(int code) const {
+    const std::string said = detail::take_ffmpeg_error();
+    if (said.empty()) return av_message(code);
+    if (said.rfind("Picture size", 0) == 0)
+      return said + "; this player takes at most " + std::to_string(kMaxSide) + " px a side and " +
+             std::to_string(kMaxPixels / 1000000) + " Mpx";
+    return said;
+  }
+
   void open(AVFormatContext* ctx, const char* url) {
     AVFormatContext* raw = ctx;
+    detail::take_ffmpeg_error();
     if (const int r = avformat_open_input(&raw, url, nullptr, nullptr); r < 0)
-      fail("not a video FFmpeg can read (" + av_message(r) + ")");  // avformat_open_input freed raw
+      fail("not a video FFmpeg can read (" + ffmpeg_reason(r) + ")");  // avformat_open_input freed raw
     format.reset(raw);
     if (const int r = avformat_find_stream_info(format.get(), nullptr); r < 0)
-      fail("cannot read its streams (" + av_message(r) + ")");
+      fail("cannot read its streams (" + ffmpeg_reason(r) + ")");
+    const int flags = format->iformat->flags;
+    seeks_by_byte = (flags & AVFMT_TS_DISCONT) != 0 && (flags & AVFMT_NO_BYTE_SEEK) == 0;
     const AVCodec* decoder = nullptr;
     stream = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
     if (stream == AVERROR_STREAM_NOT_FOUND) fail("holds no video stream");
@@ -292,6 +309,11 @@ void VideoDecoder::seek(double t_s) {
     rewind();
     return;
   }
+  if (d.seeks_by_byte) {  // decoded from the start, dropped up to the time: slower, never a frame late
+    rewind();
+    d.seek_to_s = t_s;
+    return;
+  }
   const auto ts = d.first_pts + static_cast<std::int64_t>(t_s / av_q2d(d.time_base));
   if (av_seek_frame(d.format.get(), d.stream, ts, AVSEEK_FLAG_BACKWARD) < 0) {
     rewind();  // a container that cannot seek: decoded from the start, dropped up to the time
@@ -305,10 +327,9 @@ void VideoDecoder::seek(double t_s) {
 
 void VideoDecoder::rewind() {
   Impl& d = *impl_;
-  const int r =
-      av_seek_frame(d.format.get(), d.stream,
-                    d.format->streams[d.stream]->start_time == AV_NOPTS_VALUE ? 0 : d.format->streams[d.stream]->start_time,
-                    AVSEEK_FLAG_BACKWARD);
+  const std::int64_t start = d.format->streams[d.stream]->start_time;
+  const int r = d.seeks_by_byte ? av_seek_frame(d.format.get(), d.stream, 0, AVSEEK_FLAG_BYTE)
+                                : av_seek_frame(d.format.get(), d.stream, start == AV_NOPTS_VALUE ? 0 : start, AVSEEK_FLAG_BACKWARD);
   if (r < 0 && avformat_seek_file(d.format.get(), -1, INT64_MIN, 0, INT64_MAX, 0) < 0)
     d.fail("cannot go back to its first frame (" + av_message(r) + ")");
   avcodec_flush_buffers(d.codec.get());
