@@ -2,6 +2,7 @@
 // false accepts, false blanks and time, ours beside PCL's own pipeline on the same captures.
 
 #include <cstdio>
+#include <mutex>
 
 #include "commands.hpp"
 #include "interrupt.hpp"
@@ -67,17 +68,35 @@ const Command kBenchAcquire{
       std::snprintf(small, sizeof small, "%.0f cm, %.0f deg", cm, deg);
       Progress progress("trial", static_cast<int>(bench.targets()) * trials);
       int trials_done = 0;
+      const auto print_target = [&](const bench::AcquireTarget& t) {
+        for (int gross : {0, 1})
+          for (int j = 0; j < 3; ++j)
+            print_row(t.tallies[static_cast<std::size_t>(3 * gross + j)], t.name, gross ? "30 cm, 40 deg" : small,
+                      bench::kAcquireMethods[static_cast<std::size_t>(j)]);
+        std::fflush(stdout);
+      };
       for (std::size_t i = 0; i < bench.targets(); ++i) {
-        const bench::AcquireTarget t = bench.run_target(
-            i, [] { return !interrupted(); }, [&] { progress.step(++trials_done); });
-        if (t.trials > 0) {  // Ctrl-C: the trials finished for this target are printed too (their count says how many)
-          for (int gross : {0, 1})
-            for (int j = 0; j < 3; ++j)
-              print_row(t.tallies[static_cast<std::size_t>(3 * gross + j)], t.name, gross ? "30 cm, 40 deg" : small,
-                        bench::kAcquireMethods[static_cast<std::size_t>(j)]);
-          std::fflush(stdout);
+        // A trial runs PCL for seconds and cannot stop inside: it runs on a thread of its own, and a signal is
+        // answered at once with the trials finished (the one under way is dropped).
+        std::mutex m;
+        bench::AcquireTarget finished;
+        finished.name = bench.target_name(i);
+        const auto t = unless_interrupted<bench::AcquireTarget>([&] {
+          return bench.run_target(
+              i, [] { return !interrupted(); },
+              [&](const bench::AcquireTarget& so_far) {
+                const std::lock_guard<std::mutex> lock(m);
+                finished = so_far;
+                progress.step(++trials_done);
+              });
+        });
+        const std::lock_guard<std::mutex> lock(m);
+        const bench::AcquireTarget& done = t ? *t : finished;
+        if (done.trials > 0) print_target(done);  // Ctrl-C: the trials finished for this target (their count says)
+        if (done.trials < trials) {
+          benchmark_interrupted("at " + done.name + ", trial " + std::to_string(done.trials + 1));
+          quit_now();
         }
-        if (t.trials < trials) return benchmark_interrupted("at " + t.name + ", trial " + std::to_string(t.trials + 1));
       }
       return 0;
     }};

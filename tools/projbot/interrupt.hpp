@@ -3,7 +3,14 @@
 // signal asks the work to stop at its next frame, visit or scan, so what was measured is still written; a
 // second one ends the process at once.
 
+#include <chrono>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 
 namespace projbot::tools {
 
@@ -18,5 +25,46 @@ int interrupt_exit_code();
 int benchmark_interrupted(const std::string& where);
 /// Says that a command stopped before it had produced anything, so it wrote nothing; the exit code.
 int nothing_written(const std::string& when);
+
+/// Ends the process now with interrupt_exit_code(), stdout and stderr flushed and no destructor run: a
+/// thread left by unless_interrupted may still be using what they would destroy.
+[[noreturn]] void quit_now();
+
+/// Runs `work` on a thread of its own and waits for its result, unless a signal arrives first: then it
+/// returns nothing at once and the work runs on (a PCL trial or an ICP run cannot be stopped inside), so
+/// the caller prints what was measured before and ends with quit_now(), never returning past anything the
+/// work uses. An exception from the work is thrown here.
+template <typename T>
+std::optional<T> unless_interrupted(std::function<T()> work) {
+  struct Shared {
+    std::mutex m;
+    std::optional<T> result;
+    std::exception_ptr error;
+    bool done = false;
+  };
+  auto shared = std::make_shared<Shared>();
+  std::thread([shared, work = std::move(work)] {
+    std::optional<T> r;
+    std::exception_ptr e;
+    try {
+      r.emplace(work());
+    } catch (...) {
+      e = std::current_exception();
+    }
+    const std::lock_guard<std::mutex> lock(shared->m);
+    shared->result = std::move(r), shared->error = e, shared->done = true;
+  }).detach();
+  for (;;) {
+    {
+      const std::lock_guard<std::mutex> lock(shared->m);
+      if (shared->done) {
+        if (shared->error) std::rethrow_exception(shared->error);
+        return std::move(shared->result);
+      }
+    }
+    if (interrupted()) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
 
 }  // namespace projbot::tools

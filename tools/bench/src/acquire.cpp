@@ -88,7 +88,7 @@ AcquireBench::AcquireBench(const config::Scene& scene, const AcquireOptions& opt
     : options_(options), twin_(scene, twin_options(options.seed), renderer), rng_(static_cast<std::uint32_t>(options.seed)) {}
 
 AcquireTarget AcquireBench::run_target(std::size_t i, const std::function<bool()>& keep_going,
-                                       const std::function<void()>& trial_done) {
+                                       const std::function<void(const AcquireTarget&)>& trial_done) {
   const twin::TwinTarget& target = twin_.targets()[i];
   const twin::Arrival arrival = twin_.arrive(i, static_cast<int>(i));
   const Eigen::Matrix4d T_true = alignment::rigid_inverse(arrival.truth.T_world_camera.matrix()) * target.T_world_target_true;
@@ -114,7 +114,9 @@ AcquireTarget AcquireBench::run_target(std::size_t i, const std::function<bool()
       out.tallies[3 * gross].add(ours(follower, depth, colour, footing, guess, grow_m[gross], truth));
       for (int j = 0; j < 2; ++j) out.tallies[3 * gross + 1 + j].add(pcl_pipeline(pcl[j], twin_, depth, guess, truth));
     }
-    trial_done();
+    AcquireTarget finished = out;
+    ++finished.trials;
+    trial_done(finished);
   }
   return out;
 }

@@ -171,6 +171,26 @@ alignment::DepthImage twin_scene(const std::vector<float>& models, const alignme
 
 }  // namespace
 
+void SensorStats::add(const SensorStats& more) {
+  const auto append = [](std::vector<double>& to, const std::vector<double>& from) { to.insert(to.end(), from.begin(), from.end()); };
+  append(residual_mm, more.residual_mm);
+  append(step_per_z2, more.step_per_z2);
+  append(offset_mm, more.offset_mm);
+  append(noise_mm, more.noise_mm);
+  for (std::size_t l = 0; l < lag_difference.size(); ++l) append(lag_difference[l], more.lag_difference[l]);
+  interior += more.interior, interior_missing += more.interior_missing, edge += more.edge, edge_missing += more.edge_missing;
+  for (std::size_t d = 0; d < ring.size(); ++d) {
+    ring[d] += more.ring[d], ring_missing[d] += more.ring_missing[d];
+    ring_object[d] += more.ring_object[d], ring_between[d] += more.ring_between[d];
+  }
+  left += more.left, left_missing += more.left_missing, right += more.right, right_missing += more.right_missing;
+}
+
+void SensorComparison::add(const SensorComparison& more) {
+  real.add(more.real), twin.add(more.twin), fitted.add(more.fitted);
+  instances += more.instances, images += more.images;
+}
+
 void SensorBench::image(const alignment::BopScene& scene, const alignment::BopImage& image, int min_visible, std::uint32_t seed,
                         SensorComparison& out) {
   std::vector<const alignment::BopInstance*> all;

@@ -25,18 +25,24 @@ constexpr int kSub = 4;  // samples per pixel along each axis: a pixel integrate
 
 cv::Matx33d camera_matrix(const config::Pinhole& p) { return {p.fx_px, 0, p.cx_px, 0, p.fy_px, p.cy_px, 0, 0, 1}; }
 
-// The undistorted viewing ray (x, y, 1) of each camera sample, kSub x kSub per pixel, row-major.
-std::vector<cv::Point2d> sample_rays(const Camera& camera) {
-  std::vector<cv::Point2d> pixels;
+// The undistorted viewing ray (x, y, 1) of each camera sample, kSub x kSub per pixel, row-major. Undistorting
+// them all takes seconds: done in bands of rows, asking `stop` between them (empty when it said stop).
+std::vector<cv::Point2d> sample_rays(const Camera& camera, const std::function<bool()>& stop) {
+  constexpr int kBandRows = 16;
   const int w = camera.width_px, h = camera.height_px;
-  pixels.reserve(static_cast<std::size_t>(w * h * kSub * kSub));
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int sy = 0; sy < kSub; ++sy)
-        for (int sx = 0; sx < kSub; ++sx) pixels.emplace_back(x + (sx + 0.5) / kSub - 0.5, y + (sy + 0.5) / kSub - 0.5);
   std::vector<cv::Point2d> rays;
-  cv::undistortPoints(pixels, rays, camera_matrix(camera), cv::Mat(camera.distortion), cv::noArray(), cv::noArray(),
-                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 40, 1e-12));
+  rays.reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * kSub * kSub);
+  for (int y0 = 0; y0 < h; y0 += kBandRows) {
+    if (stop && stop()) return {};
+    std::vector<cv::Point2d> pixels, band;
+    for (int y = y0; y < std::min(h, y0 + kBandRows); ++y)
+      for (int x = 0; x < w; ++x)
+        for (int sy = 0; sy < kSub; ++sy)
+          for (int sx = 0; sx < kSub; ++sx) pixels.emplace_back(x + (sx + 0.5) / kSub - 0.5, y + (sy + 0.5) / kSub - 0.5);
+    cv::undistortPoints(pixels, band, camera_matrix(camera), cv::Mat(camera.distortion), cv::noArray(), cv::noArray(),
+                        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 40, 1e-12));
+    rays.insert(rays.end(), band.begin(), band.end());
+  }
   return rays;
 }
 
@@ -271,14 +277,20 @@ int simulate(const SimulationConfig& c, const std::filesystem::path& out, const 
   const std::vector<Eigen::Matrix4d> poses = board_poses(c, g);
   const int count = static_cast<int>(poses.size());
   const std::vector<cv::Mat> patterns = gray_code_images(c.projector.width_px, c.projector.height_px);
-  const std::vector<cv::Point2d> rays = sample_rays(c.camera);
+  if (stop && stop()) return 0;
+  const std::vector<cv::Point2d> rays = sample_rays(c.camera, stop);
+  if (stop && stop()) return 0;
   CaptureWriter writer(out);
   CaptureManifest manifest{c.projector.width_px, c.projector.height_px, c.board, {}, {}};
   for (int i = 0; i < count && !(stop && stop()); ++i) {
     const std::vector<Sample> samples = trace(c, g, rays, poses[static_cast<std::size_t>(i)]);
     std::mt19937_64 rng(c.seed * 1000003u + static_cast<std::uint64_t>(i));
     std::vector<cv::Mat> images;
-    for (const cv::Mat& pattern : patterns) images.push_back(expose(c, samples, pattern, rng));
+    for (const cv::Mat& pattern : patterns) {
+      if (stop && stop()) break;  // a pose takes a second or two: one half exposed is dropped
+      images.push_back(expose(c, samples, pattern, rng));
+    }
+    if (images.size() < patterns.size()) break;
     manifest.folders.push_back(writer.write_pose(i, images));
     if (progress) progress(i + 1, count);
   }
@@ -301,7 +313,7 @@ class TwinRig final : public CaptureRig {
       : c_(c),
         g_(board_geometry(c.board)),
         poses_(board_poses(c, g_, true)),
-        rays_(sample_rays(c.camera)),
+        rays_(sample_rays(c.camera, nullptr)),
         display_(std::move(display)) {}
 
   bool ready(int, int) override {

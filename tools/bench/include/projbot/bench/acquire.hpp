@@ -53,9 +53,11 @@ class AcquireBench {
   /// The scene's twin on `renderer` (which must outlive the bench).
   AcquireBench(const config::Scene& scene, const AcquireOptions& options, engine::Renderer& renderer);
   std::size_t targets() const { return twin_.targets().size(); }
+  const std::string& target_name(std::size_t index) const { return twin_.targets()[index].config.name; }
   /// Drives to target `index`'s stop, aims, and acquires from each capture's guesses; `keep_going` is asked
-  /// before each capture and `trial_done` called after it.
-  AcquireTarget run_target(std::size_t index, const std::function<bool()>& keep_going, const std::function<void()>& trial_done);
+  /// before each capture and `trial_done` called after it with the trials finished so far.
+  AcquireTarget run_target(std::size_t index, const std::function<bool()>& keep_going,
+                           const std::function<void(const AcquireTarget&)>& trial_done);
 
  private:
   AcquireOptions options_;

@@ -27,6 +27,9 @@ struct SensorStats {
   std::vector<double> offset_mm;  // per instance: the median residual (what the ground truth's own error explains)
   std::vector<double> noise_mm;   // residuals less their instance's plane (offset and tilt): the sensor's noise
   std::array<std::vector<double>, 3> lag_difference;  // |noise - noise kLags[i] px to the right|
+
+  /// `more`'s pixels and instances added to these.
+  void add(const SensorStats& more);
 };
 
 /// The three sensors over the images measured: the real one, the twin's published Kinect v1 model, and
@@ -34,6 +37,9 @@ struct SensorStats {
 struct SensorComparison {
   SensorStats real, twin, fitted;
   int instances = 0, images = 0;
+
+  /// `more`'s images added to these (an image measured apart, then kept whole).
+  void add(const SensorComparison& more);
 };
 
 /// Renders the dataset's models at their ground truth through each image's camera and measures each
