@@ -64,6 +64,7 @@ const Command kBenchAcquire{
           "| target | guesses | method | trials | success | false accepts (look-alike) | false blanks | time median / p95 / max "
           "ms |\n"
           "|---|---|---|---|---|---|---|---|\n");
+      std::fflush(stdout);  // the header before the first trial's seconds, also into a file or pipe
       char small[48];
       std::snprintf(small, sizeof small, "%.0f cm, %.0f deg", cm, deg);
       Progress progress("trial", static_cast<int>(bench.targets()) * trials);
