@@ -12,6 +12,8 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <mutex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -136,13 +138,21 @@ Primitive read_primitive(config::BytesReader& in, const std::string& file) {
   return p;
 }
 
+// A warning on stderr, once per process: a command that loads a model twice (framing it, then drawing it)
+// says it once.
+void warn_once(const std::string& said) {
+  static std::mutex m;
+  static std::set<std::string> told;
+  const std::lock_guard<std::mutex> lock(m);
+  if (told.insert(said).second) std::cerr << "projbot: warning: " << said << "\n";
+}
+
 // A material's texture, read beside the model; a missing or unreadable one is a warning and the
 // material keeps its base colour (users' OBJ files often name a texture they did not ship).
 int load_texture(const std::filesystem::path& model, const std::string& name, Model& out) {
   if (name.empty()) return -1;
   if (name[0] == '*') {
-    std::cerr << "projbot: warning: " << model.string() << ": embedded texture '" << name
-              << "' is not supported; the material's base colour is used\n";
+    warn_once(model.string() + ": embedded texture '" + name + "' is not supported; the material's base colour is used");
     return -1;
   }
   const std::filesystem::path file = model.parent_path() / name;
@@ -150,8 +160,7 @@ int load_texture(const std::filesystem::path& model, const std::string& name, Mo
     out.images.push_back(read_image(file));
     return static_cast<int>(out.images.size() - 1);
   } catch (const AssetError& e) {
-    std::cerr << "projbot: warning: " << model.string() << ": texture " << file.string() << " not used (" << e.what()
-              << "); the material's base colour is used\n";
+    warn_once(model.string() + ": texture " + file.string() + " not used (" + e.what() + "); the material's base colour is used");
     return -1;
   }
 }
