@@ -167,8 +167,9 @@ std::array<float, 3> albedo_for(int id) {
   return {level(rng), level(rng), level(rng)};
 }
 
-// Every folder's objects, ids checked across folders before any mesh is loaded.
-std::vector<Object> folder_objects(const std::vector<fs::path>& folders) {
+// Every folder's objects, ids checked across folders before any mesh is loaded; `stopped` asked between
+// meshes (seventeen take a second or two): what it stops leaves out the rest.
+std::vector<Object> folder_objects(const std::vector<fs::path>& folders, const std::function<bool()>& stopped) {
   std::vector<alignment::BopObject> listed;
   std::map<int, fs::path> seen;
   for (const auto& folder : folders)
@@ -180,6 +181,7 @@ std::vector<Object> folder_objects(const std::vector<fs::path>& folders) {
     }
   std::vector<Object> out;
   for (const auto& o : listed) {
+    if (stopped()) break;
     Object obj;
     obj.id = o.id;
     obj.source = o.model;
@@ -193,8 +195,10 @@ std::vector<Object> folder_objects(const std::vector<fs::path>& folders) {
   return out;
 }
 
+// The objects to place, or none when a stop was asked for while they were loaded.
 std::vector<Object> objects_for(const DatasetOptions& options) {
-  std::vector<Object> out = folder_objects(options.model_folders);
+  const auto stopped = [&] { return options.stop_requested && options.stop_requested(); };
+  std::vector<Object> out = folder_objects(options.model_folders, stopped);
   if (options.procedural) {
     int id = kFirstProceduralId;
     for (auto& s : procedural_shapes()) {
@@ -210,9 +214,13 @@ std::vector<Object> objects_for(const DatasetOptions& options) {
       out.push_back(std::move(obj));
     }
   }
+  if (stopped()) return {};
   if (out.empty()) throw alignment::AlignmentError("twin dataset: no objects (no models folder and no procedural shapes)");
-  for (auto& o : out) o.rests = resting_orientations(o.model, o.points);
-  return out;
+  for (auto& o : out) {
+    if (stopped()) return {};
+    o.rests = resting_orientations(o.model, o.points);
+  }
+  return stopped() ? std::vector<Object>{} : out;
 }
 
 // The models folder: each object's PLY (copied as it came, or written from the procedural mesh) and
@@ -544,11 +552,15 @@ alignment::CameraIntrinsics ycbv_camera() { return {640, 480, 1066.778, 1067.487
 
 DatasetSummary write_twin_dataset(const fs::path& out, const DatasetOptions& options, engine::Renderer& renderer) {
   std::vector<Object> objects = objects_for(options);
+  DatasetSummary summary;
+  if (objects.empty()) {  // stopped while loading: nothing written
+    summary.interrupted = true;
+    return summary;
+  }
   for (auto& o : objects) {
     o.depth_id = renderer.add_model(o.model);
     o.colour_id = renderer.add_model(coloured(o.model, albedo_for(o.id)));
   }
-  DatasetSummary summary;
   summary.objects = static_cast<int>(objects.size());
   write_models(out / "models", objects);
   Scenery scenery(renderer, options.camera);
