@@ -202,7 +202,7 @@ std::vector<Hostile> clash_cases() {
               "",
               2,
               {"--reflectance must be scene, measured or mapped, not 'guessed'"}},
-      Hostile{"bench_appearance_dwell_zero", "bench appearance --dwell 0", "", 2, {"--dwell must be 0.1..600 seconds"}},
+      Hostile{"bench_appearance_dwell_zero", "bench appearance --dwell 0", "", 2, {"--dwell must be 0.1..3600 seconds"}},
       Hostile{"bench_appearance_gamma_nan",
               "bench appearance --scene {dir}/bad.yaml",
               "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24, gamma: .nan}\ntargets: []\n",

@@ -72,10 +72,8 @@ const Command kBenchMotion{
     [](const cli::Args& args) {
       twin::TourOptions o;
       o.mode = twin::TourMode::tracking;
-      o.visits = args.get_int("visits", 0, 1, 1000);
-      o.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
-      o.dwell_s = args.get_double("dwell", 3.0);
-      if (!(o.dwell_s >= 0.1 && o.dwell_s <= 600.0)) throw cli::UsageError("--dwell must be 0.1..600 seconds");
+      const TourFamilyArgs family = tour_family_args(args, 3.0);
+      o.visits = family.visits, o.seed = family.seed, o.dwell_s = family.dwell_s;
       const double q = args.get_double("process-noise", alignment::MotionModelConfig{}.accel_noise);
       if (!(q > 0.0 && q <= 100.0)) throw cli::UsageError("--process-noise must be in (0, 100]");
       o.motion.accel_noise = q;

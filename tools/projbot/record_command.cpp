@@ -57,14 +57,14 @@ const Command kRecord{
     [](const cli::Args& args) {
       const auto out = args.get("out");
       if (!out) throw cli::UsageError("--out DIR is required");
-      const double dwell_s = args.get_double("dwell", 2.0);
-      if (!(dwell_s > 0.0 && dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
-      const auto seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
+      const TourFamilyArgs family = tour_family_args(args, 2.0);
+      const double dwell_s = family.dwell_s;
+      const std::uint64_t seed = family.seed;
       const config::Scene scene = config::load_scene(args.get_or("config", (asset_dir() / "scenes" / "tour.yaml").string()));
       check_scene_outputs(args, scene, "the default scene");
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot record` needs a 'tour: {visits: [...]}' section");
-      const int visits = args.get_int("visits", static_cast<int>(scene.visits.size()), 1, 1000);
+      const int visits = family.visits > 0 ? family.visits : static_cast<int>(scene.visits.size());
       check_content_videos(scene);  // the recording's replay plays them: a broken one is refused before the drive
       cli::check_new_folder(*out, "a recording needs a new folder");
       catch_interrupts();  // Ctrl-C: during set-up nothing is written; later, end the stop in progress, keep every stop

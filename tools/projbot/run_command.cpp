@@ -57,10 +57,8 @@ std::optional<config::Recording> replay_of(const cli::Args& args) {
 // The run's options beyond the scene and the recording: a bad value is a usage error before anything opens.
 live::RunOptions run_options(const cli::Args& args) {
   live::RunOptions o;
-  o.visits = args.get_int("visits", 0, 1, 1000);
-  o.dwell_s = args.get_double("dwell", 4.0);
-  if (!(o.dwell_s > 0.0 && o.dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be in (0, 3600] seconds");
-  o.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
+  const TourFamilyArgs family = tour_family_args(args, 4.0);
+  o.visits = family.visits, o.dwell_s = family.dwell_s, o.seed = family.seed;
   o.seconds = args.get_double("seconds", 0.0);
   if (!(o.seconds >= 0.0 && o.seconds <= 1e6)) throw cli::UsageError("--seconds must be 0 (until the tour ends) to 1e6");
   o.headless = args.flag("headless");

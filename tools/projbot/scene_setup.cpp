@@ -41,6 +41,15 @@ void check_content_videos(const config::Scene& scene) {
       assets::VideoDecoder probe(t.content->video);
 }
 
+TourFamilyArgs tour_family_args(const cli::Args& args, double default_dwell_s, int default_visits) {
+  TourFamilyArgs t;
+  t.visits = args.get_int("visits", default_visits, 1, 1000);
+  t.dwell_s = args.get_double("dwell", default_dwell_s);
+  if (!(t.dwell_s >= 0.1 && t.dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be 0.1..3600 seconds");
+  t.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
+  return t;
+}
+
 void check_made_video(const config::Scene& scene) {
   for (const auto& t : scene.targets)
     if (t.content && !t.content->video.empty() && !std::filesystem::exists(t.content->video))

@@ -3,6 +3,7 @@
 // render-type subcommands share, and the upload of every target's model.
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <ostream>
@@ -25,6 +26,16 @@ std::filesystem::path asset_dir();
 /// Opens every target's content video once (its header and first frame), before a command that only plays
 /// it later (record: the replay would fail): throws assets::AssetError naming the file.
 void check_content_videos(const config::Scene& scene);
+
+/// The tour family's shared options (tour, run, record, bench motion, bench appearance), one range each:
+/// --visits 1..1000 (default `default_visits`: 0 is the scene's list once), --dwell 0.1..3600 s, --seed
+/// 0..2^30 (default 1). Throws cli::UsageError naming the option.
+struct TourFamilyArgs {
+  int visits = 0;
+  double dwell_s = 0.0;
+  std::uint64_t seed = 1;
+};
+TourFamilyArgs tour_family_args(const cli::Args& args, double default_dwell_s, int default_visits = 0);
 
 /// For a shipped scene, whose video the build makes into the build tree: a missing one is refused saying how
 /// to make it (config::ConfigError).

@@ -92,10 +92,8 @@ const Command kTour{
         o.mode = twin::TourMode::tracking;
       else
         throw cli::UsageError("--mode must be odometry, localized or tracking, not '" + mode + "'");
-      o.visits = args.get_int("visits", 0, 1, 1000);
-      o.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
-      o.dwell_s = args.get_double("dwell", 3.0);
-      if (!(o.dwell_s >= 0.0 && o.dwell_s <= 600.0)) throw cli::UsageError("--dwell must be 0..600 seconds");
+      const TourFamilyArgs family = tour_family_args(args, 3.0);
+      o.visits = family.visits, o.seed = family.seed, o.dwell_s = family.dwell_s;
       o.frames_dir = args.get_or("frames", "");
       o.depth_noise = !args.flag("no-noise");
       const std::string depth_model = args.get_or("depth-model", "kinect");
