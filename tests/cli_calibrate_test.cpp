@@ -237,11 +237,14 @@ TEST_F(CliTest, RenderDrawsAnMpegTsVideoAsTheSameFramesInMp4) {
     writer.finish();
   }
   const auto render_at = [&](const std::string& clip, const std::string& t) {
-    write("v.yaml", "projector: {width: 320, height: 240, fx: 300, fy: 300, cx: 159.5, cy: 119.5}\ntargets:\n  - {name: box, "
-                    "model: " + (fs::path(PROJBOT_SHARED_DATA) / "gltf/BoxTextured/glTF/BoxTextured.gltf").string() +
-                    ", scale: 0.3, pose: {translation: [0, 0, 1], rpy_deg: [200, 35, 0]}, content: {video: " + clip + "}}\n");
+    write("v.yaml",
+          "projector: {width: 320, height: 240, fx: 300, fy: 300, cx: 159.5, cy: 119.5}\ntargets:\n  - {name: box, "
+          "model: " +
+              (fs::path(PROJBOT_SHARED_DATA) / "gltf/BoxTextured/glTF/BoxTextured.gltf").string() +
+              ", scale: 0.3, pose: {translation: [0, 0, 1], rpy_deg: [200, 35, 0]}, content: {video: " + clip + "}}\n");
     const fs::path out = dir_ / (clip + "_" + t + ".png");
-    const CliRun r = run_projbot("render --scene " + (dir_ / "v.yaml").string() + " --content-time " + t + " --out " + out.string());
+    const CliRun r =
+        run_projbot("render --scene " + (dir_ / "v.yaml").string() + " --content-time " + t + " --out " + out.string());
     EXPECT_EQ(r.code, 0) << clip << " at " << t << ": " << r.output;
     return projbot::assets::read_image(out);
   };

@@ -265,14 +265,15 @@ std::vector<Hostile> clash_cases() {
           1,
           {"countdown.mp4: target 'can's video needs texture coordinates to lie on, and its model", "obj_000001.ply has none"}},
       // Issue 72: FFmpeg's error code for it is EBUSY, "Device or resource busy"; its log says the size.
-      Hostile{"bench_content_video_20000_pixels_a_side",
-              "bench content --scene {dir}/bad.yaml",
-              Files{{"bad.yaml",
-                     "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: box, model: "
-                     "{data}/gltf/BoxTextured/glTF/BoxTextured.gltf, pose: {translation: [0, 0, 1]}, content: {video: big.y4m}}\n"},
-                    {"big.y4m", "YUV4MPEG2 W20000 H20000 F30:1 Ip A1:1 C420jpeg\nFRAME\n"}},
-              1,
-              {"big.y4m: not a video FFmpeg can read (Picture size 20000x20000 is invalid; this player takes at most 8192 px"}},
+      Hostile{
+          "bench_content_video_20000_pixels_a_side",
+          "bench content --scene {dir}/bad.yaml",
+          Files{{"bad.yaml",
+                 "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\ntargets:\n  - {name: box, model: "
+                 "{data}/gltf/BoxTextured/glTF/BoxTextured.gltf, pose: {translation: [0, 0, 1]}, content: {video: big.y4m}}\n"},
+                {"big.y4m", "YUV4MPEG2 W20000 H20000 F30:1 Ip A1:1 C420jpeg\nFRAME\n"}},
+          1,
+          {"big.y4m: not a video FFmpeg can read (Picture size 20000x20000 is invalid; this player takes at most 8192 px"}},
       // "(it has 0)" read as no materials where the box has one, unnamed.
       Hostile{"bench_content_material_missing_on_an_unnamed_one",
               "bench content --scene {dir}/bad.yaml",

@@ -6,8 +6,8 @@ extern "C" {
 #include <libavutil/log.h>
 }
 
-#include <cstdio>
 #include <cstdarg>
+#include <cstdio>
 #include <string>
 #include <utility>
 

@@ -328,8 +328,9 @@ void VideoDecoder::seek(double t_s) {
 void VideoDecoder::rewind() {
   Impl& d = *impl_;
   const std::int64_t start = d.format->streams[d.stream]->start_time;
-  const int r = d.seeks_by_byte ? av_seek_frame(d.format.get(), d.stream, 0, AVSEEK_FLAG_BYTE)
-                                : av_seek_frame(d.format.get(), d.stream, start == AV_NOPTS_VALUE ? 0 : start, AVSEEK_FLAG_BACKWARD);
+  const int r = d.seeks_by_byte
+                    ? av_seek_frame(d.format.get(), d.stream, 0, AVSEEK_FLAG_BYTE)
+                    : av_seek_frame(d.format.get(), d.stream, start == AV_NOPTS_VALUE ? 0 : start, AVSEEK_FLAG_BACKWARD);
   if (r < 0 && avformat_seek_file(d.format.get(), -1, INT64_MIN, 0, INT64_MAX, 0) < 0)
     d.fail("cannot go back to its first frame (" + av_message(r) + ")");
   avcodec_flush_buffers(d.codec.get());

@@ -58,8 +58,8 @@ std::string read_yaml_text(const std::filesystem::path& path, std::uintmax_t max
   std::error_code ec;
   const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
   if (!ec && bytes > max_bytes)
-    throw ConfigError(file + ": " + std::to_string(bytes) + " bytes, more than the " + std::to_string(max_bytes >> 20) +
-                      " MB " + kind + " may be");
+    throw ConfigError(file + ": " + std::to_string(bytes) + " bytes, more than the " + std::to_string(max_bytes >> 20) + " MB " +
+                      kind + " may be");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(file + ": cannot open");
   std::string text;

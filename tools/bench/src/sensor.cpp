@@ -172,7 +172,9 @@ alignment::DepthImage twin_scene(const std::vector<float>& models, const alignme
 }  // namespace
 
 void SensorStats::add(const SensorStats& more) {
-  const auto append = [](std::vector<double>& to, const std::vector<double>& from) { to.insert(to.end(), from.begin(), from.end()); };
+  const auto append = [](std::vector<double>& to, const std::vector<double>& from) {
+    to.insert(to.end(), from.begin(), from.end());
+  };
   append(residual_mm, more.residual_mm);
   append(step_per_z2, more.step_per_z2);
   append(offset_mm, more.offset_mm);

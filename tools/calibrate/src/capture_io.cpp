@@ -144,8 +144,8 @@ int projector_side(const YAML::Node& y, const char* key, const fs::path& file) {
   const YAML::Node n = p.IsMap() ? p[key] : YAML::Node();
   const double v = n && n.IsScalar() ? n.as<double>(std::nan("")) : std::nan("");
   if (!(v >= kMinProjectorSide && v <= kMaxProjectorSide) || v != std::floor(v))
-    throw CalibrationError(file.string() + (n ? ":" + std::to_string(n.Mark().line + 1) : std::string()) + ": projector." +
-                           key + " must be a whole number of pixels, " + std::to_string(kMinProjectorSide) + ".." +
+    throw CalibrationError(file.string() + (n ? ":" + std::to_string(n.Mark().line + 1) : std::string()) + ": projector." + key +
+                           " must be a whole number of pixels, " + std::to_string(kMinProjectorSide) + ".." +
                            std::to_string(kMaxProjectorSide) + " (it is " +
                            (n && n.IsScalar() ? "'" + n.Scalar() + "'" : std::string("not given")) + ")");
   return static_cast<int>(v);
@@ -203,8 +203,8 @@ CaptureManifest read_manifest(const fs::path& dir, const SolveOptions& options) 
     skip_pattern_folders(dir, m);
   }
   if (options.board) m.board = *options.board;
-  if (m.projector_width < kMinProjectorSide || m.projector_height < kMinProjectorSide ||
-      m.projector_width > kMaxProjectorSide || m.projector_height > kMaxProjectorSide)
+  if (m.projector_width < kMinProjectorSide || m.projector_height < kMinProjectorSide || m.projector_width > kMaxProjectorSide ||
+      m.projector_height > kMaxProjectorSide)
     throw CalibrationError("projector size " + std::to_string(m.projector_width) + "x" + std::to_string(m.projector_height) +
                            " is out of range (each side " + std::to_string(kMinProjectorSide) + ".." +
                            std::to_string(kMaxProjectorSide) + " pixels)");
