@@ -62,12 +62,13 @@ std::string read_yaml_text(const std::filesystem::path& path, std::uintmax_t max
                       kind + " may be");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(file + ": cannot open");
-  std::string text;
-  text.resize(static_cast<std::size_t>(max_bytes) + 1);  // one more than allowed: a file that grew is seen
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  if (text.size() > max_bytes)
-    throw ConfigError(file + ": more than the " + std::to_string(max_bytes >> 20) + " MB " + kind + " may be");
+  std::string text;  // read in blocks up to the limit: a file that grew since its size was taken is seen
+  char block[1 << 16];
+  while (in.read(block, sizeof block) || in.gcount() > 0) {
+    text.append(block, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > max_bytes)
+      throw ConfigError(file + ": more than the " + std::to_string(max_bytes >> 20) + " MB " + kind + " may be");
+  }
   if (const std::string problem = yaml_text_problem(text, file); !problem.empty()) throw ConfigError(problem);
   return text;
 }

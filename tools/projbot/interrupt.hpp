@@ -6,8 +6,8 @@
 #include <chrono>
 #include <exception>
 #include <functional>
+#include <future>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -36,35 +36,18 @@ int nothing_written(const std::string& when);
 /// work uses. An exception from the work is thrown here.
 template <typename T>
 std::optional<T> unless_interrupted(std::function<T()> work) {
-  struct Shared {
-    std::mutex m;
-    std::optional<T> result;
-    std::exception_ptr error;
-    bool done = false;
-  };
-  auto shared = std::make_shared<Shared>();
-  std::thread([shared, work = std::move(work)] {
-    std::optional<T> r;
-    std::exception_ptr e;
+  auto promise = std::make_shared<std::promise<T>>();
+  std::future<T> result = promise->get_future();
+  std::thread([promise, work = std::move(work)] {
     try {
-      r.emplace(work());
+      promise->set_value(work());
     } catch (...) {
-      e = std::current_exception();
+      promise->set_exception(std::current_exception());
     }
-    const std::lock_guard<std::mutex> lock(shared->m);
-    shared->result = std::move(r), shared->error = e, shared->done = true;
   }).detach();
-  for (;;) {
-    {
-      const std::lock_guard<std::mutex> lock(shared->m);
-      if (shared->done) {
-        if (shared->error) std::rethrow_exception(shared->error);
-        return std::move(shared->result);
-      }
-    }
+  while (result.wait_for(std::chrono::milliseconds(10)) != std::future_status::ready)
     if (interrupted()) return std::nullopt;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  return result.get();
 }
 
 }  // namespace projbot::tools

@@ -277,7 +277,6 @@ int simulate(const SimulationConfig& c, const std::filesystem::path& out, const 
   const std::vector<Eigen::Matrix4d> poses = board_poses(c, g);
   const int count = static_cast<int>(poses.size());
   const std::vector<cv::Mat> patterns = gray_code_images(c.projector.width_px, c.projector.height_px);
-  if (stop && stop()) return 0;
   const std::vector<cv::Point2d> rays = sample_rays(c.camera, stop);
   if (stop && stop()) return 0;
   CaptureWriter writer(out);
