@@ -167,12 +167,12 @@ TEST_F(CliTest, TourWithACalibrationPaysForItsError) {
     if (at != std::string::npos) std::sscanf(out.c_str() + at, "lit at arrival, mean %lf", &mean);
     return mean;
   };
-  CliRun r = run_projbot("tour --visits 1 --mode localized --calibration " + (dir_ / "truth.yaml").string());
+  CliRun r = run_projbot("tour --visits 1 --mode localized --depth-model kinect --calibration " + (dir_ / "truth.yaml").string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("projecting with the calibration"), std::string::npos) << r.output;
   EXPECT_GT(mean_of_visit(r.output), 0.0) << r.output;
   EXPECT_LT(mean_of_visit(r.output), 2.5) << r.output;
-  r = run_projbot("tour --visits 1 --mode localized --calibration " + (dir_ / "off.yaml").string());
+  r = run_projbot("tour --visits 1 --mode localized --depth-model kinect --calibration " + (dir_ / "off.yaml").string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_GT(mean_of_visit(r.output), 3.0) << r.output;
   EXPECT_LT(mean_of_visit(r.output), 9.0) << r.output;

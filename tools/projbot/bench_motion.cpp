@@ -24,13 +24,17 @@ std::string cell(double v, int decimals = 1) {
 void print_side_by_side(const twin::TourReport& off, const twin::TourReport& on) {
   std::printf(
       "\n| # | target | motion | while moving mean / p95 / worst mm, off | on | blank frames while moving, off / on | "
-      "lost, lit again after s, off / on | still mean mm, off / on | pose age at display p50 / p95 ms (on) |\n"
-      "|---|---|---|---|---|---|---|---|---|\n");
+      "lost, lit again after s, off / on | still mean mm, off / on | lit > 10 / > 20 mm off, off / on | "
+      "pose age at display p50 / p95 ms (on) |\n"
+      "|---|---|---|---|---|---|---|---|---|---|\n");
   const auto moving = [](const twin::VisitReport& v) {
     return v.moved ? cell(v.moving_mean_mm) + " / " + cell(v.moving_p95_mm) + " / " + cell(v.max_mm_moving) : std::string("-");
   };
   const auto recovery = [](const twin::VisitReport& v) {
     return v.recovery_s == 0.0 ? std::string("-") : v.recovery_s < 0.0 ? std::string("never") : cell(v.recovery_s, 2);
+  };
+  const auto far = [](const twin::VisitReport& v) {
+    return std::to_string(v.far_off.over_10mm) + " / " + std::to_string(v.far_off.over_20mm);
   };
   // After Ctrl-C in the first run, its finished visits are printed with the second run's cells "-".
   for (std::size_t i = 0; i < off.visits.size(); ++i) {
@@ -38,11 +42,11 @@ void print_side_by_side(const twin::TourReport& off, const twin::TourReport& on)
     const bool ran = i < on.visits.size();
     const auto& b = ran ? on.visits[i] : a;
     const auto second = [ran](const std::string& text) { return ran ? text : std::string("-"); };
-    std::printf("| %d | %s | %s | %s | %s | %d / %s | %s / %s | %s / %s | %s / %s |\n", a.visit, a.target.c_str(),
+    std::printf("| %d | %s | %s | %s | %s | %d / %s | %s / %s | %s / %s | %s, %s | %s / %s |\n", a.visit, a.target.c_str(),
                 a.moved ? "moved" : "still", moving(a).c_str(), second(moving(b)).c_str(), a.moving_blank_frames,
                 second(std::to_string(b.moving_blank_frames)).c_str(), recovery(a).c_str(), second(recovery(b)).c_str(),
-                cell(a.still_mean_mm, 2).c_str(), second(cell(b.still_mean_mm, 2)).c_str(), second(cell(b.age_p50_ms, 0)).c_str(),
-                second(cell(b.age_p95_ms, 0)).c_str());
+                cell(a.still_mean_mm, 2).c_str(), second(cell(b.still_mean_mm, 2)).c_str(), far(a).c_str(),
+                second(far(b)).c_str(), second(cell(b.age_p50_ms, 0)).c_str(), second(cell(b.age_p95_ms, 0)).c_str());
   }
 }
 
@@ -52,7 +56,7 @@ const Command kBenchMotion{
     "bench motion",
     "benchmark tracking of moving targets with motion prediction off and on (the twin)",
     "projbot bench motion [--scene S.yaml] [--visits N] [--seed K] [--dwell S] [--process-noise Q]\n"
-    "                     [--processing-ms MS]\n\n"
+    "                     [--processing-ms MS] [--depth-model fitted|kinect]\n\n"
     "Runs the scene's tour twice in the digital twin in tracking mode, the same seed and motions each time:\n"
     "first drawing the newest measured pose, then the pose predicted for each projector frame's display time\n"
     "(a constant-velocity filter per target; the tracker also starts from it). The camera runs at 30 Hz,\n"
@@ -67,6 +71,7 @@ const Command kBenchMotion{
      {"visits", "N", "visits, cycling through the scene's list (default: the list once)"},
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
      {"dwell", "S", "simulated seconds of projection per visit (default 3)"},
+     depth_model_option(),
      {"process-noise", "Q", "the motion filter's acceleration noise, m s^-1.5 (turning: 3 Q rad s^-1.5; default 1)"},
      {"processing-ms", "MS", "a pose is ready this long after its capture (default: as measured on this machine)"}},
     [](const cli::Args& args) {
@@ -74,6 +79,7 @@ const Command kBenchMotion{
       o.mode = twin::TourMode::tracking;
       const TourFamilyArgs family = tour_family_args(args, 3.0);
       o.visits = family.visits, o.seed = family.seed, o.dwell_s = family.dwell_s;
+      o.fitted_depth = family.depth_model == "fitted";
       const double q = args.get_double("process-noise", alignment::MotionModelConfig{}.accel_noise);
       if (!(q > 0.0 && q <= 100.0)) throw cli::UsageError("--process-noise must be in (0, 100]");
       o.motion.accel_noise = q;
@@ -103,8 +109,8 @@ const Command kBenchMotion{
       }
       print_side_by_side(runs[0], runs[1]);
       const auto& p = scene.projector;
-      std::printf("\nprojector %.0f Hz, input lag %.0f ms; camera 30 Hz; seed %llu", p.refresh_hz, p.input_lag_ms,
-                  static_cast<unsigned long long>(o.seed));
+      std::printf("\nprojector %.0f Hz, input lag %.0f ms; camera 30 Hz, %s depth model; seed %llu", p.refresh_hz, p.input_lag_ms,
+                  family.depth_model.c_str(), static_cast<unsigned long long>(o.seed));
       if (o.processing_ms)
         std::printf("; a pose ready %.1f ms after its capture (fixed)\n", *o.processing_ms);
       else

@@ -42,7 +42,11 @@ calibrate::SimulationConfig simulation_config(const cli::Args& args, const confi
   c.poses = args.get_int("poses", 10, 1, 100);
   if (const auto file = args.get("poses-file")) {
     if (args.get("poses")) throw cli::UsageError("give --poses or --poses-file, not both");
-    c.scripted = calibrate::read_board_poses(*file);
+    try {
+      c.scripted = calibrate::read_board_poses(*file);
+    } catch (const calibrate::CalibrationError& e) {  // the file's own fault: exit 1, but say which option gave it
+      throw calibrate::CalibrationError(std::string("--poses-file: ") + e.what());
+    }
     c.poses = static_cast<int>(c.scripted.size());
   }
   c.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));

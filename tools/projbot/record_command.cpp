@@ -20,7 +20,8 @@ namespace fs = std::filesystem;
 const Command kRecord{
     "record",
     "run the session through the tour and record it (camera, base, pan-tilt, poses) to replay with run --replay",
-    "projbot record --out DIR [--config site.yaml] [--sim] [--visits N] [--dwell S] [--seed K]\n\n"
+    "projbot record --out DIR [--config site.yaml] [--sim] [--visits N] [--dwell S] [--seed K]\n"
+    "               [--depth-model fitted|kinect]\n\n"
     "Runs the projection session at every stop of the config's tour, as run does, with every camera frame\n"
     "tracked in lockstep (each frame tracked before the next is read; a search bounded by its work, not by\n"
     "wall time), and writes into DIR:\n"
@@ -53,7 +54,8 @@ const Command kRecord{
      {"sim", "", "record the twin's camera whatever `devices:` configures"},
      {"visits", "N", "visits, cycling through the tour (default: the list once)"},
      {"dwell", "S", "seconds at each stop (default 2)"},
-     {"seed", "K", "seed of the twin's drive and noise (default 1, as run's)"}},
+     {"seed", "K", "seed of the twin's drive and noise (default 1, as run's)"},
+     depth_model_option()},
     [](const cli::Args& args) {
       const auto out = args.get("out");
       if (!out) throw cli::UsageError("--out DIR is required");
@@ -71,7 +73,7 @@ const Command kRecord{
 
       Progress progress("frame", static_cast<int>(std::ceil(visits * dwell_s * 30.0)));
       live::RecordHooks hooks{[] { return interrupted(); }, [&progress](int frames) { progress.step(frames); }, &std::cout};
-      const live::Recorded r = live::record(scene, {visits, dwell_s, seed, args.flag("sim")}, *out, hooks);
+      const live::Recorded r = live::record(scene, {visits, dwell_s, seed, args.flag("sim"), family.depth_noise}, *out, hooks);
       if (!r.started) return nothing_written("while setting up");  // no folder made
       std::cout << "recorded " << r.recording.stops.size() << " stop(s), " << r.frames << " frames from " << r.recording.camera
                 << " to " << *out << "\nreplay: projbot run --replay " << *out << "\n";

@@ -49,7 +49,7 @@ std::optional<config::Recording> replay_of(const cli::Args& args) {
   const auto dir = args.get("replay");
   if (!dir) return std::nullopt;
   if (args.flag("sim")) throw cli::UsageError("--sim does not apply to --replay: the recording serves every device");
-  for (const char* k : {"visits", "dwell", "seed"})
+  for (const char* k : {"visits", "dwell", "seed", "depth-model"})
     if (args.get(k)) throw cli::UsageError(std::string("--") + k + " does not apply to --replay: it plays the recording's stops");
   return config::load_recording(*dir);
 }
@@ -59,6 +59,7 @@ live::RunOptions run_options(const cli::Args& args) {
   live::RunOptions o;
   const TourFamilyArgs family = tour_family_args(args, 4.0);
   o.visits = family.visits, o.dwell_s = family.dwell_s, o.seed = family.seed;
+  o.depth_model = family.depth_noise;
   o.seconds = args.get_double("seconds", 0.0);
   if (!(o.seconds >= 0.0 && o.seconds <= 1e6)) throw cli::UsageError("--seconds must be 0 (until the tour ends) to 1e6");
   o.headless = args.flag("headless");
@@ -157,7 +158,8 @@ const Command kRun{
     "the live engine: project onto the tracked targets while the robot tours (the twin with --sim)",
     "projbot run [--config C.yaml] [--sim | --replay DIR] [--fullscreen] [--monitor N] [--headless] [--profile p.csv]\n"
     "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n"
-    "            [--no-predict] [--compensation on|off] [--learn-reflectance [--reflectance-out DIR]]\n\n"
+    "            [--no-predict] [--compensation on|off] [--learn-reflectance [--reflectance-out DIR]]\n"
+    "            [--depth-model fitted|kinect]\n\n"
     "Opens the projector output and draws, every frame, each target the robot is projecting onto (the\n"
     "visited one and the others it expects in the projector's view at that stop) at the\n"
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
@@ -221,6 +223,7 @@ const Command kRun{
      {"visits", "N", "visits, cycling through the tour (default: the list once)"},
      {"dwell", "S", "seconds the robot projects at each stop (default 4)"},
      {"seed", "K", "seed of the twin's noise (default 1)"},
+     depth_model_option(),
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time"},
      {"compensation", "on|off",
       "radiometric compensation of each target's surface and the room's light (default on; off: the content as stored)"},

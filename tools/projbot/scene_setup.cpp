@@ -47,7 +47,20 @@ TourFamilyArgs tour_family_args(const cli::Args& args, double default_dwell_s, i
   t.dwell_s = args.get_double("dwell", default_dwell_s);
   if (!(t.dwell_s >= 0.1 && t.dwell_s <= 3600.0)) throw cli::UsageError("--dwell must be 0.1..3600 seconds");
   t.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
+  t.depth_model = args.get_or("depth-model", "fitted");
+  t.depth_noise = depth_model_named(t.depth_model);
   return t;
+}
+
+cli::OptionSpec depth_model_option() {
+  return {"depth-model", "M",
+          "the twin's depth camera: fitted (to the real sensor's frames, default) or kinect (the published model)"};
+}
+
+alignment::KinectNoiseConfig depth_model_named(const std::string& name, const std::string& option) {
+  if (name == "fitted") return alignment::KinectNoiseConfig::fitted();
+  if (name == "kinect") return {};
+  throw cli::UsageError(option + " must be kinect or fitted, not '" + name + "'");
 }
 
 void check_made_video(const config::Scene& scene) {

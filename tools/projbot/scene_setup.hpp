@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/content.hpp"
 #include "projbot/engine/renderer.hpp"
@@ -29,13 +30,22 @@ void check_content_videos(const config::Scene& scene);
 
 /// The tour family's shared options (tour, run, record, bench motion, bench appearance), one range each:
 /// --visits 1..1000 (default `default_visits`: 0 is the scene's list once), --dwell 0.1..3600 s, --seed
-/// 0..2^30 (default 1). Throws cli::UsageError naming the option.
+/// 0..2^30 (default 1), --depth-model fitted (default) or kinect. Throws cli::UsageError naming the option.
 struct TourFamilyArgs {
   int visits = 0;
   double dwell_s = 0.0;
   std::uint64_t seed = 1;
+  std::string depth_model = "fitted";                                                 ///< the twin's depth camera, by name
+  alignment::KinectNoiseConfig depth_noise = alignment::KinectNoiseConfig::fitted();  ///< ...and its model
 };
 TourFamilyArgs tour_family_args(const cli::Args& args, double default_dwell_s, int default_visits = 0);
+
+/// `--depth-model fitted|kinect`: the twin's depth camera as fitted to the real sensor's frames (the default:
+/// a twin no kinder than the real sensor) or the published Kinect v1 model. Every command that simulates depth
+/// takes it.
+cli::OptionSpec depth_model_option();
+/// The named model; cli::UsageError naming `option` for another name.
+alignment::KinectNoiseConfig depth_model_named(const std::string& name, const std::string& option = "--depth-model");
 
 /// For a shipped scene, whose video the build makes into the build tree: a missing one is refused saying how
 /// to make it (config::ConfigError).

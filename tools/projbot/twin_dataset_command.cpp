@@ -28,11 +28,19 @@ std::vector<fs::path> model_folders(const cli::Args& args) {
   return out;
 }
 
-alignment::KinectNoiseConfig sensor_model(const std::string& name) {
+// --depth-model (the name every command that simulates depth takes) or --sensor (this command's older name).
+std::string sensor_name(const cli::Args& args) {
+  if (args.get("sensor") && args.get("depth-model")) throw cli::UsageError("give --depth-model or --sensor, not both");
+  return args.get_or("depth-model", args.get_or("sensor", "fitted"));
+}
+
+alignment::KinectNoiseConfig sensor_model(const cli::Args& args) {
+  const std::string name = sensor_name(args);
   if (name == "fitted") return alignment::KinectNoiseConfig::fitted();
   if (name == "kinect") return {};
   if (name == "none") return alignment::KinectNoiseConfig::none();
-  throw cli::UsageError("--sensor must be fitted, kinect or none, got '" + name + "'");
+  throw cli::UsageError(std::string(args.get("sensor") ? "--sensor" : "--depth-model") +
+                        " must be fitted, kinect or none, got '" + name + "'");
 }
 
 int run_twin_dataset(const cli::Args& args) {
@@ -44,7 +52,7 @@ int run_twin_dataset(const cli::Args& args) {
   options.scenes = args.get_int("scenes", 10, 1, 10000);
   options.images = args.get_int("images", 10, 1, 10000);
   options.seed = static_cast<std::uint32_t>(args.get_int("seed", 1, 0, 1 << 30));
-  options.sensor = sensor_model(args.get_or("sensor", "fitted"));
+  options.sensor = sensor_model(args);
   std::vector<config::NamedPath> inputs;
   for (const auto& m : options.model_folders) inputs.push_back({"the models folder", m, true});
   args.check_clashes(inputs);
@@ -69,7 +77,7 @@ int run_twin_dataset(const cli::Args& args) {
     return nothing_written("before the first image");
   }
   std::cout << "twin-dataset: " << s.scenes << " scenes, " << s.images << " images, " << s.instances << " instances of "
-            << s.objects << " objects in " << *out << " (sensor: " << args.get_or("sensor", "fitted") << ")\n"
+            << s.objects << " objects in " << *out << " (sensor: " << sensor_name(args) << ")\n"
             << "measure on it: projbot bench dataset " << *out << "\n";
   if (s.interrupted) {
     std::cout << "interrupted: the last scene holds the images written before the stop; every scene's files are complete\n";
@@ -83,8 +91,8 @@ int run_twin_dataset(const cli::Args& args) {
 const Command kTwinDataset{
     "twin-dataset",
     "a BOP dataset rendered by the twin, its depth under the sensor model fitted to real frames",
-    "projbot twin-dataset --out DIR [--models DIR]... [--scenes N] [--images M] [--seed K] [--sensor MODEL]\n"
-    "                     [--no-procedural]\n\n"
+    "projbot twin-dataset --out DIR [--models DIR]... [--scenes N] [--images M] [--seed K]\n"
+    "                     [--depth-model fitted|kinect|none] [--no-procedural]\n\n"
     "Writes a BOP dataset (the layout bench dataset and bench sensor read) into DIR, a new or empty folder:\n"
     "N scenes (default 10) of 3 to 6 objects resting on a table, touching and hiding each other, with a wall or\n"
     "a shelf behind, each a video of M images (default 10) from a camera 0.6 to 1.5 m away, looking down 20 to\n"
@@ -106,7 +114,8 @@ const Command kTwinDataset{
      {"scenes", "N", "scenes to write (default 10)"},
      {"images", "M", "images per scene (default 10)"},
      {"seed", "K", "seed of the scenes, the cameras and the sensor's noise (default 1)"},
-     {"sensor", "MODEL", "fitted (default), kinect or none"},
+     {"depth-model", "MODEL", "the twin's depth camera: fitted (to the real sensor's frames, default), kinect or none"},
+     {"sensor", "MODEL", "the same as --depth-model (its older name)"},
      {"no-procedural", "", "leave out the procedural shapes"}},
     run_twin_dataset};
 

@@ -159,6 +159,7 @@ void RobotThread::drive(const config::Scene& scene, const RunOptions& o, session
                         const RunSources& sources, const std::stop_token& cancel) {
   Rig rig(scene, trackers.targets, *sources.devices, sources.replay,
           {.seed = o.seed,
+           .depth_model = o.depth_model,
            .interrupted = sources.interrupted,
            .replay_clock = replay_clock_ ? replay_clock_->robot() : config::Clock{}});
   const config::Clock& clock = rig.session().clock();

@@ -192,7 +192,7 @@ Recorded record(const config::Scene& scene, const RecordOptions& o, const fs::pa
   session::SceneTrackers trackers = session::make_trackers(scene, session::worker_config(true, true));
   // The robot: the configured base, pan-tilt and camera together, or the twin's (with the configured camera, if any).
   Rig rig(scene, trackers.targets, devices, nullptr,
-          {.seed = o.seed, .recording = true, .interrupted = interrupted, .replay_clock = {}});
+          {.seed = o.seed, .depth_model = o.depth_model, .recording = true, .interrupted = interrupted, .replay_clock = {}});
   QuantisedCamera quantised;
   const session::Dwell dwell = recording_dwell(rig, o.dwell_s, quantised, hooks);
   if (interrupted()) return result;  // no folder made

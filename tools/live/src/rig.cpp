@@ -15,7 +15,7 @@ Rig::Rig(const config::Scene& scene, const std::vector<session::Target>& targets
     replay_session_ = std::make_unique<session::ReplaySession>(scene, *replay, targets, options_.replay_clock);
   } else {
     twin_ = std::make_unique<twin::TwinSession>(scene, targets, options_.seed, devices.camera.get(), options_.interrupted,
-                                                options_.recording);
+                                                options_.recording, options_.depth_model);
     twin_camera_ = devices.camera == nullptr;
   }
 }

@@ -52,8 +52,16 @@ nlohmann::json neighbours_json(const std::vector<NeighbourReport>& neighbours) {
                    {"frames", n.frames},
                    {"lit_frames", n.lit_frames},
                    {"lit_mean_mm", finite_or_null(n.lit_mean_mm)},
-                   {"worst_mm", finite_or_null(n.worst_mm)}});
+                   {"worst_mm", finite_or_null(n.worst_mm)},
+                   {"lit_over_10mm_frames", n.far_off.over_10mm},
+                   {"lit_over_20mm_frames", n.far_off.over_20mm}});
   return out;
+}
+
+// "lit/frames (a / b)": the frames lit, and of them those more than 10 / 20 mm off.
+std::string lit_of(int lit, std::size_t frames, const FarOff& off) {
+  return std::to_string(lit) + "/" + std::to_string(frames) + " (" + std::to_string(off.over_10mm) + " / " +
+         std::to_string(off.over_20mm) + ")";
 }
 
 std::string fixed(double v, int decimals) {
@@ -69,15 +77,16 @@ void print_neighbours(const TourReport& report, std::ostream& out) {
   for (const auto& v : report.visits) any = any || !v.neighbours.empty();
   if (!any) return;
   out << "\nNeighbours in view, lit with the visited target (each blanked on its own):\n\n| # | visited | neighbour | Eq. 1 "
-         "guess error cm / deg | at arrival mean / max mm | lit frames | mean / worst mm over them | align ms |\n"
+         "guess error cm / deg | at arrival mean / max mm | lit frames (> 10 / > 20 mm off) | mean / worst mm over them | "
+         "align ms |\n"
          "|---|---|---|---|---|---|---|---|\n";
   for (const auto& v : report.visits)
     for (const auto& n : v.neighbours)
       out << "| " << v.visit << " | " << v.target << " | " << n.target << " | " << fixed(n.guess_error_cm, 1) << " / "
           << fixed(n.guess_error_deg, 1) << " | "
-          << (n.projected ? fixed(n.mean_mm, 2) + " / " + fixed(n.max_mm, 2) : std::string("blanked")) << " | " << n.lit_frames
-          << "/" << n.frames << " | " << fixed(n.lit_mean_mm, 2) << " / " << fixed(n.worst_mm, 2) << " | " << fixed(n.align_ms, 0)
-          << " |\n";
+          << (n.projected ? fixed(n.mean_mm, 2) + " / " + fixed(n.max_mm, 2) : std::string("blanked")) << " | "
+          << lit_of(n.lit_frames, static_cast<std::size_t>(n.frames), n.far_off) << " | " << fixed(n.lit_mean_mm, 2) << " / "
+          << fixed(n.worst_mm, 2) << " | " << fixed(n.align_ms, 0) << " |\n";
 }
 
 }  // namespace
@@ -91,7 +100,7 @@ void print_table(const TourReport& report, std::ostream& out) {
   for (const auto& v : report.visits) rows = std::max(rows, v.target_visit);
 
   out << "Projection error at the markers, mm (mean / max), mode " << to_string(report.mode) << ", seed " << report.seed
-      << ";\nthe paper's Table 1 (odometry only, one ICP per stop) beside it:\n\n";
+      << ", depth model " << report.depth_model << ";\nthe paper's Table 1 (odometry only, one ICP per stop) beside it:\n\n";
   out << "| visit |";
   for (std::size_t c = 0; c < names.size(); ++c)
     out << ' ' << names[c] << " |" << (c < 2 ? " paper target " + std::to_string(c + 1) + " |" : "");
@@ -135,7 +144,7 @@ void print_table(const TourReport& report, std::ostream& out) {
         << "; errors of each projector frame at its display time):\n\n| # | target | moved | while moving mean / p95 / worst mm "
            "| "
            "mean mm still | mean mm at the end | re-converged after the move, s | pose age at display p50 / p95 ms | "
-           "track ms/frame | lit frames | first light s (wall ms) | "
+           "track ms/frame | lit frames (> 10 / > 20 mm off) | first light s (wall ms) | "
            "search attempts, ms (longest) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& v : report.visits) {
       if (v.timeline.empty()) continue;
@@ -145,7 +154,7 @@ void print_table(const TourReport& report, std::ostream& out) {
           << " | " << fixed(v.still_mean_mm, 2) << " | " << fixed(v.timeline.back().mean_mm, 2) << " | "
           << (v.reconverge_s < 0 ? std::string("never") : fixed(v.reconverge_s, 2)) << " | " << fixed(v.age_p50_ms, 0) << " / "
           << fixed(v.age_p95_ms, 0) << " | " << (v.track_ms_mean > 0 ? fixed(v.track_ms_mean, 1) : std::string("-")) << " | "
-          << v.lit_frames << "/" << v.timeline.size() + 1 << " | "
+          << lit_of(v.lit_frames, v.timeline.size() + 1, v.far_off) << " | "
           << (v.first_light_s < 0 ? std::string("never")
                                   : fixed(v.first_light_s, 2) + " (" + fixed(v.first_light_wall_ms, 0) + ")")
           << " | "
@@ -161,6 +170,19 @@ void print_table(const TourReport& report, std::ostream& out) {
   out << "\nTour: " << report.visits.size() << " visits in " << fixed(report.wall_s, 1) << " s wall time, "
       << fixed(simulated_s, 1) << " s simulated (driving and projecting)"
       << (report.interrupted ? " (interrupted: the finished visits only)" : "") << ".\n";
+  const FarOff off = far_off(report);
+  out << "Lit far off (the visited targets and their neighbours, " << report.depth_model << " depth model): " << off.over_20mm
+      << " frames more than 20 mm off, " << off.over_10mm << " more than 10 mm"
+      << (off.over_10mm > 0 ? " (worst " + fixed(off.worst_mm, 0) + " mm)" : std::string()) << ".\n";
+}
+
+FarOff far_off(const TourReport& report) {
+  FarOff all;
+  for (const auto& v : report.visits) {
+    all.add(v.far_off);
+    for (const auto& n : v.neighbours) all.add(n.far_off);
+  }
+  return all;
 }
 
 namespace {
@@ -236,6 +258,9 @@ nlohmann::json visit_json(const VisitReport& v) {
       {"reconverge_s", v.reconverge_s},
       {"target_present", v.target_present},
       {"lit_frames", v.lit_frames},
+      {"lit_over_10mm_frames", v.far_off.over_10mm},
+      {"lit_over_20mm_frames", v.far_off.over_20mm},
+      {"lit_worst_mm", v.far_off.worst_mm},
       {"first_light_s", v.first_light_s},
       {"first_light_wall_ms", v.first_light_wall_ms},
       {"search",
@@ -254,6 +279,7 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
   nlohmann::json visits = nlohmann::json::array();
   for (const auto& v : report.visits) visits.push_back(visit_json(v));
   const auto& k = report.projector;
+  const FarOff all_off = far_off(report);
   const nlohmann::json out = {
       {"mode", to_string(report.mode)},
       {"predict", report.predict},
@@ -265,6 +291,8 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
       {"paper_table1_mm", {{"target1", kPaperMm[0]}, {"target2", kPaperMm[1]}}},
       {"wall_s", report.wall_s},
       {"interrupted", report.interrupted},
+      {"lit_far_off",
+       {{"over_10mm_frames", all_off.over_10mm}, {"over_20mm_frames", all_off.over_20mm}, {"worst_mm", all_off.worst_mm}}},
       {"visits", visits}};
   config::write_file_atomically(path, out.dump(2) + '\n');
 }

@@ -278,6 +278,7 @@ void TourStop::at_arrival(const session::Stop& at, const alignment::RgbdFrame& f
   report.markers = e.markers;
   report.mean_mm = e.mean_mm;
   report.max_mm = e.max_mm;
+  if (report.projected) report.far_off.count(e.mean_mm);
   for (std::size_t k = 1; k < at.lit.size(); ++k)
     lights_.push_back(neighbour_light(tour_.twin, tour_.trackers[lit_[k]].acquired(), lit_[k], at.lit[k], truth_, tour_.models));
   if (!tour_.options.frames_dir.empty()) write_pictures(f.colour);
@@ -477,6 +478,7 @@ void TourStop::project(double start_s) {
   for (std::size_t k = 1; k < lit_.size(); ++k) measure_neighbour(c, lights_[k - 1], drawn_of(static_cast<int>(k)));
   report.timeline.push_back(s);
   report.lit_frames += shown_ ? 1 : 0;
+  if (shown_ && s.in_world) report.far_off.count(s.mean_mm);
   if (shown_ && report.first_light_s < 0.0) {
     report.first_light_s = s.t_s;
     report.first_light_wall_ms = wall_to_light_ms_;
@@ -549,7 +551,7 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options) {
   if (options.mode == TourMode::odometry) twin_options.pose_source = robot::PoseSource::odometry;
   twin_options.seed = options.seed;
   twin_options.depth_noise = options.depth_noise;
-  if (options.fitted_depth) twin_options.depth_model = alignment::KinectNoiseConfig::fitted();
+  twin_options.depth_model = options.fitted_depth ? alignment::KinectNoiseConfig::fitted() : alignment::KinectNoiseConfig{};
   twin_options.stop_requested = options.stop_requested;
   Twin twin(scene, twin_options, renderer);
   Tour tour(scene, options, renderer, twin);

@@ -21,6 +21,7 @@ void count_frame(NeighbourLight& n, double mean_mm) {
   if (!n.shown) return;
   ++n.report.lit_frames;
   if (std::isnan(mean_mm)) return;
+  n.report.far_off.count(mean_mm);
   n.sum_mm += mean_mm;
   n.report.worst_mm = n.measured == 0 ? mean_mm : std::max(n.report.worst_mm, mean_mm);
   ++n.measured;

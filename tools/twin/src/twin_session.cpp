@@ -5,13 +5,15 @@
 namespace projbot::twin {
 
 TwinSession::TwinSession(const config::Scene& scene, const std::vector<session::Target>& targets, std::uint64_t seed,
-                         alignment::RgbdCamera* configured, std::function<bool()> stop_requested, bool colour_every_frame)
+                         alignment::RgbdCamera* configured, std::function<bool()> stop_requested, bool colour_every_frame,
+                         const alignment::KinectNoiseConfig& depth_model)
     : renderer_(engine::RendererOptions{}),
       twin_(
           scene,
           [&] {
             TwinOptions o;
             o.seed = seed;
+            o.depth_model = depth_model;
             o.stop_requested = std::move(stop_requested);  // SIGTERM while the twin is built
             return o;
           }(),

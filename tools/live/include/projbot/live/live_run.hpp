@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/config/recording.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/frame_profiler.hpp"
@@ -27,6 +28,8 @@ struct RunOptions {
   int visits = 0;  ///< 0: the tour's list once
   double dwell_s = 4.0;
   std::uint64_t seed = 1;  ///< the twin's noise
+  /// The twin's depth camera: the real sensor's fitted model (the default), or KinectNoiseConfig{} the published one.
+  alignment::KinectNoiseConfig depth_model = alignment::KinectNoiseConfig::fitted();
   double seconds = 0.0;    ///< 0: until the tour ends
   bool headless = false;   ///< offscreen, paced like a 60 Hz projector
   bool predict = true;     ///< each pose moved on to its frame's display time

@@ -10,6 +10,7 @@
 #include <functional>
 #include <ostream>
 
+#include "projbot/alignment/kinect_noise.hpp"
 #include "projbot/config/recording.hpp"
 #include "projbot/config/scene.hpp"
 
@@ -20,6 +21,8 @@ struct RecordOptions {
   double dwell_s = 2.0;    ///< seconds at each stop
   std::uint64_t seed = 1;  ///< the twin's drive and noise
   bool sim = false;        ///< the twin's devices, whatever `devices:` configures
+  /// The twin's depth camera: the real sensor's fitted model (the default), or KinectNoiseConfig{} the published one.
+  alignment::KinectNoiseConfig depth_model = alignment::KinectNoiseConfig::fitted();
 };
 
 struct RecordHooks {

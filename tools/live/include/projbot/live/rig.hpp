@@ -21,6 +21,8 @@ namespace projbot::live {
 
 struct RigOptions {
   std::uint64_t seed = 1;  ///< the twin's drive and noise
+  /// The twin's depth camera: the real sensor's fitted model (the default), or KinectNoiseConfig{} the published one.
+  alignment::KinectNoiseConfig depth_model = alignment::KinectNoiseConfig::fitted();
   /// `record`: every frame tracked before the next is read, and the twin's camera gives colour with every
   /// frame (a fakenect dump holds both). A replay is always tracked in lockstep.
   bool recording = false;

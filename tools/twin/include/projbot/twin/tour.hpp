@@ -5,6 +5,7 @@
 // projection error is measured at the target's markers.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -45,7 +46,9 @@ struct TourOptions {
   /// time this machine took to render the frame (the twin's sensor) and track it, as `projbot run` sees.
   std::optional<double> processing_ms;
   bool depth_noise = true;
-  bool fitted_depth = false;  ///< the depth camera: KinectNoiseConfig::fitted() instead of the published model
+  /// The depth camera: KinectNoiseConfig::fitted() (the real sensor's; every command's default, --depth-model)
+  /// instead of the published model (what the library's tests of single mechanisms are tuned on).
+  bool fitted_depth = false;
   /// Asked between visits and between tracking frames: true ends the tour there, keeping the visits
   /// finished so far (the unfinished one is dropped) and marking the report interrupted.
   std::function<bool()> stop_requested;
@@ -104,6 +107,26 @@ struct TimelineSample {
   bool in_world = true;  ///< the target was there (not carried away)
 };
 
+/// The lit projector frames of a target that showed it far off: by their mean error at the markers (the
+/// twin knows the truth), what a visitor sees as the content beside the object. Frames without a marker in
+/// the light are not judged.
+struct FarOff {
+  int over_10mm = 0, over_20mm = 0;
+  double worst_mm = 0.0;  ///< the worst lit frame's mean error (0 when none was measured)
+  /// One lit frame whose mean error is `mean_mm` (NaN: none measured).
+  void count(double mean_mm) {
+    if (!(mean_mm >= 0.0)) return;
+    over_10mm += mean_mm > 10.0 ? 1 : 0;
+    over_20mm += mean_mm > 20.0 ? 1 : 0;
+    worst_mm = std::max(worst_mm, mean_mm);
+  }
+  void add(const FarOff& o) {
+    over_10mm += o.over_10mm;
+    over_20mm += o.over_20mm;
+    worst_mm = std::max(worst_mm, o.worst_mm);
+  }
+};
+
 /// A target that shared the view at a stop besides the visited one (issue 11, item 5): acquired from
 /// the same capture, tracked with the visited one in tracking mode, and lit or blanked on its own.
 struct NeighbourReport {
@@ -115,6 +138,7 @@ struct NeighbourReport {
   int lit_frames = 0, frames = 0;                                 ///< projector frames, the arrival's included
   double lit_mean_mm = std::numeric_limits<double>::quiet_NaN();  ///< over its lit frames (the arrival's included)
   double worst_mm = std::numeric_limits<double>::quiet_NaN();     ///< the worst of those frames' means
+  FarOff far_off;                                                 ///< of its lit frames, those shown far off
 };
 
 struct VisitReport {
@@ -159,6 +183,7 @@ struct VisitReport {
   int second_pass_frames = 0;
   bool target_present = true;  ///< the target was in the world when the robot arrived
   int lit_frames = 0;          ///< projector frames that showed the target, the arrival's included
+  FarOff far_off;              ///< of those, the frames shown far off
   /// Simulated seconds from arrival to the first lit frame: 0 when the acquisition lit it at once, -1
   /// when it never did.
   double first_light_s = -1.0;
@@ -190,6 +215,8 @@ TourReport run_tour(const config::Scene& scene, const TourOptions& options);
 
 /// The paper's Table 1 beside ours: a row per visit of each target, a column per target, mm.
 void print_table(const TourReport& report, std::ostream& out);
+/// The lit frames shown far off over the whole tour, the visited targets' and their neighbours'.
+FarOff far_off(const TourReport& report);
 /// The whole report as JSON (see the README for the fields).
 void write_report_json(const TourReport& report, const std::filesystem::path& path);
 

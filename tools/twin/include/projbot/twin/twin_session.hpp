@@ -20,8 +20,10 @@ class TwinSession {
  public:
   /// `stop_requested`, asked while the twin is built (its map survey), ends that with
   /// robot::SetupInterrupted.
+  /// `depth_model`: the twin's depth camera (TwinOptions::depth_model).
   TwinSession(const config::Scene& scene, const std::vector<session::Target>& targets, std::uint64_t seed,
-              alignment::RgbdCamera* configured, std::function<bool()> stop_requested, bool colour_every_frame = false);
+              alignment::RgbdCamera* configured, std::function<bool()> stop_requested, bool colour_every_frame = false,
+              const alignment::KinectNoiseConfig& depth_model = alignment::KinectNoiseConfig::fitted());
   session::Session& session() { return session_; }
   Twin& twin() { return twin_; }
   /// The renderer the twin draws with (its thread is the one that built the session).
