@@ -100,12 +100,12 @@ TEST(ProjectionFrames, TheMeasuredFramePeriodSetsTheDisplayTime) {
   // A 60 Hz projector whose frames come every 20 ms (50 Hz, as measured): after ten frames the display
   // time is 20 ms ahead, not 16.7.
   ScriptedPoses poses;
-  poses.publish(0, at(0.0, 0.0, 1.0), 0.5);
   session::ProjectionConfig c = config_60hz();
   c.input_lag_ms = 0.0;
   session::ProjectionFrames frames(c);
   double t = 1.0;
   for (int i = 0; i < 11; ++i, t += 0.020) frames.frame_started(t);
+  poses.publish(0, at(0.0, 0.0, 1.0), t - 0.03);
   EXPECT_NEAR(frames.period_s(), 0.020, 1e-12);
   EXPECT_NEAR(frames.compose(t, {{0}, 0.0, t}, poses.source()).at(0).display_s, t + 0.020, 1e-12);
 }
@@ -130,4 +130,27 @@ TEST(ProjectionFrames, ASilentCameraBlanksEverythingUntilItSeesAgain) {
   // Nothing lit (driving): nothing to blank for silence either.
   EXPECT_TRUE(frames.compose(9.0, {{}, 1.0, 2.00}, poses.source()).empty());
   EXPECT_EQ(frames.silent_frames(), 1u);
+}
+
+TEST(ProjectionFrames, APoseNoNewerFrameConfirmedIsBlankedAfterThreeFrames) {
+  // Issue 87: the camera goes on handing frames over while the tracker is busy (a rescue, a search): its
+  // newest pose is drawn while it is at most 100 ms older than the newest frame, then blanked, each target
+  // on its own, until a pose from a newer frame comes. With no camera watched, the frame's start is the
+  // newest frame.
+  ScriptedPoses poses;
+  poses.publish(0, at(0.0, 0.0, 1.0), 3.00);
+  poses.publish(1, at(0.2, 0.0, 1.0), 3.09);
+  session::ProjectionFrames frames(config_60hz());
+  EXPECT_EQ(frames.compose(3.10, {{0, 1}, 1.0, 3.095}, poses.source()).size(), 2u);
+  const auto drawn = frames.compose(3.14, {{0, 1}, 1.0, 3.133}, poses.source());
+  ASSERT_EQ(drawn.size(), 1u);
+  EXPECT_EQ(drawn[0].target, 1);
+  EXPECT_EQ(frames.unconfirmed_blanks(), 1u);
+  poses.publish(0, at(0.0, 0.0, 1.0), 3.133);
+  EXPECT_EQ(frames.compose(3.16, {{0, 1}, 1.0, 3.133}, poses.source()).size(), 2u);
+  session::ProjectionConfig unwatched = config_60hz();
+  unwatched.max_unconfirmed_s = 0.0;
+  session::ProjectionFrames all(unwatched);
+  EXPECT_EQ(all.compose(9.0, {{0, 1}, 1.0, 9.0}, poses.source()).size(), 2u);
+  EXPECT_EQ(all.unconfirmed_blanks(), 0u);
 }

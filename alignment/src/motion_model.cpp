@@ -48,12 +48,17 @@ MotionFilter::MotionFilter(MotionModelConfig config)
     : cfg_(config), position_noise_(cfg_.position_noise_m), rotation_noise_(cfg_.rotation_noise_rad) {}
 
 void MotionFilter::reset() {
+  restart();
+  noise_measured_ = false;
+  position_noise_ = cfg_.position_noise_m;
+  rotation_noise_ = cfg_.rotation_noise_rad;
+}
+
+void MotionFilter::restart() {
   count_ = 0;
   measured_ = filtered_ = Eigen::Matrix4d::Identity();
   window_.clear();
-  history_.clear();
-  position_noise_ = cfg_.position_noise_m;
-  rotation_noise_ = cfg_.rotation_noise_rad;
+  history_.clear();  // second differences across the gap or the jump would be the motion's, not the noise's
   translation_ = {};
   rotation_ = {};
 }
@@ -81,10 +86,10 @@ void MotionFilter::predict_to(double dt) {
 
 void MotionFilter::update(const Eigen::Matrix4d& T, double t_s) {
   const double dt = t_s - t_;
-  if (count_ > 0 && !(dt > 0.0 && dt <= cfg_.max_gap_s)) reset();
+  if (count_ > 0 && !(dt > 0.0 && dt <= cfg_.max_gap_s)) restart();
   if (count_ > 0 && jumped(T, dt)) {
     ++jumps_;
-    reset();
+    restart();
   }
   if (count_ == 0) {
     filtered_ = T;
@@ -124,7 +129,7 @@ void MotionFilter::measure_noise() {
   // Second differences, a - b - r (b - c) with r the ratio of the frame intervals: zero for a steady
   // motion, 1 + (1 + r)^2 + r^2 times the per-frame variance for noise (6 at even intervals). The norm of
   // a 3-D normal vector with sigma s per axis has median 1.538 s.
-  if (history_.size() < 5) return;
+  if (history_.size() < static_cast<std::size_t>(kNoisePoses)) return;
   std::vector<double> moves, turns;
   for (std::size_t i = 2; i < history_.size(); ++i) {
     const Stamped &a = history_[i], &b = history_[i - 1], &c = history_[i - 2];
@@ -143,6 +148,7 @@ void MotionFilter::measure_noise() {
   };
   position_noise_ = std::max(cfg_.position_noise_m, median(moves) / 1.538);
   rotation_noise_ = std::max(cfg_.rotation_noise_rad, median(turns) / 1.538);
+  noise_measured_ = true;
 }
 
 MotionState MotionFilter::state() const {
@@ -150,7 +156,7 @@ MotionState MotionFilter::state() const {
   s.T = measured_;
   s.time_s = t_;
   s.max_horizon_s = cfg_.max_horizon_s;
-  if (count_ < std::max(2, cfg_.min_poses)) return s;
+  if (count_ < std::max(2, cfg_.min_poses) || !noise_known()) return s;
   // Each part of the motion is used only when it stands out of the measurement noise over the window;
   // the other part stays as measured, so a target that only turns is not also slid by noise. The
   // difference of two measured poses has sqrt(2) times their noise.
