@@ -14,8 +14,8 @@
 // run --sim measures each frame against the twin's truth at its display time: the box carried at
 // 0.5 m/s (visit 2 of the motion scene) stays within a few mm of where it is drawn.
 TEST(CliLiveTest, RunMeasuresTheErrorAtDisplayTime) {
-  const CliRun r =
-      run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) + "/scenes/motion.yaml --visits 2 --dwell 2.5");
+  const CliRun r = run_projbot("run --headless --config " + std::string(PROJBOT_ASSET_DIR) +
+                               "/scenes/motion.yaml --visits 2 --dwell 2.5 --depth-model kinect");
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string key = "error at display (markers drawn vs true, twin): while moving mean ";
   const auto at = r.output.find(key);

@@ -82,6 +82,7 @@ class LiveLoopTest : public ::testing::Test {
     c.projection.refresh_hz = 60.0;
     c.projection.input_lag_ms = 20.0;
     c.projection.predict = predict;
+    c.projection.max_unconfirmed_s = 0.0;  // scripted poses, no tracker to fall behind (ProjectionFrames tests it)
     c.seconds = seconds;
     c.paced_hz = 60.0;
     session::LiveLoop loop(*renderer_, projector_, {engine::DrawItem(model_, Eigen::Matrix4d::Identity())}, c, clock_.clock());
@@ -207,6 +208,7 @@ TEST_F(LiveLoopTest, StepsFrameByFrameOnASimulatedClockWithoutDrawing) {
   c.projection.T_projector_camera = at(0.1, 0.0, 0.0);
   c.projection.input_lag_ms = 20.0;
   c.projection.silent_camera_s = 0.0;
+  c.projection.max_unconfirmed_s = 0.0;  // scripted poses, no tracker to fall behind
   session::LiveLoop loop(*renderer_, projector_, {}, c, {[&] { return now_s; }, [&](double t) { now_s = t; }});
   session::LiveInputs in;
   in.stop = [] { return session::LiveStop{{0}, 0.0, 1}; };

@@ -134,32 +134,35 @@ TEST(MotionModel, ANoisierTrackerIsMeasuredAndAveragedNotExtrapolated) {
   EXPECT_TRUE(steady.state().moving());
 }
 
-// Issue 87: the first poses of a stop, under a sensor ten times noisier than the configured (the shop figure
-// at 2 m under the fitted depth model: millimetres from frame to frame), are no motion: nothing is
-// extrapolated before the noise is measured, so no frame is drawn beyond the poses' own scatter. A gap in
-// the poses (a search, a busy worker) restarts the motion but keeps the noise measured.
-TEST(MotionModel, NoMotionIsSeenBeforeTheNoiseIsMeasured) {
+// Issue 87: the first poses of a stop, and of every restart after a gap, under a sensor ten times noisier
+// than the configured (the shop figure at 2 m under the fitted depth model: millimetres from frame to
+// frame), are drawn where they were measured until the noise is measured: nothing extrapolated, so no frame
+// is drawn beyond the poses' own scatter. The tracker's start (state, predict) may extrapolate from
+// min_poses on: it is refined.
+TEST(MotionModel, NothingIsDrawnAheadBeforeTheNoiseIsMeasured) {
   const Eigen::Matrix4d still = Trajectory{}.at(0.0);
   std::mt19937 rng(3);
+  int tracker_moving = 0;
   for (int trial = 0; trial < 50; ++trial) {
     MotionFilter f;
-    for (int k = 0; k < 12; ++k) {
-      const Eigen::Matrix4d measured = noisy(still, rng, 0.007, 0.3 * kDeg);
-      f.update(measured, k * kDt);
-      if (k < MotionFilter::kNoisePoses - 1) {  // drawn where measured, nothing extrapolated
-        EXPECT_FALSE(f.state().moving()) << "trial " << trial << ", pose " << k;
-        EXPECT_EQ(f.predict(k * kDt + 0.1), measured) << "trial " << trial << ", pose " << k;
+    for (const double t0 : {0.0, 1.0}) {  // a stop, then the poses again after a gap (a busy worker)
+      for (int k = 0; k < MotionFilter::kNoisePoses - 1; ++k) {
+        const Eigen::Matrix4d measured = noisy(still, rng, 0.007, 0.3 * kDeg);
+        f.update(measured, t0 + k * kDt);
+        const MotionState drawn = f.drawn_state();
+        EXPECT_FALSE(drawn.moving()) << "trial " << trial << ", pose " << k;
+        EXPECT_EQ(predict_pose(drawn, t0 + k * kDt + 0.1), measured) << "trial " << trial << ", pose " << k;
+        tracker_moving += f.state().moving() ? 1 : 0;
       }
     }
-    EXPECT_TRUE(f.noise_known());
-    const double measured_noise = f.position_noise_m();
-    EXPECT_GT(measured_noise, 0.004) << "trial " << trial;
-    f.update(noisy(still, rng, 0.007, 0.3 * kDeg), 12 * kDt + 0.5);  // after a half-second gap
-    EXPECT_TRUE(f.noise_known());
-    EXPECT_EQ(f.position_noise_m(), measured_noise);
-    f.reset();  // a new stop: the noise is learnt again
-    EXPECT_FALSE(f.noise_known());
   }
+  EXPECT_GT(tracker_moving, 0);  // what was drawn before: the configured 0.7 mm took this scatter for motion
+  // Once the noise is measured, the drawn state is the filter's.
+  const Trajectory traj;
+  MotionFilter steady;
+  for (int k = 0; k < MotionFilter::kNoisePoses; ++k) steady.update(traj.at(k * kDt), k * kDt);
+  EXPECT_TRUE(steady.drawn_state().moving());
+  EXPECT_EQ(steady.drawn_state().velocity_m_s, steady.state().velocity_m_s);
 }
 
 // A sudden stop at 0.5 m/s: the prediction may run on past the stop for two frames at most, and never
@@ -200,9 +203,8 @@ TEST(MotionModel, PredictionIsBoundedInTimeAndSpeed) {
   traj.v = {3.0, 0.0, 0.0};  // faster than anyone carries a target: clamped to 2 m/s
   traj.w.setZero();
   MotionFilter f;
-  constexpr int n = MotionFilter::kNoisePoses;  // the motion is seen once the noise is measured
-  for (int k = 0; k < n; ++k) f.update(traj.at(k * kDt), k * kDt);
-  const double t = (n - 1) * kDt;
+  for (int k = 0; k < 5; ++k) f.update(traj.at(k * kDt), k * kDt);
+  const double t = 4 * kDt;
   EXPECT_NEAR(f.state().velocity_m_s.norm(), 2.0, 1e-9);
   // A second ahead is held at the 0.1 s horizon: 2 m/s x 0.1 s = 200 mm past the newest pose.
   EXPECT_NEAR(translation_mm(f.predict(t + 1.0), traj.at(t)), 200.0, 1e-6);

@@ -48,17 +48,12 @@ MotionFilter::MotionFilter(MotionModelConfig config)
     : cfg_(config), position_noise_(cfg_.position_noise_m), rotation_noise_(cfg_.rotation_noise_rad) {}
 
 void MotionFilter::reset() {
-  restart();
-  noise_measured_ = false;
-  position_noise_ = cfg_.position_noise_m;
-  rotation_noise_ = cfg_.rotation_noise_rad;
-}
-
-void MotionFilter::restart() {
   count_ = 0;
   measured_ = filtered_ = Eigen::Matrix4d::Identity();
   window_.clear();
-  history_.clear();  // second differences across the gap or the jump would be the motion's, not the noise's
+  history_.clear();
+  position_noise_ = cfg_.position_noise_m;
+  rotation_noise_ = cfg_.rotation_noise_rad;
   translation_ = {};
   rotation_ = {};
 }
@@ -86,10 +81,10 @@ void MotionFilter::predict_to(double dt) {
 
 void MotionFilter::update(const Eigen::Matrix4d& T, double t_s) {
   const double dt = t_s - t_;
-  if (count_ > 0 && !(dt > 0.0 && dt <= cfg_.max_gap_s)) restart();
+  if (count_ > 0 && !(dt > 0.0 && dt <= cfg_.max_gap_s)) reset();
   if (count_ > 0 && jumped(T, dt)) {
     ++jumps_;
-    restart();
+    reset();
   }
   if (count_ == 0) {
     filtered_ = T;
@@ -148,7 +143,6 @@ void MotionFilter::measure_noise() {
   };
   position_noise_ = std::max(cfg_.position_noise_m, median(moves) / 1.538);
   rotation_noise_ = std::max(cfg_.rotation_noise_rad, median(turns) / 1.538);
-  noise_measured_ = true;
 }
 
 MotionState MotionFilter::state() const {
@@ -156,7 +150,7 @@ MotionState MotionFilter::state() const {
   s.T = measured_;
   s.time_s = t_;
   s.max_horizon_s = cfg_.max_horizon_s;
-  if (count_ < std::max(2, cfg_.min_poses) || !noise_known()) return s;
+  if (count_ < std::max(2, cfg_.min_poses)) return s;
   // Each part of the motion is used only when it stands out of the measurement noise over the window;
   // the other part stays as measured, so a target that only turns is not also slid by noise. The
   // difference of two measured poses has sqrt(2) times their noise.
@@ -187,6 +181,17 @@ MotionState MotionFilter::state() const {
     s.angular_velocity_rad_s = clamp_norm(rotation_.rate, cfg_.max_rate_deg_s * M_PI / 180.0);
   }
   return s;
+}
+
+MotionState MotionFilter::drawn_state() const {
+  if (cfg_.noise_window >= kNoisePoses && history_.size() < static_cast<std::size_t>(kNoisePoses)) {
+    MotionState s;
+    s.T = measured_;
+    s.time_s = t_;
+    s.max_horizon_s = cfg_.max_horizon_s;
+    return s;
+  }
+  return state();
 }
 
 }  // namespace projbot::alignment

@@ -142,7 +142,7 @@ PoseSample TargetFollower::found(const DepthImage& frame, const Eigen::Matrix4d&
   last_found_s_ = frame.capture_time_s;
   PoseSample sample = still_sample(T, frame.capture_time_s, false, inlier_ratio, rmse_mm);
   filter_.update(T, frame.capture_time_s);
-  if (cfg_.predict) sample.motion = filter_.state();
+  if (cfg_.predict) sample.motion = filter_.drawn_state();
   return sample;
 }
 

@@ -83,20 +83,20 @@ class MotionFilter {
   /// Jumps seen (poses the filter started again from, see jump_factor), for tests and statistics.
   int jumps() const { return jumps_; }
   /// A measured pose (the tracker's) captured at t_s. A pose not newer than the last, after a gap
-  /// longer than max_gap_s, or one that jumped (jump_factor) restarts the filter from it, keeping the noise
-  /// measured so far: that is the sensor's at this target, not the motion's.
+  /// longer than max_gap_s, or one that jumped (jump_factor) restarts the filter from it.
   void update(const Eigen::Matrix4d& T_camera_target, double t_s);
   /// The state to extrapolate from: still (the newest measured pose, zero velocity) until min_poses
-  /// poses are in, the noise has been measured (noise_window; not before kNoisePoses poses since the last
-  /// reset) and the target has moved more than that noise over the stillness window. Before the noise is
-  /// measured only the configured one is known, and a real sensor's can be ten times it: the first poses
-  /// of the shop figure under the fitted depth model read as motion and were drawn up to 0.4 m ahead.
+  /// poses are in and the target has moved more than noise over the stillness window.
   MotionState state() const;
+  /// The state to draw: state(), but still (the newest measured pose) until the noise has been measured
+  /// since the last reset (kNoisePoses poses; noise_window at least that). Before that only the configured
+  /// noise is known, and a real sensor's can be ten times it: the first poses of the shop figure under the
+  /// fitted depth model, and of every restart after a busy worker's gap, read as motion and were drawn up
+  /// to 0.4 m ahead at the markers. The tracker starts from state()'s prediction (predict()): a start is
+  /// refined, and extrapolating it early is what keeps up with a target moved off at once.
+  MotionState drawn_state() const;
   /// Poses the noise is measured from, at least (second differences of the last noise_window).
   static constexpr int kNoisePoses = 5;
-  /// Whether the noise in use is known: measured since the last reset, or not measured (noise_window
-  /// below kNoisePoses: the configured is taken as known).
-  bool noise_known() const { return noise_measured_ || cfg_.noise_window < kNoisePoses; }
   /// No pose since the last reset: state() and predict() know nothing yet.
   bool empty() const { return count_ == 0; }
   Eigen::Matrix4d predict(double t_s) const { return predict_pose(state(), t_s); }
@@ -115,7 +115,6 @@ class MotionFilter {
     Eigen::Matrix2d P = Eigen::Matrix2d::Zero();
   };
   void restart_velocity(const Eigen::Matrix4d& T, double dt);
-  void restart();  // the motion forgotten, the noise measured kept
   bool jumped(const Eigen::Matrix4d& T, double dt) const;
   void predict_to(double dt);
   struct Stamped {
@@ -124,8 +123,7 @@ class MotionFilter {
   };
 
   MotionModelConfig cfg_;
-  int count_ = 0;  // poses since the last reset or restart
-  bool noise_measured_ = false;
+  int count_ = 0;  // poses since the last reset
   double t_ = 0.0;
   Eigen::Matrix4d measured_ = Eigen::Matrix4d::Identity();  // the newest measured pose
   Eigen::Matrix4d filtered_ = Eigen::Matrix4d::Identity();  // the filter's pose at t_
