@@ -13,10 +13,12 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 
+#include "cli_run.hpp"
 #include "projbot/alignment/nearest_points.hpp"
 #include "projbot/alignment/pose_error.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/assets/image.hpp"
 #include "projbot/config/rigid.hpp"
 #include "projbot/config/scene.hpp"
 
@@ -112,7 +114,7 @@ TEST(BopDataset, ReadsTheSharedYcbvFrames) {
   const int v = static_cast<int>(first.k.fy_px * t.y() / t.z() + first.k.cy_px);
   EXPECT_LT(depth.at(u, v), t.z() + 0.005);
   EXPECT_GT(depth.at(u, v), t.z() - 0.06);
-  const auto mask = projbot::alignment::read_bop_mask(data.scenes[0], first, gelatin);
+  const auto mask = projbot::alignment::read_bop_mask(data.scenes[0], first, gelatin, depth);
   std::size_t on = 0;
   for (auto m : mask) on += m;
   EXPECT_EQ(on, 18265U);
@@ -141,6 +143,58 @@ TEST_F(BopCopy, AMissingDepthImageIsNamed) {
   fs::remove(scene() / "depth" / "000007.png");
   const std::string e = error();
   EXPECT_NE(e.find("depth/000007.png: missing"), std::string::npos) << e;
+}
+
+// Images of another size than their scene's (issue 88): none is indexed with another's size; each is
+// refused naming the files and both sizes, at the library and through `bench sensor`, which crashed on
+// them (its twin rendered at the camera's default size, the real depth indexed at its own).
+TEST_F(BopCopy, AnImageOfAnotherSizeIsNamedWithBothSizes) {
+  using namespace projbot::alignment;
+  const BopDataset data = read_bop_dataset(dir_);
+  const BopScene& s = data.scenes.at(0);
+  const BopImage& first = s.images.at(0);
+  const BopImage& second = s.images.at(1);
+  const DepthImage depth = read_bop_depth(first);
+  projbot::assets::write_png_gray16(second.depth, {641, 480, std::vector<std::uint16_t>(641 * 480, 900)});
+  const DepthImage wide = read_bop_depth(second);
+  try {
+    check_same_size(second, wide, first.depth, depth);
+    ADD_FAILURE() << "a 641x480 depth image beside 640x480 ones was taken";
+  } catch (const AlignmentError& e) {
+    EXPECT_NE(std::string(e.what()).find("is 641x480, but " + first.depth.string() + " of the same scene is 640x480"),
+              std::string::npos)
+        << e.what();
+  }
+  char name[48];
+  std::snprintf(name, sizeof name, "%06d_%06d.png", first.id, first.instances.at(0).gt_index);
+  const fs::path mask = scene() / "mask_visib" / name;
+  projbot::assets::write_png(mask, {1, 1, {255, 255, 255, 255}});
+  try {
+    read_bop_mask(s, first, first.instances.at(0), depth);
+    ADD_FAILURE() << "a 1x1 mask beside a 640x480 depth image was taken";
+  } catch (const AlignmentError& e) {
+    EXPECT_NE(std::string(e.what()).find(mask.string() + ": is 1x1, but its image's depth"), std::string::npos) << e.what();
+  }
+  for (const auto& m : fs::directory_iterator(kYcbv / "models"))  // bench sensor loads every object's model
+    fs::copy_file(m.path(), dir_ / "models" / m.path().filename(), fs::copy_options::skip_existing);
+  const CliRun r = run_projbot("bench sensor " + dir_.string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("is 1x1, but its image's depth"), std::string::npos) << r.output;
+}
+
+// An empty symmetry list names no symmetry (issue 88: it made the mug symmetric, scored by ADD-S).
+TEST_F(BopCopy, AnEmptySymmetryListIsNoSymmetry) {
+  const auto before = read_bop_dataset(dir_);
+  nlohmann::json info = nlohmann::json::parse(slurp(dir_ / "models" / "models_info.json"));
+  info["14"]["symmetries_discrete"] = nlohmann::json::array();
+  spill(dir_ / "models" / "models_info.json", info.dump());
+  const auto after = read_bop_dataset(dir_);
+  EXPECT_FALSE(after.object(14)->symmetric);
+  for (const auto& o : before.objects) EXPECT_EQ(after.object(o.id)->symmetric, o.symmetric) << "object " << o.id;
+  info["14"]["symmetries_discrete"] =
+      nlohmann::json::array({nlohmann::json::array({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1})});
+  spill(dir_ / "models" / "models_info.json", info.dump());
+  EXPECT_TRUE(read_bop_dataset(dir_).object(14)->symmetric);
 }
 
 TEST_F(BopCopy, AnInstanceCountThatDisagreesIsRefused) {

@@ -387,6 +387,45 @@ std::vector<Hostile> usage_cases() {
               bop_files(R"({"cam_K": [500, 0, 320, 0, 500, 240, 0, 0, 1], "depth_scale": 1e300})", "[0, 0, 900]"),
               1,
               {"scene_camera.json: image 1: depth_scale must be a number within 0.001..1000"}},
+      // Issue 88: K's form, one key per id, symmetry entries that are none.
+      Hostile{"bench_dataset_cam_k_skew",
+              "bench dataset {dir}/bop",
+              bop_files(R"({"cam_K": [500, 3, 320, 0, 500, 240, 0, 0, 1], "depth_scale": 1})", "[0, 0, 900]"),
+              1,
+              {"scene_camera.json: image 1: cam_K must be [fx, 0, cx, 0, fy, cy, 0, 0, 1]"}},
+      Hostile{"bench_dataset_cam_k_tiny_focal",
+              "bench dataset {dir}/bop",
+              bop_files(R"({"cam_K": [1e-300, 0, 320, 0, 500, 240, 0, 0, 1], "depth_scale": 1})", "[0, 0, 900]"),
+              1,
+              {"scene_camera.json: image 1: cam_K's focal lengths must be 1 to 100000 px"}},
+      Hostile{"bench_dataset_cam_k_last_row",
+              "bench dataset {dir}/bop",
+              bop_files(R"({"cam_K": [500, 0, 320, 0, 500, 240, 0, 0, 2], "depth_scale": 1})", "[0, 0, 900]"),
+              1,
+              {"cam_K must be [fx, 0, cx, 0, fy, cy, 0, 0, 1]"}},
+      Hostile{"bench_dataset_image_listed_twice",
+              "bench dataset {dir}/bop",
+              [] {
+                Files f = bop_files(R"({"cam_K": [500, 0, 320, 0, 500, 240, 0, 0, 1], "depth_scale": 1})", "[0, 0, 900]");
+                for (auto& [name, text] : f.list)
+                  if (name == "bop/test/000000/scene_camera.json")
+                    text = R"({"1": {"cam_K": [500, 0, 320, 0, 500, 240, 0, 0, 1], "depth_scale": 1}, )"
+                           R"("01": {"cam_K": [500, 0, 320, 0, 500, 240, 0, 0, 1], "depth_scale": 1}})";
+                return f;
+              }(),
+              1,
+              {"scene_camera.json: image 1 is listed twice ('01' and '1')"}},
+      Hostile{"bench_dataset_symmetries_garbage",
+              "bench dataset {dir}/bop",
+              [] {
+                Files f = bop_files(R"({"cam_K": [500, 0, 320, 0, 500, 240, 0, 0, 1], "depth_scale": 1})", "[0, 0, 900]");
+                for (auto& [name, text] : f.list)
+                  if (name == "bop/models/models_info.json")
+                    text = R"({"1": {"diameter": 100, "symmetries_discrete": "garbage"}})";
+                return f;
+              }(),
+              1,
+              {"models_info.json: object 1: symmetries_discrete must be a list of symmetries"}},
       Hostile{"bench_dataset_bad_perturb", "bench dataset {dir} --perturb 20", "", 2, {"--perturb must be MM,DEG"}},
       Hostile{"slam_no_rawlog", "slam --out-map {dir}/m --out-trajectory {dir}/t.txt", "", 2, {"--rawlog is required"}},
       Hostile{"slam_missing_rawlog",

@@ -22,6 +22,10 @@ Files box_files(const std::string& scene = kBoxScene, std::vector<std::pair<std:
   return f;
 }
 
+// A calibration file (calibrate solve's calib.yaml) for the 64x48 test projector.
+const std::string kCalibration =
+    "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\nprojector_from_camera: {translation: [0, 0, 0]}\n";
+
 }  // namespace
 
 // Outputs that would destroy an input (issue 47): refused before any work, exit 2, naming both; inputs that
@@ -118,6 +122,19 @@ std::vector<Hostile> clash_cases() {
               box_files(kBoxScene),
               2,
               {"--report {dir}/box/BoxTextured.gltf is also the input the model of target 'box'"}},
+      // Issue 88: the scene's calibration is an input like the scene (tour, run and render replaced it, exit 0).
+      Hostile{"tour_report_over_the_calibration",
+              "tour --scene {dir}/s.yaml --report {dir}/calib.yaml",
+              Files{{"calib.yaml", kCalibration},
+                    {"s.yaml", "calibration: calib.yaml\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}},
+              2,
+              {"--report {dir}/calib.yaml is also the input the calibration of"}},
+      Hostile{"run_profile_over_the_calibration",
+              "run --headless --config {dir}/s.yaml --profile {dir}/calib.yaml",
+              Files{{"calib.yaml", kCalibration},
+                    {"s.yaml", "calibration: calib.yaml\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}},
+              2,
+              {"--profile {dir}/calib.yaml is also the input the calibration of"}},
       Hostile{"bench_content_report_over_the_video",
               "bench content --scene {dir}/s.yaml --report {dir}/clip.mp4",
               box_files(kBoxScene + "    content: {video: clip.mp4}\n", {{"clip.mp4", "not a video, and must stay as it is"}}),

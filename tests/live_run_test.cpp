@@ -1,21 +1,22 @@
 // The live engine as a library (live::run): the twin's robot thread and the render loop together, drawn
 // offscreen, each frame measured against the twin's truth.
 
-#include "projbot/live/live_run.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <sstream>
 
 #include "projbot/live/reflectance_probe.hpp"
+#include "projbot/live/run.hpp"
+#include "projbot/twin/twin_rig.hpp"
 
 namespace {
 
-projbot::live::RunSources twin_sources(projbot::hardware::Devices& devices, const projbot::config::Scene& scene,
-                                       std::ostream& log, std::ostream& errors) {
+projbot::live::RunSources twin_sources(projbot::live::Devices& devices, const projbot::config::Scene& scene, std::ostream& log,
+                                       std::ostream& errors) {
   projbot::live::RunSources s;
   s.devices = &devices;
+  s.open_rig = projbot::twin::rig_opener({});  // no base, no recording: the twin, seed 1, the fitted depth model
   s.open_output = [&scene](projbot::engine::Renderer& r) {
     return r.make_offscreen(scene.projector.width_px, scene.projector.height_px);
   };
@@ -34,7 +35,7 @@ double median(std::vector<double> v) {
 TEST(LiveRun, ATwinVisitIsDrawnTrackedAndMeasured) {
   const auto scene = projbot::config::load_scene(std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml");
   projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
-  projbot::hardware::Devices devices;  // none: the twin serves every device
+  projbot::live::Devices devices;  // none: the twin serves every device
   std::ostringstream log, errors;
   projbot::live::RunOptions o;
   o.visits = 1;
@@ -58,7 +59,7 @@ TEST(LiveRun, ATwinVisitIsDrawnTrackedAndMeasured) {
 TEST(LiveRun, ARunEndsAfterItsSeconds) {
   const auto scene = projbot::config::load_scene(std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml");
   projbot::engine::Renderer renderer(projbot::engine::RendererOptions{});
-  projbot::hardware::Devices devices;
+  projbot::live::Devices devices;
   std::ostringstream log, errors;
   projbot::live::RunOptions o;
   o.headless = true;
@@ -87,12 +88,12 @@ TEST(LiveRun, MissingSourcesAreRefused) {
 TEST(ReflectanceProbe, StepsThroughBlackAndGreyOnceThePoseIsAccepted) {
   const auto scene = projbot::config::load_scene(std::string(PROJBOT_ASSET_DIR) + "/scenes/tour.yaml");
   projbot::live::ReflectanceProbe probe(scene, std::vector<const projbot::assets::Model*>(scene.targets.size(), nullptr), 0.1);
-  projbot::session::Stop stop;
+  projbot::live::Stop stop;
   stop.target = 0;
   projbot::alignment::PoseSample pose;
   pose.lost = false;
   pose.capture_time_s = 9.9;  // the last stop's
-  const projbot::session::PoseSource poses = [&](int, projbot::alignment::PoseSample& out) { return (out = pose), true; };
+  const projbot::live::PoseSource poses = [&](int, projbot::alignment::PoseSample& out) { return (out = pose), true; };
   const auto frame = [](double captured_s, bool colour) {
     projbot::alignment::RgbdFrame f;
     f.depth.capture_time_s = captured_s;

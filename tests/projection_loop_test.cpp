@@ -1,38 +1,46 @@
-// The live loop's per-frame decision (session::ProjectionFrames) on a scripted pose source and a fake
-// clock: what is drawn, where (Eq. 2, at the display time), and what is blanked.
+// The live projection loop (live::ProjectionLoop) on a real renderer (lavapipe, validation on), an offscreen
+// target, a fake clock and a scripted pose source: frames paced on the loop's clock, a target drawn only
+// while found, drawn where it will be at display time, and the display error meter's figures.
+
+#include "projbot/live/projection_loop.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <map>
-
-#include "projbot/session/projection.hpp"
+#include <cmath>
+#include <functional>
+#include <optional>
 
 using namespace projbot;
 
 namespace {
 
-// Poses by target, as a tracker worker would publish them.
-struct ScriptedPoses {
-  std::map<int, alignment::PoseSample> newest;
-  session::PoseSource source() {
-    return [this](int target, alignment::PoseSample& out) {
-      const auto it = newest.find(target);
-      if (it == newest.end()) return false;
-      out = it->second;
-      return true;
-    };
+config::ProjectorConfig small_projector() {
+  config::ProjectorConfig p;
+  p.width_px = 64, p.height_px = 48, p.fx_px = 60, p.fy_px = 60, p.cx_px = 32, p.cy_px = 24, p.near_m = 0.05, p.far_m = 20;
+  p.refresh_hz = 60.0;
+  return p;
+}
+
+// A white square 0.2 m a side in the model's z = 0 plane.
+assets::Model square() {
+  assets::Model m;
+  m.source = "test-square";
+  assets::Primitive p;
+  const float h = 0.1F;
+  for (const auto& c : {std::array<float, 3>{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}}) {
+    assets::Vertex v;
+    v.position = c;
+    v.color = {1, 1, 1, 1};
+    p.vertices.push_back(v);
   }
-  void publish(int target, const Eigen::Matrix4d& T, double capture_s, bool lost = false) {
-    alignment::PoseSample s;
-    s.T_camera_target = T;
-    s.capture_time_s = capture_s;
-    s.lost = lost;
-    s.motion.T = T;
-    s.motion.time_s = capture_s;
-    newest[target] = s;
-  }
-};
+  p.indices = {0, 1, 2, 0, 2, 3};
+  assets::Material material;
+  material.double_sided = true;
+  m.materials.push_back(material);
+  m.primitives.push_back(std::move(p));
+  return m;
+}
 
 Eigen::Matrix4d at(double x, double y, double z) {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
@@ -40,117 +48,200 @@ Eigen::Matrix4d at(double x, double y, double z) {
   return T;
 }
 
-session::ProjectionConfig config_60hz() {
-  session::ProjectionConfig c;
-  c.T_projector_camera = at(0.1, 0.0, 0.0);  // the projector 10 cm beside the camera
-  c.refresh_hz = 60.0;
-  c.input_lag_ms = 20.0;
-  return c;
+// A clock that moves when the loop sleeps (its frames at 60 Hz) and by a microsecond per read, so a test
+// sees exactly the frames it scripts, however slow the renderer.
+struct FakeClock {
+  double t_s = 10.0;
+  config::Clock clock() {
+    return {[this] { return t_s += 1e-6; }, [this](double until_s) { t_s = std::max(t_s, until_s); }};
+  }
+};
+
+class ProjectionLoopTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    engine::RendererOptions o;
+    o.validation = true;
+    renderer_ = std::make_unique<engine::Renderer>(o);
+    model_ = renderer_->add_model(square());
+  }
+  static void TearDownTestSuite() { renderer_.reset(); }
+  void TearDown() override {
+    EXPECT_EQ(renderer_->validation_errors(), 0U);
+    EXPECT_EQ(renderer_->validation_warnings(), 0U);
+  }
+
+  // The loop over `seconds` of fake time at 60 Hz; the pose of target 0 is `pose(t)` (nullopt: none yet,
+  // or lost); the meter measures against `truth(t)`.
+  using Uniform = std::optional<std::array<std::uint8_t, 3>>;
+  live::ProjectionFigures run(double seconds, const std::function<std::optional<alignment::PoseSample>(double)>& pose,
+                              const std::function<Eigen::Matrix4d(double)>& truth, bool predict, assets::Image* last = nullptr,
+                              const std::function<Uniform(double)>& uniform = {}) {
+    live::ProjectionLoopConfig c;
+    c.projection.T_projector_camera = at(0.1, 0.0, 0.0);
+    c.projection.refresh_hz = 60.0;
+    c.projection.input_lag_ms = 20.0;
+    c.projection.predict = predict;
+    c.projection.max_unconfirmed_s = 0.0;  // scripted poses, no tracker to fall behind (ProjectionFrames tests it)
+    c.seconds = seconds;
+    c.paced_hz = 60.0;
+    live::ProjectionLoop loop(*renderer_, projector_, {engine::DrawItem(model_, Eigen::Matrix4d::Identity())}, c, clock_.clock());
+    live::ProjectionInputs in;
+    in.stop = [] { return live::LitStop{{0}, 0.0, 1}; };
+    in.poses = [&](int, alignment::PoseSample& out) {
+      const auto p = pose(clock_.t_s);
+      if (p) out = *p;
+      return p.has_value();
+    };
+    in.camera_last_s = [this] { return clock_.t_s; };
+    in.keep_going = [] { return true; };
+    if (uniform) in.uniform = [&] { return uniform(clock_.t_s); };
+    in.meter = [&](const live::DrawnPose& d) {
+      const Eigen::Vector3d error = d.T_camera_target.topRightCorner<3, 1>() - truth(d.display_s).topRightCorner<3, 1>();
+      return live::DisplayError{1000.0 * error.norm(), d.display_s > 10.25};
+    };
+    auto target = renderer_->make_offscreen(projector_.width_px, projector_.height_px);
+    engine::FrameProfiler profiler;
+    live::ProjectionFigures f = loop.run(*target, in, profiler);
+    if (last) *last = target->read_back();
+    return f;
+  }
+
+  alignment::PoseSample seen(const Eigen::Matrix4d& T, double capture_s, const Eigen::Vector3d& velocity) {
+    alignment::PoseSample s;
+    s.T_camera_target = T;
+    s.capture_time_s = capture_s;
+    s.motion.T = T;
+    s.motion.time_s = capture_s;
+    s.motion.velocity_m_s = velocity;
+    s.lost = false;
+    return s;
+  }
+
+  static inline std::unique_ptr<engine::Renderer> renderer_;
+  static inline std::size_t model_ = 0;
+  config::ProjectorConfig projector_ = small_projector();
+  FakeClock clock_;
+};
+
+TEST_F(ProjectionLoopTest, PacesItsFramesAndBlanksATargetNotFoundOrLost) {
+  // Found 0.1 s into the run, lost at 0.3 s: 30 frames in 0.5 s, those between drawn.
+  const auto pose = [&](double t) -> std::optional<alignment::PoseSample> {
+    if (t < 10.1) return std::nullopt;
+    alignment::PoseSample s = seen(at(0, 0, 1), 10.1, Eigen::Vector3d::Zero());
+    s.lost = t >= 10.3;
+    return s;
+  };
+  assets::Image last;
+  const live::ProjectionFigures f = run(
+      0.5, pose, [](double) { return at(0, 0, 1); }, true, &last);
+  ASSERT_NEAR(static_cast<double>(f.rows.size()), 30.0, 1.0);
+  std::size_t drawn = 0;
+  for (const live::ProjectionRow& r : f.rows) drawn += r.target == 0 ? 1 : 0;
+  EXPECT_NEAR(static_cast<double>(drawn), 12.0, 1.0);  // 0.2 s at 60 Hz
+  EXPECT_EQ(f.blank + drawn, f.rows.size());
+  EXPECT_EQ(f.ages_ms.size(), drawn);
+  EXPECT_EQ(last.lit_pixels(), 0U);  // the last frame, the target lost: black
+}
+
+// A uniform colour asked for (a reflectance measured at a stop) replaces the targets over the whole image
+// for as long as it is asked, counted apart from blank frames; then the target is drawn again.
+TEST_F(ProjectionLoopTest, ShowsAUniformColourInsteadOfTheTargetsWhileAsked) {
+  const auto pose = [&](double) -> std::optional<alignment::PoseSample> {
+    return seen(at(0, 0, 1), 10.0, Eigen::Vector3d::Zero());
+  };
+  const auto truth = [](double) { return at(0, 0, 1); };
+  const auto grey_until = [](double end_s) {
+    return [end_s](double t) -> Uniform {
+      if (t >= 10.2 && t < end_s) return std::array<std::uint8_t, 3>{128, 128, 128};
+      return std::nullopt;
+    };
+  };
+  assets::Image last;
+  live::ProjectionFigures f = run(0.5, pose, truth, false, &last, grey_until(10.3));
+  EXPECT_NEAR(static_cast<double>(f.uniform), 6.0, 1.0);  // 0.1 s at 60 Hz
+  EXPECT_EQ(f.blank, 0U);
+  std::size_t drawn = 0;
+  for (const live::ProjectionRow& r : f.rows) drawn += r.target == 0 ? 1 : 0;
+  EXPECT_EQ(drawn + f.uniform, f.rows.size());
+  EXPECT_GT(last.lit_pixels(), 0U);                                                  // the square again...
+  EXPECT_EQ(last.pixel(0, 0)[0], 0);                                                 // ...on black
+  f = run(0.5, pose, truth, false, &last, grey_until(99.0));                         // grey to the end
+  EXPECT_EQ(last.pixel(0, 0)[0], 128);                                               // the whole image
+  EXPECT_EQ(last.pixel(projector_.width_px / 2, projector_.height_px / 2)[1], 128);  // the target not drawn
+}
+
+TEST_F(ProjectionLoopTest, DrawsAMovingTargetWhereItWillBeAtDisplayTimeAndMeasuresIt) {
+  // A target moving at 0.5 m/s along x, each pose 30 ms old when read: drawn where it is at display time
+  // (error ~0), and without prediction where it was seen (0.5 m/s x (30 ms + a frame + 20 ms lag) behind).
+  const Eigen::Vector3d v(0.5, 0.0, 0.0);
+  const auto truth = [&](double t) { return at(0.5 * (t - 10.0), 0.0, 1.0); };
+  const auto pose = [&](double t) -> std::optional<alignment::PoseSample> { return seen(truth(t - 0.03), t - 0.03, v); };
+  assets::Image last;
+  const live::ProjectionFigures predicted = run(0.5, pose, truth, true, &last);
+  const live::ProjectionFigures as_seen = run(0.5, pose, truth, false);
+  ASSERT_EQ(predicted.blank, 0U);
+  ASSERT_FALSE(predicted.still_mm.empty());
+  ASSERT_FALSE(predicted.moving_mm.empty());  // the meter's `moving` (after 0.25 s) sorts the frames
+  EXPECT_EQ(predicted.still_mm.size() + predicted.moving_mm.size(), predicted.rows.size());
+  for (const double e : predicted.moving_mm) EXPECT_LT(e, 0.01);
+  const double behind_mm = 1000.0 * 0.5 * (0.03 + 1.0 / 60.0 + 0.020);  // 33.3 mm
+  for (const double e : as_seen.moving_mm) EXPECT_NEAR(e, behind_mm, 0.1);
+  // Each row: the pose's age is capture to display (30 ms + a frame + 20 ms), the row's error the meter's.
+  for (const live::ProjectionRow& r : predicted.rows) {
+    EXPECT_NEAR(r.age_ms, 1000.0 * (0.03 + 1.0 / 60.0 + 0.020), 0.1);
+    EXPECT_NEAR(r.display_ms - r.capture_ms, r.age_ms, 0.1);
+    EXPECT_LT(r.error_mm, 0.01);
+  }
+  EXPECT_GT(last.lit_pixels(), 100U);  // the square, 0.2 m at about 1 m through a 60 px focal length
 }
 
 }  // namespace
 
-TEST(ProjectionFrames, DrawsEachFoundTargetThroughEq2AndBlanksTheRest) {
-  // Three lit targets: one found, one lost, one never found; a fourth found but not lit at this stop.
-  ScriptedPoses poses;
-  poses.publish(0, at(0.0, 0.0, 1.0), 10.00);
-  poses.publish(1, at(0.2, 0.0, 1.0), 10.00, true);
-  poses.publish(3, at(0.4, 0.0, 1.0), 10.00);
-  session::ProjectionFrames frames(config_60hz());
-  const auto drawn = frames.compose(10.05, {{0, 1, 2}, 9.0, 10.04}, poses.source());
-  ASSERT_EQ(drawn.size(), 1u);
-  EXPECT_EQ(drawn[0].target, 0);
-  EXPECT_DOUBLE_EQ(drawn[0].capture_s, 10.00);
-  // Displayed one period (the configured 1/60 s until frames have run) plus the 20 ms lag later.
-  EXPECT_NEAR(drawn[0].display_s, 10.05 + 1.0 / 60.0 + 0.020, 1e-12);
-  // Eq. 2: the target 1 m ahead of the camera lies 10 cm beside it in the projector's frame.
-  EXPECT_TRUE(drawn[0].T_projector_target.isApprox(at(0.1, 0.0, 1.0), 1e-12));
-  EXPECT_EQ(frames.silent_frames(), 0u);
+namespace {
+
+TEST_F(ProjectionLoopTest, StepsFrameByFrameOnASimulatedClockWithoutDrawing) {
+  // As the twin's tour runs it: one frame per step at the clock's time, decided and measured, nothing
+  // drawn. Found at 0.1 s, lost at 0.3 s; a truth 2 mm off in x while still, 0 mm after 0.25 s.
+  double now_s = 0.0;
+  live::ProjectionLoopConfig c;
+  c.projection.T_projector_camera = at(0.1, 0.0, 0.0);
+  c.projection.input_lag_ms = 20.0;
+  c.projection.silent_camera_s = 0.0;
+  c.projection.max_unconfirmed_s = 0.0;  // scripted poses, no tracker to fall behind
+  live::ProjectionLoop loop(*renderer_, projector_, {}, c, {[&] { return now_s; }, [&](double t) { now_s = t; }});
+  live::ProjectionInputs in;
+  in.stop = [] { return live::LitStop{{0}, 0.0, 1}; };
+  in.poses = [&](int, alignment::PoseSample& out) {
+    if (now_s < 0.1 - 1e-9) return false;
+    out = seen(at(0, 0, 1), 0.1, Eigen::Vector3d::Zero());
+    out.lost = now_s >= 0.3 - 1e-9;
+    return true;
+  };
+  in.meter = [](const live::DrawnPose& d) { return live::DisplayError{d.display_s > 0.25 ? 0.0 : 2.0, d.display_s > 0.25}; };
+  loop.begin();
+  std::size_t drawn = 0;
+  for (int k = 0; k < 30; ++k) {
+    now_s = k / 60.0;
+    const std::optional<live::DecidedFrame> f = loop.frame(nullptr, in, nullptr);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_DOUBLE_EQ(f->start_s, now_s);
+    EXPECT_NEAR(f->display_s, now_s + 1.0 / 60.0 + 0.020, 1e-9);  // a frame period and the input lag later
+    drawn += f->drawn.size();
+    for (const live::DrawnPose& d : f->drawn) {
+      EXPECT_EQ(d.target, 0);
+      EXPECT_NEAR(d.T_projector_target(0, 3), 0.1, 1e-12);  // Eq. 2 with the configured R_cp, T_cp
+      EXPECT_NEAR(d.display_s, f->display_s, 1e-12);
+    }
+  }
+  EXPECT_EQ(drawn, 12U);  // frames 6..17: found at 0.1 s, lost at 0.3 s
+  const live::ProjectionFigures& figures = loop.figures();
+  ASSERT_EQ(figures.rows.size(), 30U);
+  EXPECT_EQ(figures.blank, 18U);
+  EXPECT_EQ(figures.still_mm.size() + figures.moving_mm.size(), 12U);
+  for (const double e : figures.still_mm) EXPECT_DOUBLE_EQ(e, 2.0);
+  EXPECT_NEAR(figures.rows[6].age_ms, 1000.0 * (6 / 60.0 + 1.0 / 60.0 + 0.020 - 0.1), 1e-6);
+  EXPECT_NEAR(figures.rows[29].clock_s, 29 / 60.0, 1e-12);
 }
 
-TEST(ProjectionFrames, PosesFromBeforeTheStopAreNotDrawn) {
-  ScriptedPoses poses;
-  poses.publish(0, at(0.0, 0.0, 1.0), 4.99);  // the last stop's
-  session::ProjectionFrames frames(config_60hz());
-  EXPECT_TRUE(frames.compose(5.02, {{0}, 5.0, 5.01}, poses.source()).empty());
-  poses.publish(0, at(0.0, 0.0, 1.0), 5.01);
-  EXPECT_EQ(frames.compose(5.03, {{0}, 5.0, 5.02}, poses.source()).size(), 1u);
-}
-
-TEST(ProjectionFrames, AMovingTargetIsDrawnWhereItWillBeAtDisplayTime) {
-  // A target seen moving at 0.5 m/s along x: drawn where it will be when the frame is lit, not where
-  // the camera saw it; with prediction off, where it was seen.
-  ScriptedPoses poses;
-  poses.publish(0, at(0.0, 0.0, 1.0), 1.000);
-  poses.newest[0].motion.velocity_m_s = Eigen::Vector3d(0.5, 0.0, 0.0);
-  session::ProjectionFrames frames(config_60hz());
-  const auto drawn = frames.compose(1.030, {{0}, 0.0, 1.02}, poses.source());
-  ASSERT_EQ(drawn.size(), 1u);
-  const double ahead_s = drawn[0].display_s - 1.000;  // 30 ms + 1/60 s + 20 ms: within the 0.1 s horizon
-  ASSERT_LT(ahead_s, 0.1);
-  EXPECT_NEAR(drawn[0].T_camera_target(0, 3), 0.5 * ahead_s, 1e-9);
-  EXPECT_NEAR(drawn[0].T_projector_target(0, 3), 0.1 + 0.5 * ahead_s, 1e-9);
-  session::ProjectionConfig still = config_60hz();
-  still.predict = false;
-  session::ProjectionFrames as_seen(still);
-  EXPECT_NEAR(as_seen.compose(1.030, {{0}, 0.0, 1.02}, poses.source()).at(0).T_camera_target(0, 3), 0.0, 1e-12);
-}
-
-TEST(ProjectionFrames, TheMeasuredFramePeriodSetsTheDisplayTime) {
-  // A 60 Hz projector whose frames come every 20 ms (50 Hz, as measured): after ten frames the display
-  // time is 20 ms ahead, not 16.7.
-  ScriptedPoses poses;
-  session::ProjectionConfig c = config_60hz();
-  c.input_lag_ms = 0.0;
-  session::ProjectionFrames frames(c);
-  double t = 1.0;
-  for (int i = 0; i < 11; ++i, t += 0.020) frames.frame_started(t);
-  poses.publish(0, at(0.0, 0.0, 1.0), t - 0.03);
-  EXPECT_NEAR(frames.period_s(), 0.020, 1e-12);
-  EXPECT_NEAR(frames.compose(t, {{0}, 0.0, t}, poses.source()).at(0).display_s, t + 0.020, 1e-12);
-}
-
-TEST(ProjectionFrames, ASilentCameraBlanksEverythingUntilItSeesAgain) {
-  // The camera hands over nothing for more than 100 ms: every target is blanked, and once frames come
-  // again only poses captured after the silence are drawn. A replay (not watched) draws on.
-  ScriptedPoses poses;
-  poses.publish(0, at(0.0, 0.0, 1.0), 2.00);
-  session::ProjectionFrames frames(config_60hz());
-  EXPECT_EQ(frames.compose(2.05, {{0}, 1.0, 2.00}, poses.source()).size(), 1u);
-  EXPECT_TRUE(frames.compose(2.15, {{0}, 1.0, 2.00}, poses.source()).empty());
-  EXPECT_EQ(frames.silent_frames(), 1u);
-  EXPECT_TRUE(frames.compose(2.20, {{0}, 1.0, 2.19}, poses.source()).empty());  // back, but the pose is from before
-  poses.publish(0, at(0.0, 0.0, 1.0), 2.19);
-  EXPECT_EQ(frames.compose(2.21, {{0}, 1.0, 2.19}, poses.source()).size(), 1u);
-  EXPECT_EQ(frames.silent_frames(), 1u);
-  session::ProjectionConfig replay = config_60hz();
-  replay.silent_camera_s = 0.0;
-  session::ProjectionFrames lockstep(replay);
-  EXPECT_EQ(lockstep.compose(9.0, {{0}, 1.0, 2.00}, poses.source()).size(), 1u);
-  // Nothing lit (driving): nothing to blank for silence either.
-  EXPECT_TRUE(frames.compose(9.0, {{}, 1.0, 2.00}, poses.source()).empty());
-  EXPECT_EQ(frames.silent_frames(), 1u);
-}
-
-TEST(ProjectionFrames, APoseNoNewerFrameConfirmedIsBlankedAfterThreeFrames) {
-  // Issue 87: the camera goes on handing frames over while the tracker is busy (a rescue, a search): its
-  // newest pose is drawn while it is at most 100 ms older than the newest frame, then blanked, each target
-  // on its own, until a pose from a newer frame comes. With no camera watched, the frame's start is the
-  // newest frame.
-  ScriptedPoses poses;
-  poses.publish(0, at(0.0, 0.0, 1.0), 3.00);
-  poses.publish(1, at(0.2, 0.0, 1.0), 3.09);
-  session::ProjectionFrames frames(config_60hz());
-  EXPECT_EQ(frames.compose(3.10, {{0, 1}, 1.0, 3.095}, poses.source()).size(), 2u);
-  const auto drawn = frames.compose(3.14, {{0, 1}, 1.0, 3.133}, poses.source());
-  ASSERT_EQ(drawn.size(), 1u);
-  EXPECT_EQ(drawn[0].target, 1);
-  EXPECT_EQ(frames.unconfirmed_blanks(), 1u);
-  poses.publish(0, at(0.0, 0.0, 1.0), 3.133);
-  EXPECT_EQ(frames.compose(3.16, {{0, 1}, 1.0, 3.133}, poses.source()).size(), 2u);
-  session::ProjectionConfig unwatched = config_60hz();
-  unwatched.max_unconfirmed_s = 0.0;
-  session::ProjectionFrames all(unwatched);
-  EXPECT_EQ(all.compose(9.0, {{0, 1}, 1.0, 9.0}, poses.source()).size(), 2u);
-  EXPECT_EQ(all.unconfirmed_blanks(), 0u);
-}
+}  // namespace

@@ -1,8 +1,8 @@
 // A session from a recording, at the library: poses.csv written by PoseLog and checked by PoseCheck (a
 // replay's poses against the recording's, and malformed files refused naming file and line), and the
-// recording's devices (ReplaySession) answering what was recorded or refusing a stop it does not hold.
+// recording's devices (ReplayRig) answering what was recorded or refusing a stop it does not hold.
 
-#include "projbot/session/replay.hpp"
+#include "projbot/live/replay.hpp"
 
 #include <gtest/gtest.h>
 
@@ -28,8 +28,8 @@ config::Scene two_targets() {
   return scene;
 }
 
-session::Stop stop_lighting_both(int visit) {
-  session::Stop stop;
+live::Stop stop_lighting_both(int visit) {
+  live::Stop stop;
   stop.visit = visit;
   stop.target = 0;
   stop.lit.resize(2);
@@ -62,7 +62,7 @@ class ReplayTest : public ::testing::Test {
   // The message of the ConfigError that reading `text` as poses.csv throws.
   std::string refusal(const std::string& text) {
     try {
-      session::PoseCheck check(write(text));
+      live::PoseCheck check(write(text));
     } catch (const config::ConfigError& e) {
       return e.what();
     }
@@ -73,10 +73,10 @@ class ReplayTest : public ::testing::Test {
 
 TEST_F(ReplayTest, APoseLogReadBackComparesItsOwnPosesExactlyAndMeasuresADifference) {
   const config::Scene scene = two_targets();
-  session::PoseLog log;
+  live::PoseLog log;
   log.add(scene, stop_lighting_both(0), 1, {pose_at(0.1), std::nullopt});
   log.add(scene, stop_lighting_both(0), 2, {pose_at(0.2), pose_at(-0.3)});
-  session::PoseCheck same(write(log.text()));
+  live::PoseCheck same(write(log.text()));
   same.compare(scene, stop_lighting_both(0), 1, {pose_at(0.1), std::nullopt});
   same.compare(scene, stop_lighting_both(0), 2, {pose_at(0.2), pose_at(-0.3)});
   EXPECT_EQ(same.compared, 3);  // the box's missing pose of frame 1 agrees, but there is nothing to compare
@@ -84,7 +84,7 @@ TEST_F(ReplayTest, APoseLogReadBackComparesItsOwnPosesExactlyAndMeasuresADiffere
   EXPECT_EQ(same.max_mm, 0.0);
   EXPECT_EQ(same.unreached(), 0);
 
-  session::PoseCheck moved(write(log.text()));
+  live::PoseCheck moved(write(log.text()));
   moved.compare(scene, stop_lighting_both(0), 2, {pose_at(0.2015), std::nullopt});  // 1.5 mm off; the box lost
   EXPECT_NEAR(moved.max_mm, 1.5, 1e-6);
   EXPECT_EQ(moved.compared, 1);
@@ -95,9 +95,9 @@ TEST_F(ReplayTest, APoseLogReadBackComparesItsOwnPosesExactlyAndMeasuresADiffere
   alignment::PoseSample rounded = pose_at(0.1);
   rounded.T_camera_target.topLeftCorner<3, 3>() =
       Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix() * (1.0 + 1e-7);
-  session::PoseLog turned_log;
+  live::PoseLog turned_log;
   turned_log.add(scene, stop_lighting_both(0), 1, {rounded, std::nullopt});
-  session::PoseCheck turned(write(turned_log.text()));
+  live::PoseCheck turned(write(turned_log.text()));
   turned.compare(scene, stop_lighting_both(0), 1, {rounded, std::nullopt});
   EXPECT_EQ(turned.max_deg, 0.0);
   alignment::PoseSample two = rounded;
@@ -108,7 +108,7 @@ TEST_F(ReplayTest, APoseLogReadBackComparesItsOwnPosesExactlyAndMeasuresADiffere
 }
 
 TEST_F(ReplayTest, AMalformedPoseFileIsRefusedNamingItsLine) {
-  const std::string header = std::string(session::PoseLog::kHeader) + "\n";
+  const std::string header = std::string(live::PoseLog::kHeader) + "\n";
   const std::string row = "0,1,duck,1,0,1,0,0,0.1,0,1,0,0,0,0,1,1\n";
   EXPECT_NE(refusal("visit,frame\n" + row).find("poses.csv:1: not the poses of a recording"), std::string::npos);
   EXPECT_NE(refusal(header + "0,1,duck,1,0,1,0\n").find("poses.csv:2: expected visit, frame, target and 14 numbers"),
@@ -135,12 +135,12 @@ TEST_F(ReplayTest, TheRecordingsDevicesAnswerWhatWasRecordedAndRefuseAStopItDoes
   // The session it serves: the demo tour's scene, its targets with a stand-in model cloud.
   const config::Scene scene = config::load_scene(std::filesystem::path(PROJBOT_ASSET_DIR) / "scenes" / "tour.yaml");
   alignment::ModelCloud cloud;
-  std::vector<session::Target> targets;
+  std::vector<live::Target> targets;
   for (int i = 0; i < static_cast<int>(scene.targets.size()); ++i) targets.push_back({i, &cloud, Eigen::Vector3d::Zero()});
-  session::ReplayClock clock;
+  live::ReplayClock clock;
   clock.close();  // no projector: the robot does not wait for one
   const config::Clock robot = clock.robot();
-  session::ReplaySession replay(scene, recording, targets, robot);
+  live::ReplayRig replay(scene, recording, targets, robot);
   const robot::StopReport r = replay.drive_to({1.0, 2.0, 0.5}, 0);
   EXPECT_DOUBLE_EQ(robot.now_s(), 7.5);  // the drive took its recorded time on the replay's clock
   EXPECT_TRUE(r.arrived);
@@ -153,10 +153,10 @@ TEST_F(ReplayTest, TheRecordingsDevicesAnswerWhatWasRecordedAndRefuseAStopItDoes
   try {
     replay.drive_to({1.0, 2.0, 0.5}, 1);
     FAIL() << "a stop the recording does not hold was driven to";
-  } catch (const session::SessionError& e) {
+  } catch (const live::SessionError& e) {
     EXPECT_NE(std::string(e.what()).find("asked for stop 2 but the recording holds 1"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(replay.drive_to({3.0, 2.0, 0.5}, 0), session::SessionError);  // another stop than recorded
+  EXPECT_THROW(replay.drive_to({3.0, 2.0, 0.5}, 0), live::SessionError);  // another stop than recorded
 }
 
 // What `record` learnt of the targets' reflectance travels in recording.yaml (`reflectance:`, a PNG per
@@ -216,7 +216,7 @@ TEST_F(ReplayTest, ARecordingsLearntReflectanceReplacesTheScenesSurfaceAndIsRefu
 TEST(ReplayClock, EachProjectorFrameSeesWhatTheRobotDidUpToItsTimeAndNothingAfter) {
   const std::vector<double> events = {0.0, 0.01, 0.05, 0.05, 0.1, 0.3335, 0.5};
   for (const bool slow_robot : {false, true}) {
-    session::ReplayClock clock;
+    live::ReplayClock clock;
     std::atomic<int> done{0};
     std::jthread robot([&] {
       const config::Clock c = clock.robot();
@@ -237,7 +237,7 @@ TEST(ReplayClock, EachProjectorFrameSeesWhatTheRobotDidUpToItsTimeAndNothingAfte
       EXPECT_EQ(done.load(), expected) << "frame at " << T << " s, slow robot " << slow_robot;
     }
   }
-  session::ReplayClock clock;
+  live::ReplayClock clock;
   std::atomic<bool> released{false};
   std::jthread robot([&] {
     clock.robot().sleep_until(10.0);  // the projector never gets there: the run ends first

@@ -13,7 +13,7 @@
 #include "projbot/alignment/verification.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/photometry.hpp"
-#include "projbot/session/session.hpp"
+#include "projbot/live/stop_sequence.hpp"
 #include "projbot/twin/appearance.hpp"
 #include "projbot/twin/camera.hpp"
 #include "projbot/twin/raycast.hpp"

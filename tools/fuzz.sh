@@ -47,10 +47,14 @@ if [[ $target == gltf ]]; then find ../shared/data/gltf -name '*.gl*' -size -300
 export ASAN_OPTIONS="allocator_may_return_null=1:max_allocation_size_mb=1024:detect_leaks=0:${ASAN_OPTIONS:-}"
 malloc_limit=512
 [[ $target == rawlog ]] && malloc_limit=2048
+# PROJBOT_FUZZ_SEED fixes libFuzzer's mutation sequence (CI's smoke run: the same inputs every time, so a
+# red CI is a change's, not a dice roll's); unset, each run explores anew.
+seed=()
+[[ -n ${PROJBOT_FUZZ_SEED:-} ]] && seed=(-seed="$PROJBOT_FUZZ_SEED")
 log=build/fuzz/$target.log
 set +e
 start=$(date +%s)
-"./build/fuzz/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=3072 \
+"./build/fuzz/tests/fuzz/fuzz_$target" "${seed[@]}" -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=3072 \
   -malloc_limit_mb=$malloc_limit -artifact_prefix="$findings/" -print_final_stats=1 "$corpus" >"$log" 2>&1
 status=$?
 elapsed=$(($(date +%s) - start))

@@ -103,15 +103,39 @@ std::string image_name(int id, const char* ext) {
   return name;
 }
 
-bool has_symmetries(const json& info) { return info.contains("symmetries_discrete") || info.contains("symmetries_continuous"); }
+// Whether an object's entry names a symmetry: a non-empty list of them. Anything else under those keys
+// is an error naming the object (an empty list, or a string, made it symmetric before: scored by ADD-S).
+bool has_symmetries(const fs::path& file, const std::string& key, const json& info) {
+  bool any = false;
+  for (const char* k : {"symmetries_discrete", "symmetries_continuous"}) {
+    if (!info.is_object() || !info.contains(k)) continue;
+    const json& list = info.at(k);
+    if (!list.is_array()) fail(file, "object " + key + ": " + k + " must be a list of symmetries");
+    for (const json& s : list)
+      if (!s.is_array() && !s.is_object()) fail(file, "object " + key + ": " + k + " holds an entry that is not a symmetry");
+    any = any || !list.empty();
+  }
+  return any;
+}
+
+// One key per id: "1" and "01" name the same image (or object), which would be counted twice.
+void check_unique_ids(const fs::path& file, const json& object, const std::string& what) {
+  std::map<int, std::string> seen;
+  for (const auto& [key, value] : object.items()) {
+    const int id = parse_id(file, key);
+    if (const auto [at, added] = seen.emplace(id, key); !added)
+      fail(file, what + " " + std::to_string(id) + " is listed twice ('" + at->second + "' and '" + key + "')");
+  }
+}
 
 }  // namespace
 
 std::vector<BopObject> read_bop_models(const fs::path& models) {
   const fs::path file = models / "models_info.json", root = models.parent_path();
   const json info = read_json(file);
+  check_unique_ids(file, info, "object");
   bool any_symmetry = false;
-  for (const auto& [key, value] : info.items()) any_symmetry = any_symmetry || has_symmetries(value);
+  for (const auto& [key, value] : info.items()) any_symmetry = has_symmetries(file, key, value) || any_symmetry;
   // BOP's YCB-V ships symmetries; a dataset that names none anywhere (converted elsewhere) but is YCB-V
   // gets YCB-V's list, so its cans and clamps are not scored as if their turn could be seen.
   const bool ycbv = root.filename().string().find("ycbv") != std::string::npos ||
@@ -125,8 +149,8 @@ std::vector<BopObject> read_bop_models(const fs::path& models) {
       fail(file, "object " + key + ": diameter must be a finite number > 0 (mm)");
     o.diameter_m = d.get<double>() / 1000.0;
     o.model = models / ("obj_" + image_name(o.id, ".ply"));
-    o.symmetric =
-        any_symmetry ? has_symmetries(value) : ycbv && std::count(kYcbvSymmetricIds.begin(), kYcbvSymmetricIds.end(), o.id) > 0;
+    o.symmetric = any_symmetry ? has_symmetries(file, key, value)
+                               : ycbv && std::count(kYcbvSymmetricIds.begin(), kYcbvSymmetricIds.end(), o.id) > 0;
     objects.push_back(o);
   }
   if (objects.empty()) fail(file, "lists no objects");
@@ -141,7 +165,11 @@ BopImage read_camera(const fs::path& file, const fs::path& folder, int id, const
   BopImage image;
   image.id = id;
   const auto K = numbers(file, member(file, cam, "cam_K", where), 9, where + ": cam_K");
-  if (!(K[0] > 0.0) || !(K[4] > 0.0)) fail(file, where + ": cam_K's focal lengths must be > 0");
+  // A pinhole camera's K: focal lengths of a real camera's (1 to 100000 px), no skew, last row 0 0 1.
+  if (!(K[0] >= 1.0 && K[0] <= 1e5) || !(K[4] >= 1.0 && K[4] <= 1e5))
+    fail(file, where + ": cam_K's focal lengths must be 1 to 100000 px");
+  if (K[1] != 0.0 || K[3] != 0.0 || K[6] != 0.0 || K[7] != 0.0 || K[8] != 1.0)
+    fail(file, where + ": cam_K must be [fx, 0, cx, 0, fy, cy, 0, 0, 1] (no skew, last row 0 0 1)");
   image.k.fx_px = K[0], image.k.fy_px = K[4], image.k.cx_px = K[2], image.k.cy_px = K[5];
   const json& scale = member(file, cam, "depth_scale", where);
   if (!scale.is_number() || !(scale.get<double>() >= 1e-3 && scale.get<double>() <= 1e3))
@@ -179,6 +207,7 @@ BopInstance read_instance(const fs::path& file, const json& gt, const std::strin
 void read_instances(const fs::path& folder, std::map<int, BopImage>& images, Rounding& rounding) {
   const fs::path gt_file = folder / "scene_gt.json", info_file = folder / "scene_gt_info.json";
   const json gt = read_json(gt_file);
+  check_unique_ids(gt_file, gt, "image");
   std::error_code ec;
   const std::optional<json> info = fs::exists(info_file, ec) ? std::optional<json>(read_json(info_file)) : std::nullopt;
   for (const auto& [key, list] : gt.items()) {
@@ -215,6 +244,7 @@ BopScene read_scene(const fs::path& folder, Rounding& rounding) {
   scene.folder = folder;
   const fs::path cam_file = folder / "scene_camera.json";
   const json cams = read_json(cam_file);
+  check_unique_ids(cam_file, cams, "image");
   std::map<int, BopImage> images;
   for (const auto& [key, cam] : cams.items()) {
     const int id = parse_id(cam_file, key);
@@ -287,7 +317,15 @@ DepthImage read_bop_depth(const BopImage& image) {
   return d;
 }
 
-std::vector<std::uint8_t> read_bop_mask(const BopScene& scene, const BopImage& image, const BopInstance& instance) {
+void check_same_size(const BopImage& image, const DepthImage& depth, const fs::path& first_file, const DepthImage& first) {
+  if (depth.width != first.width || depth.height != first.height)
+    fail(image.depth, "is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) + ", but " + first_file.string() +
+                          " of the same scene is " + std::to_string(first.width) + "x" + std::to_string(first.height) +
+                          ": one camera, one size");
+}
+
+std::vector<std::uint8_t> read_bop_mask(const BopScene& scene, const BopImage& image, const BopInstance& instance,
+                                        const DepthImage& depth) {
   char name[48];
   std::snprintf(name, sizeof name, "%06d_%06d.png", image.id, instance.gt_index);
   const fs::path file = scene.folder / "mask_visib" / name;
@@ -297,6 +335,9 @@ std::vector<std::uint8_t> read_bop_mask(const BopScene& scene, const BopImage& i
   } catch (const assets::AssetError& e) {
     throw AlignmentError(e.what());
   }
+  if (mask.width != depth.width || mask.height != depth.height)
+    fail(file, "is " + std::to_string(mask.width) + "x" + std::to_string(mask.height) + ", but its image's depth " +
+                   image.depth.string() + " is " + std::to_string(depth.width) + "x" + std::to_string(depth.height));
   std::vector<std::uint8_t> out(static_cast<std::size_t>(mask.width) * mask.height);
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = mask.rgba[4 * i] > 127 ? 1 : 0;
   return out;

@@ -292,6 +292,7 @@ void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::pat
   std::ifstream probe(path, std::ios::binary);
   if (!probe) root.fail(node, "calibration", "cannot open '" + path.string() + "'");
   const ProjectorCalibration c = load_calibration(path);
+  scene.calibration = path;
   if (c.photometry)
     for (const char* key : {"gamma", "gamma_rgb", "mixing", "black_level", "brightness_lm"})
       if (root.has("projector") && root.child("projector", false)[key])

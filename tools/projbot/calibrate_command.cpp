@@ -15,7 +15,7 @@
 #include "projbot/calibrate/capture.hpp"
 #include "projbot/calibrate/pattern_screen.hpp"
 #include "projbot/config/scene.hpp"
-#include "projbot/hardware/devices.hpp"
+#include "projbot/live/devices.hpp"
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
@@ -218,9 +218,9 @@ CalibrationDevices open_calibration_devices(const cli::Args& args, const config:
   config::DevicesConfig wanted;
   wanted.camera = scene.devices.camera;
   wanted.projector = scene.devices.projector;
-  std::vector<hardware::DeviceCheck> checks;
+  std::vector<live::DeviceCheck> checks;
   CalibrationDevices d;
-  d.devices = hardware::open_devices(wanted, checks, true);  // an absent device: an error naming it, before anything is shown
+  d.devices = live::open_devices(wanted, checks, true);  // an absent device: an error naming it, before anything is shown
   for (const auto& c : checks) std::cout << "opened " << c.config << ": " << c.detail << '\n';
   engine::RendererOptions ro;  // after the monitors were checked: that check starts and stops GLFW
   ro.windowing = true;

@@ -8,7 +8,7 @@
 #include "cli.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
-#include "projbot/hardware/devices.hpp"
+#include "projbot/live/devices.hpp"
 
 namespace projbot::tools {
 
@@ -16,7 +16,7 @@ namespace projbot::tools {
 /// shown), and the projector's window (full screen with --fullscreen or devices.projector.fullscreen, on
 /// --monitor or devices.projector.monitor), titled `title`. Members are destroyed window first.
 struct CalibrationDevices {
-  hardware::Devices devices;
+  live::Devices devices;
   std::unique_ptr<engine::Renderer> renderer;
   std::unique_ptr<engine::RenderTarget> window;
 };

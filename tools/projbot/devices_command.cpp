@@ -14,7 +14,7 @@
 #include "interrupt.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
-#include "projbot/hardware/devices.hpp"
+#include "projbot/live/devices.hpp"
 #include "projbot/robot/laser.hpp"
 #include "projbot/robot/pose2d.hpp"
 #include "projbot/robot/ros2_base.hpp"
@@ -103,15 +103,15 @@ const Command kDevices{"devices",
                            scene = config::load_scene(*path);  // a bad file fails before the listing
                          int domain = scene && scene->devices.base ? scene->devices.base->domain : 0;
                          domain = args.get_int("domain", domain, 0, 232);
-                         hardware::list_found(std::cout, domain);
+                         live::list_found(std::cout, domain);
                          if (!scene) return 0;
                          std::cout << "\nconfigured in " << scene->source.string() << ":\n";
                          if (!scene->devices.any()) {
                            std::cout << "  no `devices:` section: every device is the digital twin's (projbot run --sim)\n";
                            return 0;
                          }
-                         std::vector<hardware::DeviceCheck> checks;
-                         hardware::open_devices(scene->devices, checks, false);
+                         std::vector<live::DeviceCheck> checks;
+                         live::open_devices(scene->devices, checks, false);
                          bool all_ok = true;
                          for (const auto& c : checks) {
                            std::cout << "  " << c.config << ": " << (c.ok ? "ok, " : "FAILED: ") << c.detail << "\n";

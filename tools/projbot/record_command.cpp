@@ -10,7 +10,8 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "progress.hpp"
-#include "projbot/live/recorder.hpp"
+#include "projbot/live/record.hpp"
+#include "projbot/twin/twin_rig.hpp"
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
@@ -72,8 +73,9 @@ const Command kRecord{
       catch_interrupts();  // Ctrl-C: during set-up nothing is written; later, end the stop in progress, keep every stop
 
       Progress progress("frame", static_cast<int>(std::ceil(visits * dwell_s * 30.0)));
-      live::RecordHooks hooks{[] { return interrupted(); }, [&progress](int frames) { progress.step(frames); }, &std::cout};
-      const live::Recorded r = live::record(scene, {visits, dwell_s, seed, args.flag("sim"), family.depth_noise}, *out, hooks);
+      live::RecordHooks hooks{[] { return interrupted(); }, [&progress](int frames) { progress.step(frames); }, &std::cout,
+                              twin::rig_opener({.seed = seed, .depth_model = family.depth_noise})};
+      const live::Recorded r = live::record(scene, {visits, dwell_s, seed, args.flag("sim")}, *out, hooks);
       if (!r.started) return nothing_written("while setting up");  // no folder made
       std::cout << "recorded " << r.recording.stops.size() << " stop(s), " << r.frames << " frames from " << r.recording.camera
                 << " to " << *out << "\nreplay: projbot run --replay " << *out << "\n";

@@ -6,13 +6,18 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "projbot/config/output_file.hpp"
+#include "projbot/console/console.hpp"
+#include "projbot/console/osc.hpp"
 #include "projbot/engine/frame_profiler.hpp"
-#include "projbot/live/live_run.hpp"
+#include "projbot/live/run.hpp"
+#include "projbot/twin/twin_rig.hpp"
 #include "scene_setup.hpp"
 
 namespace projbot::tools {
@@ -21,7 +26,7 @@ namespace {
 // The error of the frames drawn, against the twin's truth at each frame's display time: the mean distance
 // between where the projector's light lands and where the markers truly are then (mm; the tour's
 // definition, twin::marker_errors).
-void print_display_errors(std::ostream& out, const session::LiveFigures& f) {
+void print_display_errors(std::ostream& out, const live::ProjectionFigures& f) {
   double still = 0.0, moving = 0.0;
   for (const double e : f.still_mm) still += e / static_cast<double>(f.still_mm.size());
   for (const double e : f.moving_mm) moving += e / static_cast<double>(f.moving_mm.size());
@@ -55,11 +60,9 @@ std::optional<config::Recording> replay_of(const cli::Args& args) {
 }
 
 // The run's options beyond the scene and the recording: a bad value is a usage error before anything opens.
-live::RunOptions run_options(const cli::Args& args) {
+live::RunOptions run_options(const cli::Args& args, const TourFamilyArgs& family) {
   live::RunOptions o;
-  const TourFamilyArgs family = tour_family_args(args, 4.0);
-  o.visits = family.visits, o.dwell_s = family.dwell_s, o.seed = family.seed;
-  o.depth_model = family.depth_noise;
+  o.visits = family.visits, o.dwell_s = family.dwell_s;
   o.seconds = args.get_double("seconds", 0.0);
   if (!(o.seconds >= 0.0 && o.seconds <= 1e6)) throw cli::UsageError("--seconds must be 0 (until the tour ends) to 1e6");
   o.headless = args.flag("headless");
@@ -90,16 +93,17 @@ std::unique_ptr<engine::RenderTarget> open_output(engine::Renderer& renderer, co
 }
 
 void print_frames(std::ostream& out, const live::RunResult& r) {
-  const session::LiveFigures& f = r.figures;
+  const live::ProjectionFigures& f = r.figures;
   out << engine::format_summary(r.summary) << '\n';
   out << std::fixed << std::setprecision(1) << "pose age at display (depth capture to expected display), " << f.ages_ms.size()
       << " frames with a target: p50 " << engine::percentile(f.ages_ms, 0.5) << " ms, p95 " << engine::percentile(f.ages_ms, 0.95)
       << " ms, p99 " << engine::percentile(f.ages_ms, 0.99) << " ms, max " << engine::percentile(f.ages_ms, 1.0) << " ms; "
       << f.blank << " frames blank (driving, acquiring or lost)";
   if (f.with_neighbours > 0) out << "; " << f.with_neighbours << " frames lit a neighbour too";
-  if (f.uniform > 0)
-    out << "; " << f.uniform << " frames black or grey while " << r.reflectance_measured
+  if (f.uniform > r.blackout_frames)
+    out << "; " << f.uniform - r.blackout_frames << " frames black or grey while " << r.reflectance_measured
         << " target reflectance(s) were measured";
+  if (r.blackout_frames > 0) out << "; " << r.blackout_frames << " frames blacked out by the operator";
   if (r.silent_frames > 0)
     out << "; " << r.silent_frames << " frames blanked because the camera had handed over no frame for "
         << std::lround(1000.0 * r.silent_camera_s) << " ms";
@@ -112,7 +116,7 @@ void print_frames(std::ostream& out, const live::RunResult& r) {
 }
 
 void print_replay(std::ostream& out, const config::Recording& recording, int visits, std::size_t tracked,
-                  const session::PoseCheck& check) {
+                  const live::PoseCheck& check) {
   out << "replay of " << recording.folder().string() << ": " << visits << " of " << recording.stops.size() << " stops, "
       << tracked << " poses tracked in lockstep (each lit target's, every frame); against the recording's: " << check.compared
       << " compared, largest difference " << std::setprecision(4) << check.max_mm << " mm, " << check.max_deg << " deg; "
@@ -135,12 +139,12 @@ void print_replay(std::ostream& out, const config::Recording& recording, int vis
 // time (empty for a blank frame), all on the frame profiler's clock; then its start on the run's clock (a
 // replay: the recording's), the first drawn target's content time, its video frame's presentation time
 // and where it was drawn (its origin in the projector's frame, mm).
-void write_profile(const std::string& csv, const std::vector<session::LiveRow>& rows, const config::Scene& scene) {
+void write_profile(const std::string& csv, const std::vector<live::ProjectionRow>& rows, const config::Scene& scene) {
   std::ostringstream f;
   f << "frame,start_ms,pose_age_ms,target,capture_ms,display_ms,error_mm,clock_s,content_s,video_pts_s,x_mm,y_mm,z_mm\n";
   const auto opt = [](double v) { return std::isnan(v) ? std::string() : std::to_string(v); };
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    const session::LiveRow& r = rows[i];
+    const live::ProjectionRow& r = rows[i];
     f << i << ',' << r.start_ms << ',' << (r.age_ms >= 0 ? std::to_string(r.age_ms) : std::string()) << ','
       << (r.target >= 0 ? scene.targets[static_cast<std::size_t>(r.target)].name : std::string()) << ',' << opt(r.capture_ms)
       << ',' << opt(r.display_ms) << ',' << opt(r.error_mm) << ',' << opt(r.clock_s) << ',' << opt(r.content_s) << ','
@@ -151,6 +155,94 @@ void write_profile(const std::string& csv, const std::vector<session::LiveRow>& 
   std::cout << "per-frame profile written to " << csv << '\n';
 }
 
+// The operator's controls (--console, --osc): the show's, and the servers acting on them, which go first.
+struct Operated {
+  std::unique_ptr<live::ShowControl> show;
+  std::unique_ptr<console::Console> console;
+  std::unique_ptr<console::OscControl> osc;
+};
+
+std::optional<console::ConsoleConfig> console_config(const cli::Args& args) {
+  const auto listen = args.get("console");
+  const auto token_file = args.get("console-token");
+  if (!listen) {
+    if (token_file) throw cli::UsageError("--console-token applies to --console");
+    return std::nullopt;
+  }
+  console::ConsoleConfig c;
+  try {
+    c = console::parse_listen(*listen, "--console");
+    if (token_file) c.token = console::read_token(*token_file);
+  } catch (const console::ConsoleError& e) {
+    throw cli::UsageError(e.what());
+  }
+  if (c.token.empty() && !console::is_loopback(c.host))
+    throw cli::UsageError("--console " + *listen +
+                          ": a console on an address other than loopback needs a token (--console-token FILE)");
+  return c;
+}
+
+std::optional<console::OscConfig> osc_config(const cli::Args& args) {
+  const auto allow = args.get("osc-allow");
+  const auto send = args.get("osc-send");
+  if (!args.get("osc")) {
+    if (allow || send) throw cli::UsageError(std::string(allow ? "--osc-allow" : "--osc-send") + " applies to --osc");
+    return std::nullopt;
+  }
+  console::OscConfig c;
+  c.port = args.get_int("osc", 0, 0, 65535);
+  if (send) {
+    try {
+      const console::ConsoleConfig to = console::parse_listen(*send, "--osc-send");
+      c.send_host = to.host, c.send_port = to.port;
+    } catch (const console::ConsoleError& e) {
+      throw cli::UsageError(e.what());
+    }
+    if (c.send_port == 0) throw cli::UsageError("--osc-send " + *send + ": a desk's port is from 1 to 65535");
+  }
+  std::stringstream hosts(allow.value_or(""));
+  for (std::string h; std::getline(hosts, h, ',');)
+    if (!h.empty()) c.allowed.push_back(h);
+  return c;
+}
+
+Operated open_controls(const cli::Args& args, const config::Scene& scene, bool replay) {
+  const std::optional<console::ConsoleConfig> page = console_config(args);
+  const std::optional<console::OscConfig> osc = osc_config(args);
+  if (!page && !osc) return {};
+  if (replay)
+    throw cli::UsageError(
+        "--console and --osc do not apply to --replay: a replay's frames wait on its robot, which a "
+        "pause would stall");
+  Operated o;
+  o.show = std::make_unique<live::ShowControl>(live::site_targets(scene));
+  if (page) {
+    o.console = std::make_unique<console::Console>(*o.show, *page);
+    std::cout << "console: " << o.console->url() << (page->token.empty() ? "" : " (actions need the token)") << std::endl;
+  }
+  if (osc) {
+    o.osc = std::make_unique<console::OscControl>(*o.show, *osc);
+    std::cout << "osc: UDP port " << o.osc->port() << ", actions from loopback";
+    for (const std::string& h : osc->allowed) std::cout << ", " << h;
+    if (!osc->send_host.empty()) std::cout << "; the state to " << osc->send_host << ':' << osc->send_port << " on each change";
+    std::cout << std::endl;
+  }
+  return o;
+}
+
+void print_controls(std::ostream& out, const live::RunResult& r, const Operated& o) {
+  out << "console: " << r.blackout_frames << " frames blacked out";
+  if (!r.blackout_latency_ms.empty()) {
+    out << "; from each blackout's request to its first black frame's display:";
+    for (const double ms : r.blackout_latency_ms) out << ' ' << std::fixed << std::setprecision(1) << ms << " ms";
+  }
+  if (o.console) out << "; " << o.console->refused() << " requests refused";
+  if (o.osc)
+    out << "; OSC: " << o.osc->taken() << " actions taken, " << o.osc->refused() << " messages refused, " << o.osc->sent()
+        << " states sent";
+  out << '\n';
+}
+
 }  // namespace
 
 const Command kRun{
@@ -159,7 +251,8 @@ const Command kRun{
     "projbot run [--config C.yaml] [--sim | --replay DIR] [--fullscreen] [--monitor N] [--headless] [--profile p.csv]\n"
     "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n"
     "            [--no-predict] [--compensation on|off] [--learn-reflectance [--reflectance-out DIR]]\n"
-    "            [--depth-model fitted|kinect]\n\n"
+    "            [--depth-model fitted|kinect] [--console [ADDR:]PORT [--console-token FILE]]\n"
+    "            [--osc PORT [--osc-allow HOSTS] [--osc-send [HOST:]PORT]]\n\n"
     "Opens the projector output and draws, every frame, each target the robot is projecting onto (the\n"
     "visited one and the others it expects in the projector's view at that stop) at the\n"
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
@@ -206,6 +299,15 @@ const Command kRun{
     "time; a video, model or texture file that changes on disk is loaded again and swapped in at a later\n"
     "frame (tracking goes on; a model of another shape is not), and one that fails to load leaves the old\n"
     "one and says why.\n"
+    "With --console [ADDR:]PORT the operator's console is served while the show runs (docs/console.md): a web\n"
+    "page with the map, the phase, each target's state and error, and buttons to black the projector out,\n"
+    "pause the tour and send the robot to a target; under it GET /api/state and /api/events (server-sent\n"
+    "events) and POST /api/blackout, /api/pause, /api/goto. It listens on 127.0.0.1 unless an address is\n"
+    "given; any other address needs --console-token FILE (a file only its owner may read: mode 0600), and\n"
+    "every action must then carry `Authorization: Bearer TOKEN`. Port 0 takes a free one (printed).\n"
+    "With --osc PORT the same actions come over OSC (UDP): /projbot/blackout i, /projbot/pause i (1 on, 0 off)\n"
+    "and /projbot/goto s (a target's name), taken only from loopback senders and the hosts --osc-allow lists;\n"
+    "with --osc-send, /projbot/state s i s i i (phase, visit, target, blackout, paused) goes there on each change.\n"
     "Without --config the shipped demo tour runs in the twin.\n",
     {{"config", "FILE", "tour scene (default: assets/scenes/tour.yaml)", cli::PathRole::input_file},
      {"sim", "", "run against the digital twin, whatever `devices:` configures (the default without one)"},
@@ -232,7 +334,14 @@ const Command kRun{
       "compensate with it"},
      {"reflectance-out", "DIR",
       "with --learn-reflectance: save what is learnt (each map as a PNG, surfaces.yaml) in this new folder",
-      cli::PathRole::output_folder}},
+      cli::PathRole::output_folder},
+     {"console", "[ADDR:]PORT", "serve the operator's console (web page and API) there; ADDR defaults to 127.0.0.1"},
+     {"console-token", "FILE", "the token the console's actions must carry (a file of mode 0600); needed off loopback",
+      cli::PathRole::input_file},
+     {"osc", "PORT", "take show control over OSC on this UDP port (0: any free one): /projbot/blackout i, pause i, goto s"},
+     {"osc-allow", "HOSTS", "with --osc: the senders besides loopback whose actions are taken (IP addresses, comma-separated)"},
+     {"osc-send", "[HOST:]PORT",
+      "with --osc: send /projbot/state (phase, visit, target, blackout, paused) there on each change"}},
     [](const cli::Args& args) {
       catch_interrupts();  // Ctrl-C / SIGTERM: leave the frame loop at the next frame, then write what was measured
       if (args.flag("learn-reflectance") && args.get("replay"))
@@ -247,12 +356,13 @@ const Command kRun{
       if (recording) config::use_learnt_reflectance(scene, *recording);  // compensated as the session learnt it
       if (scene.visits.empty())
         throw config::ConfigError(scene.source.string() + ": `projbot run` needs a 'tour: {visits: [...]}' section");
-      std::optional<session::PoseCheck> check;
+      const Operated operated = open_controls(args, scene, recording.has_value());
+      std::optional<live::PoseCheck> check;
       if (recording) check.emplace(recording->folder() / "poses.csv");
-      hardware::Devices devices = args.flag("sim") || recording
-                                      ? hardware::Devices{}
-                                      : hardware::open_run_devices(scene, args.flag("headless"), std::cout);
-      const live::RunOptions o = run_options(args);
+      live::Devices devices =
+          args.flag("sim") || recording ? live::Devices{} : live::open_run_devices(scene, args.flag("headless"), std::cout);
+      const TourFamilyArgs family = tour_family_args(args, 4.0);
+      const live::RunOptions o = run_options(args, family);
 
       engine::RendererOptions ro;
       ro.windowing = !o.headless;
@@ -262,12 +372,14 @@ const Command kRun{
       const bool configured = !args.flag("sim") && !recording;
       live::RunSources sources;
       sources.devices = &devices;
+      sources.open_rig = twin::rig_opener({.seed = family.seed, .depth_model = family.depth_noise});
       sources.replay = recording ? &*recording : nullptr;
       sources.check = check ? &*check : nullptr;
       sources.open_output = [&](engine::Renderer& r) { return open_output(r, args, scene, o.headless, configured); };
       sources.interrupted = [] { return interrupted(); };
       sources.log = &std::cout;
       sources.errors = &std::cerr;
+      sources.show = operated.show.get();
       const live::RunResult r = live::run(renderer, scene, o, sources);
 
       print_frames(std::cout, r);
@@ -280,6 +392,7 @@ const Command kRun{
           print_display_errors(std::cout, r.figures);
         print_robot(std::cout, r, devices.camera != nullptr);
       }
+      if (operated.show) print_controls(std::cout, r, operated);
       if (const auto csv = args.get("profile")) write_profile(*csv, r.figures.rows, scene);
       if (!r.failure.empty()) {
         std::cerr << "projbot run: " << r.failure << " (the projection was blanked; what was measured until then is above)\n";

@@ -105,6 +105,7 @@ void add_model_inputs(const std::filesystem::path& model, const std::string& who
 std::vector<config::NamedPath> scene_inputs(const config::Scene& scene, const std::string& scene_name) {
   std::vector<config::NamedPath> out;
   if (!scene.source.empty()) out.push_back({scene_name, scene.source, false});
+  if (!scene.calibration.empty()) out.push_back({"the calibration of " + scene_name, scene.calibration, false});
   for (const auto& t : scene.targets) {
     const std::string whose = "target '" + t.name + "'";
     add_model_inputs(t.model, whose, out);

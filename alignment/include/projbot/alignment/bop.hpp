@@ -92,10 +92,18 @@ struct BopModel {
 /// Loads `object`'s model file; throws assets::AssetError naming it when it cannot be read.
 BopModel load_bop_model(const BopObject& object, double scale);
 
-/// The image's depth in metres; an image whose size disagrees with the first image's camera is an error.
+/// The image's depth in metres, at its own size (a reader of several images checks they agree:
+/// check_same_size).
 DepthImage read_bop_depth(const BopImage& image);
+/// Throws AlignmentError naming `image`'s depth file and both sizes when `depth` (read from it) is not
+/// the size of `first` (a scene's first image's depth, read from `first_file`).
+void check_same_size(const BopImage& image, const DepthImage& depth, const std::filesystem::path& first_file,
+                     const DepthImage& first);
 
-/// mask_visib/IMAGE_GTINDEX.png of one instance as a per-pixel flag (row-major, the depth image's size).
-std::vector<std::uint8_t> read_bop_mask(const BopScene& scene, const BopImage& image, const BopInstance& instance);
+/// mask_visib/IMAGE_GTINDEX.png of one instance as a per-pixel flag (row-major), which must be the size of
+/// its image's depth (`depth`, as read_bop_depth gave it): otherwise an AlignmentError naming the mask, the
+/// depth image and both sizes.
+std::vector<std::uint8_t> read_bop_mask(const BopScene& scene, const BopImage& image, const BopInstance& instance,
+                                        const DepthImage& depth);
 
 }  // namespace projbot::alignment

@@ -17,7 +17,7 @@
 
 namespace projbot::alignment {
 
-/// What a projection session hands a lit target's frames to (session::Session::visit): the stop's initial
+/// What a projection session hands a lit target's frames to (live::StopSequence::visit): the stop's initial
 /// guess, then the camera's frames, each tracked in order (lockstep) or the newest taken when free (live).
 /// TrackerWorker is the engine's; the twin's tour has one on its simulated clock.
 class PoseTracker {

@@ -13,7 +13,7 @@ inline double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-/// A clock and a wait on it, in seconds: the steady clock, a replay's recording clock (session::ReplayClock)
+/// A clock and a wait on it, in seconds: the steady clock, a replay's recording clock (live::ReplayClock)
 /// or a test's. Whoever keeps time through one (the live loop, a session, a recorded camera) asks it alone.
 struct Clock {
   std::function<double()> now_s;

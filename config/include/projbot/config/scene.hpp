@@ -175,7 +175,8 @@ struct TargetConfig {
 
 /// A whole scene file.
 struct Scene {
-  std::filesystem::path source;  ///< the file it came from (empty when parsed from a string)
+  std::filesystem::path source;       ///< the file it came from (empty when parsed from a string)
+  std::filesystem::path calibration;  ///< its `calibration:` file (an input like the scene itself); empty: none
   ProjectorConfig projector;
   std::vector<TargetConfig> targets;
   /// The robot's pan-tilt rig (optional `robot.pan_tilt` section; defaults: default_pan_tilt()).

@@ -1,0 +1,36 @@
+// The show's state as the console's API gives it.
+
+#include <nlohmann/json.hpp>
+
+#include "projbot/console/console.hpp"
+
+namespace projbot::console {
+
+std::string state_json(const live::ShowState& s) {
+  nlohmann::json targets = nlohmann::json::array();
+  for (const live::TargetShowState& t : s.targets) {
+    nlohmann::json j{{"name", t.name}, {"state", t.state}, {"visited", t.visited}};
+    j["error_mm"] = t.error_mm >= 0.0 ? nlohmann::json(t.error_mm) : nlohmann::json(nullptr);
+    j["at"] = t.at ? nlohmann::json{{"x_m", (*t.at)[0]}, {"y_m", (*t.at)[1]}} : nlohmann::json(nullptr);
+    targets.push_back(std::move(j));
+  }
+  nlohmann::json stops = nlohmann::json::array();
+  for (const auto& p : s.stops) stops.push_back({{"x_m", p[0]}, {"y_m", p[1]}, {"heading_rad", p[2]}});
+  nlohmann::json robot = stops.empty() ? nlohmann::json(nullptr) : stops.back();
+  return nlohmann::json{{"sequence", s.sequence},
+                        {"clock_s", s.clock_s},
+                        {"phase", s.phase},
+                        {"visit", s.visit},
+                        {"visiting", s.visiting.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.visiting)},
+                        {"robot", robot},
+                        {"stops", stops},
+                        {"targets", targets},
+                        {"frame_rate_hz", s.frame_rate_hz},
+                        {"pose_age_ms", s.pose_age_ms >= 0.0 ? nlohmann::json(s.pose_age_ms) : nlohmann::json(nullptr)},
+                        {"blackout", s.blackout},
+                        {"paused", s.paused},
+                        {"go_to", s.go_to.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.go_to)}}
+      .dump();
+}
+
+}  // namespace projbot::console
