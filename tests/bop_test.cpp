@@ -182,6 +182,27 @@ TEST_F(BopCopy, AnImageOfAnotherSizeIsNamedWithBothSizes) {
   EXPECT_NE(r.output.find("is 1x1, but its image's depth"), std::string::npos) << r.output;
 }
 
+// A valid grey mask that packs well (a small object's: a 20 x 10 px patch in 640 x 480, 396 bytes as zlib's
+// level 9 packs it; tests/data/mask_visib_packed.png) is read, not refused as a corrupt header (issue 88: the
+// size check counted the 4 bytes a pixel it is read into, not the 1 the file stores).
+TEST_F(BopCopy, ASmallObjectsWellPackedGreyMaskIsRead) {
+  using namespace projbot::alignment;
+  const BopDataset data = read_bop_dataset(dir_);
+  const BopScene& s = data.scenes.at(0);
+  const BopImage& first = s.images.at(0);
+  const DepthImage depth = read_bop_depth(first);
+  char name[48];
+  std::snprintf(name, sizeof name, "%06d_%06d.png", first.id, first.instances.at(0).gt_index);
+  const fs::path mask = scene() / "mask_visib" / name;
+  fs::copy_file(fs::path(PROJBOT_SOURCE_DIR) / "tests" / "data" / "mask_visib_packed.png", mask,
+                fs::copy_options::overwrite_existing);
+  ASSERT_LT(fs::file_size(mask), 1190U);  // 640 x 480 x 4 bytes is more than 1032 times the file
+  const auto read = read_bop_mask(s, first, first.instances.at(0), depth);
+  std::size_t on = 0;
+  for (const auto m : read) on += m;
+  EXPECT_EQ(on, 200U);
+}
+
 // An empty symmetry list names no symmetry (issue 88: it made the mug symmetric, scored by ADD-S).
 TEST_F(BopCopy, AnEmptySymmetryListIsNoSymmetry) {
   const auto before = read_bop_dataset(dir_);
@@ -265,6 +286,22 @@ TEST_F(BopCopy, ACameraRotationIsCheckedTheSameWay) {
         replace_first(cams, R"("depth_scale")", R"("cam_R_w2c": [1.5, 0, 0, 0, 1, 0, 0, 0, 1], "depth_scale")"));
   const std::string e = error();
   EXPECT_NE(e.find("scene_camera.json: image 1: cam_R_w2c: pose's rotation is not a proper rotation"), std::string::npos) << e;
+}
+
+// Issue 88: a scene a killed twin-dataset left half written (`.000001.partial`, hidden) is not read as a
+// scene, so the dataset beside it still loads; a --scenes entry that is a path is refused by name.
+TEST_F(BopCopy, AHiddenPartialSceneIsSkippedAndASceneNamedByPathIsRefused) {
+  spill(dir_ / "test" / ".000001.partial" / "scene_gt.json", "{ half written");
+  EXPECT_EQ(error(), "(no error)");
+  EXPECT_EQ(read_bop_dataset(dir_).scenes.size(), 1U);
+  try {
+    read_bop_dataset(dir_, {"../test/000000"});
+    ADD_FAILURE() << "a scene named by a path was taken";
+  } catch (const AlignmentError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene '../test/000000' is a path; name a scene folder of it (e.g. 000000)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // Issue 72: a translation behind the camera or past 100 m, a depth scale out of 0.001..1000, refused by name.

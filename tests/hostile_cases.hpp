@@ -104,6 +104,13 @@ inline std::string dims(long long w, long long h, long long n) {
 }
 inline const std::string kPly =
     "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+/// A tetrahedron's two faces, `mm` across, as an ASCII PLY (a BOP model's units).
+inline std::string triangle_ply(double mm) {
+  const std::string s = std::to_string(mm);
+  return "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\n"
+         "property list uchar int vertex_indices\nend_header\n0 0 0\n" +
+         s + " 0 0\n0 " + s + " 0\n0 0 " + s + "\n3 0 1 2\n3 0 2 3\n";
+}
 inline const std::string kGood16 = "{src}/tests/fuzz/corpus/depth_png/gray16_4x3.png";
 inline const std::string kIni =
     "[MappingApplication]\nlocalizationLinDistance = 0.2\n[ICP]\nmaxIterations = 80\nthresholdDist = 0.3\n";

@@ -118,7 +118,7 @@ TEST_F(RealFrames, BenchDatasetReportsEachEstimateAndAlignAgreesWithIt) {
 TEST_F(RealFrames, BenchDatasetStartsDoNotDependOnTheOtherPerturbations) {
   const auto starts = [&](const std::string& perturb, const std::string& name) {
     const fs::path report = dir_ / name;
-    const CliRun r = run_projbot("bench dataset " + kYcbv.string() + " --scenes 000000 --max-instances 1 " + perturb +
+    const CliRun r = run_projbot("bench dataset " + kYcbv.string() + " --scenes 000000 --max-instances 3 " + perturb +
                                  " --report " + report.string());
     EXPECT_EQ(r.code, 0) << r.output;
     std::vector<std::string> out;
@@ -130,6 +130,15 @@ TEST_F(RealFrames, BenchDatasetStartsDoNotDependOnTheOtherPerturbations) {
   const std::vector<std::string> alone = starts("--perturb 50,15", "alone.json");
   const std::vector<std::string> beside = starts("--perturb 20,5 --perturb 50,15", "beside.json");
   ASSERT_EQ(alone.size(), 6U);  // the first image's 3 instances, ours and PCL's from the same start
+  // --max-instances counts instances, not images (issue 88: 1 ran the whole first image).
+  {
+    const CliRun one = run_projbot("bench dataset " + kYcbv.string() + " --scenes 000000 --max-instances 1 --perturb 50,15");
+    EXPECT_NE(one.output.find("| all | 50 mm, 15 deg | projbot | 1 |"), std::string::npos) << one.output;
+    const CliRun track =
+        run_projbot("bench dataset " + kYcbv.string() + " --scenes 000000 --max-instances 1 --track --perturb 20,5");
+    EXPECT_NE(track.output.find("| all | 20 mm, 5 deg | projbot | 20 |"), std::string::npos)
+        << track.output;  // 1 object, 20 images
+  }
   EXPECT_EQ(alone[0], alone[1]);
   EXPECT_EQ(alone, beside);
   EXPECT_NE(alone, starts("--perturb 50,15 --seed 2", "seed2.json"));

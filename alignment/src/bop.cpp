@@ -78,7 +78,8 @@ int parse_id(const fs::path& file, const std::string& key) {
   int id = -1;
   std::istringstream in(key);
   in >> id;
-  if (!in || !in.eof() || id < 0) fail(file, "key '" + key + "' is not an id (a whole number >= 0)");
+  if (!in || !in.eof() || id < 0 || id > kMaxBopId)
+    fail(file, "key '" + key + "' is not an id (a whole number 0.." + std::to_string(kMaxBopId) + ")");
   return id;
 }
 
@@ -190,8 +191,8 @@ BopImage read_camera(const fs::path& file, const fs::path& folder, int id, const
 BopInstance read_instance(const fs::path& file, const json& gt, const std::string& where, Rounding& rounding) {
   BopInstance inst;
   const json& obj = member(file, gt, "obj_id", where);
-  if (!obj.is_number_integer() || obj.get<long long>() < 0 || obj.get<long long>() > 1000000)
-    fail(file, where + ": obj_id must be a whole number >= 0");
+  if (!obj.is_number_integer() || obj.get<long long>() < 0 || obj.get<long long>() > kMaxBopId)
+    fail(file, where + ": obj_id must be a whole number 0.." + std::to_string(kMaxBopId));
   inst.obj_id = obj.get<int>();
   const auto R = numbers(file, member(file, gt, "cam_R_m2c", where), 9, where + ": cam_R_m2c");
   const auto t = numbers(file, member(file, gt, "cam_t_m2c", where), 3, where + ": cam_t_m2c");
@@ -275,11 +276,18 @@ BopDataset read_bop_dataset(const fs::path& root, const std::vector<std::string>
   if (const std::string why = config::input_folder_problem(split_dir); !why.empty())
     fail(split_dir, why + " (the dataset's " + split + " split)");
   std::vector<fs::path> folders;
-  for (const auto& entry : fs::directory_iterator(split_dir, ec))
-    if (entry.is_directory() && (scenes.empty() || std::count(scenes.begin(), scenes.end(), entry.path().filename().string())))
+  // A hidden folder is no scene: twin-dataset writes `.SCENE.partial` and renames it when whole, so one left
+  // by a writer that was killed is work in progress, not a broken dataset.
+  for (const auto& entry : fs::directory_iterator(split_dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_directory() && name.front() != '.' && (scenes.empty() || std::count(scenes.begin(), scenes.end(), name)))
       folders.push_back(entry.path());
-  for (const std::string& s : scenes)
+  }
+  for (const std::string& s : scenes) {
+    if (fs::path(s).filename() != s || s == "." || s == "..")
+      fail(split_dir, "scene '" + s + "' is a path; name a scene folder of it (e.g. 000000)");
     if (!fs::is_directory(split_dir / s, ec)) fail(split_dir / s, "no such scene");
+  }
   if (folders.empty()) fail(split_dir, "holds no scene folders");
   std::sort(folders.begin(), folders.end());
   Rounding rounding;

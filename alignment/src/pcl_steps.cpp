@@ -241,7 +241,7 @@ Eigen::Vector3d centroid_of(const ModelCloud& model) {
 
 ModelCloud model_cloud_from(const assets::Model& model, std::size_t samples) {
   const auto s = assets::sample_surface(model, samples, 1);
-  return {s.points, s.normals, s.colours, {}};
+  return {s.points, s.normals, s.colours, model.source};  // a refusal of the cloud names the file
 }
 
 namespace {

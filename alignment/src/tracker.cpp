@@ -79,7 +79,8 @@ double silhouette_step(const float* z, const CameraIntrinsics& k, const Eigen::V
 ProjectiveTracker::ProjectiveTracker(ModelCloud model, CameraIntrinsics intrinsics, TrackerConfig config)
     : model_(std::move(model)), k_(intrinsics), cfg_(std::move(config)) {
   if (model_.points.size() < 10 || model_.normals.size() != model_.points.size())
-    throw AlignmentError("tracker: the model needs at least 10 points with normals");
+    throw AlignmentError((model_.source.empty() ? std::string("tracker: the model") : model_.source + ": the model") +
+                         " needs at least 10 points with normals (its surface has no area to sample?)");
   if (!(k_.fx_px > 0) || !(k_.fy_px > 0) || k_.width_px <= 0 || k_.height_px <= 0)
     throw AlignmentError("tracker: bad intrinsics");
   if (cfg_.pyramid_levels < 1 || cfg_.iterations.size() != static_cast<std::size_t>(cfg_.pyramid_levels) ||

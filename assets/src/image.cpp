@@ -48,17 +48,31 @@ void append_bytes(void* context, void* data, int size) {
 
 }  // namespace
 
-void write_png(const std::filesystem::path& path, const Image& image) {
-  if (image.width <= 0 || image.height <= 0 || image.rgba.size() != static_cast<std::size_t>(image.width) * image.height * 4)
+namespace {
+
+// An 8-bit PNG of `channels` per pixel, written atomically.
+void write_png_8bit(const std::filesystem::path& path, int width, int height, int channels,
+                    const std::vector<std::uint8_t>& data) {
+  if (width <= 0 || height <= 0 || data.size() != static_cast<std::size_t>(width) * height * channels)
     throw AssetError(path.string() + ": refusing to write an empty or inconsistent image");
   std::vector<std::uint8_t> png;
-  if (stbi_write_png_to_func(append_bytes, &png, image.width, image.height, 4, image.rgba.data(), image.width * 4) == 0)
+  if (stbi_write_png_to_func(append_bytes, &png, width, height, channels, data.data(), width * channels) == 0)
     throw AssetError(path.string() + ": cannot encode PNG");
   try {
     config::write_file_atomically(path, png.data(), png.size());
   } catch (const config::OutputError& e) {
     throw AssetError(e.what());
   }
+}
+
+}  // namespace
+
+void write_png(const std::filesystem::path& path, const Image& image) {
+  write_png_8bit(path, image.width, image.height, 4, image.rgba);
+}
+
+void write_png_gray8(const std::filesystem::path& path, int width, int height, const std::vector<std::uint8_t>& values) {
+  write_png_8bit(path, width, height, 1, values);
 }
 
 namespace {
@@ -115,7 +129,8 @@ namespace {
 
 // stb allocates what the header claims before it inflates a byte. Deflate packs at most 1032 bytes into
 // one, so a header that claims more than that from this file's size is corrupt: refused before stb
-// allocates it (a 100-byte PNG claiming 20000x20000 pixels once took 550 MB).
+// allocates it (a 100-byte PNG claiming 20000x20000 pixels once took 550 MB). `bytes_per_pixel`: as the
+// file stores them (a grey 8-bit mask 1, not the 4 it is read into: a valid 1.5 kB 640x480 mask was refused).
 void check_claimed_size(const std::filesystem::path& path, int w, int h, int bytes_per_pixel) {
   std::error_code ec;
   const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
@@ -180,7 +195,7 @@ Image read_image(const std::filesystem::path& path) {
   int w = 0, h = 0, comps = 0;
   check_png_chunks(path);
   if (!stbi_info(path.c_str(), &w, &h, &comps)) throw AssetError(path.string() + ": cannot read image: " + stbi_failure_reason());
-  check_claimed_size(path, w, h, 4);
+  check_claimed_size(path, w, h, std::max(1, comps) * (stbi_is_16_bit(path.c_str()) != 0 ? 2 : 1));
   unsigned char* data = stbi_load(path.c_str(), &w, &h, &comps, 4);
   if (data == nullptr) throw AssetError(path.string() + ": cannot read image: " + stbi_failure_reason());
   Image img;

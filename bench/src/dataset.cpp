@@ -98,6 +98,7 @@ void DatasetBench::image(const alignment::BopScene& scene, const alignment::BopI
   k.width_px = depth.width, k.height_px = depth.height;
   for (const alignment::BopInstance& inst : image.instances) {
     if (inst.visible_px >= 0 && inst.visible_px < min_visible) continue;
+    if (!take_instance()) return;
     const alignment::BopModel& m = model(inst.obj_id);
     Estimators& e = estimators(m, k);
     for (std::size_t p = 0; p < perturbations_.size() && !stopped(); ++p) {
@@ -137,6 +138,7 @@ void DatasetBench::track(const alignment::BopScene& scene, int min_visible, std:
   k.width_px = frames.front().width, k.height_px = frames.front().height;
   for (const alignment::BopInstance& start : scene.images.front().instances) {
     if (start.visible_px >= 0 && start.visible_px < min_visible) continue;
+    if (!take_instance()) return;
     const alignment::BopModel& m = model(start.obj_id);
     for (std::size_t p = 0; p < perturbations_.size() && !stopped(); ++p) follow(scene, frames, k, m, start, p, rows);
   }

@@ -50,6 +50,10 @@ bool inside_or_equal(const fs::path& p, const fs::path& folder) {
 
 std::string quoted(const NamedPath& n) { return n.name + " " + n.path.string(); }
 
+std::string inside_output(const NamedPath& out, const NamedPath& folder) {
+  return quoted(out) + " is inside the output folder " + quoted(folder) + "; writing one would replace or mix with the other";
+}
+
 struct GeneratedAssets {
   fs::path shipped, generated;
 };
@@ -115,9 +119,13 @@ std::optional<std::string> find_path_clash(const std::vector<NamedPath>& inputs,
         return quoted(out) + " is inside the input folder " + quoted(in) +
                " and would replace part of it; write it outside that folder";
     }
-    for (std::size_t j = 0; j < i; ++j)
-      if (resolved(outputs[j].path) == o)
-        return quoted(out) + " and " + quoted(outputs[j]) + " are the same path; each output needs its own";
+    for (std::size_t j = 0; j < i; ++j) {
+      const fs::path other = resolved(outputs[j].path);
+      if (other == o) return quoted(out) + " and " + quoted(outputs[j]) + " are the same path; each output needs its own";
+      // One output inside another's folder: writing the folder would replace or mix with the other.
+      if (outputs[j].folder && inside_or_equal(o, other)) return inside_output(out, outputs[j]);
+      if (out.folder && inside_or_equal(other, o)) return inside_output(outputs[j], out);
+    }
   }
   return std::nullopt;
 }

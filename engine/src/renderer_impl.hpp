@@ -218,6 +218,10 @@ struct Renderer::Impl {
 
   // A model's buffers, textures and descriptor sets (its surface white).
   GpuModel make_gpu_model(const assets::Model& model);
+  /// The model's vertex and index buffers on the device; EngineError naming the file and its triangle count
+  /// when they pass the device's limits (not Vulkan's bare ErrorOutOfDeviceMemory).
+  void upload_geometry(GpuModel& g, const assets::Model& model, const std::vector<detail::GpuVertex>& vertices,
+                       const std::vector<std::uint32_t>& indices);
   std::size_t add_model(const assets::Model& model);
   void replace_model(std::size_t model, const assets::Model& fresh);
   void set_surface(std::size_t model, const assets::Image& reflectance);

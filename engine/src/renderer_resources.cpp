@@ -168,6 +168,35 @@ const vk::raii::Pipeline& Renderer::Impl::lens_pipeline(vk::Format format) {
   return lens_pipelines.emplace(format, vk::raii::Pipeline(gpu->device, nullptr, info)).first->second;
 }
 
+namespace {
+
+std::string megabytes(vk::DeviceSize bytes) { return std::to_string((bytes + (1U << 20) - 1) >> 20) + " MB"; }
+
+// What a model too large for the device is told: its file, its triangles, and the limit it passed.
+EngineError too_large(const assets::Model& model, vk::DeviceSize bytes, const std::string& limit) {
+  return EngineError(model.source + ": " + std::to_string(model.triangle_count()) + " triangles (" + megabytes(bytes) +
+                     " of vertices and indices) do not fit the GPU: " + limit + "; simplify the mesh");
+}
+
+}  // namespace
+
+void Renderer::Impl::upload_geometry(GpuModel& g, const assets::Model& model, const std::vector<GpuVertex>& vertices,
+                                     const std::vector<std::uint32_t>& indices) {
+  const vk::DeviceSize vertex_bytes = vertices.size() * sizeof(GpuVertex), index_bytes = indices.size() * sizeof(std::uint32_t);
+  const auto props = gpu->physical.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceMaintenance3Properties>();
+  const vk::DeviceSize most = props.get<vk::PhysicalDeviceMaintenance3Properties>().maxMemoryAllocationSize;
+  if (std::max(vertex_bytes, index_bytes) > most)
+    throw too_large(model, vertex_bytes + index_bytes, "one buffer may hold at most " + megabytes(most));
+  try {
+    g.vertices = gpu->upload_buffer(vertices.data(), vertex_bytes, vk::BufferUsageFlagBits::eVertexBuffer);
+    g.indices = gpu->upload_buffer(indices.data(), index_bytes, vk::BufferUsageFlagBits::eIndexBuffer);
+  } catch (const vk::OutOfDeviceMemoryError&) {
+    throw too_large(model, vertex_bytes + index_bytes, "its memory is full");
+  } catch (const vk::OutOfHostMemoryError&) {
+    throw too_large(model, vertex_bytes + index_bytes, "the memory it maps is full");
+  }
+}
+
 GpuModel Renderer::Impl::make_gpu_model(const assets::Model& model) {
   if (model.primitives.empty()) throw EngineError(model.source + ": model has no triangles to draw");
   GpuModel g;
@@ -181,8 +210,7 @@ GpuModel Renderer::Impl::make_gpu_model(const assets::Model& model) {
     for (const auto& v : p.vertices) vertices.push_back(to_gpu(v));
     indices.insert(indices.end(), p.indices.begin(), p.indices.end());
   }
-  g.vertices = gpu->upload_buffer(vertices.data(), vertices.size() * sizeof(GpuVertex), vk::BufferUsageFlagBits::eVertexBuffer);
-  g.indices = gpu->upload_buffer(indices.data(), indices.size() * sizeof(std::uint32_t), vk::BufferUsageFlagBits::eIndexBuffer);
+  upload_geometry(g, model, vertices, indices);
   for (const auto& img : model.images) g.textures.push_back(img.rgba.empty() ? detail::Image{} : upload_texture(img));
   g.materials = model.materials;
 

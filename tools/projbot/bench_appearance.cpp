@@ -104,7 +104,8 @@ const Command kBenchAppearance{
     "bench appearance",
     "benchmark what a visitor sees of each target, radiometric compensation off and on (the twin)",
     "projbot bench appearance [--scene S.yaml] [--visits N] [--seed K] [--dwell S] [--frames DIR]\n"
-    "                         [--reflectance scene|measured|mapped] [--report FILE.json] [--depth-model fitted|kinect]\n\n"
+    "                         [--reflectance scene|measured|mapped] [--report FILE.json] [--depth-model fitted|kinect]\n"
+    "                         [--processing-ms MS]\n\n"
     "Runs the scene's tour in the digital twin, tracking. At each arrival, and through a scripted motion\n"
     "(from its start to its end, a frame every 0.1 s), the visited target's projector frame is drawn with\n"
     "compensation off (the content as stored) and on (what makes the target's surface show it: the content\n"
@@ -138,6 +139,7 @@ const Command kBenchAppearance{
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
      {"dwell", "S", "simulated seconds of projection per visit (default 3)"},
      depth_model_option(),
+     processing_ms_option(),
      {"frames", "DIR", "write each visit's pictures here", cli::PathRole::output_folder},
      {"reflectance", "scene|measured|mapped",
       "each target's reflectance: the scene's surface (default), measured at its stop as one colour, or measured over "
@@ -150,6 +152,7 @@ const Command kBenchAppearance{
       const TourFamilyArgs family = tour_family_args(args, 3.0);
       o.visits = family.visits, o.seed = family.seed, o.dwell_s = family.dwell_s;
       o.fitted_depth = family.depth_model == "fitted";
+      o.processing_ms = family.processing_ms;
       if (const auto frames = args.get("frames")) o.frames_dir = *frames;
       const std::string reflectance = args.get_or("reflectance", "scene");
       if (reflectance != "scene" && reflectance != "measured" && reflectance != "mapped")

@@ -121,6 +121,7 @@ int run_bench_dataset(const cli::Args& args) {
   if (const std::string note = alignment::rounded_rotations_note(data); !note.empty()) std::cout << note << "\n";
   catch_interrupts();
   bench::DatasetBench bench(data, scale, perturbations, seed, [] { return interrupted(); });
+  bench.limit_instances(max_instances);
   std::vector<DatasetEstimate> rows;
   int instances = 0, total = 0;
   for (const auto& s : data.scenes)
@@ -185,7 +186,7 @@ const Command kBenchDataset{
      {"seed", "K", "seed of the starts (default 1)"},
      {"min-visible", "PX", "skip instances with fewer visible pixels (default 1500)"},
      {"scenes", "A,B", "only these scene folders (default: all of test/)"},
-     {"max-instances", "N", "stop after N instances (default: all)"},
+     {"max-instances", "N", "at most N instances (with --track: N objects followed from the first image; default: all)"},
      {"model-scale", "S", "model units to metres (default 0.001: BOP's millimetres)"},
      {"track", "", "follow each scene's objects frame by frame from one perturbed start on its first image"},
      {"report", "FILE", "JSON report, one row per estimate", cli::PathRole::output_file}},

@@ -73,7 +73,7 @@ const Command kBenchMotion{
      {"dwell", "S", "simulated seconds of projection per visit (default 3)"},
      depth_model_option(),
      {"process-noise", "Q", "the motion filter's acceleration noise, m s^-1.5 (turning: 3 Q rad s^-1.5; default 1)"},
-     {"processing-ms", "MS", "a pose is ready this long after its capture (default: as measured on this machine)"}},
+     processing_ms_option()},
     [](const cli::Args& args) {
       twin::TourOptions o;
       o.mode = twin::TourMode::tracking;
@@ -84,10 +84,7 @@ const Command kBenchMotion{
       if (!(q > 0.0 && q <= 100.0)) throw cli::UsageError("--process-noise must be in (0, 100]");
       o.motion.accel_noise = q;
       o.motion.angular_accel_noise = 3.0 * q;
-      if (args.get("processing-ms")) {
-        o.processing_ms = args.get_double("processing-ms", 0.0);
-        if (!(*o.processing_ms >= 0.0 && *o.processing_ms <= 1000.0)) throw cli::UsageError("--processing-ms must be 0..1000");
-      }
+      o.processing_ms = family.processing_ms;
       const auto scene = config::load_scene(args.get_or("scene", (asset_dir() / "scenes" / "motion.yaml").string()));
       check_scene_outputs(args, scene);
       catch_interrupts();

@@ -141,8 +141,10 @@ void Args::check_paths(const std::vector<config::NamedPath>& more_inputs) const 
     if (const std::string problem = config::input_file_problem(inputs[i].path);
         problem.find("not a regular file") != std::string::npos)
       throw InputError(inputs[i].name + " " + inputs[i].path.string() + ": " + problem);
-  check_outputs();
+  // Clashes first: an output inside another output's folder that does not exist yet is that clash, not a
+  // missing folder.
   if (const auto clash = config::find_path_clash(inputs, outputs)) throw UsageError(*clash);
+  check_outputs();
 }
 
 void Args::check_clashes(const std::vector<config::NamedPath>& more_inputs) const {

@@ -49,7 +49,17 @@ TourFamilyArgs tour_family_args(const cli::Args& args, double default_dwell_s, i
   t.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, 1 << 30));
   t.depth_model = args.get_or("depth-model", "fitted");
   t.depth_noise = depth_model_named(t.depth_model);
+  if (args.get("processing-ms")) {
+    t.processing_ms = args.get_double("processing-ms", 0.0);
+    if (!(*t.processing_ms >= 0.0 && *t.processing_ms <= 1000.0)) throw cli::UsageError("--processing-ms must be 0..1000");
+  }
   return t;
+}
+
+cli::OptionSpec processing_ms_option() {
+  return {"processing-ms", "MS",
+          "a pose is ready this long after its capture (default: as measured on this machine); fixed, the figures do "
+          "not depend on the machine's load"};
 }
 
 cli::OptionSpec depth_model_option() {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -30,13 +31,15 @@ void check_content_videos(const config::Scene& scene);
 
 /// The tour family's shared options (tour, run, record, bench motion, bench appearance), one range each:
 /// --visits 1..1000 (default `default_visits`: 0 is the scene's list once), --dwell 0.1..3600 s, --seed
-/// 0..2^30 (default 1), --depth-model fitted (default) or kinect. Throws cli::UsageError naming the option.
+/// 0..2^30 (default 1), --depth-model fitted (default) or kinect, --processing-ms 0..1000 where the command takes
+/// it. Throws cli::UsageError naming the option.
 struct TourFamilyArgs {
   int visits = 0;
   double dwell_s = 0.0;
   std::uint64_t seed = 1;
   std::string depth_model = "fitted";                                                 ///< the twin's depth camera, by name
   alignment::KinectNoiseConfig depth_noise = alignment::KinectNoiseConfig::fitted();  ///< ...and its model
+  std::optional<double> processing_ms;  ///< a pose ready this long after its capture; none: as measured here
 };
 TourFamilyArgs tour_family_args(const cli::Args& args, double default_dwell_s, int default_visits = 0);
 
@@ -44,6 +47,9 @@ TourFamilyArgs tour_family_args(const cli::Args& args, double default_dwell_s, i
 /// a twin no kinder than the real sensor) or the published Kinect v1 model. Every command that simulates depth
 /// takes it.
 cli::OptionSpec depth_model_option();
+/// `--processing-ms MS`: the twin's tracker takes this long per frame instead of its measured time, so a
+/// figure does not follow the machine's load.
+cli::OptionSpec processing_ms_option();
 /// The named model; cli::UsageError naming `option` for another name.
 alignment::KinectNoiseConfig depth_model_named(const std::string& name, const std::string& option = "--depth-model");
 

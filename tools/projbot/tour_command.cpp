@@ -76,9 +76,7 @@ const Command kTour{
      {"no-noise", "", "depth without the Kinect v1 noise model"},
      depth_model_option(),
      {"no-predict", "", "draw the newest measured pose, not the one predicted for display time (tracking mode)"},
-     {"processing-ms", "MS",
-      "a pose is ready this long after its capture (default: as measured on this machine); fixed, the report does not "
-      "depend on the machine's load"},
+     processing_ms_option(),
      {"compensation", "on|off",
       "radiometric compensation of each target's surface and the room's light (default on; off: the content as stored)"},
      {"calibration", "FILE",
@@ -102,10 +100,7 @@ const Command kTour{
       o.depth_noise = !args.flag("no-noise");
       o.fitted_depth = family.depth_model == "fitted";
       o.predict = !args.flag("no-predict");
-      if (args.get("processing-ms")) {
-        o.processing_ms = args.get_double("processing-ms", 0.0);
-        if (!(*o.processing_ms >= 0.0 && *o.processing_ms <= 1000.0)) throw cli::UsageError("--processing-ms must be 0..1000");
-      }
+      o.processing_ms = family.processing_ms;
       o.compensation = on_off(args, "compensation", true);
       const std::string scene_path = args.get_or("scene", (asset_dir() / "scenes" / "shop.yaml").string());
       const auto scene = config::load_scene(scene_path);

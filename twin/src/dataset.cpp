@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
+#include <sstream>
 
 #include "projbot/alignment/bop.hpp"
 #include "projbot/assets/image.hpp"
@@ -30,6 +32,9 @@ constexpr double kContactM = 0.003;       // vertices this near the table carry 
 constexpr double kStableMarginM = 0.003;  // its centre lies this far inside what carries it
 constexpr double kSameSurfaceM = 0.001;   // an instance's pixel is visible where it is the nearest surface
 constexpr double kDepthUnitMm = 0.1;      // depth PNGs in 0.1 mm, as the real frames' are
+// What the table in front of the shelf can hold (0.70 x 0.58 m, the first object within 4 cm of its middle)
+// and what the camera, 0.6-1.5 m away, sees as more than a few pixels: an object's largest side.
+constexpr double kMinSideMm = 10.0, kMaxSideMm = 500.0;
 
 // A way an object rests on the table: the rotation that takes its model frame there (before its turn
 // about the vertical) and how likely it is (the area of the face it stands on).
@@ -169,7 +174,23 @@ std::array<float, 3> albedo_for(int id) {
 
 // Every folder's objects, ids checked across folders before any mesh is loaded; `stopped` asked between
 // meshes (seventeen take a second or two): what it stops leaves out the rest.
-std::vector<Object> folder_objects(const std::vector<fs::path>& folders, const std::function<bool()>& stopped) {
+// An object the table cannot hold, or too small to be seen, would never be placed: said, with its size.
+void check_placeable(const std::vector<Eigen::Vector3d>& points, const fs::path& file) {
+  Eigen::AlignedBox3d box;
+  for (const auto& p : points) box.extend(p);
+  const double side_mm = points.empty() ? 0.0 : 1000.0 * box.sizes().maxCoeff();
+  if (!(side_mm >= kMinSideMm && side_mm <= kMaxSideMm)) {
+    std::ostringstream what;
+    what << file.string() << ": " << std::fixed << std::setprecision(side_mm < 1.0 ? 4 : 1) << side_mm
+         << " mm across; the twin's table places objects " << static_cast<int>(kMinSideMm) << ".." << static_cast<int>(kMaxSideMm)
+         << " mm across (models in millimetres, as BOP's are)";
+    throw alignment::AlignmentError(what.str());
+  }
+}
+
+// The procedural shapes take `procedural` ids from kFirstProceduralId: a folder's object there (an earlier
+// twin dataset's models folder) would be two objects under one id.
+std::vector<Object> folder_objects(const std::vector<fs::path>& folders, int procedural, const std::function<bool()>& stopped) {
   std::vector<alignment::BopObject> listed;
   std::map<int, fs::path> seen;
   for (const auto& folder : folders)
@@ -177,6 +198,11 @@ std::vector<Object> folder_objects(const std::vector<fs::path>& folders, const s
       if (const auto [at, fresh] = seen.emplace(o.id, folder); !fresh)
         throw alignment::AlignmentError(folder.string() + ": object " + std::to_string(o.id) + " is also in " +
                                         at->second.string() + " (ids must differ across --models folders)");
+      if (o.id >= kFirstProceduralId && o.id < kFirstProceduralId + procedural)
+        throw alignment::AlignmentError(folder.string() + ": object " + std::to_string(o.id) +
+                                        " has an id of the procedural shapes (" + std::to_string(kFirstProceduralId) + ".." +
+                                        std::to_string(kFirstProceduralId + procedural - 1) +
+                                        "); renumber it, or leave the shapes out with --no-procedural");
       listed.push_back(o);
     }
   std::vector<Object> out;
@@ -188,6 +214,7 @@ std::vector<Object> folder_objects(const std::vector<fs::path>& folders, const s
     obj.model = assets::load_model(o.model);
     assets::scale_and_recenter(obj.model, 0.001, false);
     obj.points = vertices(obj.model);
+    check_placeable(obj.points, o.model);
     obj.diameter_mm = 1000.0 * o.diameter_m;
     if (o.symmetric) obj.symmetries = json{{"symmetries_discrete", half_turn(obj.points)}};
     out.push_back(std::move(obj));
@@ -198,10 +225,11 @@ std::vector<Object> folder_objects(const std::vector<fs::path>& folders, const s
 // The objects to place, or none when a stop was asked for while they were loaded.
 std::vector<Object> objects_for(const DatasetOptions& options) {
   const auto stopped = [&] { return options.stop_requested && options.stop_requested(); };
-  std::vector<Object> out = folder_objects(options.model_folders, stopped);
-  if (options.procedural) {
+  std::vector<ProceduralShape> shapes = options.procedural ? procedural_shapes() : std::vector<ProceduralShape>{};
+  std::vector<Object> out = folder_objects(options.model_folders, static_cast<int>(shapes.size()), stopped);
+  {
     int id = kFirstProceduralId;
-    for (auto& s : procedural_shapes()) {
+    for (auto& s : shapes) {
       Object obj;
       obj.id = id++;
       obj.model = std::move(s.model);
@@ -428,7 +456,7 @@ json vector_mm(const Eigen::Vector3d& t_m) { return json::array({1000.0 * t_m.x(
 
 // Where an instance shows, counted as BOP counts it, and its mask_visib image.
 struct Visibility {
-  assets::Image mask;
+  std::vector<std::uint8_t> mask;  // 8-bit grey, 255 where visible, as BOP's mask_visib
   int all = 0, visible = 0, valid = 0;
   Eigen::AlignedBox2i all_box, visible_box;
 };
@@ -436,7 +464,7 @@ struct Visibility {
 Visibility visibility(const std::vector<float>& alone, const std::vector<float>& scene, const std::vector<float>& measured, int w,
                       int h) {
   Visibility v;
-  v.mask = {w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 4, 0)};
+  v.mask.assign(static_cast<std::size_t>(w) * h, 0);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const auto i = static_cast<std::size_t>(y) * w + x;
@@ -447,9 +475,8 @@ Visibility visibility(const std::vector<float>& alone, const std::vector<float>&
       ++v.visible;
       v.valid += alignment::has_depth(measured[i]) ? 1 : 0;
       v.visible_box.extend(Eigen::Vector2i(x, y));
-      std::fill_n(v.mask.rgba.begin() + static_cast<std::ptrdiff_t>(4 * i), 3, std::uint8_t{255});
+      v.mask[i] = 255;
     }
-  for (std::size_t i = 3; i < v.mask.rgba.size(); i += 4) v.mask.rgba[i] = 255;
   return v;
 }
 
@@ -488,7 +515,8 @@ int write_image(const fs::path& folder, int image, const std::vector<Placed>& pl
     const Visibility v = visibility(r.alone_m[i], r.scene_m, measured.depth_m, k.width_px, k.height_px);
     if (v.all == 0) continue;  // outside the picture: not annotated, as BOP leaves such objects out
     const Eigen::Matrix4d T = T_camera_world * placed[i].T_world_model;
-    assets::write_png(folder / "mask_visib" / (numbered(image, "_") + numbered(static_cast<int>(gt.size()), ".png")), v.mask);
+    assets::write_png_gray8(folder / "mask_visib" / (numbered(image, "_") + numbered(static_cast<int>(gt.size()), ".png")),
+                            k.width_px, k.height_px, v.mask);
     gt.push_back({{"cam_R_m2c", matrix_json(T.topLeftCorner<3, 3>())},
                   {"cam_t_m2c", vector_mm(T.topRightCorner<3, 1>())},
                   {"obj_id", placed[i].object->id}});

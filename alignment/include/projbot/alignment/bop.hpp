@@ -15,6 +15,10 @@
 
 namespace projbot::alignment {
 
+/// The largest image or object id: BOP names their files with six digits (000001.png, obj_000001.ply), so a
+/// larger one would name a file no reader looks for. Readers refuse one; writers keep within it.
+constexpr int kMaxBopId = 999999;
+
 /// One object of the dataset (models_info.json).
 struct BopObject {
   int id = 0;
@@ -85,7 +89,7 @@ BopDataset read_bop_dataset(const std::filesystem::path& root, const std::vector
 struct BopModel {
   const BopObject* info = nullptr;
   ModelCloud cloud;                                  ///< surface samples, for estimation
-  std::vector<Eigen::Vector3f> vertices;             ///< the mesh's vertices, for ADD / ADD-S
+  std::vector<Eigen::Vector3f> vertices;             ///< the mesh's vertices for ADD / ADD-S (at most 30000, evenly)
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< bounding-box centre, model frame
 };
 

@@ -41,6 +41,9 @@ struct Gray16Image {
 /// leaves any previous file unchanged. Throws AssetError naming the file.
 void write_png(const std::filesystem::path& path, const Image& image);
 
+/// Writes an 8-bit single-channel PNG (a mask, as BOP's are) of width * height values, as write_png does.
+void write_png_gray8(const std::filesystem::path& path, int width, int height, const std::vector<std::uint8_t>& values);
+
 /// Writes a 16-bit single-channel PNG (a depth image) atomically, as write_png does. Throws AssetError.
 void write_png_gray16(const std::filesystem::path& path, const Gray16Image& image);
 

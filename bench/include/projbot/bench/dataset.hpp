@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -60,6 +61,8 @@ class DatasetBench {
   /// image as `run` follows a target; a frame's estimate is what the renderer would show (the newest
   /// published pose unless lost).
   void track(const alignment::BopScene& scene, int min_visible, std::vector<DatasetEstimate>& rows);
+  /// At most `n` instances over all calls: estimated (image) or followed from the first image (track).
+  void limit_instances(int n) { instances_left_ = n; }
 
  private:
   struct Estimators {
@@ -75,6 +78,7 @@ class DatasetBench {
   const alignment::BopModel& model(int id);
   Estimators& estimators(const alignment::BopModel& m, const alignment::CameraIntrinsics& k);
   bool stopped() const { return stop_requested_ && stop_requested_(); }
+  bool take_instance() { return instances_left_ > 0 ? (--instances_left_, true) : false; }
 
   const alignment::BopDataset& data_;
   double scale_;
@@ -83,6 +87,7 @@ class DatasetBench {
   std::function<bool()> stop_requested_;
   std::map<int, alignment::BopModel> models_;
   std::map<int, std::pair<alignment::CameraIntrinsics, Estimators>> estimators_;
+  int instances_left_ = std::numeric_limits<int>::max();
 };
 
 /// The report: {"instances": [one object per estimate], "interrupted": b}, written atomically. Throws

@@ -37,7 +37,7 @@ std::string input_file_problem(const std::filesystem::path& path);
 std::string input_folder_problem(const std::filesystem::path& path);
 
 /// The first clash between `inputs` and `outputs`, as one line naming both, or nothing:
-/// - an output on the same file as an input or another output;
+/// - an output on the same file as an input or another output, or inside another output's folder;
 /// - an input inside (or equal to) an output folder, which the output would replace or mix into;
 /// - an output file that exists inside an input folder (it would replace part of the input).
 /// Paths are compared after resolving links and "..", so a link to the scene is the scene.
