@@ -94,6 +94,41 @@ TEST_F(CliTest, RunServesTheConsoleItsBlackoutAndGoTo) {
   EXPECT_NE(out.find("1 requests refused; OSC: 1 actions taken, 0 messages refused, 0 states sent"), std::string::npos) << out;
 }
 
+// The site file starts the controls (issue 70: `console: {listen, token_file}` and `osc: {port, allow, send}`):
+// the tour scene with both sections serves the page and listens for OSC without an option given; a console
+// off loopback needs the site's token file (mode 0600), refused naming the site file's key otherwise.
+TEST_F(CliTest, RunStartsTheControlsTheSiteFileNames) {
+  std::ifstream in(fs::path(PROJBOT_ASSET_DIR) / "scenes" / "tour.yaml");
+  std::string tour{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  for (std::size_t at = 0; (at = tour.find("../models/", at)) != std::string::npos;)
+    tour.replace(at, 3, std::string(PROJBOT_ASSET_DIR) + "/");
+  const fs::path site = write("site.yaml", tour + "console: {listen: \"127.0.0.1:0\"}\nosc: {port: 49555, allow: [10.0.0.7]}\n");
+  const CliRun r = run_projbot("run --sim --headless --seconds 2 --config " + site.string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_GT(console_port(r.output), 0) << r.output;
+  EXPECT_NE(r.output.find("osc: UDP port 49555, actions from loopback, 10.0.0.7"), std::string::npos) << r.output;
+
+  const fs::path open = write("open.yaml", tour + "console: {listen: \"0.0.0.0:0\"}\n");
+  const CliRun refused = run_projbot("run --sim --headless --seconds 1 --config " + open.string());
+  EXPECT_EQ(refused.code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("console.listen in " + open.string() +
+                                " 0.0.0.0:0: a console on an address other than "
+                                "loopback needs a token (console.token_file in " +
+                                open.string() + ")"),
+            std::string::npos)
+      << refused.output;
+  const fs::path token = write("token", "a-token-of-sixteen-or-more\n");
+  ::chmod(token.c_str(), 0600);
+  const fs::path with_token = write("token.yaml", tour + "console: {listen: \"0.0.0.0:0\", token_file: token}\n");
+  const CliRun served = run_projbot("run --sim --headless --seconds 1 --config " + with_token.string());
+  EXPECT_EQ(served.code, 0) << served.output;
+  EXPECT_NE(served.output.find("(actions need the token)"), std::string::npos) << served.output;
+  const CliRun bad =
+      run_projbot("run --sim --headless --seconds 1 --config " + write("bad.yaml", tour + "osc: {port: 0}\n").string());
+  EXPECT_EQ(bad.code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("osc.port"), std::string::npos) << bad.output;
+}
+
 TEST_F(CliTest, RunRefusesAConsoleItCannotServeSafely) {
   const CliRun open = run_projbot("run --sim --headless --seconds 1 --console 0.0.0.0:0");
   EXPECT_EQ(open.code, 2) << open.output;

@@ -270,6 +270,40 @@ Photometry read_calibrated_photometry(const MapReader& r, const YAML::Node& node
   return p;
 }
 
+// `console: {listen: [ADDR:]PORT, token_file: FILE}` and `osc: {port: N, allow: [HOST...], send: HOST:PORT}`:
+// how the operator's controls start at this site (issue 70). The listen address is checked where the
+// console starts (its parser is the console's); the token file is an input, beside the scene.
+void read_operator(MapReader& root, const std::filesystem::path& base, Scene& scene) {
+  if (YAML::Node n = root.child("console", false)) {
+    MapReader m(n, "console", root.file());
+    ConsoleSite c;
+    c.listen = m.get<std::string>("listen", "", true);
+    if (c.listen.empty()) m.fail(n["listen"], "console.listen", "expected [ADDR:]PORT");
+    if (YAML::Node t = m.child("token_file", false)) {
+      if (!t.IsScalar() || t.Scalar().empty()) m.fail(t, "console.token_file", "expected the path of a token file");
+      c.token_file = beside_scene(t.Scalar(), base);
+    }
+    m.reject_unknown();
+    scene.console = c;
+  }
+  if (YAML::Node n = root.child("osc", false)) {
+    MapReader m(n, "osc", root.file());
+    OscSite o;
+    o.port = m.get<int>("port", 0, true);
+    if (o.port < 1 || o.port > 65535) m.fail(n["port"], "osc.port", "must be 1..65535");
+    if (YAML::Node a = m.child("allow", false)) {
+      if (!a.IsSequence()) m.fail(a, "osc.allow", "expected a list of hosts");
+      for (const auto& h : a) {
+        if (!h.IsScalar() || h.Scalar().empty()) m.fail(h, "osc.allow", "expected a host name or address");
+        o.allow.push_back(h.Scalar());
+      }
+    }
+    o.send = m.get<std::string>("send", "");
+    m.reject_unknown();
+    scene.osc = o;
+  }
+}
+
 // `calibration: calib.yaml` (issue 13's output): the projector's intrinsics A_p and the camera-to-projector
 // extrinsics R_cp, T_cp as a calibration measured them; they replace the scene's own.
 void apply_calibration(MapReader& root, Scene& scene, const std::filesystem::path& base) {
@@ -504,6 +538,7 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
   read_targets(r, file, base, scene);
   read_props(r, file, base, scene);
   scene.devices = read_devices(r);
+  read_operator(r, base, scene);
   apply_calibration(r, scene, base);
   read_tour(r, file, scene);
   r.reject_unknown();

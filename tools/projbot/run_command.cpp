@@ -162,43 +162,57 @@ struct Operated {
   std::unique_ptr<console::OscControl> osc;
 };
 
-std::optional<console::ConsoleConfig> console_config(const cli::Args& args) {
+// --console and --console-token, else the site file's `console:` (its keys named with the file).
+std::optional<console::ConsoleConfig> console_config(const cli::Args& args, const config::Scene& scene) {
   const auto listen = args.get("console");
-  const auto token_file = args.get("console-token");
+  auto token_file = args.get("console-token");
+  std::string listen_name = "--console", token_name = "--console-token FILE";
+  if (!listen && token_file) throw cli::UsageError("--console-token applies to --console");
+  if (!listen && !scene.console) return std::nullopt;
   if (!listen) {
-    if (token_file) throw cli::UsageError("--console-token applies to --console");
-    return std::nullopt;
+    listen_name = "console.listen in " + scene.source.string();
+    token_name = "console.token_file in " + scene.source.string();
+    if (!scene.console->token_file.empty()) token_file = scene.console->token_file.string();
   }
+  const std::string address = listen ? *listen : scene.console->listen;
   console::ConsoleConfig c;
   try {
-    c = console::parse_listen(*listen, "--console");
+    c = console::parse_listen(address, listen_name);
     if (token_file) c.token = console::read_token(*token_file);
   } catch (const console::ConsoleError& e) {
     throw cli::UsageError(e.what());
   }
   if (c.token.empty() && !console::is_loopback(c.host))
-    throw cli::UsageError("--console " + *listen +
-                          ": a console on an address other than loopback needs a token (--console-token FILE)");
+    throw cli::UsageError(listen_name + " " + address + ": a console on an address other than loopback needs a token (" +
+                          token_name + ")");
   return c;
 }
 
-std::optional<console::OscConfig> osc_config(const cli::Args& args) {
-  const auto allow = args.get("osc-allow");
-  const auto send = args.get("osc-send");
+// --osc, --osc-allow and --osc-send, else the site file's `osc:`.
+std::optional<console::OscConfig> osc_config(const cli::Args& args, const config::Scene& scene) {
+  auto allow = args.get("osc-allow");
+  auto send = args.get("osc-send");
   if (!args.get("osc")) {
     if (allow || send) throw cli::UsageError(std::string(allow ? "--osc-allow" : "--osc-send") + " applies to --osc");
-    return std::nullopt;
+    if (!scene.osc) return std::nullopt;
   }
   console::OscConfig c;
-  c.port = args.get_int("osc", 0, 0, 65535);
+  if (args.get("osc")) {
+    c.port = args.get_int("osc", 0, 0, 65535);
+  } else {
+    c.port = scene.osc->port;
+    c.allowed = scene.osc->allow;
+    if (!scene.osc->send.empty()) send = scene.osc->send;
+  }
   if (send) {
+    const std::string send_name = args.get("osc") ? "--osc-send" : "osc.send in " + scene.source.string();
     try {
-      const console::ConsoleConfig to = console::parse_listen(*send, "--osc-send");
+      const console::ConsoleConfig to = console::parse_listen(*send, send_name);
       c.send_host = to.host, c.send_port = to.port;
     } catch (const console::ConsoleError& e) {
       throw cli::UsageError(e.what());
     }
-    if (c.send_port == 0) throw cli::UsageError("--osc-send " + *send + ": a desk's port is from 1 to 65535");
+    if (c.send_port == 0) throw cli::UsageError(send_name + " " + *send + ": a desk's port is from 1 to 65535");
   }
   std::stringstream hosts(allow.value_or(""));
   for (std::string h; std::getline(hosts, h, ',');)
@@ -207,8 +221,12 @@ std::optional<console::OscConfig> osc_config(const cli::Args& args) {
 }
 
 Operated open_controls(const cli::Args& args, const config::Scene& scene, bool replay) {
-  const std::optional<console::ConsoleConfig> page = console_config(args);
-  const std::optional<console::OscConfig> osc = osc_config(args);
+  if (replay && !args.get("console") && !args.get("osc")) {  // a site's controls serve the live show only
+    if (scene.console || scene.osc) std::cout << "note: the site file's console: and osc: are not started for a replay\n";
+    return {};
+  }
+  const std::optional<console::ConsoleConfig> page = console_config(args, scene);
+  const std::optional<console::OscConfig> osc = osc_config(args, scene);
   if (!page && !osc) return {};
   if (replay)
     throw cli::UsageError(

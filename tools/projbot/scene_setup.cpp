@@ -116,6 +116,8 @@ std::vector<config::NamedPath> scene_inputs(const config::Scene& scene, const st
   std::vector<config::NamedPath> out;
   if (!scene.source.empty()) out.push_back({scene_name, scene.source, false});
   if (!scene.calibration.empty()) out.push_back({"the calibration of " + scene_name, scene.calibration, false});
+  if (scene.console && !scene.console->token_file.empty())
+    out.push_back({"the console's token file of " + scene_name, scene.console->token_file, false});
   for (const auto& t : scene.targets) {
     const std::string whose = "target '" + t.name + "'";
     add_model_inputs(t.model, whose, out);

@@ -173,6 +173,20 @@ struct TargetConfig {
   }
 };
 
+/// `console:` the operator's console, as the site file starts it (run's --console and --console-token
+/// given on the command line replace it).
+struct ConsoleSite {
+  std::string listen;                ///< [ADDR:]PORT, as --console takes it (checked where the console starts)
+  std::filesystem::path token_file;  ///< `token_file:`, beside the scene file; empty: none
+};
+
+/// `osc:` show control over OSC, as the site file starts it (--osc, --osc-allow and --osc-send replace it).
+struct OscSite {
+  int port = 0;                    ///< UDP port 1..65535
+  std::vector<std::string> allow;  ///< hosts whose actions are taken besides loopback
+  std::string send;                ///< HOST:PORT the show's state goes to on each change; empty: none
+};
+
 /// A whole scene file.
 struct Scene {
   std::filesystem::path source;       ///< the file it came from (empty when parsed from a string)
@@ -190,6 +204,8 @@ struct Scene {
   std::vector<std::string> visits;                    ///< `tour.visits:` target names in order
   std::vector<PropConfig> props;                      ///< `props:` the twin's static non-targets
   DevicesConfig devices;                              ///< `devices:` real devices (none: the twin)
+  std::optional<ConsoleSite> console;                 ///< `console:` the operator's page (none: not served)
+  std::optional<OscSite> osc;                         ///< `osc:` show control from a desk (none: not listened for)
 
   /// Kinect v1 depth: 640x480, fx = fy = 525 px, 0.5-4.5 m.
   static Camera kinect_v1_depth_camera() { return {Pinhole::kinect_v1(), 0.5, 4.5}; }
