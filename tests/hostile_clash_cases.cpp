@@ -26,6 +26,12 @@ Files box_files(const std::string& scene = kBoxScene, std::vector<std::pair<std:
 const std::string kCalibration =
     "projector: {width: 64, height: 48, fx: 50, fy: 50, cx: 32, cy: 24}\nprojector_from_camera: {translation: [0, 0, 0]}\n";
 
+// The tour scene s.yaml taking its projector from calib.yaml (kCalibration) beside it.
+Files calibrated_tour() {
+  return Files{{"calib.yaml", kCalibration},
+               {"s.yaml", "calibration: calib.yaml\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}};
+}
+
 }  // namespace
 
 // Outputs that would destroy an input (issue 47): refused before any work, exit 2, naming both; inputs that
@@ -125,14 +131,12 @@ std::vector<Hostile> clash_cases() {
       // Issue 88: the scene's calibration is an input like the scene (tour, run and render replaced it, exit 0).
       Hostile{"tour_report_over_the_calibration",
               "tour --scene {dir}/s.yaml --report {dir}/calib.yaml",
-              Files{{"calib.yaml", kCalibration},
-                    {"s.yaml", "calibration: calib.yaml\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}},
+              calibrated_tour(),
               2,
               {"--report {dir}/calib.yaml is also the input the calibration of"}},
       Hostile{"run_profile_over_the_calibration",
               "run --headless --config {dir}/s.yaml --profile {dir}/calib.yaml",
-              Files{{"calib.yaml", kCalibration},
-                    {"s.yaml", "calibration: calib.yaml\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}},
+              calibrated_tour(),
               2,
               {"--profile {dir}/calib.yaml is also the input the calibration of"}},
       // Issue 88: an output inside another output's folder (the report replaced a visit's picture).
@@ -144,8 +148,7 @@ std::vector<Hostile> clash_cases() {
       Hostile{
           "run_profile_inside_the_reflectance_folder",
           "run --headless --config {dir}/s.yaml --learn-reflectance --reflectance-out {dir}/r --profile {dir}/r/surfaces.yaml",
-          Files{{"calib.yaml", kCalibration},
-                {"s.yaml", "calibration: calib.yaml\n" + with(kTour, kRoomProjector, "projector: {near: 0.1, far: 10}\n")}},
+          calibrated_tour(),
           2,
           {"--profile {dir}/r/surfaces.yaml is inside the output folder --reflectance-out {dir}/r"}},
       Hostile{"bench_content_report_over_the_video",

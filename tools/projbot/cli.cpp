@@ -93,19 +93,6 @@ int Args::get_int(const std::string& name, int fallback, int min_value, int max_
 
 void Args::check_outputs() const {
   namespace fs = std::filesystem;
-  // An output file inside another output's folder is find_path_clash's to name (the folder may not exist yet).
-  std::vector<fs::path> folders;
-  for (const auto& [name, role] : roles_)
-    if (const auto value = get(name); value && role == PathRole::output_folder)
-      folders.push_back(fs::absolute(*value).lexically_normal());
-  const auto in_output_folder = [&](const fs::path& p) {
-    const fs::path file = fs::absolute(p).lexically_normal();
-    for (const auto& f : folders) {
-      const fs::path rel = file.lexically_relative(f);
-      if (!rel.empty() && *rel.begin() != ".." && rel != ".") return true;
-    }
-    return false;
-  };
   for (const auto& entry : roles_) {
     const std::string& name = entry.first;  // not a structured binding: clang 14 cannot capture one
     const PathRole role = entry.second;
@@ -118,7 +105,7 @@ void Args::check_outputs() const {
         throw UsageError("--" + name + " " + e.what());
       }
     };
-    if (role == PathRole::output_file && !in_output_folder(*value)) check(config::check_writable, *value);
+    if (role == PathRole::output_file) check(config::check_writable, *value);
     if (role != PathRole::output_folder) continue;
     std::error_code ec;
     const fs::path dir = fs::path(*value).lexically_normal();
@@ -154,6 +141,9 @@ void Args::check_paths(const std::vector<config::NamedPath>& more_inputs) const 
     if (const std::string problem = config::input_file_problem(inputs[i].path);
         problem.find("not a regular file") != std::string::npos)
       throw InputError(inputs[i].name + " " + inputs[i].path.string() + ": " + problem);
+  // Outputs among themselves first: one inside another's folder is that clash, not a missing folder (the
+  // folder is made by the run). Then each output's own checks, then outputs against inputs.
+  if (const auto clash = config::find_path_clash({}, outputs)) throw UsageError(*clash);
   check_outputs();
   if (const auto clash = config::find_path_clash(inputs, outputs)) throw UsageError(*clash);
 }

@@ -175,10 +175,9 @@ std::array<float, 3> albedo_for(int id) {
 // Every folder's objects, ids checked across folders before any mesh is loaded; `stopped` asked between
 // meshes (seventeen take a second or two): what it stops leaves out the rest.
 // An object the table cannot hold, or too small to be seen, would never be placed: said, with its size.
-void check_placeable(const std::vector<Eigen::Vector3d>& points, const fs::path& file) {
-  Eigen::AlignedBox3d box;
-  for (const auto& p : points) box.extend(p);
-  const double side_mm = points.empty() ? 0.0 : 1000.0 * box.sizes().maxCoeff();
+void check_placeable(const assets::Model& model, const fs::path& file) {
+  const Eigen::AlignedBox3d box = model.bounds();
+  const double side_mm = box.isEmpty() ? 0.0 : 1000.0 * box.sizes().maxCoeff();
   if (!(side_mm >= kMinSideMm && side_mm <= kMaxSideMm)) {
     std::ostringstream what;
     what << file.string() << ": " << std::fixed << std::setprecision(side_mm < 1.0 ? 4 : 1) << side_mm
@@ -214,7 +213,7 @@ std::vector<Object> folder_objects(const std::vector<fs::path>& folders, int pro
     obj.model = assets::load_model(o.model);
     assets::scale_and_recenter(obj.model, 0.001, false);
     obj.points = vertices(obj.model);
-    check_placeable(obj.points, o.model);
+    check_placeable(obj.model, o.model);
     obj.diameter_mm = 1000.0 * o.diameter_m;
     if (o.symmetric) obj.symmetries = json{{"symmetries_discrete", half_turn(obj.points)}};
     out.push_back(std::move(obj));
