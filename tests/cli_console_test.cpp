@@ -1,7 +1,8 @@
 // The operator's console through the executable (issue 70): `projbot run --sim --headless --console`
-// serves the page and its API while the twin tours; a blackout asked over HTTP blacks the projector out
-// (counted in the run's closing lines, with the time from the request to its first black frame), a
-// go-to sends the robot to the target asked for, and bad options are refused before anything opens.
+// serves the page and its API while the twin tours; the projector's frame and the camera's view as small
+// pictures; a blackout asked over HTTP blacks the projector out (counted in the run's closing lines, with
+// the time from the request to its first black frame), a pause holds the robot at its stop, a go-to sends
+// it to the target asked for, and bad options are refused before anything opens.
 
 // clang-format off
 #include "cli_fixture.hpp"  // before httplib.h: it brings resolv.h, whose _res macro breaks Eigen's headers after it
@@ -11,7 +12,10 @@
 #include <lo/lo.h>
 #include <sys/stat.h>
 
+#include <fstream>
 #include <nlohmann/json.hpp>
+
+#include "projbot/assets/image.hpp"
 
 using namespace cli_fixture;
 
@@ -39,6 +43,23 @@ json wait_state(httplib::Client& c, const std::function<bool(const json&)>& done
   return last;
 }
 
+// The newest picture of `kind` ("frame", "camera") that satisfies `done`, asked for twice a second as the
+// page asks, within `limit_s`; an empty image when none came.
+projbot::assets::Image wait_picture(httplib::Client& c, const std::string& kind, const fs::path& dir,
+                                    const std::function<bool(const projbot::assets::Image&)>& done, double limit_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_s);
+  const fs::path file = dir / (kind + ".png");
+  while (std::chrono::steady_clock::now() < end) {
+    if (const auto r = c.Get("/api/" + kind + ".png"); r && r->status == 200) {
+      std::ofstream(file, std::ios::binary) << r->body;
+      projbot::assets::Image image = projbot::assets::read_image(file);
+      if (done(image)) return image;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  return {};
+}
+
 httplib::Result post(httplib::Client& c, const std::string& path, const json& body) {
   return c.Post(path.c_str(), body.dump(), "application/json");
 }
@@ -61,16 +82,31 @@ TEST_F(CliTest, RunServesTheConsoleItsBlackoutAndGoTo) {
   EXPECT_EQ(s.at("visiting"), "duck");
   EXPECT_GT(s.at("frame_rate_hz").get<double>(), 10.0);
 
+  // Held at the duck (the dwell does not end while paused) for what follows.
+  ASSERT_EQ(post(c, "/api/pause", {{"on", true}})->status, 200);
+  // The pictures: the projector's frame with the duck's light in it, the camera's view, both small.
+  const auto lit_frame = [](const projbot::assets::Image& i) { return i.lit_pixels() > 100; };
+  const projbot::assets::Image frame = wait_picture(c, "frame", dir_, lit_frame, 10.0);
+  EXPECT_EQ(frame.width, 320);
+  EXPECT_GT(frame.lit_pixels(), 100U);
+  const projbot::assets::Image camera = wait_picture(c, "camera", dir_, lit_frame, 10.0);
+  EXPECT_EQ(camera.width, 320);
+  EXPECT_EQ(camera.height, 240);
+
   ASSERT_EQ(post(c, "/api/blackout", {{"on", true}})->status, 200);
   s = wait_state(
       c, [](const json& j) { return j.at("blackout") == true; }, 5.0);
   EXPECT_TRUE(s.at("blackout").get<bool>()) << s.dump();
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  // The projector's picture goes black with it.
+  const projbot::assets::Image dark = wait_picture(
+      c, "frame", dir_, [](const projbot::assets::Image& i) { return i.width > 0 && i.lit_pixels() == 0; }, 5.0);
+  EXPECT_EQ(dark.width, 320) << "no black picture of the projector's frame during the blackout";
   ASSERT_EQ(post(c, "/api/blackout", {{"on", false}})->status, 200);
   // The tour would go to the box next: ask for the duck again, over OSC, and see the robot leave for it.
   const lo_address desk = lo_address_new("127.0.0.1", osc_port.c_str());
   EXPECT_GT(lo_send(desk, "/projbot/goto", "s", "duck"), 0);  // bytes sent
   lo_address_free(desk);
+  ASSERT_EQ(post(c, "/api/pause", {{"on", false}})->status, 200);
   s = wait_state(
       c, [](const json& j) { return j.at("visit").get<int>() >= 2 && j.at("visiting") == "duck"; }, 90.0);
   EXPECT_EQ(s.at("visit"), 2) << s.dump();

@@ -358,4 +358,89 @@ TEST(ShowReporter, ReportsWhatTheFramesDrew) {
   EXPECT_EQ(show.state()->targets.at(0).state, "idle");
 }
 
+// The top half white, the bottom black.
+projbot::assets::Image half_white(int width, int height) {
+  projbot::assets::Image image{width, height, std::vector<std::uint8_t>(static_cast<std::size_t>(width) * height * 4, 0)};
+  for (int y = 0; y < height / 2; ++y)
+    for (int x = 0; x < width; ++x) std::fill_n(image.pixel(x, y), 4, std::uint8_t{255});
+  return image;
+}
+
+live::ShowPictures::Png wait_png(live::ShowPictures& pictures, live::ShowPictures::Kind kind) {
+  for (int i = 0; i < 500; ++i) {
+    if (live::ShowPictures::Png png = pictures.png(kind)) return png;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return nullptr;
+}
+
+// A PNG's bytes decoded (through a file: the assets module reads files).
+template <typename Bytes>
+projbot::assets::Image decoded(const Bytes& png) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("projbot_picture_" + std::to_string(::getpid()) + ".png");
+  std::ofstream(file, std::ios::binary)
+      .write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  projbot::assets::Image image = projbot::assets::read_image(file);
+  std::filesystem::remove(file);
+  return image;
+}
+// The pictures (issue 70): taken only while someone asked for them, shrunk for the page, encoded off the
+// engine's threads; a kind that can never be given says why.
+TEST(ShowPictures, TakesPicturesOnlyWhileWantedAndEncodesThemSmall) {
+  live::ShowPictures pictures({.max_width = 320, .period_s = 0.0, .interest_s = 5.0});
+  using Kind = live::ShowPictures::Kind;
+  EXPECT_FALSE(pictures.due(Kind::frame));  // no one has asked: nothing is copied
+  EXPECT_EQ(pictures.png(Kind::frame), nullptr);
+  EXPECT_TRUE(pictures.due(Kind::frame));
+  EXPECT_FALSE(pictures.due(Kind::camera));
+
+  pictures.offer(Kind::frame, half_white(640, 480));
+  const live::ShowPictures::Png png = wait_png(pictures, Kind::frame);
+  ASSERT_NE(png, nullptr);
+  const projbot::assets::Image small = decoded(*png);
+  EXPECT_EQ(small.width, 320);
+  EXPECT_EQ(small.height, 240);
+  EXPECT_EQ(small.pixel(10, 10)[0], 255);   // the top half white
+  EXPECT_EQ(small.pixel(10, 230)[0], 0);    // the bottom black
+  EXPECT_EQ(small.pixel(10, 119)[1], 255);  // the edge falls between rows: no row mixes the two
+  EXPECT_EQ(small.pixel(10, 120)[1], 0);
+
+  pictures.png(Kind::camera);
+  pictures.set_unavailable(Kind::camera, "no camera here");
+  EXPECT_FALSE(pictures.due(Kind::camera));
+  EXPECT_EQ(pictures.unavailable(Kind::camera), "no camera here");
+  EXPECT_EQ(pictures.unavailable(Kind::frame), "");
+
+  live::ShowPictures slow({.max_width = 320, .period_s = 60.0, .interest_s = 5.0});
+  slow.png(Kind::frame);
+  slow.offer(Kind::frame, half_white(64, 48));
+  EXPECT_FALSE(slow.due(Kind::frame));  // one a period
+  const live::ShowPictures::Png tiny = wait_png(slow, Kind::frame);
+  ASSERT_NE(tiny, nullptr);
+  EXPECT_EQ(decoded(*tiny).width, 64);  // already small: as it is
+}
+
+TEST_F(ConsoleTest, ServesThePicturesTheEngineOffers) {
+  console::Console server(show_, console::parse_listen("127.0.0.1:0", "--console"));
+  httplib::Client c("127.0.0.1", server.port());
+  const auto none = c.Get("/api/frame.png");
+  ASSERT_TRUE(none);
+  EXPECT_EQ(none->status, 404);
+  EXPECT_NE(json::parse(none->body).at("error").get<std::string>().find("no picture yet"), std::string::npos);
+  using Kind = live::ShowPictures::Kind;
+  ASSERT_TRUE(show_.pictures().due(Kind::frame));  // asked for: the engine would offer one now
+  show_.pictures().offer(Kind::frame, half_white(640, 480));
+  ASSERT_NE(wait_png(show_.pictures(), Kind::frame), nullptr);
+  const auto got = c.Get("/api/frame.png");
+  ASSERT_TRUE(got);
+  EXPECT_EQ(got->status, 200);
+  EXPECT_EQ(got->get_header_value("Content-Type"), "image/png");
+  EXPECT_EQ(decoded(got->body).width, 320);
+  show_.pictures().set_unavailable(Kind::camera, "the camera gives no colour");
+  const auto camera = c.Get("/api/camera.png");
+  EXPECT_EQ(camera->status, 404);
+  EXPECT_EQ(json::parse(camera->body).at("error"), "the camera gives no colour");
+}
+
 }  // namespace

@@ -26,6 +26,8 @@
 #endif
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -66,6 +68,36 @@ void write_png_8bit(const std::filesystem::path& path, int width, int height, in
 }
 
 }  // namespace
+
+std::vector<std::uint8_t> encode_png(const Image& image) {
+  if (image.width <= 0 || image.height <= 0 || image.rgba.size() != static_cast<std::size_t>(image.width) * image.height * 4)
+    throw AssetError("encode_png: an empty or inconsistent image");
+  std::vector<std::uint8_t> png;
+  if (stbi_write_png_to_func(append_bytes, &png, image.width, image.height, 4, image.rgba.data(), image.width * 4) == 0)
+    throw AssetError("encode_png: cannot encode PNG");
+  return png;
+}
+
+// A box filter: each output pixel averages the source pixels whose centres fall in its footprint.
+Image shrunk(const Image& image, int max_width) {
+  if (max_width <= 0 || image.width <= max_width) return image;
+  const double step = static_cast<double>(image.width) / max_width;
+  Image out{max_width, std::max(1, static_cast<int>(std::lround(image.height / step))), {}};
+  out.rgba.assign(static_cast<std::size_t>(out.width) * out.height * 4, 0);
+  for (int y = 0; y < out.height; ++y) {
+    const int y0 = static_cast<int>(y * step), y1 = std::min(image.height, std::max(y0 + 1, static_cast<int>((y + 1) * step)));
+    for (int x = 0; x < out.width; ++x) {
+      const int x0 = static_cast<int>(x * step), x1 = std::min(image.width, std::max(x0 + 1, static_cast<int>((x + 1) * step)));
+      std::array<unsigned, 4> sum{};
+      for (int v = y0; v < y1; ++v)
+        for (int u = x0; u < x1; ++u)
+          for (int c = 0; c < 4; ++c) sum[static_cast<std::size_t>(c)] += image.pixel(u, v)[c];
+      const unsigned n = static_cast<unsigned>((x1 - x0) * (y1 - y0));
+      for (int c = 0; c < 4; ++c) out.pixel(x, y)[c] = static_cast<std::uint8_t>((sum[static_cast<std::size_t>(c)] + n / 2) / n);
+    }
+  }
+  return out;
+}
 
 void write_png(const std::filesystem::path& path, const Image& image) {
   write_png_8bit(path, image.width, image.height, 4, image.rgba);

@@ -47,6 +47,11 @@ struct Console::Impl {
   bool json_body(const httplib::Request& req, httplib::Response& res, json& out);
   void routes();
   void events(httplib::Response& res);
+  void picture(live::ShowPictures::Kind kind, httplib::Response& res);
+  /// A picture asked for before the engine took one: not a request refused.
+  static bool picture_not_yet(const httplib::Request& req, const httplib::Response& res) {
+    return res.status == 404 && (req.path == "/api/frame.png" || req.path == "/api/camera.png");
+  }
 
   live::ShowControl& show;
   ConsoleConfig config;
@@ -118,6 +123,19 @@ void Console::Impl::events(httplib::Response& res) {
       [this](bool) { viewers.fetch_sub(1); });
 }
 
+// The newest picture of `kind` (asking for it is what makes the engine take the next): 404 saying why
+// while there is none, which a page asking twice a second soon gets past.
+void Console::Impl::picture(live::ShowPictures::Kind kind, httplib::Response& res) {
+  live::ShowPictures& pictures = show.pictures();
+  const live::ShowPictures::Png png = pictures.png(kind);
+  res.set_header("Cache-Control", "no-store");
+  if (!png) {
+    const std::string why = pictures.unavailable(kind);
+    return refuse(res, 404, why.empty() ? "no picture yet: the engine takes one within a second of being asked" : why);
+  }
+  res.set_content(reinterpret_cast<const char*>(png->data()), png->size(), "image/png");
+}
+
 void Console::Impl::routes() {
   server.Get("/", [](const httplib::Request&, httplib::Response& res) { res.set_content(kPage, "text/html; charset=utf-8"); });
   server.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
@@ -125,6 +143,10 @@ void Console::Impl::routes() {
     res.set_content(state_json(*show.state()), "application/json");
   });
   server.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) { events(res); });
+  server.Get("/api/frame.png",
+             [this](const httplib::Request&, httplib::Response& res) { picture(live::ShowPictures::Kind::frame, res); });
+  server.Get("/api/camera.png",
+             [this](const httplib::Request&, httplib::Response& res) { picture(live::ShowPictures::Kind::camera, res); });
   const auto on_off = [this](const std::string& key, auto act) {
     return [this, key, act](const httplib::Request& req, httplib::Response& res) {
       json body;
@@ -160,8 +182,8 @@ Console::Console(live::ShowControl& show, ConsoleConfig config) : impl_(std::mak
   i.server.set_write_timeout(5, 0);
   // Every answer of 400 or more passes here before it is written (a logger runs after: a client could
   // read the answer before the count).
-  i.server.set_error_handler([&i](const httplib::Request&, httplib::Response& res) {
-    i.refused.fetch_add(1);
+  i.server.set_error_handler([&i](const httplib::Request& req, httplib::Response& res) {
+    if (!i.picture_not_yet(req, res)) i.refused.fetch_add(1);
     if (res.body.empty()) refuse(res, res.status, "HTTP " + std::to_string(res.status) + " (see GET / for the page, /api/state)");
   });
   i.server.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr) {

@@ -66,6 +66,8 @@ class RunObserver final : public StopObserver {
       : scene_(scene), state_(state), handoffs_(handoffs), rig_(rig), check_(check), log_(log), clock_(rig.session().clock()) {}
   /// Each stop's visited target's reflectance measured by `probe` from the trackers' poses.
   void learn(ReflectanceProbe* probe, live::PoseSource poses) { probe_ = probe, poses_ = std::move(poses); }
+  /// The camera's colour view offered to the operator's page while it is wanted.
+  void show_to(ShowPictures* pictures) { pictures_ = pictures; }
   void driving(int visit) override {
     visit_ = visit + 1;
     state_.publish({.lit = {}, .since_s = clock_.now_s(), .visit = visit_});
@@ -88,6 +90,8 @@ class RunObserver final : public StopObserver {
       handoffs_.from_capture_ms.push_back(1000.0 * (now - f.depth.capture_time_s));
       handoffs_.in_session_ms.push_back(1000.0 * (now - f.delivered_s));
       handoffs_.last_s = now;
+      if (pictures_ && !f.colour.rgba.empty() && pictures_->due(ShowPictures::Kind::camera))
+        pictures_->offer(ShowPictures::Kind::camera, f.colour);
       if (probe_)
         if (const std::string said = probe_->frame(f, now, poses_); !said.empty()) log_ << said << std::endl;
     }
@@ -119,6 +123,7 @@ class RunObserver final : public StopObserver {
   config::Clock clock_;  // the session's
   ReflectanceProbe* probe_ = nullptr;
   live::PoseSource poses_;
+  ShowPictures* pictures_ = nullptr;
   int visit_ = 0;
 };
 
@@ -197,6 +202,11 @@ void RobotThread::drive(const config::Scene& scene, const RunOptions& o, live::S
   measured_ = rig.knows_truth();
   const config::Clock& clock = rig.session().clock();
   RunObserver observer(scene, state_, handoffs_, rig, sources.check, *sources.log);
+  if (sources.show) {
+    ShowPictures& pictures = sources.show->pictures();
+    observer.show_to(&pictures);
+    rig.colour_wanted([&pictures] { return pictures.due(ShowPictures::Kind::camera); });
+  }
   if (probe_) {
     observer.learn(probe_, [&trackers](int index, alignment::PoseSample& pose) {
       return trackers.owned[static_cast<std::size_t>(index)]->latest(pose);
@@ -324,17 +334,30 @@ void learn_in_loop(live::ProjectionInputs& in, ReflectanceProbe& probe, engine::
   };
 }
 
+// The projector's frame, offered to the operator's page when one is due (read back from an offscreen
+// target; a window's frames are not read back, which the page is told once).
+void picture_frame(ShowPictures& pictures, engine::RenderTarget& target) {
+  if (!pictures.due(ShowPictures::Kind::frame)) return;
+  try {
+    pictures.offer(ShowPictures::Kind::frame, target.read_back());
+  } catch (const engine::EngineError&) {
+    pictures.set_unavailable(ShowPictures::Kind::frame,
+                             "the projector's frames go to a window and are not read back (a --headless run shows them)");
+  }
+}
+
 // The render thread's side of the operator's controls: every frame black while the blackout is on (before
 // anything else the projector would show), the latency of each blackout measured at its first black
-// frame, and the show's state reported from each frame.
+// frame, the show's state reported from each frame and its picture taken while wanted.
 void operate_in_loop(ProjectionInputs& in, ShowControl& show, ShowReporter& reporter, const RobotState& seen,
-                     const ProjectionLoop& loop, RunResult& r) {
+                     const ProjectionLoop& loop, engine::RenderTarget& target, RunResult& r) {
   in.uniform = [&show, other = in.uniform]() -> std::optional<std::array<std::uint8_t, 3>> {
     if (show.blackout()) return std::array<std::uint8_t, 3>{0, 0, 0};
     return other ? other() : std::nullopt;
   };
-  in.after_frame = [after = in.after_frame, &show, &reporter, &seen, &loop, &r](const DecidedFrame& f) {
+  in.after_frame = [after = in.after_frame, &show, &reporter, &seen, &loop, &target, &r](const DecidedFrame& f) {
     if (after) after(f);
+    picture_frame(show.pictures(), target);
     if (f.uniform && show.blackout()) {
       ++r.blackout_frames;
       if (const std::optional<double> asked = show.take_blackout_asked())
@@ -375,7 +398,7 @@ RunResult run(engine::Renderer& renderer, const config::Scene& scene, const RunO
   live::ProjectionInputs in = live_inputs(scene, robot, seen, trackers, out.content, sources);
   if (probe) learn_in_loop(in, *probe, renderer, out, r.reflectance_measured);
   std::optional<ShowReporter> reporter;
-  if (sources.show) operate_in_loop(in, *sources.show, reporter.emplace(*sources.show), seen, loop, r);
+  if (sources.show) operate_in_loop(in, *sources.show, reporter.emplace(*sources.show), seen, loop, *out.target, r);
   r.figures = loop.run(*out.target, in, profiler);
   r.failure = robot.finish(renderer, *out.target, scene.projector);
   for (const auto& w : trackers.owned)

@@ -38,7 +38,7 @@ alignment::RgbdFrame TwinCamera::next() {
   if (uniform) {  // the scene under the projector's one colour, as the colour camera sees it
     f.colour = colour_camera_->draw(twin_, T_world_camera, twin_.true_head().T_world_projector.matrix(),
                                     uniform_frame(twin_.scene().projector, *uniform));
-  } else if (frame_ == 0 || colour_every_frame_) {
+  } else if (frame_ == 0 || colour_every_frame_ || (colour_wanted_ && colour_wanted_())) {
     f.colour = twin_.capture_colour(T_world_camera, static_cast<std::uint32_t>(seed_ * 7919 + visit_ * 1009 + frame_));
   }
   f.depth.capture_time_s = captured;

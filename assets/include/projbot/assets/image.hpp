@@ -47,6 +47,14 @@ void write_png_gray8(const std::filesystem::path& path, int width, int height, c
 /// Writes a 16-bit single-channel PNG (a depth image) atomically, as write_png does. Throws AssetError.
 void write_png_gray16(const std::filesystem::path& path, const Gray16Image& image);
 
+/// An RGBA8 image as PNG bytes in memory (what a web page is sent). Throws AssetError for an empty or
+/// inconsistent image.
+std::vector<std::uint8_t> encode_png(const Image& image);
+
+/// `image` made at most `max_width` pixels wide (its aspect kept; each pixel the mean of those it covers);
+/// an image already that small is returned as it is.
+Image shrunk(const Image& image, int max_width);
+
 /// Reads a PNG or JPEG into RGBA8. Throws AssetError naming the file.
 Image read_image(const std::filesystem::path& path);
 

@@ -8,6 +8,7 @@
 //   GET  /api/state     the show's state (JSON)        POST /api/pause    {"on": true|false}
 //   GET  /api/events    the same, pushed as it changes POST /api/goto     {"target": NAME}
 //                       (server-sent events)
+//   GET  /api/frame.png the projector's frame, small    GET /api/camera.png  the camera's view, small
 
 #include <filesystem>
 #include <memory>

@@ -79,6 +79,9 @@ class Rig {
   /// The projector shows `shown`'s colour while it says so (a reflectance measured at a stop): a
   /// simulated camera is told; a real one sees the real projector's light.
   virtual void projector_shows(UniformLight /*shown*/) {}
+  /// A frame's colour is wanted while `wanted` says so (the operator's page): a simulated camera that gives
+  /// colour with a stop's first frame only renders it then too; a real one gives it with every frame.
+  virtual void colour_wanted(std::function<bool()> /*wanted*/) {}
 };
 
 /// How a rig runs its session.

@@ -2,7 +2,8 @@
 // The show's controls and its state, shared between the live engine and whoever operates it (the
 // console's page and API, OSC, a script): the operator asks (blackout, pause, go to a target) from any
 // thread; the render thread reads the blackout once per frame and publishes the show's state about five
-// times a second; the robot thread reads the pause and the go-to between frames. Neither engine thread ever
+// times a second; the robot thread reads the pause and the go-to between frames. Both offer pictures
+// (ShowPictures) while someone looks at them. Neither engine thread ever
 // waits on an operator: every call here is a flag or a pointer swapped under a short lock.
 
 #include <array>
@@ -18,6 +19,7 @@
 
 #include "projbot/config/scene.hpp"
 #include "projbot/live/projection_loop.hpp"
+#include "projbot/live/show_pictures.hpp"
 
 namespace projbot::live {
 
@@ -79,6 +81,8 @@ class ShowControl {
   /// Waits until a state newer than `sequence` is published or `timeout_ms` pass; the newest either way.
   std::shared_ptr<const ShowState> wait_newer(std::uint64_t sequence, int timeout_ms) const;
   const std::vector<SiteTarget>& targets() const { return targets_; }
+  /// The projector's frame and the camera's view as small PNGs (the engine offers them while wanted).
+  ShowPictures& pictures() { return pictures_; }
 
   // The engine's side.
   bool blackout() const { return blackout_; }
@@ -101,6 +105,7 @@ class ShowControl {
   mutable std::condition_variable changed_;
   std::shared_ptr<const ShowState> state_;
   double blackout_asked_s_ = -1.0;  // under mutex_
+  ShowPictures pictures_;
 };
 
 /// The stop as the render thread last read the robot's state.

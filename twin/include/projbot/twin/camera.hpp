@@ -38,6 +38,8 @@ class TwinCamera final : public alignment::RgbdCamera {
   /// colour camera sees it (SpectatorView through the camera's pinhole, drawn with `renderer`).
   using UniformLight = std::function<std::optional<std::array<std::uint8_t, 3>>()>;
   void see_projector(engine::Renderer& renderer, UniformLight shown);
+  /// Colour also with each frame while `wanted` says so (the operator's page asked for the camera's view).
+  void colour_wanted(std::function<bool()> wanted) { colour_wanted_ = std::move(wanted); }
 
  private:
   Twin& twin_;
@@ -50,6 +52,7 @@ class TwinCamera final : public alignment::RgbdCamera {
   std::chrono::steady_clock::time_point tick_{};
   double last_capture_ms_ = 0.0;
   UniformLight shown_;
+  std::function<bool()> colour_wanted_;
   std::unique_ptr<SpectatorView> colour_camera_;  // see_projector's
 };
 

@@ -41,6 +41,8 @@ class TwinRig final : public live::Rig {
   std::unique_ptr<live::SurfaceSurvey> reflectance_survey() override;
   /// The twin's camera sees the projector's light when it shows one colour (TwinCamera::see_projector).
   void projector_shows(live::UniformLight shown) override;
+  /// The twin's camera renders colour with a frame while `wanted` says so (TwinCamera::colour_wanted).
+  void colour_wanted(std::function<bool()> wanted) override { twin_camera_.colour_wanted(std::move(wanted)); }
   Twin& twin() { return twin_; }
 
  private:
