@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "projbot/config/clock.hpp"
 #include "projbot/console/osc.hpp"
 
 namespace {
@@ -319,6 +320,28 @@ TEST_F(ConsoleTest, OscTellsTheDeskOfEachChange) {
   ASSERT_EQ(heard.states.size(), 2U);
   EXPECT_EQ(heard.states[0], "driving 1  00");
   EXPECT_EQ(heard.states[1], "lit 1 duck 10");
+}
+
+// The render thread's pace between offscreen frames is cut short by a blackout asked for (its first
+// black frame starts at once), and only by that.
+TEST(ShowControl, ABlackoutAskedForWakesTheRenderThreadsPace) {
+  live::ShowControl show(two_targets());
+  const double t0 = projbot::config::steady_now_s();
+  EXPECT_FALSE(show.sleep_until(t0 + 0.05));  // nothing asked: the whole pace
+  EXPECT_GE(projbot::config::steady_now_s(), t0 + 0.05);
+  show.set_paused(true);
+  EXPECT_FALSE(show.sleep_until(projbot::config::steady_now_s() + 0.02));  // a pause waits for the next frame
+  std::thread desk([&show] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    show.set_blackout(true, projbot::config::steady_now_s());
+  });
+  const double asleep = projbot::config::steady_now_s();
+  EXPECT_TRUE(show.sleep_until(asleep + 30.0));
+  EXPECT_LT(projbot::config::steady_now_s(), asleep + 30.0);
+  desk.join();
+  EXPECT_TRUE(show.sleep_until(projbot::config::steady_now_s() + 30.0));  // until its first black frame takes it
+  ASSERT_TRUE(show.take_blackout_asked().has_value());
+  EXPECT_FALSE(show.sleep_until(projbot::config::steady_now_s() + 0.01));
 }
 
 // The render thread's report: the phase and each target's state from the frames it drew, a blackout's

@@ -115,11 +115,20 @@ std::optional<DecidedFrame> ProjectionLoop::frame(engine::RenderTarget* target, 
   return f;
 }
 
+// The next frame's start: one period after the last (Clock::pace), or at once when the inputs' sleep is
+// woken for something to show now, the cadence going on from there.
+void ProjectionLoop::pace(double& next_s, const ProjectionInputs& in) {
+  if (!in.pace_sleep) return clock_.pace(next_s, 1.0 / cfg_.paced_hz);
+  next_s += 1.0 / cfg_.paced_hz;
+  const double now = in.pace_sleep(next_s) ? clock_.now_s() : std::max(next_s, clock_.now_s());
+  if (now < next_s || now > next_s + 0.05) next_s = now;
+}
+
 ProjectionFigures ProjectionLoop::run(engine::RenderTarget& target, const ProjectionInputs& in, engine::FrameProfiler& profiler) {
   begin();
   double next_s = t0_s_;
   while (in.keep_going() && !target.poll_close() && (cfg_.seconds == 0.0 || clock_.now_s() - t0_s_ < cfg_.seconds)) {
-    if (cfg_.paced_hz > 0.0) clock_.pace(next_s, 1.0 / cfg_.paced_hz);  // no vsync: paced like a projector
+    if (cfg_.paced_hz > 0.0) pace(next_s, in);  // no vsync: paced like a projector
     frame(&target, in, &profiler);
   }
   return std::move(figures_);

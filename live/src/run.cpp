@@ -351,6 +351,7 @@ void picture_frame(ShowPictures& pictures, engine::RenderTarget& target) {
 // frame, the show's state reported from each frame and its picture taken while wanted.
 void operate_in_loop(ProjectionInputs& in, ShowControl& show, ShowReporter& reporter, const RobotState& seen,
                      const ProjectionLoop& loop, engine::RenderTarget& target, RunResult& r) {
+  in.pace_sleep = [&show](double until_s) { return show.sleep_until(until_s); };  // a live loop: the steady clock
   in.uniform = [&show, other = in.uniform]() -> std::optional<std::array<std::uint8_t, 3>> {
     if (show.blackout()) return std::array<std::uint8_t, 3>{0, 0, 0};
     return other ? other() : std::nullopt;

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "projbot/config/clock.hpp"
+
 namespace projbot::live {
 
 std::vector<SiteTarget> site_targets(const config::Scene& scene) {
@@ -28,6 +30,13 @@ void ShowControl::set_blackout(bool on, double asked_s) {
     if (!on) blackout_asked_s_ = -1.0;
   }
   blackout_ = on;
+  asked_.notify_all();
+}
+
+bool ShowControl::sleep_until(double until_s) const {
+  std::unique_lock lock(mutex_);
+  const auto wait = std::chrono::duration<double>(std::max(0.0, until_s - config::steady_now_s()));
+  return asked_.wait_for(lock, wait, [this] { return blackout_asked_s_ >= 0.0; });
 }
 
 bool ShowControl::go_to(const std::string& target) {

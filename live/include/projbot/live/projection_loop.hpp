@@ -87,6 +87,9 @@ struct ProjectionInputs {
   /// A colour (8-bit levels) to show over the whole image instead of the targets (a reflectance measured
   /// at a stop: the projector's black, then its mid grey); nullopt or empty: the targets. Read once per frame.
   std::function<std::optional<std::array<std::uint8_t, 3>>()> uniform;
+  /// Offscreen pacing (paced_hz): sleeps until `until_s` on the loop's clock, or less when something must
+  /// be shown at once (an operator's blackout), saying so with true; empty: the clock's own sleep.
+  std::function<bool(double until_s)> pace_sleep;
 };
 
 /// The render thread's loop. Not thread-safe: one owner, the thread that owns the renderer.
@@ -114,6 +117,7 @@ class ProjectionLoop {
 
  private:
   std::vector<DrawnPose> decide(const LitStop& stop, const ProjectionInputs& in, double now_s);
+  void pace(double& next_s, const ProjectionInputs& in);
   void compose(const LitStop& stop, const ProjectionInputs& in, std::vector<engine::DrawItem>& out,
                std::vector<DrawnPose>& drawn);
   void measure(const std::vector<DrawnPose>& drawn, const DisplayMeter& meter, double start_ms, double start_s, bool uniform);

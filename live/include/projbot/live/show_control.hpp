@@ -94,6 +94,9 @@ class ShowControl {
   /// When the blackout now on was asked for (steady clock), once: the render thread takes it at its
   /// first black frame to measure the latency; nullopt when taken or off.
   std::optional<double> take_blackout_asked();
+  /// The render thread's pace between offscreen frames: sleeps until `until_s` (steady clock) or until a
+  /// blackout asked for waits for its first black frame; true when woken for one (the frame starts now).
+  bool sleep_until(double until_s) const;
   /// The render thread's: the state now (its sequence is set here). Wakes every wait_newer.
   void publish(ShowState state);
 
@@ -103,6 +106,7 @@ class ShowControl {
   std::atomic<int> go_to_{-1};
   mutable std::mutex mutex_;
   mutable std::condition_variable changed_;
+  mutable std::condition_variable asked_;  // a blackout asked for
   std::shared_ptr<const ShowState> state_;
   double blackout_asked_s_ = -1.0;  // under mutex_
   ShowPictures pictures_;
