@@ -14,7 +14,7 @@ packages=(
   libglfw3-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
   libpcl-dev libopenni2-dev libfreenect-dev libfreenect-bin cyclonedds-dev cyclonedds-tools libtiff-dev libboost-dev libmrpt-dev
   libopencv-dev libopencv-contrib-dev libassimp-dev libavformat-dev libavcodec-dev libswscale-dev libavutil-dev
-  libcpp-httplib-dev liblo-dev
+  libcpp-httplib-dev liblo-dev chromium chromium-driver python3-selenium
   libx11-dev libxrandr-dev xvfb x11-apps xauth bc valgrind
 )
 
