@@ -182,4 +182,45 @@ TEST_F(CliTest, RunRefusesAConsoleItCannotServeSafely) {
   EXPECT_NE(alone.output.find("--console-token applies to --console"), std::string::npos) << alone.output;
 }
 
+// Switching a target's video from the console (issue 70): the content scene with the site's
+// `content_folder:`, a video in it switched to on the duck over HTTP, said in run's output as it comes in;
+// a folder that is not there refused naming the key.
+TEST_F(CliTest, RunSwitchesATargetsVideoFromTheContentFolder) {
+  std::ifstream in(fs::path(PROJBOT_ASSET_DIR) / "scenes" / "content.yaml");
+  std::string scene{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  for (std::size_t at = 0; (at = scene.find("../models/", at)) != std::string::npos;)
+    scene.replace(at, 3, std::string(PROJBOT_ASSET_DIR) + "/");
+  for (std::size_t at = 0; (at = scene.find("../videos/", at)) != std::string::npos;)
+    scene.replace(at, 3, std::string(PROJBOT_GENERATED_ASSET_DIR) + "/");
+  fs::create_directories(dir_ / "videos");
+  fs::copy_file(fs::path(PROJBOT_GENERATED_ASSET_DIR) / "videos" / "countdown.mp4", dir_ / "videos" / "second.mp4");
+  const fs::path site = write("content_site.yaml", scene + "content_folder: videos\n");
+  cli_fixture::Background run({"run", "--sim", "--headless", "--depth-model", "kinect", "--visits", "1", "--dwell", "30",
+                               "--config", site.string(), "--console", "127.0.0.1:0"},
+                              dir_ / "content_run.log");
+  ASSERT_TRUE(run.wait_for_output("console: http://", std::chrono::seconds(60))) << run.output();
+  httplib::Client c("127.0.0.1", console_port(run.output()));
+  c.set_read_timeout(5, 0);
+  EXPECT_EQ(json::parse(c.Get("/api/content")->body).at("files"), json::array({"second.mp4"}));
+  ASSERT_EQ(wait_state(
+                c, [](const json& j) { return j.at("phase") == "lit"; }, 90.0)
+                .at("phase"),
+            "lit");
+  EXPECT_EQ(post(c, "/api/content", {{"target", "duck"}, {"file", "../content_site.yaml"}})->status, 404);
+  ASSERT_EQ(post(c, "/api/content", {{"target", "duck"}, {"file", "second.mp4"}})->status, 200);
+  EXPECT_TRUE(run.wait_for_output("second.mp4: now plays on 'duck', from its start", std::chrono::seconds(20))) << run.output();
+  const json s = wait_state(
+      c, [](const json& j) { return j.at("targets").at(0).at("content") == "second.mp4"; }, 5.0);
+  EXPECT_EQ(s.at("targets").at(0).at("content"), "second.mp4") << s.dump();
+  EXPECT_EQ(s.at("targets").at(1).at("content"), "countdown.mp4") << s.dump();  // the box goes on with its own
+  const auto [code, after_s] = run.signal_and_wait(SIGINT, std::chrono::seconds(60));
+  EXPECT_EQ(code, 130) << run.output();
+
+  const fs::path nowhere = write("nowhere.yaml", scene + "content_folder: nowhere\n");
+  const CliRun refused = run_projbot("run --sim --headless --seconds 1 --config " + nowhere.string());
+  EXPECT_EQ(refused.code, 1) << refused.output;  // a scene file's error, as every other
+  EXPECT_NE(refused.output.find("content_folder"), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("nowhere is not a folder"), std::string::npos) << refused.output;
+}
+
 }  // namespace

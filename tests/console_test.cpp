@@ -30,7 +30,7 @@ namespace live = projbot::live;
 namespace console = projbot::console;
 
 std::vector<live::SiteTarget> two_targets() {
-  return {{"duck", true, std::array<double, 2>{3.0, 3.2}}, {"poster", false, std::nullopt}};
+  return {{"duck", true, std::array<double, 2>{3.0, 3.2}, ""}, {"poster", false, std::nullopt, ""}};
 }
 
 const httplib::Headers kNoHeaders{};
@@ -320,6 +320,52 @@ TEST_F(ConsoleTest, OscTellsTheDeskOfEachChange) {
   ASSERT_EQ(heard.states.size(), 2U);
   EXPECT_EQ(heard.states[0], "driving 1  00");
   EXPECT_EQ(heard.states[1], "lit 1 duck 10");
+}
+
+// Switching a target's video (issue 70): only a file the content folder lists, by name (no path, no link
+// out of it, no hidden file), only on a target that plays a video; the same over HTTP and OSC.
+TEST(ShowControlContent, OnlyAFileTheContentFolderListsByName) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("projbot_content_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "videos" / "sub");
+  for (const char* f : {"a.mp4", "b.mp4", ".hidden.mp4", "sub/c.mp4"}) std::ofstream(dir / "videos" / f) << "x";
+  std::ofstream(dir / "secret.mp4") << "x";
+  std::filesystem::create_symlink(dir / "secret.mp4", dir / "videos" / "out.mp4");
+  std::filesystem::create_symlink(dir / "videos" / "a.mp4", dir / "videos" / "in.mp4");
+  live::ShowControl show({{"duck", true, std::nullopt, "clip.mp4"}, {"poster", false, std::nullopt, ""}}, dir / "videos");
+  EXPECT_EQ(show.content_files(), (std::vector<std::string>{"a.mp4", "b.mp4", "in.mp4"}));
+  using Answer = live::ShowControl::ContentAnswer;
+  EXPECT_EQ(show.content_of(0), "clip.mp4");
+  for (const char* bad : {"../secret.mp4", "out.mp4", ".hidden.mp4", "sub/c.mp4", "sub", "", "/etc/passwd"})
+    EXPECT_EQ(show.switch_content("duck", bad), Answer::no_file) << bad;
+  EXPECT_EQ(show.switch_content("poster", "a.mp4"), Answer::no_video);
+  EXPECT_EQ(show.switch_content("nobody", "a.mp4"), Answer::no_target);
+  EXPECT_TRUE(show.take_content_switches().empty());
+
+  console::Console server(show, console::parse_listen("127.0.0.1:0", "--console"));
+  httplib::Client c("127.0.0.1", server.port());
+  EXPECT_EQ(json::parse(c.Get("/api/content")->body).at("files"), json::array({"a.mp4", "b.mp4", "in.mp4"}));
+  EXPECT_EQ(post(c, "/api/content", R"({"target": "duck", "file": "b.mp4"})")->status, 200);
+  EXPECT_EQ(post(c, "/api/content", R"({"target": "duck", "file": "../secret.mp4"})")->status, 404);
+  EXPECT_EQ(post(c, "/api/content", R"({"target": "poster", "file": "a.mp4"})")->status, 409);
+  EXPECT_EQ(post(c, "/api/content", R"({"target": "duck"})")->status, 400);
+  console::OscControl osc(show, {});
+  const lo_address desk = lo_address_new("127.0.0.1", std::to_string(osc.port()).c_str());
+  lo_send(desk, "/projbot/content", "ss", "duck", "in.mp4");
+  lo_send(desk, "/projbot/content", "ss", "duck", "out.mp4");
+  lo_address_free(desk);
+  for (int i = 0; i < 200 && osc.taken() + osc.refused() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_EQ(osc.taken(), 1U);
+  EXPECT_EQ(osc.refused(), 1U);
+  const auto switches = show.take_content_switches();
+  ASSERT_EQ(switches.size(), 2U);
+  EXPECT_EQ(switches[0], std::make_pair(0, dir / "videos" / "b.mp4"));
+  EXPECT_EQ(switches[1], std::make_pair(0, dir / "videos" / "in.mp4"));
+  EXPECT_EQ(show.content_of(0), "in.mp4");
+
+  live::ShowControl no_folder({{"duck", true, std::nullopt, "clip.mp4"}}, {});
+  EXPECT_EQ(no_folder.switch_content("duck", "a.mp4"), Answer::no_folder);
+  EXPECT_TRUE(no_folder.content_files().empty());
+  std::filesystem::remove_all(dir);
 }
 
 // The render thread's pace between offscreen frames is cut short by a blackout asked for (its first

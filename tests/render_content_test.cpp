@@ -336,6 +336,60 @@ TEST_F(RenderTest, SceneContentSwapsAChangedVideoAndKeepsTheOldOneWhenTheNewFail
   fs::remove_all(dir);
 }
 
+TEST_F(RenderTest, SceneContentSwitchesATargetsVideoAndReusesTheTexturesLetGo) {
+  // The operator's console (issue 70) switches a target's video: the new one plays from its start at a
+  // later frame; switching back to the first size reuses the texture let go; a file that does not open
+  // leaves the playing one, said once; a target without a video cannot switch.
+  const fs::path dir = fs::temp_directory_path() / ("projbot_render_switch_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const auto clip = [&](const std::string& name, std::int64_t first, int w, int h) {
+    projbot::assets::VideoWriter writer(dir / name, w, h, 30);
+    for (int i = 0; i < 10; ++i) writer.write(projbot::assets::frame_code_image(first + i, w, h));
+    writer.finish();
+    return dir / name;
+  };
+  const fs::path first = clip("first.mp4", 0, 320, 240), other = clip("other.mp4", 700, 160, 120);
+  const ContentQuad q = content_quad(*renderer_, projector(200, 200, 150, 150, 99.5, 99.5), video_content(first));
+  projbot::engine::SceneContent content(*renderer_, q.scene, q.models, q.items);
+  auto target = renderer_->make_offscreen(200, 200);
+  const auto code_at = [&](double at) {  // waits (the test, not a renderer) for the frame due, then draws it
+    for (int k = 0; k < 1000; ++k) {
+      const projbot::engine::SceneContent::Sample s = content.show(0, at);
+      if (std::abs(s.pts_s - std::floor(s.content_s * 30.0 + 1e-9) / 30.0) < 1e-3) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    EXPECT_TRUE(renderer_->draw_frame(*target, q.scene.projector, q.items));
+    return projbot::assets::read_frame_code(target->read_back(), 25, 25, 150, 150);
+  };
+  const auto switched = [&](const fs::path& file) {
+    content.switch_video(0, file);
+    std::vector<std::string> said;
+    for (int k = 0; k < 1000 && said.empty(); ++k) {
+      said = content.reload_changed(0.0, 1e9);  // no file looked at again: only the switch
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return said;
+  };
+  EXPECT_EQ(code_at(0.2), 6);
+  std::vector<std::string> said = switched(other);
+  ASSERT_EQ(said.size(), 1U);
+  EXPECT_NE(said[0].find("other.mp4: now plays on 'a', from its start"), std::string::npos) << said[0];
+  EXPECT_EQ(code_at(0.2), 700);  // from its own start at the content time it came in
+  EXPECT_EQ(code_at(0.3), 703);
+  said = switched(first);
+  ASSERT_EQ(said.size(), 1U);
+  EXPECT_EQ(code_at(0.3), 0);              // the first size's texture, let go, drawn again
+  EXPECT_EQ(content.videos().size(), 1U);  // the file watched is the one playing
+  said = switched(dir / "missing.mp4");
+  ASSERT_EQ(said.size(), 1U);
+  EXPECT_NE(said[0].find("missing.mp4"), std::string::npos) << said[0];
+  EXPECT_NE(said[0].find("its old video goes on"), std::string::npos) << said[0];
+  EXPECT_EQ(code_at(0.4), 3);
+  EXPECT_THROW(content.switch_video(1, other), projbot::engine::EngineError);
+  renderer_->finish(*target);
+  fs::remove_all(dir);
+}
+
 namespace {
 
 // A 4 x 1 strip (red, green, blue, white), sampled nearest and repeating: the texel for texture coordinate u.

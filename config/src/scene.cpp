@@ -286,6 +286,13 @@ void read_operator(MapReader& root, const std::filesystem::path& base, Scene& sc
     m.reject_unknown();
     scene.console = c;
   }
+  if (YAML::Node n = root.child("content_folder", false)) {
+    if (!n.IsScalar() || n.Scalar().empty()) root.fail(n, "content_folder", "expected the path of a folder of videos");
+    scene.content_folder = beside_scene(n.Scalar(), base);
+    std::error_code ec;
+    if (!std::filesystem::is_directory(scene.content_folder, ec))
+      root.fail(n, "content_folder", scene.content_folder.string() + " is not a folder");
+  }
   if (YAML::Node n = root.child("osc", false)) {
     MapReader m(n, "osc", root.file());
     OscSite o;

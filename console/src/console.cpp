@@ -46,6 +46,7 @@ struct Console::Impl {
   bool within_rate(httplib::Response& res);
   bool json_body(const httplib::Request& req, httplib::Response& res, json& out);
   void routes();
+  void actions();
   void events(httplib::Response& res);
   void picture(live::ShowPictures::Kind kind, httplib::Response& res);
   /// A picture asked for before the engine took one: not a request refused.
@@ -147,6 +148,15 @@ void Console::Impl::routes() {
              [this](const httplib::Request&, httplib::Response& res) { picture(live::ShowPictures::Kind::frame, res); });
   server.Get("/api/camera.png",
              [this](const httplib::Request&, httplib::Response& res) { picture(live::ShowPictures::Kind::camera, res); });
+  server.Get("/api/content", [this](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    reply(res, 200, {{"files", show.content_files()}});
+  });
+  actions();
+}
+
+// What an operator does (each asks for the token, a JSON body and a place within the rate).
+void Console::Impl::actions() {
   const auto on_off = [this](const std::string& key, auto act) {
     return [this, key, act](const httplib::Request& req, httplib::Response& res) {
       json body;
@@ -158,6 +168,18 @@ void Console::Impl::routes() {
   };
   server.Post("/api/blackout", on_off("blackout", [this](bool on) { show.set_blackout(on, config::steady_now_s()); }));
   server.Post("/api/pause", on_off("paused", [this](bool on) { show.set_paused(on); }));
+  server.Post("/api/content", [this](const httplib::Request& req, httplib::Response& res) {
+    json body;
+    if (!authorised(req, res) || !json_body(req, res, body) || !within_rate(res)) return;
+    if (!body.contains("target") || !body["target"].is_string() || !body.contains("file") || !body["file"].is_string())
+      return refuse(res, 400, "expected {\"target\": NAME, \"file\": NAME}");
+    const std::string target = body["target"].get<std::string>(), file = body["file"].get<std::string>();
+    using Answer = live::ShowControl::ContentAnswer;
+    const Answer a = show.switch_content(target, file);
+    if (a != Answer::switched)
+      return refuse(res, a == Answer::no_target || a == Answer::no_file ? 404 : 409, show.said(a, target, file));
+    reply(res, 200, {{"target", target}, {"content", file}});
+  });
   server.Post("/api/goto", [this](const httplib::Request& req, httplib::Response& res) {
     json body;
     if (!authorised(req, res) || !json_body(req, res, body) || !within_rate(res)) return;

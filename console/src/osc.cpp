@@ -82,6 +82,12 @@ int on_goto(const char*, const char*, lo_arg** argv, int, lo_message message, vo
   return 0;
 }
 
+int on_content(const char*, const char*, lo_arg** argv, int, lo_message message, void* data) {
+  auto& i = *static_cast<Impl*>(data);
+  if (i.allowed(message)) i.act(i.show.switch_content(&argv[0]->s, &argv[1]->s) == live::ShowControl::ContentAnswer::switched);
+  return 0;
+}
+
 // Anything else sent to the port: counted, and dropped.
 int on_other(const char*, const char*, lo_arg**, int, lo_message, void* data) {
   static_cast<Impl*>(data)->refused.fetch_add(1);
@@ -99,6 +105,7 @@ OscControl::OscControl(live::ShowControl& show, OscConfig config) : impl_(std::m
   lo_server_thread_add_method(impl_->server, "/projbot/blackout", "i", on_blackout, impl_.get());
   lo_server_thread_add_method(impl_->server, "/projbot/pause", "i", on_pause, impl_.get());
   lo_server_thread_add_method(impl_->server, "/projbot/goto", "s", on_goto, impl_.get());
+  lo_server_thread_add_method(impl_->server, "/projbot/content", "ss", on_content, impl_.get());
   lo_server_thread_add_method(impl_->server, nullptr, nullptr, on_other, impl_.get());
   lo_server_thread_start(impl_->server);
   if (!impl_->config.send_host.empty()) impl_->teller = std::jthread([i = impl_.get()](std::stop_token stop) { i->tell(stop); });

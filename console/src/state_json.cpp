@@ -12,6 +12,7 @@ std::string state_json(const live::ShowState& s) {
     nlohmann::json j{{"name", t.name}, {"state", t.state}, {"visited", t.visited}};
     j["error_mm"] = t.error_mm >= 0.0 ? nlohmann::json(t.error_mm) : nlohmann::json(nullptr);
     j["at"] = t.at ? nlohmann::json{{"x_m", (*t.at)[0]}, {"y_m", (*t.at)[1]}} : nlohmann::json(nullptr);
+    j["content"] = t.content.empty() ? nlohmann::json(nullptr) : nlohmann::json(t.content);
     targets.push_back(std::move(j));
   }
   nlohmann::json stops = nlohmann::json::array();

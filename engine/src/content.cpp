@@ -157,6 +157,7 @@ SceneContent::SceneContent(Renderer& renderer, const config::Scene& scene, const
     players_.push_back(std::move(s));
   }
   watch_models(scene, models, items);
+  for (const config::TargetConfig& t : scene.targets) names_.push_back(t.name);
 }
 
 const SceneContent::Stream* SceneContent::find(int target) const {
@@ -265,7 +266,67 @@ std::vector<std::string> SceneContent::reload_changed(double now_s, double inter
   if (due) last_look_s_ = now_s;
   reload_videos(due, said);
   reload_models(due, said);
+  take_switches(said);
   return said;
+}
+
+void SceneContent::switch_video(int target, const std::filesystem::path& file) {
+  const Stream* s = find(target);
+  if (s == nullptr || !s->player) throw EngineError("target " + std::to_string(target) + " plays no video to switch");
+  switches_.push_back(
+      {target, file, std::async(std::launch::async, [file] { return std::make_unique<assets::VideoDecoder>(file); })});
+}
+
+// The switches whose video has opened, in the order asked.
+void SceneContent::take_switches(std::vector<std::string>& said) {
+  while (!switches_.empty() && loaded(switches_.front().loading)) {
+    const Switch& sw = switches_.front();
+    try {
+      said.push_back(switch_in(sw, switches_.front().loading.get()));
+    } catch (const std::exception& e) {
+      said.push_back(std::string(e.what()) + " (asked for on '" + names_.at(static_cast<std::size_t>(sw.target)) +
+                     "'; its old video goes on)");
+    }
+    switches_.erase(switches_.begin());
+  }
+}
+
+// The target's stream given the new player (from content time now, as a changed file is), a texture of its
+// size, and a watch on its file; the old player and texture let go where no other target plays them.
+std::string SceneContent::switch_in(const Switch& sw, std::unique_ptr<assets::VideoDecoder> decoder) {
+  Stream& s = *find(sw.target);
+  auto fresh = make_player(std::move(decoder), s.spec.loop);
+  const std::shared_ptr<assets::VideoPlayer> old = s.player;
+  const std::size_t old_texture = s.texture;
+  s.texture = texture_for(s, fresh->info().width, fresh->info().height);
+  s.player = fresh;
+  s.offset_s = s.last_s;
+  s.spec.video = sw.file;
+  Watch w;
+  w.player = fresh;
+  w.stamp.file = sw.file;
+  w.stamp.changed();
+  watches_.push_back(std::move(w));
+  release(old, old_texture);
+  return sw.file.string() + ": now plays on '" + names_.at(static_cast<std::size_t>(sw.target)) + "', from its start";
+}
+
+// A texture no stream draws, of this size, or a new one: switching back and forth adds none.
+std::size_t SceneContent::texture_for(const Stream& s, int width, int height) {
+  std::vector<std::size_t>& spare = spare_textures_[{width, height}];
+  if (spare.empty()) return renderer_.add_streamed_texture(s.model, s.material, width, height);
+  const std::size_t texture = spare.back();
+  spare.pop_back();
+  renderer_.bind_streamed_texture(texture, s.model, s.material);
+  return texture;
+}
+
+void SceneContent::release(const std::shared_ptr<assets::VideoPlayer>& player, std::size_t texture) {
+  const auto plays = [&](const Stream& s) { return s.player == player; };
+  if (std::none_of(players_.begin(), players_.end(), plays))
+    std::erase_if(watches_, [&](const Watch& w) { return w.player == player; });
+  if (std::none_of(players_.begin(), players_.end(), [&](const Stream& s) { return s.player && s.texture == texture; }))
+    spare_textures_[{player->info().width, player->info().height}].push_back(texture);
 }
 
 void SceneContent::reload_videos(bool due, std::vector<std::string>& said) {

@@ -349,16 +349,27 @@ void picture_frame(ShowPictures& pictures, engine::RenderTarget& target) {
 // The render thread's side of the operator's controls: every frame black while the blackout is on (before
 // anything else the projector would show), the latency of each blackout measured at its first black
 // frame, the show's state reported from each frame and its picture taken while wanted.
+// The videos the operator switched targets to, handed to the content (each swapped in at a later frame,
+// and said, by reload_changed).
+void switch_content(ShowControl& show, engine::SceneContent& content, std::ostream& errors) {
+  for (const auto& [target, file] : show.take_content_switches()) try {
+      content.switch_video(target, file);
+    } catch (const engine::EngineError& e) {
+      errors << "content: " << e.what() << std::endl;
+    }
+}
+
 void operate_in_loop(ProjectionInputs& in, ShowControl& show, ShowReporter& reporter, const RobotState& seen,
-                     const ProjectionLoop& loop, engine::RenderTarget& target, RunResult& r) {
+                     const ProjectionLoop& loop, Output& out, std::ostream& errors, RunResult& r) {
   in.pace_sleep = [&show](double until_s) { return show.sleep_until(until_s); };  // a live loop: the steady clock
   in.uniform = [&show, other = in.uniform]() -> std::optional<std::array<std::uint8_t, 3>> {
     if (show.blackout()) return std::array<std::uint8_t, 3>{0, 0, 0};
     return other ? other() : std::nullopt;
   };
-  in.after_frame = [after = in.after_frame, &show, &reporter, &seen, &loop, &target, &r](const DecidedFrame& f) {
+  in.after_frame = [after = in.after_frame, &show, &reporter, &seen, &loop, &out, &errors, &r](const DecidedFrame& f) {
     if (after) after(f);
-    picture_frame(show.pictures(), target);
+    picture_frame(show.pictures(), *out.target);
+    switch_content(show, out.content, errors);
     if (f.uniform && show.blackout()) {
       ++r.blackout_frames;
       if (const std::optional<double> asked = show.take_blackout_asked())
@@ -399,7 +410,7 @@ RunResult run(engine::Renderer& renderer, const config::Scene& scene, const RunO
   live::ProjectionInputs in = live_inputs(scene, robot, seen, trackers, out.content, sources);
   if (probe) learn_in_loop(in, *probe, renderer, out, r.reflectance_measured);
   std::optional<ShowReporter> reporter;
-  if (sources.show) operate_in_loop(in, *sources.show, reporter.emplace(*sources.show), seen, loop, *out.target, r);
+  if (sources.show) operate_in_loop(in, *sources.show, reporter.emplace(*sources.show), seen, loop, out, *sources.errors, r);
   r.figures = loop.run(*out.target, in, profiler);
   r.failure = robot.finish(renderer, *out.target, scene.projector);
   for (const auto& w : trackers.owned)

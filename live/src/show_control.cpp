@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include "projbot/config/clock.hpp"
 
@@ -11,17 +12,76 @@ namespace projbot::live {
 std::vector<SiteTarget> site_targets(const config::Scene& scene) {
   std::vector<SiteTarget> out;
   for (const config::TargetConfig& t : scene.targets) {
-    SiteTarget s{t.name, false, std::nullopt};
+    SiteTarget s{t.name, false, std::nullopt, ""};
     const std::optional<Eigen::Matrix4d>& pose = t.T_map_target ? t.T_map_target : t.T_world_target;
     if (pose) s.at = std::array<double, 2>{(*pose)(0, 3), (*pose)(1, 3)};
     s.reachable = pose.has_value() && t.stop.has_value();
+    if (t.content && !t.content->video.empty()) s.content = t.content->video.filename().string();
     out.push_back(std::move(s));
   }
   return out;
 }
 
-ShowControl::ShowControl(std::vector<SiteTarget> targets)
-    : targets_(std::move(targets)), state_(std::make_shared<const ShowState>()) {}
+ShowControl::ShowControl(std::vector<SiteTarget> targets, std::filesystem::path content_folder)
+    : targets_(std::move(targets)), state_(std::make_shared<const ShowState>()), content_folder_(std::move(content_folder)) {
+  for (const SiteTarget& t : targets_) content_.push_back(t.content);
+}
+
+std::vector<std::string> ShowControl::content_files() const {
+  std::vector<std::string> out;
+  std::error_code ec;
+  if (content_folder_.empty()) return out;
+  const std::filesystem::path folder = std::filesystem::canonical(content_folder_, ec);
+  if (ec) return out;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.empty() || name.front() == '.') continue;
+    const std::filesystem::path real = std::filesystem::canonical(entry.path(), ec);  // a link followed
+    if (ec || real.parent_path() != folder || !std::filesystem::is_regular_file(real, ec)) continue;
+    out.push_back(name);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+ShowControl::ContentAnswer ShowControl::switch_content(const std::string& target, const std::string& file) {
+  if (content_folder_.empty()) return ContentAnswer::no_folder;
+  const auto it = std::find_if(targets_.begin(), targets_.end(), [&](const SiteTarget& t) { return t.name == target; });
+  if (it == targets_.end()) return ContentAnswer::no_target;
+  if (it->content.empty()) return ContentAnswer::no_video;
+  const std::vector<std::string> files = content_files();  // a name listed, never a path
+  if (std::find(files.begin(), files.end(), file) == files.end()) return ContentAnswer::no_file;
+  const auto index = static_cast<std::size_t>(it - targets_.begin());
+  const std::lock_guard lock(mutex_);
+  content_[index] = file;
+  switches_.emplace_back(static_cast<int>(index), content_folder_ / file);
+  return ContentAnswer::switched;
+}
+
+std::string ShowControl::said(ContentAnswer answer, const std::string& target, const std::string& file) const {
+  switch (answer) {
+    case ContentAnswer::no_folder:
+      return "the site file names no content_folder: no content to switch to";
+    case ContentAnswer::no_target:
+      return "no target '" + target + "'";
+    case ContentAnswer::no_video:
+      return "target '" + target + "' plays no video to switch";
+    case ContentAnswer::no_file:
+      return "no file '" + file + "' in the content folder (GET /api/content lists them)";
+    default:
+      return "";
+  }
+}
+
+std::vector<std::pair<int, std::filesystem::path>> ShowControl::take_content_switches() {
+  const std::lock_guard lock(mutex_);
+  return std::exchange(switches_, {});
+}
+
+std::string ShowControl::content_of(std::size_t index) const {
+  const std::lock_guard lock(mutex_);
+  return index < content_.size() ? content_[index] : std::string();
+}
 
 void ShowControl::set_blackout(bool on, double asked_s) {
   {
@@ -122,6 +182,7 @@ ShowState ShowReporter::build(const StopView& stop, const ProjectionFigures& fig
     const bool drawn = std::any_of(drawn_.begin(), drawn_.end(), [&](const DrawnPose& d) { return d.target == index; });
     t.state = drawn ? "lit" : lit ? "blank" : "idle";
     t.visited = !stop.lit.empty() && stop.lit.front() == index;
+    t.content = control_.content_of(i);
     if (drawn && newest && newest->target == index && !std::isnan(newest->error_mm)) t.error_mm = newest->error_mm;
     s.targets.push_back(std::move(t));
   }

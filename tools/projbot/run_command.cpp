@@ -233,7 +233,7 @@ Operated open_controls(const cli::Args& args, const config::Scene& scene, bool r
         "--console and --osc do not apply to --replay: a replay's frames wait on its robot, which a "
         "pause would stall");
   Operated o;
-  o.show = std::make_unique<live::ShowControl>(live::site_targets(scene));
+  o.show = std::make_unique<live::ShowControl>(live::site_targets(scene), scene.content_folder);
   if (page) {
     o.console = std::make_unique<console::Console>(*o.show, *page);
     std::cout << "console: " << o.console->url() << (page->token.empty() ? "" : " (actions need the token)") << std::endl;

@@ -206,6 +206,9 @@ struct Scene {
   DevicesConfig devices;                              ///< `devices:` real devices (none: the twin)
   std::optional<ConsoleSite> console;                 ///< `console:` the operator's page (none: not served)
   std::optional<OscSite> osc;                         ///< `osc:` show control from a desk (none: not listened for)
+  /// `content_folder:` (beside the scene file) the videos an operator may switch a target's content to,
+  /// by name (the console, OSC); empty: none.
+  std::filesystem::path content_folder;
 
   /// Kinect v1 depth: 640x480, fx = fy = 525 px, 0.5-4.5 m.
   static Camera kinect_v1_depth_camera() { return {Pinhole::kinect_v1(), 0.5, 4.5}; }

@@ -9,6 +9,7 @@
 //   GET  /api/events    the same, pushed as it changes POST /api/goto     {"target": NAME}
 //                       (server-sent events)
 //   GET  /api/frame.png the projector's frame, small    GET /api/camera.png  the camera's view, small
+//   GET  /api/content   the videos a target may switch to  POST /api/content {"target": NAME, "file": NAME}
 
 #include <filesystem>
 #include <memory>

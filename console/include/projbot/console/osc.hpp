@@ -4,6 +4,7 @@
 //   /projbot/blackout i   1: every projector frame black until 0
 //   /projbot/pause i      1: the tour holds at its stop until 0
 //   /projbot/goto s       the robot leaves for that target now
+//   /projbot/content s s  that target plays that video (a file name in the site's content folder)
 //
 // the same actions as the console's page, through the same live::ShowControl. UDP; an action is taken
 // only from a loopback sender or a host the operator listed (by IP address): anything else is counted

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <future>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -91,6 +92,12 @@ class SceneContent {
   /// render thread. Returns one line per swap or failure, naming the file.
   std::vector<std::string> reload_changed(double now_s, double interval_s = 0.5);
 
+  /// Target `target`'s video replaced by `file` (the operator's console, issue 70): opened on a loader
+  /// thread; a later reload_changed swaps it in for this target alone (targets that shared its video go on
+  /// with it), playing from its own start, and says so; a file that does not open is said there, and the
+  /// old video goes on. Throws EngineError for a target that plays no video.
+  void switch_video(int target, const std::filesystem::path& file);
+
   /// Target `target`'s player (it must have a video; targets with the same video and start share one).
   const assets::VideoPlayer& player(int target) const;
   /// The videos played, each once (targets with the same video and start share one).
@@ -137,7 +144,17 @@ class SceneContent {
     std::uint64_t shape = 0;  // shape_of its model
     std::future<assets::Model> loading;
   };
+  // A video the operator asked a target to play, while it opens.
+  struct Switch {
+    int target = -1;
+    std::filesystem::path file;
+    std::future<std::unique_ptr<assets::VideoDecoder>> loading;
+  };
   static std::uint64_t shape_of(const assets::Model& model);
+  void take_switches(std::vector<std::string>& said);
+  std::string switch_in(const Switch& sw, std::unique_ptr<assets::VideoDecoder> decoder);
+  std::size_t texture_for(const Stream& s, int width, int height);
+  void release(const std::shared_ptr<assets::VideoPlayer>& player, std::size_t texture);
   void watch_models(const config::Scene& scene, const std::vector<assets::Model>& models, const std::vector<DrawItem>& items);
   void reload_videos(bool due, std::vector<std::string>& said);
   void reload_models(bool due, std::vector<std::string>& said);
@@ -150,6 +167,9 @@ class SceneContent {
   std::vector<Stream> players_;
   std::vector<Watch> watches_;             // one per player
   std::vector<ModelWatch> model_watches_;  // one per target
+  std::vector<Switch> switches_;
+  std::map<std::pair<int, int>, std::vector<std::size_t>> spare_textures_;  // no stream draws them; by width, height
+  std::vector<std::string> names_;                                          // the targets', by index
   double last_look_s_ = -1e300;
   bool exact_ = false;
 };

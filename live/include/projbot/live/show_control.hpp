@@ -11,6 +11,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -28,6 +29,7 @@ struct SiteTarget {
   std::string name;
   bool reachable = false;                   ///< the robot can go to it (a stop, a place on the map)
   std::optional<std::array<double, 2>> at;  ///< where the map says it stands (x, y m); nullopt: not placed
+  std::string content;                      ///< the file name of the video it plays; empty: none (no switching)
 };
 
 /// The scene's targets, in order, as SiteTargets.
@@ -42,6 +44,7 @@ struct TargetShowState {
   bool visited = false;                     ///< the stop's visited target (the others lit are neighbours)
   double error_mm = -1;                     ///< at its display time, where a truth is known; -1: not measured
   std::optional<std::array<double, 2>> at;  ///< where the map says it stands (x, y m)
+  std::string content;                      ///< the video it plays (the last one switched to); empty: none
 };
 
 /// What the show is doing, as the render thread last saw it.
@@ -64,8 +67,9 @@ struct ShowState {
 
 class ShowControl {
  public:
-  /// `targets`: the scene's, in order (site_targets); go_to accepts the reachable ones.
-  explicit ShowControl(std::vector<SiteTarget> targets);
+  /// `targets`: the scene's, in order (site_targets); go_to accepts the reachable ones. `content_folder`:
+  /// the site's videos a target's content may be switched to (empty: none).
+  explicit ShowControl(std::vector<SiteTarget> targets, std::filesystem::path content_folder = {});
 
   // The operator's side (any thread).
   /// Every projector frame black from the next one until released. `asked_s` (steady clock): when the
@@ -76,6 +80,14 @@ class ShowControl {
   /// The robot leaves its stop now for `target`'s (a scene target's name); false (nothing changed) for a
   /// name that is not one, or one the robot cannot go to.
   bool go_to(const std::string& target);
+  /// The videos a target may switch to: the files directly in the content folder, by name, sorted (hidden
+  /// ones left out; a link only where it leads to a file inside the folder). Empty without a folder.
+  std::vector<std::string> content_files() const;
+  enum class ContentAnswer { switched, no_folder, no_target, no_video, no_file };
+  /// Target `target` plays `file` (a name content_files lists; nothing else, no path) from a later frame.
+  ContentAnswer switch_content(const std::string& target, const std::string& file);
+  /// What a ContentAnswer other than `switched` means, for whoever asked.
+  std::string said(ContentAnswer answer, const std::string& target, const std::string& file) const;
   /// The newest state published (a default one before the first).
   std::shared_ptr<const ShowState> state() const;
   /// Waits until a state newer than `sequence` is published or `timeout_ms` pass; the newest either way.
@@ -91,6 +103,10 @@ class ShowControl {
   std::optional<int> take_go_to();
   /// A go-to asked for and not taken yet (scene index).
   std::optional<int> pending_go_to() const;
+  /// The switches asked for since last taken, in order: a scene index and the video's path.
+  std::vector<std::pair<int, std::filesystem::path>> take_content_switches();
+  /// The video target `index` plays as last asked (its file name; empty: none).
+  std::string content_of(std::size_t index) const;
   /// When the blackout now on was asked for (steady clock), once: the render thread takes it at its
   /// first black frame to measure the latency; nullopt when taken or off.
   std::optional<double> take_blackout_asked();
@@ -109,6 +125,9 @@ class ShowControl {
   mutable std::condition_variable asked_;  // a blackout asked for
   std::shared_ptr<const ShowState> state_;
   double blackout_asked_s_ = -1.0;  // under mutex_
+  std::filesystem::path content_folder_;
+  std::vector<std::string> content_;                             // under mutex_, by scene index
+  std::vector<std::pair<int, std::filesystem::path>> switches_;  // under mutex_
   ShowPictures pictures_;
 };
 
