@@ -2,7 +2,7 @@
 """The operator's console in a real browser (issue 70, item 5): `projbot run --sim --headless --console`
 with a token, driven by headless Chromium through chromedriver (Debian's chromium, chromium-driver and
 python3-selenium). The page loads and shows the map with the targets and the robot, which moves from one
-stop to the next; the projector's frame and the camera's view arrive as pictures; the blackout button is
+stop to the next, and the tour's table as it grows; the projector's frame and the camera's view arrive as pictures; the blackout button is
 refused until the token is typed, then blanks the projector (the page's own picture of the projector goes
 black, and the engine's closing line gives the time from the request to the first black frame); the B
 key releases it. A screenshot of the page is kept in the output folder.
@@ -89,6 +89,8 @@ def check_page(driver, base, run):
     circles = driver.execute_script("return document.querySelectorAll('#map circle').length;")
     if circles < 2:
         fail(f"the map shows {circles} targets, expected the tour's 2", run)
+    wait("the tour's table with the first visit", lambda: driver.execute_script(
+        "const r = document.querySelector('#tour tr'); return r && r.textContent.includes('duck');"), 10, run)
     # The map is drawn anew with each state: read it afresh each time.
     robot = lambda: driver.execute_script("const r = document.getElementById('robot'); return r && r.getAttribute('points');")
     robot_at = wait("the robot on the map", robot, 5, run)

@@ -390,6 +390,46 @@ TEST(ShowControl, ABlackoutAskedForWakesTheRenderThreadsPace) {
   EXPECT_FALSE(show.sleep_until(projbot::config::steady_now_s() + 0.01));
 }
 
+// The tour's table (issue 70): a row per visit, its frames at the stop, those that drew its visited
+// target (a blackout's do not), the target's error at display where measured, each frame's counted once.
+TEST(ShowReporter, GrowsTheToursTableVisitByVisit) {
+  live::ShowControl show(two_targets());
+  live::ShowReporter reporter(show, 0.0);
+  live::ProjectionFigures figures;
+  const auto measured = [&](int target, double error_mm, double clock_s) {
+    live::ProjectionRow row;
+    row.target = target;
+    row.error_mm = error_mm;
+    row.clock_s = clock_s;
+    figures.rows.push_back(row);
+  };
+  live::DecidedFrame lit, black;
+  lit.drawn.push_back(live::DrawnPose{});
+  lit.drawn.back().target = 0;
+  black.uniform = true;
+  const live::StopView at_duck{{0}, 1, false, {3.0, 1.8, 1.57}};
+  reporter.frame(live::DecidedFrame{}, at_duck, figures, 10.0, 0.0);  // acquiring: nothing drawn
+  reporter.frame(lit, at_duck, figures, 10.1, 0.1);
+  measured(0, 2.0, 0.1);
+  reporter.frame(lit, at_duck, figures, 10.2, 0.2);
+  measured(0, 4.0, 0.2);
+  reporter.frame(black, at_duck, figures, 10.3, 0.3);
+  reporter.frame(black, at_duck, figures, 10.4, 0.4);  // the same newest row: not counted again
+  reporter.frame(live::DecidedFrame{}, live::StopView{{}, 2, false, {}}, figures, 10.5, 0.5);  // driving
+  const auto s = show.state();
+  ASSERT_EQ(s->tour.size(), 1U);
+  EXPECT_EQ(s->tour[0].visit, 1);
+  EXPECT_EQ(s->tour[0].target, "duck");
+  EXPECT_EQ(s->tour[0].frames, 5U);
+  EXPECT_EQ(s->tour[0].lit_frames, 2U);
+  EXPECT_EQ(s->tour[0].measured, 2U);
+  EXPECT_DOUBLE_EQ(s->tour[0].mean_mm, 3.0);
+  EXPECT_DOUBLE_EQ(s->tour[0].worst_mm, 4.0);
+  const json j = json::parse(console::state_json(*s));
+  EXPECT_EQ(j.at("tour").at(0).at("lit_frames"), 2);
+  EXPECT_EQ(j.at("tour").at(0).at("mean_mm"), 3.0);
+}
+
 // The render thread's report: the phase and each target's state from the frames it drew, a blackout's
 // frames leaving them as the projector would show them without it, five states a second at most.
 TEST(ShowReporter, ReportsWhatTheFramesDrew) {

@@ -17,6 +17,15 @@ std::string state_json(const live::ShowState& s) {
   }
   nlohmann::json stops = nlohmann::json::array();
   for (const auto& p : s.stops) stops.push_back({{"x_m", p[0]}, {"y_m", p[1]}, {"heading_rad", p[2]}});
+  nlohmann::json tour = nlohmann::json::array();
+  const auto mm = [](double v) { return v >= 0.0 ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  for (const live::VisitShowRow& r : s.tour)
+    tour.push_back({{"visit", r.visit},
+                    {"target", r.target},
+                    {"frames", r.frames},
+                    {"lit_frames", r.lit_frames},
+                    {"mean_mm", mm(r.mean_mm)},
+                    {"worst_mm", mm(r.worst_mm)}});
   nlohmann::json robot = stops.empty() ? nlohmann::json(nullptr) : stops.back();
   return nlohmann::json{{"sequence", s.sequence},
                         {"clock_s", s.clock_s},
@@ -30,7 +39,8 @@ std::string state_json(const live::ShowState& s) {
                         {"pose_age_ms", s.pose_age_ms >= 0.0 ? nlohmann::json(s.pose_age_ms) : nlohmann::json(nullptr)},
                         {"blackout", s.blackout},
                         {"paused", s.paused},
-                        {"go_to", s.go_to.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.go_to)}}
+                        {"go_to", s.go_to.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.go_to)},
+                        {"tour", tour}}
       .dump();
 }
 

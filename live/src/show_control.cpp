@@ -154,9 +154,32 @@ void ShowReporter::frame(const DecidedFrame& f, const StopView& stop, const Proj
     stops_.push_back(stop.believed);
     stops_visit_ = stop.visit;
   }
+  count(f, stop, figures);
   if (now_s - last_published_s_ < period_s_) return;
   last_published_s_ = now_s;
   control_.publish(build(stop, figures, clock_s));
+}
+
+// The tour's row for the stop's visit: each frame at a stop counted, those that drew its visited target,
+// and that target's error at display where measured (the newest row measured is the frame before's).
+void ShowReporter::count(const DecidedFrame& f, const StopView& stop, const ProjectionFigures& figures) {
+  if (stop.lit.empty() || stop.visit <= 0) return;
+  const int visited = stop.lit.front();
+  if (tour_.empty() || tour_.back().visit != stop.visit) {
+    tour_.emplace_back();
+    tour_.back().visit = stop.visit;
+    tour_.back().target = control_.targets().at(static_cast<std::size_t>(visited)).name;
+  }
+  VisitShowRow& row = tour_.back();
+  ++row.frames;
+  if (!f.uniform && std::any_of(f.drawn.begin(), f.drawn.end(), [&](const DrawnPose& d) { return d.target == visited; }))
+    ++row.lit_frames;
+  const ProjectionRow* newest = figures.rows.empty() ? nullptr : &figures.rows.back();
+  if (!newest || newest->target != visited || std::isnan(newest->error_mm) || newest->clock_s == last_counted_s_) return;
+  last_counted_s_ = newest->clock_s;
+  const double sum = (row.measured > 0 ? row.mean_mm * static_cast<double>(row.measured) : 0.0) + newest->error_mm;
+  row.mean_mm = sum / static_cast<double>(++row.measured);
+  row.worst_mm = std::max(row.worst_mm, newest->error_mm);
 }
 
 // The targets' states say what the projector shows when not blacked out (or black or grey for a
@@ -192,6 +215,7 @@ ShowState ShowReporter::build(const StopView& stop, const ProjectionFigures& fig
   s.blackout = control_.blackout();
   s.paused = control_.paused();
   if (const auto g = control_.pending_go_to()) s.go_to = site.at(static_cast<std::size_t>(*g)).name;
+  s.tour = tour_;
   return s;
 }
 

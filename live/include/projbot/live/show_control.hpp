@@ -47,6 +47,16 @@ struct TargetShowState {
   std::string content;                      ///< the video it plays (the last one switched to); empty: none
 };
 
+/// One visit of the tour as the projector lit it: its visited target's frames while the robot stood there.
+struct VisitShowRow {
+  int visit = 0;  ///< 1-based
+  std::string target;
+  std::size_t frames = 0, lit_frames = 0;  ///< the projector's frames at the stop; those that drew the target
+  /// The target's error at display over its measured lit frames, mean and worst (mm; -1: none measured).
+  double mean_mm = -1.0, worst_mm = -1.0;
+  std::size_t measured = 0;  ///< lit frames whose error was measured (the twin's)
+};
+
 /// What the show is doing, as the render thread last saw it.
 struct ShowState {
   std::uint64_t sequence = 0;  ///< grows with each state published
@@ -62,7 +72,8 @@ struct ShowState {
   double frame_rate_hz = 0.0;            ///< over the last second
   double pose_age_ms = -1.0;             ///< the newest drawn pose's age at display; -1: nothing drawn
   bool blackout = false, paused = false;
-  std::string go_to;  ///< a target asked for and not reached yet
+  std::string go_to;               ///< a target asked for and not reached yet
+  std::vector<VisitShowRow> tour;  ///< a row per visit so far, the newest last
 };
 
 class ShowControl {
@@ -150,6 +161,7 @@ class ShowReporter {
 
  private:
   ShowState build(const StopView& stop, const ProjectionFigures& figures, double clock_s) const;
+  void count(const DecidedFrame& f, const StopView& stop, const ProjectionFigures& figures);
   ShowControl& control_;
   double period_s_;
   double last_published_s_ = -1e9;
@@ -157,6 +169,8 @@ class ShowReporter {
   std::vector<DrawnPose> drawn_;  // the newest frame's that showed the targets (a blackout's shows none)
   std::vector<std::array<double, 3>> stops_;
   int stops_visit_ = 0;  // the visit whose stop was last added
+  std::vector<VisitShowRow> tour_;
+  double last_counted_s_ = -1.0;  // the figures' row last counted into the tour (its clock_s)
 };
 
 }  // namespace projbot::live
