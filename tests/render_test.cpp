@@ -329,3 +329,35 @@ TEST_F(RenderTest, BadRequestsAreErrors) {
   empty.source = "empty";
   EXPECT_THROW(renderer_->add_model(empty), projbot::engine::EngineError);
 }
+
+// The operator's picture of the projector's frame (issue 70): a copy of the next frame drawn, recorded into
+// that frame's commands and taken once it is done, without waiting: the frame asked for, not a later one,
+// every pixel of it. A depth camera's frames are not copied.
+TEST_F(RenderTest, CopiesTheNextFrameWithoutWaitingForIt) {
+  const projbot::config::ProjectorConfig p = projector(64, 48, 60, 60, 31.5, 23.5);
+  auto target = renderer_->make_offscreen(64, 48);
+  const auto draw = [&](std::array<std::uint8_t, 3> rgb) {
+    renderer_->set_background(rgb);
+    ASSERT_TRUE(renderer_->draw_frame(*target, p, std::span<const DrawItem>{}));
+  };
+  EXPECT_FALSE(target->take_copy().has_value());  // none asked
+  draw({10, 10, 10});
+  ASSERT_TRUE(target->copy_next());
+  draw({200, 30, 40});               // the frame copied (no read back here: it would fill the same buffer)
+  ASSERT_TRUE(target->copy_next());  // asked again before taken: the same copy
+  std::optional<Image> copy;
+  for (int k = 0; k < 4 && !copy; ++k) {
+    draw({0, 0, 255});  // later frames do not change it
+    copy = target->take_copy();
+  }
+  ASSERT_TRUE(copy.has_value()) << "the copy never came";
+  EXPECT_EQ(copy->width, 64);
+  std::size_t other = 0;
+  for (int y = 0; y < copy->height; ++y)
+    for (int x = 0; x < copy->width; ++x) other += copy->pixel(x, y)[0] != 200 || copy->pixel(x, y)[2] != 40 ? 1 : 0;
+  EXPECT_EQ(other, 0U) << "pixels not of the frame asked for";
+  EXPECT_FALSE(target->take_copy().has_value());  // taken once
+  renderer_->set_background({0, 0, 0});
+  renderer_->finish(*target);
+  EXPECT_FALSE(renderer_->make_depth_camera(32, 24)->copy_next());
+}

@@ -137,6 +137,19 @@ class TargetBackend {
   virtual bool poll_close() { return false; }
   virtual std::uint64_t native_window() const { return 0; }
   virtual assets::Image read_back() = 0;
+  /// Where a frame's copy is recorded (CopyOfNext); null for a target whose frames are not copied (a window,
+  /// a depth camera).
+  virtual vk::Buffer copy_buffer() { return nullptr; }
+  /// The copy's bytes, once its frame is done: the image as read_back gives it.
+  virtual assets::Image copied() { throw EngineError("this target's frames are not copied"); }
+
+  /// A copy of the next frame, recorded into its own commands (nothing waits for it): asked for, then the
+  /// slot whose frame holds it, then done once that slot is retired.
+  struct CopyOfNext {
+    bool asked = false;
+    std::optional<std::size_t> slot;
+    bool done = false;
+  } copy;
   /// True for a depth camera target: R32 float colour holding camera-frame depth, 0 where no surface.
   virtual bool depth_output() const { return false; }
   virtual DepthMap read_back_depth() { throw EngineError("read_back_depth: this target renders colour, not depth"); }

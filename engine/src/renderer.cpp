@@ -132,6 +132,7 @@ void Renderer::Impl::retire(detail::TargetBackend& t, std::size_t index) {
   if (gpu->device.waitForFences(*slot.fence, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
     throw EngineError("a frame's fence never signalled");
   slot.held.clear();  // the GPU has copied what the frame read from host memory
+  if (t.copy.slot == index) t.copy.done = true;
   if (!slot.pending) return;
   slot.pending = false;
   if (slot.profiler == nullptr) return;
@@ -232,6 +233,20 @@ void Renderer::Impl::record_lens(const vk::raii::CommandBuffer& cmd, detail::Tar
   cmd.endRendering();
 }
 
+// The frame's image copied into the target's host buffer after its last write (its layout is then
+// eTransferSrcOptimal), made visible to the host by the time the slot's fence signals.
+void Renderer::Impl::record_copy(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, vk::Image color,
+                                 std::size_t slot) {
+  const vk::Extent2D e = t.extent();
+  cmd.copyImageToBuffer(color, vk::ImageLayout::eTransferSrcOptimal, t.copy_buffer(),
+                        vk::BufferImageCopy(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, 1),
+                                            {0, 0, 0}, vk::Extent3D(e, 1)));
+  const vk::MemoryBarrier2 to_host(vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite,
+                                   vk::PipelineStageFlagBits2::eHost, vk::AccessFlagBits2::eHostRead);
+  cmd.pipelineBarrier2(vk::DependencyInfo({}, to_host, {}, {}));
+  t.copy = {false, slot, false};
+}
+
 bool Renderer::Impl::draw_frame(detail::TargetBackend& t, const config::ProjectorConfig& projector, const PoseReader& read_poses,
                                 FrameProfiler* profiler) {
   ensure_slots(t);
@@ -293,6 +308,7 @@ bool Renderer::Impl::draw_frame(detail::TargetBackend& t, const config::Projecto
                      vk::AccessFlagBits2::eColorAttachmentWrite,
                      to_present ? vk::PipelineStageFlagBits2::eNone : vk::PipelineStageFlagBits2::eCopy,
                      to_present ? vk::AccessFlagBits2::eNone : vk::AccessFlagBits2::eTransferRead);
+  if (t.copy.asked && !to_present) record_copy(cmd, t, frame->color, si);
   if (*t.timestamps) cmd.writeTimestamp2(vk::PipelineStageFlagBits2::eAllCommands, *t.timestamps, q0 + 1);
   cmd.end();
   if (profiler) rec.recorded_ms = profiler->now_ms();
@@ -322,6 +338,19 @@ int RenderTarget::height() const { return static_cast<int>(backend_->extent().he
 bool RenderTarget::poll_close() { return backend_->poll_close(); }
 std::uint64_t RenderTarget::native_window() const { return backend_->native_window(); }
 assets::Image RenderTarget::read_back() { return backend_->read_back(); }
+
+bool RenderTarget::copy_next() {
+  if (!backend_->copy_buffer()) return false;
+  if (!backend_->copy.slot) backend_->copy.asked = true;  // one copy at a time
+  return true;
+}
+
+std::optional<assets::Image> RenderTarget::take_copy() {
+  detail::TargetBackend::CopyOfNext& c = backend_->copy;
+  if (!c.slot || !c.done) return std::nullopt;
+  c = {};
+  return backend_->copied();
+}
 DepthMap RenderTarget::read_back_depth() { return backend_->read_back_depth(); }
 
 Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl>(options)) {}

@@ -259,6 +259,7 @@ struct Renderer::Impl {
 
   // Waits for a slot's previous frame and hands its timing to its profiler.
   void retire(detail::TargetBackend& t, std::size_t index);
+  void record_copy(const vk::raii::CommandBuffer& cmd, detail::TargetBackend& t, vk::Image color, std::size_t slot);
 
   // `projector`: the pinhole drawn through (a lens canvas's, or the projector's); `panel`: the projector
   // whose light compensation divides out.

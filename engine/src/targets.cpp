@@ -64,6 +64,16 @@ class OffscreenBackend final : public TargetBackend {
     return out;
   }
 
+  vk::Buffer copy_buffer() override { return depth_output_ ? vk::Buffer{} : *readback_.buffer; }
+  assets::Image copied() override {
+    assets::Image out;
+    out.width = static_cast<int>(color_.extent.width);
+    out.height = static_cast<int>(color_.extent.height);
+    const auto* bytes = static_cast<const std::uint8_t*>(readback_.mapped);
+    out.rgba.assign(bytes, bytes + readback_.size);
+    return out;
+  }
+
   DepthMap read_back_depth() override {
     if (!depth_output_) throw EngineError("read_back_depth: this target renders colour; use read_back");
     DepthMap out;

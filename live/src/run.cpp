@@ -334,21 +334,16 @@ void learn_in_loop(live::ProjectionInputs& in, ReflectanceProbe& probe, engine::
   };
 }
 
-// The projector's frame, offered to the operator's page when one is due (read back from an offscreen
-// target; a window's frames are not read back, which the page is told once).
+// The projector's frame, offered to the operator's page: a copy recorded into a frame's own commands when
+// one is due and taken once that frame is done, so the render thread never waits for it. A window's
+// frames are not copied, which the page is told once.
 void picture_frame(ShowPictures& pictures, engine::RenderTarget& target) {
-  if (!pictures.due(ShowPictures::Kind::frame)) return;
-  try {
-    pictures.offer(ShowPictures::Kind::frame, target.read_back());
-  } catch (const engine::EngineError&) {
+  if (std::optional<assets::Image> copy = target.take_copy()) pictures.offer(ShowPictures::Kind::frame, std::move(*copy));
+  if (pictures.due(ShowPictures::Kind::frame) && !target.copy_next())
     pictures.set_unavailable(ShowPictures::Kind::frame,
                              "the projector's frames go to a window and are not read back (a --headless run shows them)");
-  }
 }
 
-// The render thread's side of the operator's controls: every frame black while the blackout is on (before
-// anything else the projector would show), the latency of each blackout measured at its first black
-// frame, the show's state reported from each frame and its picture taken while wanted.
 // The videos the operator switched targets to, handed to the content (each swapped in at a later frame,
 // and said, by reload_changed).
 void switch_content(ShowControl& show, engine::SceneContent& content, std::ostream& errors) {

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -111,6 +112,13 @@ class RenderTarget {
   std::uint64_t native_window() const;
   /// Offscreen: the last drawn frame as RGBA8 (waits for it). Windows and depth cameras: throws EngineError.
   assets::Image read_back();
+  /// Offscreen colour: a copy of the next frame drawn, recorded into that frame's own commands, so that
+  /// nothing waits for it (read_back waits for the GPU); take_copy gives it once that frame is done. One
+  /// copy at a time: asking again before it is taken changes nothing. False for a target whose frames are
+  /// not copied (a window, a depth camera).
+  bool copy_next();
+  /// The copy asked for by copy_next, once its frame is done (never waits); nullopt before.
+  std::optional<assets::Image> take_copy();
   /// Depth cameras: the last drawn frame's depth (waits for it). Other targets: throws EngineError.
   DepthMap read_back_depth();
 
