@@ -407,7 +407,7 @@ TEST(ShowReporter, GrowsTheToursTableVisitByVisit) {
   lit.drawn.push_back(live::DrawnPose{});
   lit.drawn.back().target = 0;
   black.uniform = true;
-  const live::StopView at_duck{{0}, 1, false, {3.0, 1.8, 1.57}};
+  const live::StopView at_duck{{0}, 1, false, {3.0, 1.8, 1.57}, std::nullopt};
   reporter.frame(live::DecidedFrame{}, at_duck, figures, 10.0, 0.0);  // acquiring: nothing drawn
   reporter.frame(lit, at_duck, figures, 10.1, 0.1);
   measured(0, 2.0, 0.1);
@@ -415,7 +415,7 @@ TEST(ShowReporter, GrowsTheToursTableVisitByVisit) {
   measured(0, 4.0, 0.2);
   reporter.frame(black, at_duck, figures, 10.3, 0.3);
   reporter.frame(black, at_duck, figures, 10.4, 0.4);  // the same newest row: not counted again
-  reporter.frame(live::DecidedFrame{}, live::StopView{{}, 2, false, {}}, figures, 10.5, 0.5);  // driving
+  reporter.frame(live::DecidedFrame{}, live::StopView{{}, 2, false, {}, std::nullopt}, figures, 10.5, 0.5);  // driving
   const auto s = show.state();
   ASSERT_EQ(s->tour.size(), 1U);
   EXPECT_EQ(s->tour[0].visit, 1);
@@ -439,7 +439,7 @@ TEST(ShowReporter, ReportsWhatTheFramesDrew) {
   live::DecidedFrame lit;
   lit.drawn.push_back(live::DrawnPose{});
   lit.drawn.back().target = 0;
-  const live::StopView at_duck{{0}, 1, false, {3.0, 1.8, 1.57}};
+  const live::StopView at_duck{{0}, 1, false, {3.0, 1.8, 1.57}, std::nullopt};
   reporter.frame(lit, at_duck, figures, 10.0, 0.0);
   auto s = show.state();
   EXPECT_EQ(s->phase, "lit");
@@ -462,7 +462,11 @@ TEST(ShowReporter, ReportsWhatTheFramesDrew) {
   EXPECT_EQ(s->phase, "lit");
   EXPECT_NEAR(s->frame_rate_hz, 2.0 / 0.3, 1e-9);
 
-  reporter.frame(live::DecidedFrame{}, live::StopView{{}, 2, false, {}}, figures, 10.6, 0.6);
+  EXPECT_EQ(s->robot, (std::array<double, 3>{3.0, 1.8, 1.57}));  // at the stop: its pose
+  reporter.frame(live::DecidedFrame{}, live::StopView{{}, 2, false, {}, std::array<double, 3>{4.0, 2.0, 0.5}}, figures, 10.6,
+                 0.6);
+  EXPECT_EQ(show.state()->robot, (std::array<double, 3>{4.0, 2.0, 0.5}));  // driving: where it believes it is now
+  EXPECT_EQ(show.state()->stops.size(), 1U);
   EXPECT_EQ(show.state()->phase, "driving");
   EXPECT_EQ(show.state()->targets.at(0).state, "idle");
 }

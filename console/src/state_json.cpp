@@ -26,7 +26,9 @@ std::string state_json(const live::ShowState& s) {
                     {"lit_frames", r.lit_frames},
                     {"mean_mm", mm(r.mean_mm)},
                     {"worst_mm", mm(r.worst_mm)}});
-  nlohmann::json robot = stops.empty() ? nlohmann::json(nullptr) : stops.back();
+  const nlohmann::json robot =
+      s.robot ? nlohmann::json{{"x_m", (*s.robot)[0]}, {"y_m", (*s.robot)[1]}, {"heading_rad", (*s.robot)[2]}}
+              : nlohmann::json(nullptr);
   return nlohmann::json{{"sequence", s.sequence},
                         {"clock_s", s.clock_s},
                         {"phase", s.phase},

@@ -38,6 +38,7 @@ struct RobotState {
   // The truth at the stop (the twin's), so the render thread measures each frame at its display time;
   // null where nothing serves a truth (a replay, the configured robot).
   std::shared_ptr<const StopTruth> truth{};
+  std::optional<std::array<double, 3>> moving{};  // while driving: where it believes it is now (none at a stop)
 };
 
 // The mean marker error of a target drawn (at its display time and pose), against the truth then; NaN
@@ -70,7 +71,19 @@ class RunObserver final : public StopObserver {
   void show_to(ShowPictures* pictures) { pictures_ = pictures; }
   void driving(int visit) override {
     visit_ = visit + 1;
-    state_.publish({.lit = {}, .since_s = clock_.now_s(), .visit = visit_});
+    driving_since_s_ = clock_.now_s();
+    state_.publish({.lit = {}, .since_s = driving_since_s_, .visit = visit_});
+  }
+  /// Where the robot believes it is while it drives, published about ten times a second (on the steady
+  /// clock: a simulated drive steps faster than its own time) for the operator's map.
+  void moving(const robot::Pose2D& believed) {
+    const double now = config::steady_now_s();
+    if (driving_since_s_ < 0.0 || now - moved_s_ < 0.1) return;
+    moved_s_ = now;
+    state_.publish({.lit = {},
+                    .since_s = driving_since_s_,
+                    .visit = visit_,
+                    .moving = std::array<double, 3>{believed.x_m, believed.y_m, believed.theta_rad}});
   }
   /// The visit last published (1-based).
   int visit() const { return visit_; }
@@ -80,6 +93,7 @@ class RunObserver final : public StopObserver {
     std::vector<DrawnTarget> lit;
     for (const LitTarget& l : stop.lit) lit.push_back({l.target, l.target == stop.target ? stop.target_visit : 0});
     visit_ = stop.visit + 1;
+    driving_since_s_ = -1.0;  // at a stop: the map shows the stop's pose
     const robot::Pose2D& at = stop.drive.estimate;
     state_.publish({lit, since_s, visit_, false, {at.x_m, at.y_m, at.theta_rad}, rig_.truth(stop)});
   }
@@ -125,6 +139,8 @@ class RunObserver final : public StopObserver {
   live::PoseSource poses_;
   ShowPictures* pictures_ = nullptr;
   int visit_ = 0;
+  double driving_since_s_ = -1.0;  // the drive under way began (session clock); -1: none
+  double moved_s_ = -1e9;          // the last pose published while driving (steady clock)
 };
 
 // The operator's pause and go-to during a dwell: not over while paused; over at once when a go-to is asked.
@@ -206,6 +222,7 @@ void RobotThread::drive(const config::Scene& scene, const RunOptions& o, live::S
     ShowPictures& pictures = sources.show->pictures();
     observer.show_to(&pictures);
     rig.colour_wanted([&pictures] { return pictures.due(ShowPictures::Kind::camera); });
+    rig.session().navigator().watch_drive([&observer](const robot::Pose2D& believed) { observer.moving(believed); });
   }
   if (probe_) {
     observer.learn(probe_, [&trackers](int index, alignment::PoseSample& pose) {
@@ -219,6 +236,7 @@ void RobotThread::drive(const config::Scene& scene, const RunOptions& o, live::S
     if (sources.show) take_the_operators_turn(*sources.show, rig.session(), *sources.log, cancel);
     rig.session().visit(v, trackers.workers, dwell, observer, cancel);
   }
+  rig.session().navigator().watch_drive({});  // the observer goes with this scope
   state_.publish({.lit = {}, .since_s = clock.now_s(), .visit = observer.visit(), .done = true});
 }
 
@@ -370,7 +388,7 @@ void operate_in_loop(ProjectionInputs& in, ShowControl& show, ShowReporter& repo
       if (const std::optional<double> asked = show.take_blackout_asked())
         r.blackout_latency_ms.push_back(1000.0 * (f.display_s - *asked));
     }
-    StopView stop{{}, seen.visit, seen.done, seen.believed};
+    StopView stop{{}, seen.visit, seen.done, seen.believed, seen.moving};
     for (const DrawnTarget& lit : seen.lit) stop.lit.push_back(lit.target);
     reporter.frame(f, stop, loop.figures(), f.start_s, f.start_s - loop.started_s());
   };

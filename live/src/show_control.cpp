@@ -195,6 +195,7 @@ ShowState ShowReporter::build(const StopView& stop, const ProjectionFigures& fig
   const std::vector<SiteTarget>& site = control_.targets();
   if (!stop.lit.empty()) s.visiting = site.at(static_cast<std::size_t>(stop.lit.front())).name;
   s.stops = stops_;
+  s.robot = stop.moving ? stop.moving : stops_.empty() ? std::nullopt : std::optional(stops_.back());
   const ProjectionRow* newest = figures.rows.empty() ? nullptr : &figures.rows.back();
   for (std::size_t i = 0; i < site.size(); ++i) {
     TargetShowState t;

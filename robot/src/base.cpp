@@ -48,10 +48,12 @@ BaseTwist BaseController::update(const Pose2D& estimate, const Pose2D& goal, dou
   return cmd;
 }
 
-bool drive_loop(BaseController& controller, DriveSteps& steps, const Pose2D& goal, double timeout_s) {
+bool drive_loop(BaseController& controller, DriveSteps& steps, const Pose2D& goal, double timeout_s,
+                const std::function<void(const Pose2D&)>& watch) {
   controller.reset();
   for (long step = 0;; ++step) {
     steps.sense(step);
+    if (watch) watch(steps.believed_pose());
     const BaseTwist cmd = controller.update(steps.believed_pose(), goal, steps.step_s());
     if (controller.arrived() || steps.elapsed_s() > timeout_s) break;
     steps.command(cmd);

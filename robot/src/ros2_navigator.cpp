@@ -108,7 +108,7 @@ StopReport Ros2Navigator::drive_to(const Pose2D& goal, int index) {
   r.index = index;
   r.goal = goal;
   Steps steps(*this);
-  r.arrived = drive_loop(controller_, steps, goal, timeout_s_);
+  r.arrived = drive_loop(controller_, steps, goal, timeout_s_, watch_);
   r.drive_seconds = steps.elapsed_s();
   r.estimate = believed_pose();
   r.odometry = compose(T_map_odom_start_, last_.pose);

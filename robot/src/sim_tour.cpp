@@ -111,7 +111,7 @@ StopReport SimRobot::drive_to(const Pose2D& goal, int index) {
   r.index = index;
   r.goal = goal;
   Steps steps(*this, r);
-  r.arrived = drive_loop(controller_, steps, goal, c_.max_seconds_per_stop);
+  r.arrived = drive_loop(controller_, steps, goal, c_.max_seconds_per_stop, watch_);
   r.drive_seconds = steps.elapsed_s();
   r.truth = base_.true_pose();
   r.odometry = odometry_.pose();

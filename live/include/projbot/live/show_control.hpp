@@ -68,6 +68,8 @@ struct ShowState {
   std::string visiting;  ///< the visited target's name; empty while driving
   /// Where the robot believed it was at each stop so far (map frame: x, y in m, heading in rad), the newest last.
   std::vector<std::array<double, 3>> stops;
+  /// Where it believes it is now: while driving, its pose at the newest control step read; else the newest stop's.
+  std::optional<std::array<double, 3>> robot;
   std::vector<TargetShowState> targets;  ///< by scene index
   double frame_rate_hz = 0.0;            ///< over the last second
   double pose_age_ms = -1.0;             ///< the newest drawn pose's age at display; -1: nothing drawn
@@ -144,10 +146,11 @@ class ShowControl {
 
 /// The stop as the render thread last read the robot's state.
 struct StopView {
-  std::vector<int> lit;              ///< scene indices, the visited one first; empty while driving
-  int visit = 0;                     ///< 1-based; 0 before the first
-  bool done = false;                 ///< the tour is over (or the robot failed)
-  std::array<double, 3> believed{};  ///< where the robot believed it was at the stop (x, y m; heading rad)
+  std::vector<int> lit;                         ///< scene indices, the visited one first; empty while driving
+  int visit = 0;                                ///< 1-based; 0 before the first
+  bool done = false;                            ///< the tour is over (or the robot failed)
+  std::array<double, 3> believed{};             ///< where the robot believed it was at the stop (x, y m; heading rad)
+  std::optional<std::array<double, 3>> moving{};  ///< while driving: where it believes it is now
 };
 
 /// The render thread's side of ShowControl: each frame seen, the show's state published about five times

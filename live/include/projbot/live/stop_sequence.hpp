@@ -105,6 +105,8 @@ class StopSequence {
                config::Clock clock = config::Clock::steady());
   /// The clock its stops and frames are timed on.
   const config::Clock& clock() const { return clock_; }
+  /// The robot it drives (to watch its drives).
+  robot::Navigator& navigator() { return base_; }
 
   /// The target of the tour's `visit`-th stop (0-based, cycling through scene.visits): its scene index.
   int target_of(int visit) const;

@@ -6,6 +6,8 @@
 // reading the motor encoders. Everything above this interface (odometry, localisation, the
 // controller, the tour) is the same for the twin and the robot.
 
+#include <functional>
+
 #include "projbot/robot/youbot.hpp"
 
 namespace projbot::robot {
@@ -80,7 +82,9 @@ class DriveSteps {
 };
 
 /// The drive to a stop: sense, ask `controller`, command, until it says arrived or `timeout_s` has passed;
-/// then halt and settle. Returns whether it arrived.
-bool drive_loop(BaseController& controller, DriveSteps& steps, const Pose2D& goal, double timeout_s);
+/// then halt and settle. Returns whether it arrived. `watch` (when set) is told the believed pose at
+/// every step.
+bool drive_loop(BaseController& controller, DriveSteps& steps, const Pose2D& goal, double timeout_s,
+                const std::function<void(const Pose2D&)>& watch = {});
 
 }  // namespace projbot::robot
