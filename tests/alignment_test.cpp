@@ -11,6 +11,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/scan_alignment.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/scene.hpp"
 
 namespace fs = std::filesystem;
@@ -39,7 +40,7 @@ Eigen::Matrix4d perturb(const Eigen::Matrix4d& T, double angle_deg, double shift
   const Eigen::Vector3d axis = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
   const Eigen::Vector3d dir = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
   Eigen::Matrix4d D = Eigen::Matrix4d::Identity();
-  D.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, axis).toRotationMatrix();
+  D.topLeftCorner<3, 3>() = Eigen::AngleAxisd(projbot::config::radians(angle_deg), axis).toRotationMatrix();
   D.topRightCorner<3, 1>() = shift_m * dir;
   return D * T;
 }

@@ -19,6 +19,7 @@
 #include "projbot/alignment/registration.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/assets/image.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/rigid.hpp"
 #include "projbot/config/scene.hpp"
 
@@ -263,7 +264,7 @@ TEST_F(BopCopy, ARoundedRotationIsMadeOrthonormalAndCounted) {
   const Eigen::Matrix3d R = data.scenes[0].images[0].instances[0].T_camera_model.topLeftCorner<3, 3>();
   EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
-  EXPECT_NEAR(std::atan2(R(1, 0), R(0, 0)) * 180.0 / M_PI, 30.0, 0.05);
+  EXPECT_NEAR(projbot::config::degrees(std::atan2(R(1, 0), R(0, 0))), 30.0, 0.05);
   const std::string note = projbot::alignment::rounded_rotations_note(data);
   EXPECT_NE(note.find("1 rotation rounded off orthonormal (worst 0.0019"), std::string::npos) << note;
   EXPECT_EQ(projbot::alignment::rounded_rotations_note(read_bop_dataset(kYcbv)), "") << "float32 rotations are not rounded";
@@ -335,7 +336,7 @@ TEST(PoseError, AddIsTheMeanVertexDistanceAndAddsForgivesASymmetry) {
   // Points on a ring about z: turning it about z by any angle is a symmetry.
   std::vector<Eigen::Vector3f> ring;
   for (int i = 0; i < 360; ++i) {
-    const double a = i * M_PI / 180.0;
+    const double a = projbot::config::radians(i);
     ring.emplace_back(static_cast<float>(0.05 * std::cos(a)), static_cast<float>(0.05 * std::sin(a)), 0.0F);
   }
   const Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
@@ -413,7 +414,7 @@ TEST(UnseenTurn, TheRealMugWithItsHandleHiddenIsTurnedBackToItsGuess) {
       EXPECT_FALSE(view.all[0].is_slide());
     }
     for (const double deg : {-65.0, -40.0, 40.0, 65.0}) {
-      const Eigen::Matrix4d found = turn_axis(view, view.all.front()).turn(deg * M_PI / 180.0) * truth;
+      const Eigen::Matrix4d found = turn_axis(view, view.all.front()).turn(projbot::config::radians(deg)) * truth;
       ASSERT_GT(add_error_m(m.vertices, found, truth), 0.02) << instance.obj_id << ' ' << deg;
       const Eigen::Matrix4d back = nearest_unseen_turn(m.cloud, found, truth, depth, image.k);
       if (instance.obj_id == 14)

@@ -17,6 +17,7 @@
 #include "projbot/calibrate/capture.hpp"
 #include "projbot/calibrate/photometric.hpp"
 #include "projbot/calibrate/procam.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/scene.hpp"
 
 namespace fs = std::filesystem;
@@ -56,7 +57,7 @@ SimulationConfig twin_config(int poses) {
 
 double angle_deg(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
   const Eigen::Matrix3d d = a.block<3, 3>(0, 0) * b.block<3, 3>(0, 0).transpose();
-  return std::acos(std::clamp((d.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
+  return projbot::config::degrees(std::acos(std::clamp((d.trace() - 1.0) / 2.0, -1.0, 1.0)));
 }
 
 }  // namespace

@@ -14,8 +14,10 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "projbot/assets/image.hpp"
+#include "raw_http.hpp"
 
 using namespace cli_fixture;
 
@@ -221,6 +223,62 @@ TEST_F(CliTest, RunSwitchesATargetsVideoFromTheContentFolder) {
   EXPECT_EQ(refused.code, 1) << refused.output;  // a scene file's error, as every other
   EXPECT_NE(refused.output.find("content_folder"), std::string::npos) << refused.output;
   EXPECT_NE(refused.output.find("nowhere is not a folder"), std::string::npos) << refused.output;
+}
+
+// The hostile run (issue 70, item 5) through the executable: a twin run with a token on its console takes
+// a thousand malformed requests, a body claiming 100 MB, 200 silent connections, a wrong token twenty
+// times, paths out of the page and a content name out of its folder. Every one is refused, nothing is
+// acted on, and the show goes on: its state keeps coming at the projector's rate, the run ends on Ctrl-C
+// as always, having drawn its frames.
+TEST_F(CliTest, RunGoesOnUnderHostileConsoleClients) {
+  const fs::path token = dir_ / "hostile_token";
+  std::ofstream(token) << "a-token-of-sixteen-or-more\n";
+  fs::permissions(token, fs::perms::owner_read | fs::perms::owner_write);
+  std::set<std::string> before;
+  for (const auto& e : fs::directory_iterator(dir_)) before.insert(e.path().filename().string());
+  cli_fixture::Background run({"run", "--sim", "--headless", "--depth-model", "kinect", "--visits", "2", "--dwell", "20",
+                               "--console", "127.0.0.1:0", "--console-token", token.string()},
+                              dir_ / "hostile_run.log");
+  ASSERT_TRUE(run.wait_for_output("console: http://", std::chrono::seconds(60))) << run.output();
+  const int port = console_port(run.output());
+  httplib::Client c("127.0.0.1", port);
+  c.set_read_timeout(30, 0);  // behind the silent connections, each given up on after the read timeout
+  ASSERT_EQ(wait_state(
+                c, [](const json& j) { return j.at("phase") == "lit"; }, 90.0)
+                .at("phase"),
+            "lit");
+  const std::vector<std::string> junk = raw_http::junk();
+  std::size_t answered_otherwise = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const std::string answer = raw_http::send(port, junk[static_cast<std::size_t>(i) % junk.size()]);
+    answered_otherwise += !answer.empty() && answer.rfind("HTTP/1.1 4", 0) != 0 ? 1 : 0;  // closed unanswered: refused too
+  }
+  EXPECT_EQ(answered_otherwise, 0U);
+  const std::string huge = raw_http::send(port, raw_http::huge_body());
+  EXPECT_TRUE(huge.empty() || huge.rfind("HTTP/1.1 413", 0) == 0) << huge.substr(0, 200);
+  const std::vector<int> held = raw_http::hold(port, 200);
+  EXPECT_EQ(held.size(), 200U);
+  httplib::Headers wrong{{"Authorization", "Bearer wrong-token-wrong-token"}};
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(c.Post("/api/blackout", wrong, R"({"on": true})", "application/json")->status, 401);
+  EXPECT_EQ(c.Get("/../../../etc/passwd")->status, 404);
+  EXPECT_EQ(c.Post("/api/content", wrong, R"({"target": "duck", "file": "../../etc/passwd"})", "application/json")->status, 401);
+  for (const int fd : held) ::close(fd);
+  const json s = wait_state(
+      c, [](const json& j) { return j.at("frame_rate_hz").get<double>() > 30.0; }, 10.0);
+  EXPECT_GT(s.at("frame_rate_hz").get<double>(), 30.0) << s.dump();  // the projector's loop went on (60 Hz paced)
+  EXPECT_FALSE(s.at("blackout").get<bool>());
+  const auto [code, after_s] = run.signal_and_wait(SIGINT, std::chrono::seconds(60));
+  EXPECT_EQ(code, 130) << run.output();
+  const std::string out = run.output();
+  const auto line = out.rfind("requests refused");
+  ASSERT_NE(line, std::string::npos) << out;
+  const auto start = out.rfind("; ", line) + 2;
+  EXPECT_GE(std::stoi(out.substr(start)), 22) << out.substr(start, 80);  // at least the wrong tokens and the paths
+  EXPECT_EQ(out.find("0 frames blacked out"), out.rfind("console: ") + 9) << out;
+  std::set<std::string> after;
+  for (const auto& e : fs::directory_iterator(dir_)) after.insert(e.path().filename().string());
+  before.insert("hostile_run.log");
+  EXPECT_EQ(after, before);  // nothing written but the run's own log
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "projbot/config/angles.hpp"
 #include "projbot/config/isolated_read.hpp"
 #include "projbot/config/scene.hpp"
 
@@ -145,7 +146,7 @@ TEST(SceneTest, TargetContent) {
 
 TEST(SceneTest, RpyIsRzRyRx) {
   const auto s = parse_scene(kGood, "/scenes/s.yaml");
-  const double d = M_PI / 180.0;
+  const double d = projbot::config::radians(1.0);
   const Eigen::Matrix3d expected =
       (Eigen::AngleAxisd(30 * d, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(20 * d, Eigen::Vector3d::UnitY()) *
        Eigen::AngleAxisd(10 * d, Eigen::Vector3d::UnitX()))

@@ -22,6 +22,7 @@
 
 #include "projbot/config/clock.hpp"
 #include "projbot/console/osc.hpp"
+#include "raw_http.hpp"
 
 namespace {
 
@@ -93,24 +94,6 @@ TEST_F(ConsoleTest, MalformedRequestsGetA4xxAndChangeNothing) {
   EXPECT_EQ(c.Get("/api/state")->status, 200);  // and it still answers
 }
 
-// Raw bytes to the console's port: what a broken or hostile client sends, without an HTTP library's manners.
-std::string send_raw(int port, const std::string& bytes) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_port = htons(static_cast<std::uint16_t>(port));
-  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  std::string answer;
-  if (::connect(fd, reinterpret_cast<const sockaddr*>(&to), sizeof to) == 0) {
-    (void)!::write(fd, bytes.data(), bytes.size());
-    ::shutdown(fd, SHUT_WR);
-    char buf[512];
-    for (ssize_t n; (n = ::read(fd, buf, sizeof buf)) > 0;) answer.append(buf, static_cast<std::size_t>(n));
-  }
-  ::close(fd);
-  return answer;
-}
-
 // Hostile clients (issue 70, item 5): a thousand malformed requests, a body claiming 100 MB, 200
 // connections held open at once, a path out of the page, a wrong token again and again. Each is refused,
 // nothing changes, and the console still answers a proper request at the end.
@@ -119,33 +102,17 @@ TEST_F(ConsoleTest, HostileClientsAreRefusedAndTheConsoleGoesOn) {
   config.token = "a-token-of-sixteen-or-more";
   console::Console server(show_, config);
   const int port = server.port();
-  const std::vector<std::string> junk{
-      "GARBAGE\r\n\r\n",
-      "GET\r\n\r\n",
-      "POST /api/blackout HTTP/1.1\r\nContent-Length: -5\r\n\r\n",
-      std::string(5000, 'A') + "\r\n\r\n",
-      "GET /%00%ff HTTP/1.1\r\n\r\n",
-      "POST /api/goto HTTP/1.1\r\nContent-Type: application/json\r\nContent-Length: 3\r\n\r\n{\"t"};
+  const std::vector<std::string> junk = raw_http::junk();
   for (int i = 0; i < 1000; ++i) {
-    const std::string answer = send_raw(port, junk[static_cast<std::size_t>(i) % junk.size()]);
+    const std::string answer = raw_http::send(port, junk[static_cast<std::size_t>(i) % junk.size()]);
     if (!answer.empty()) {  // some are closed without a word: also a refusal
       EXPECT_EQ(answer.rfind("HTTP/1.1 4", 0), 0U) << answer.substr(0, 80);
     }
   }
-  const std::string huge = send_raw(port,
-                                    "POST /api/blackout HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
-                                    "Content-Length: 104857600\r\n\r\n{\"on\": true}");
+  const std::string huge = raw_http::send(port, raw_http::huge_body());
   // Refused unread: a 413, or (httplib skipping the claimed body, the client gone) the connection closed.
   EXPECT_TRUE(huge.empty() || huge.rfind("HTTP/1.1 413", 0) == 0) << huge.substr(0, 200);
-  std::vector<int> held;
-  for (int i = 0; i < 200; ++i) {  // connected and silent
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in to{};
-    to.sin_family = AF_INET;
-    to.sin_port = htons(static_cast<std::uint16_t>(port));
-    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(fd, reinterpret_cast<const sockaddr*>(&to), sizeof to) == 0) held.push_back(fd);
-  }
+  const std::vector<int> held = raw_http::hold(port, 200);
   EXPECT_EQ(held.size(), 200U);
   httplib::Client c("127.0.0.1", port);
   c.set_read_timeout(30, 0);  // behind the silent ones, each given up on after the read timeout

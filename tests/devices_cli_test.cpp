@@ -21,6 +21,7 @@
 #include "device_fixtures.hpp"
 #include "projbot/alignment/freenect_source.hpp"
 #include "projbot/assets/image.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/robot/pan_tilt.hpp"
 #include "projbot/robot/pose2d.hpp"
@@ -430,7 +431,8 @@ TEST_F(DevicesCli, RunLocalisesAConfiguredRobotByItsLaser) {
                                   "}\n  laser: {class: CHokuyoURG, params: {COM_port_LIN: " + urg.string() +
                                   ", pose_x: 0.25}, map: " + (dir_ / "map").string() + "}\n");
   const Eigen::Vector3d& start = scene.robot_start;
-  const double set_down_x = start.x() + 0.12, set_down_y = start.y() - 0.09, set_down_rad = start.z() + 4.0 * M_PI / 180.0;
+  const double set_down_x = start.x() + 0.12, set_down_y = start.y() - 0.09,
+               set_down_rad = start.z() + projbot::config::radians(4.0);
   const fs::path log = dir_ / "sim-base.txt", pid = dir_ / "sim-base.pid";
   // Its own --seconds bounds it (not `timeout`, which would pass the stop signal on twice: the second quits at once).
   ASSERT_EQ(std::system(("sh -c 'echo $$ > " + pid.string() + "; exec " + std::string(PROJBOT_EXE) +

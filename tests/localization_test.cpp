@@ -12,6 +12,7 @@
 #include <numbers>
 #include <tuple>
 
+#include "projbot/config/angles.hpp"
 #include "projbot/robot/sim_tour.hpp"
 
 namespace {
@@ -19,7 +20,7 @@ namespace {
 using namespace projbot::robot;
 namespace fs = std::filesystem;
 const fs::path kData = fs::path(PROJBOT_SHARED_DATA) / "mrpt";
-[[maybe_unused]] double deg(double d) { return d * std::numbers::pi / 180.0; }
+[[maybe_unused]] double deg(double d) { return projbot::config::radians(d); }
 
 fs::path temp_dir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("projbot_" + name + "_" + std::to_string(::getpid()));

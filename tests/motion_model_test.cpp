@@ -9,11 +9,13 @@
 #include <cmath>
 #include <random>
 
+#include "projbot/config/angles.hpp"
+
 namespace projbot::alignment {
 namespace {
 
 constexpr double kDt = 1.0 / 30.0;  // the depth camera's frame interval
-constexpr double kDeg = M_PI / 180.0;
+constexpr double kDeg = projbot::config::radians(1.0);
 
 Eigen::Matrix4d pose(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();

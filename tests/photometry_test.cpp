@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 
+#include "projbot/config/angles.hpp"
 #include "projbot/engine/renderer.hpp"
 
 namespace {
@@ -133,7 +134,7 @@ struct Patch {
     projector = mixed_projector();
     projector.width_px = 320, projector.height_px = 200, projector.fx_px = projector.fy_px = 350.0;
     projector.cx_px = 150.3, projector.cy_px = 104.1;
-    T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(projbot::config::radians(40.0), Eigen::Vector3d::UnitY()).toRotationMatrix();
     T.topRightCorner<3, 1>() = Eigen::Vector3d(0.15, -0.05, 2.0);
   }
   Eigen::Vector3d normal() const { return T.topLeftCorner<3, 3>() * Eigen::Vector3d::UnitZ(); }

@@ -8,12 +8,13 @@
 #include <fstream>
 #include <numbers>
 
+#include "projbot/config/angles.hpp"
 #include "projbot/robot/ptu_d46.hpp"
 
 namespace {
 
 using namespace projbot::robot;
-constexpr double kStep = 185.1428 / 3600.0 * std::numbers::pi / 180.0;  // PTU-D46-17 resolution
+constexpr double kStep = projbot::config::radians(185.1428 / 3600.0);  // PTU-D46-17 resolution
 
 TEST(PtuD46, InitialisesAndReadsTheResolution) {
   PtuD46Emulator unit;

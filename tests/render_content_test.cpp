@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "projbot/config/angles.hpp"
 #include "render_fixture.hpp"
 
 using namespace render_test;
@@ -524,7 +525,7 @@ TEST_F(RenderTest, SceneContentSwapsAChangedTextureAndKeepsTheModelWhereItCannot
   t.name = "box";
   t.model = dir / "BoxTextured.gltf";
   t.scale = 0.3;
-  t.T_projector_target = pose(0, 0, 1, 200 * M_PI / 180, 35 * M_PI / 180, 0);
+  t.T_projector_target = pose(0, 0, 1, projbot::config::radians(200), projbot::config::radians(35), 0);
   scene.targets.push_back(t);
   std::vector<Model> models;
   const std::vector<DrawItem> items = projbot::engine::upload_scene(*renderer_, scene, &models);

@@ -16,6 +16,8 @@
 #include <string>
 #include <thread>
 
+#include "projbot/config/angles.hpp"
+
 using namespace projbot;
 
 namespace {
@@ -101,8 +103,9 @@ TEST_F(ReplayTest, APoseLogReadBackComparesItsOwnPosesExactlyAndMeasuresADiffere
   turned.compare(scene, stop_lighting_both(0), 1, {rounded, std::nullopt});
   EXPECT_EQ(turned.max_deg, 0.0);
   alignment::PoseSample two = rounded;
-  two.T_camera_target.topLeftCorner<3, 3>() = rounded.T_camera_target.topLeftCorner<3, 3>() *
-                                              Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  two.T_camera_target.topLeftCorner<3, 3>() =
+      rounded.T_camera_target.topLeftCorner<3, 3>() *
+      Eigen::AngleAxisd(projbot::config::radians(2.0), Eigen::Vector3d::UnitZ()).toRotationMatrix();
   turned.compare(scene, stop_lighting_both(0), 1, {two, std::nullopt});
   EXPECT_NEAR(turned.max_deg, 2.0, 1e-4);
 }

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "dds_loopback.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/robot/laser.hpp"
 #include "projbot/robot/localization.hpp"
 
@@ -174,7 +175,7 @@ TEST(Ros2Navigator, LocalisesOnTheLaserWhereOdometryAloneIsOff) {
             << " rejected), " << r.correct_ms_mean << " ms each; drove " << r.drive_seconds << " s\n";
   EXPECT_TRUE(r.arrived);
   EXPECT_LT(distance(r.estimate, truth), 0.015);
-  EXPECT_LT(std::abs(r.estimate.theta_rad - truth.theta_rad), 0.5 * M_PI / 180.0);
+  EXPECT_LT(std::abs(r.estimate.theta_rad - truth.theta_rad), projbot::config::radians(0.5));
   EXPECT_LT(distance(truth, goal), 0.03);
   EXPECT_GT(distance(r.odometry, truth), 0.06);  // the start's 6 cm and 2 degrees, carried along (9 cm)
   EXPECT_GE(r.corrections, 20);

@@ -1,6 +1,7 @@
 // The shop's stops in the twin: acquisition of the figure beside its shelf, the Duck's colour, the
 // spectator's view and what the visitor sees.
 
+#include "projbot/config/angles.hpp"
 #include "twin_helpers.hpp"
 
 namespace {
@@ -39,7 +40,7 @@ TEST_F(ShopFigureStop, TheShopFigureIsFoundFromATenDegreeGuessBesideItsShelf) {
   // 10 degrees about the line of sight through the figure's chest, and 5 cm sideways.
   const Eigen::Vector3d chest = (T_true * Eigen::Vector4d(0.0, 1.0, 0.0, 1.0)).head<3>();
   Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
-  turn.topLeftCorner<3, 3>() = Eigen::AngleAxisd(10.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  turn.topLeftCorner<3, 3>() = Eigen::AngleAxisd(projbot::config::radians(10.0), Eigen::Vector3d::UnitZ()).toRotationMatrix();
   turn.topRightCorner<3, 1>() = chest - turn.topLeftCorner<3, 3>() * chest + Eigen::Vector3d(0.05, 0.0, 0.0);
   const Eigen::Matrix4d guess = turn * T_true;
   const double grow_m = projbot::alignment::guess_reach_m(cloud, 0.05, 10.0);
@@ -82,8 +83,8 @@ TEST_F(ShopFigureStop, TheShopFigureIsFoundFromATenDegreeGuessBesideItsShelf) {
 // the first ICP stages run (no restart, no global search) and what they leave is not taken: blanked.
 TEST_F(ShopFigureStop, AnAcquisitionStopsAtItsBudgetAndBlanks) {
   Eigen::Matrix4d guess = T_true;  // 30 cm sideways and turned 40 degrees about the vertical
-  guess.topLeftCorner<3, 3>() =
-      Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix() * T_true.topLeftCorner<3, 3>();
+  guess.topLeftCorner<3, 3>() = Eigen::AngleAxisd(projbot::config::radians(40.0), Eigen::Vector3d::UnitY()).toRotationMatrix() *
+                                T_true.topLeftCorner<3, 3>();
   guess(0, 3) += 0.30;
   projbot::alignment::WorkerConfig none;
   none.acquire_budget_ms = 0.0;

@@ -16,6 +16,7 @@
 #include "projbot/alignment/tracker.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
 
@@ -32,7 +33,8 @@ inline Eigen::Matrix4d perturb(const Eigen::Matrix4d& T, double angle_deg, doubl
   std::normal_distribution<double> g;
   Eigen::Matrix4d D = Eigen::Matrix4d::Identity();
   D.topLeftCorner<3, 3>() =
-      Eigen::AngleAxisd(angle_deg * M_PI / 180.0, Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized()).toRotationMatrix();
+      Eigen::AngleAxisd(projbot::config::radians(angle_deg), Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized())
+          .toRotationMatrix();
   // Rotate about the target's own centre (its origin after recentring), then shift.
   Eigen::Matrix4d out = T;
   out.topLeftCorner<3, 3>() = D.topLeftCorner<3, 3>() * T.topLeftCorner<3, 3>();

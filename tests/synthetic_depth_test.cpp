@@ -1,6 +1,7 @@
 // Acquisition on synthetic Kinect v1 frames: the Duck rendered by the engine's depth camera at known
 // poses 0.8-2.0 m away, with and without the Kinect v1 noise model.
 
+#include "projbot/config/angles.hpp"
 #include "synthetic_depth_fixture.hpp"
 
 using namespace synthetic_depth;
@@ -100,7 +101,7 @@ TEST_F(SyntheticDepthTest, AFootingFromTheMapHoldsThePoseUprightAtItsHeight) {
   // (a table's height). The footing is where the map says it stands: upright, its lowest point 0.8 m
   // up. A pose lifted 3 cm or tipped fails it; a guess tipped 35 degrees and 4 cm too high is stood
   // upright at the surveyed height before ICP and found.
-  const double s = std::sin(20.0 * M_PI / 180.0), c = std::cos(20.0 * M_PI / 180.0);
+  const double s = std::sin(projbot::config::radians(20.0)), c = std::cos(projbot::config::radians(20.0));
   Eigen::Matrix4d T_world_camera = Eigen::Matrix4d::Identity();
   T_world_camera.topLeftCorner<3, 3>().col(0) = Eigen::Vector3d(1, 0, 0);
   T_world_camera.topLeftCorner<3, 3>().col(1) = Eigen::Vector3d(0, -s, -c);
@@ -128,7 +129,7 @@ TEST_F(SyntheticDepthTest, AFootingFromTheMapHoldsThePoseUprightAtItsHeight) {
   EXPECT_FALSE(lifted.stands || lifted.converged);
   EXPECT_NEAR(lifted.footing_height_error_mm, 30.0, 0.5);
   Eigen::Matrix4d tipped = Eigen::Matrix4d::Identity();  // 120 degrees about the world's x through the duck
-  tipped.topLeftCorner<3, 3>() = Eigen::AngleAxisd(120.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  tipped.topLeftCorner<3, 3>() = Eigen::AngleAxisd(projbot::config::radians(120.0), Eigen::Vector3d::UnitX()).toRotationMatrix();
   const Eigen::Vector3d middle = T_world_target.topRightCorner<3, 1>();
   tipped.topRightCorner<3, 1>() = middle - tipped.topLeftCorner<3, 3>() * middle + Eigen::Vector3d(0.0, 0.0, 0.04);
   const AlignmentResult tipped_score = aligner.score(scan, moved(tipped), footing);
@@ -186,7 +187,8 @@ TEST_F(SyntheticDepthTest, ColourTurnsABoxSeenFaceOnAboutItsFacesNormalAndReache
   ASSERT_GT(std::abs(normal.z()), 0.9);
   for (const double turn_deg : {1.0, -1.0}) {
     Eigen::Matrix4d off = b.T;
-    off.topLeftCorner<3, 3>() = Eigen::AngleAxisd(turn_deg * M_PI / 180.0, normal).toRotationMatrix() * b.T.topLeftCorner<3, 3>();
+    off.topLeftCorner<3, 3>() =
+        Eigen::AngleAxisd(projbot::config::radians(turn_deg), normal).toRotationMatrix() * b.T.topLeftCorner<3, 3>();
     off.topRightCorner<3, 1>() += b.T.topLeftCorner<3, 3>() * Eigen::Vector3d(0.008, -0.006, 0.0);
     const ColourRefinement r = colour_refined(b.cloud, off, b.depth, b.colour, k_);
     const Eigen::Matrix4d err = rigid_inverse(b.T) * r.T_camera_model;
@@ -225,7 +227,7 @@ TEST_F(SyntheticDepthTest, LooksAlikeTellsATexturedBoxsTurnsOntoItselfFromWrongP
   const FaceOnBox b = face_on_box();
   const auto turned = [](double deg, const Eigen::Vector3d& axis, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) {
     Eigen::Matrix4d D = Eigen::Matrix4d::Identity();
-    D.topLeftCorner<3, 3>() = Eigen::AngleAxisd(deg * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+    D.topLeftCorner<3, 3>() = Eigen::AngleAxisd(projbot::config::radians(deg), axis.normalized()).toRotationMatrix();
     D.topRightCorner<3, 1>() = t;
     return D;
   };

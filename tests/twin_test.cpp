@@ -1,6 +1,7 @@
 // The digital twin: the projection-error measurement on hand-computed cases, the mesh ray caster, bad
 // scenes and tours named, and the room standing in the depth images.
 
+#include "projbot/config/angles.hpp"
 #include "twin_helpers.hpp"
 
 namespace {
@@ -63,7 +64,7 @@ TEST_F(MarkerErrorTest, MarkersTheProjectorSeesEdgeOnAreNotMeasured) {
   EXPECT_TRUE(seen_edge_on(scene_, {0.499, 0.0, 1.0}));
   const auto turned = [&](double deg) {  // the slab turned about its vertical axis through its centre
     Eigen::Matrix4d T = T_true_;
-    T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(projbot::config::radians(deg), Eigen::Vector3d::UnitY()).toRotationMatrix();
     return std::vector<PlacedMesh>{{&slab_, T}};
   };
   EXPECT_FALSE(seen_edge_on(turned(60.0), {0.0, 0.0, 1.0}));

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "projbot/config/angles.hpp"
+
 namespace projbot::alignment {
 
 namespace {
@@ -63,7 +65,8 @@ std::vector<Eigen::Matrix4d> turns_about(const Eigen::Vector3d& centre, double t
   for (int axis = 0; axis < 3; ++axis)
     for (const double sign : {1.0, -1.0}) {
       Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-      T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(sign * turn_deg * M_PI / 180.0, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
+      T.topLeftCorner<3, 3>() =
+          Eigen::AngleAxisd(sign * config::radians(turn_deg), Eigen::Vector3d::Unit(axis)).toRotationMatrix();
       T.topRightCorner<3, 1>() = centre - T.topLeftCorner<3, 3>() * centre;
       turns.push_back(T);
     }

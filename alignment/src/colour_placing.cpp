@@ -10,6 +10,7 @@
 #include "front_samples.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/config/angles.hpp"
 
 namespace projbot::alignment {
 
@@ -145,7 +146,7 @@ ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& 
     const int n = static_cast<int>(std::lround(reach_deg / step_deg));
     for (int i = -n; i <= n; ++i) {
       SampleMove m = from;
-      m.turn = Eigen::AngleAxisd(i * step_deg * M_PI / 180.0, turn_axis).toRotationMatrix() * from.turn;
+      m.turn = Eigen::AngleAxisd(i * config::radians(step_deg), turn_axis).toRotationMatrix() * from.turn;
       consider(m);
     }
   };
@@ -172,7 +173,7 @@ ColourRefinement colour_refined(const ModelCloud& model, const Eigen::Matrix4d& 
   out.T_camera_model.topLeftCorner<3, 3>() = best_move.turn * R;
   out.T_camera_model.topRightCorner<3, 1>() = best_move(t);
   out.shift_m = best_move.shift;
-  out.turn_deg = Eigen::AngleAxisd(best_move.turn).angle() * 180.0 / M_PI;
+  out.turn_deg = config::degrees(Eigen::AngleAxisd(best_move.turn).angle());
   out.agreement_after = best;
   out.out_of_reach = on_rim;
   return out;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "projbot/config/angles.hpp"
+
 namespace projbot::alignment {
 
 Eigen::Matrix4d rigid_inverse(const Eigen::Matrix4d& T) {
@@ -34,7 +36,7 @@ Eigen::Matrix4d projector_from_target(const Eigen::Matrix4d& T_projector_camera,
 
 double rotation_angle_deg(const Eigen::Matrix4d& T) {
   const double c = std::clamp((T.topLeftCorner<3, 3>().trace() - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c) * 180.0 / M_PI;
+  return config::degrees(std::acos(c));
 }
 
 double translation_norm_m(const Eigen::Matrix4d& T) { return T.topRightCorner<3, 1>().norm(); }

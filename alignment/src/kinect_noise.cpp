@@ -8,6 +8,8 @@
 #include <random>
 #include <vector>
 
+#include "projbot/config/angles.hpp"
+
 namespace projbot::alignment {
 namespace {
 
@@ -137,7 +139,7 @@ DepthImage apply_kinect_v1_noise(const DepthImage& clean, const CameraIntrinsics
   DepthImage out = clean;
   const int w = clean.width, h = clean.height;
   const float* zin = clean.depth_m.data();
-  const double cos_max = std::cos(cfg.max_incidence_deg * M_PI / 180.0);
+  const double cos_max = std::cos(config::radians(cfg.max_incidence_deg));
   const auto cos2_max = static_cast<float>(cos_max * cos_max);
   const std::vector<float>& gauss = gaussian_table();
   XorShift rng(seed);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "projbot/alignment/equations.hpp"
+#include "projbot/config/angles.hpp"
 
 namespace projbot::alignment {
 namespace {
@@ -160,7 +161,7 @@ MotionState MotionFilter::state() const {
   const double turned_rad = log_so3(measured_.topLeftCorner<3, 3>() * oldest.topLeftCorner<3, 3>().transpose()).norm();
   const bool translating = moved_m > std::max(cfg_.still_sigmas * M_SQRT2 * position_noise_, cfg_.min_speed_m_s * span_s);
   const bool turning =
-      turned_rad > std::max(cfg_.still_sigmas * M_SQRT2 * rotation_noise_, cfg_.min_rate_deg_s * M_PI / 180.0 * span_s);
+      turned_rad > std::max(cfg_.still_sigmas * M_SQRT2 * rotation_noise_, config::radians(cfg_.min_rate_deg_s) * span_s);
   // A still part whose measured noise is well above the configured one: the mean of the window's poses.
   if (!translating && position_noise_ > cfg_.average_above * cfg_.position_noise_m) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -178,7 +179,7 @@ MotionState MotionFilter::state() const {
   }
   if (turning) {
     s.T.topLeftCorner<3, 3>() = filtered_.topLeftCorner<3, 3>();
-    s.angular_velocity_rad_s = clamp_norm(rotation_.rate, cfg_.max_rate_deg_s * M_PI / 180.0);
+    s.angular_velocity_rad_s = clamp_norm(rotation_.rate, config::radians(cfg_.max_rate_deg_s));
   }
   return s;
 }

@@ -22,6 +22,7 @@
 #include "pcl_steps.hpp"
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/clock.hpp"
 #include "serial_kdtree.hpp"
 
@@ -169,7 +170,7 @@ struct Aligner::Impl {
       CountingIcp icp(cfg.point_to_plane, hold_weak && last);
       if (cfg.max_normal_angle_deg < 180.0) {
         auto normals = pcl::make_shared<pcl::registration::CorrespondenceRejectorSurfaceNormal>();
-        normals->setThreshold(std::cos(cfg.max_normal_angle_deg * M_PI / 180.0));
+        normals->setThreshold(std::cos(config::radians(cfg.max_normal_angle_deg)));
         icp.addCorrespondenceRejector(normals);
       }
       if (cfg.icp_median_factor > 0.0) {  // PCL compares squared distances
@@ -348,7 +349,7 @@ struct Aligner::Impl {
     const Eigen::Vector3d up = r.T_scan_model.topLeftCorner<3, 3>() * footing.up_model;
     const double cosine = std::clamp(up.normalized().dot(footing.floor.normal), -1.0, 1.0);
     r.footing_height_error_mm = 1000.0 * (h - footing.height_m);
-    r.footing_tilt_deg = std::acos(cosine) * 180.0 / M_PI;
+    r.footing_tilt_deg = config::degrees(std::acos(cosine));
     const double above = h - footing.height_m;
     // A support found in the frame says the target rests on it: not floating above it.
     const double float_limit = footing.upright_known ? cfg.footing_height_m : cfg.support_float_m;
@@ -502,7 +503,7 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     // each camera axis, or with a footing (upright is known) about the floor's normal by one and two steps.
     const Eigen::Vector3d c = m.extent.centre_in(T_init);
     std::vector<Eigen::AngleAxisd> turns;
-    const double step = m.cfg.restart_angle_deg * M_PI / 180.0;
+    const double step = config::radians(m.cfg.restart_angle_deg);
     for (int i = 0; i < 3; ++i)
       for (const double sign : {1.0, -1.0})
         if (!footing || !footing->upright_known)

@@ -7,6 +7,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/clock.hpp"
 
 namespace projbot::bench {
@@ -18,7 +19,7 @@ Eigen::Matrix4d perturbed(const Eigen::Matrix4d& T, double cm, double deg, std::
   const Eigen::Vector3d axis = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
   const Eigen::Vector3d shift = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized() * cm / 100.0;
   Eigen::Matrix4d out = T;
-  out.topLeftCorner<3, 3>() = Eigen::AngleAxisd(deg * M_PI / 180.0, axis).toRotationMatrix() * T.topLeftCorner<3, 3>();
+  out.topLeftCorner<3, 3>() = Eigen::AngleAxisd(config::radians(deg), axis).toRotationMatrix() * T.topLeftCorner<3, 3>();
   out.topRightCorner<3, 1>() += shift;
   return out;
 }

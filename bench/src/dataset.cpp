@@ -10,6 +10,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/pose_error.hpp"
 #include "projbot/alignment/verification.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/clock.hpp"
 #include "projbot/config/output_file.hpp"
 
@@ -34,7 +35,7 @@ Eigen::Matrix4d perturbed(const Eigen::Matrix4d& T, const Eigen::Vector3d& centr
   std::normal_distribution<double> n(0.0, 1.0);
   const Eigen::Vector3d axis = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
   const Eigen::Vector3d shift = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized() * p.mm / 1000.0;
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(p.deg * M_PI / 180.0, axis).toRotationMatrix();
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(config::radians(p.deg), axis).toRotationMatrix();
   const Eigen::Vector3d c = (T * centre_model.homogeneous()).head<3>();
   Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
   turn.topLeftCorner<3, 3>() = R;

@@ -14,6 +14,7 @@
 #include "capture_io.hpp"
 #include "projbot/calibrate/capture.hpp"
 #include "projbot/calibrate/procam.hpp"
+#include "projbot/config/angles.hpp"
 
 namespace projbot::calibrate {
 namespace {
@@ -168,7 +169,7 @@ cv::Mat expose(const SimulationConfig& c, const std::vector<Sample>& samples, co
 }
 
 Eigen::Matrix3d tilt(double rx_deg, double ry_deg, double rz_deg) {
-  const double k = M_PI / 180.0;
+  const double k = config::radians(1.0);
   return (Eigen::AngleAxisd(rx_deg * k, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(ry_deg * k, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(rz_deg * k, Eigen::Vector3d::UnitZ()))
       .toRotationMatrix();

@@ -10,6 +10,7 @@
 
 #include "capture_io.hpp"
 #include "projbot/calibrate/procam.hpp"
+#include "projbot/config/angles.hpp"
 #include "solve_views.hpp"
 
 namespace projbot::calibrate {
@@ -199,7 +200,7 @@ TruthComparison compare(const Calibration& c, const Calibration& t) {
   r.camera_fy_pct = pct(k.fy_px, l.fy_px);
   r.camera_principal_px = std::hypot(k.cx_px - l.cx_px, k.cy_px - l.cy_px);
   const Eigen::Matrix3d dR = c.T_projector_camera.block<3, 3>(0, 0) * t.T_projector_camera.block<3, 3>(0, 0).transpose();
-  r.rotation_deg = std::acos(std::clamp((dR.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
+  r.rotation_deg = config::degrees(std::acos(std::clamp((dR.trace() - 1.0) / 2.0, -1.0, 1.0)));
   r.translation_mm = 1000.0 * (c.T_projector_camera.block<3, 1>(0, 3) - t.T_projector_camera.block<3, 1>(0, 3)).norm();
   r.projector_lens = config::has_distortion(c.projector.distortion) || config::has_distortion(t.projector.distortion);
   if (r.projector_lens) r.projector_lens_px = lens_difference_px(c.projector, t.projector);

@@ -5,13 +5,14 @@
 #include <cstdio>
 #include <string>
 
+#include "projbot/config/angles.hpp"
 #include "projbot/config/rigid.hpp"
 #include "projbot/config/scene.hpp"
 
 namespace projbot::config {
 
 Eigen::Matrix4d pose_from_xyz_rpy(const Eigen::Vector3d& translation_m, const Eigen::Vector3d& rpy_deg) {
-  const Eigen::Vector3d rad = rpy_deg * (M_PI / 180.0);
+  const Eigen::Vector3d rad = rpy_deg * radians(1.0);
   const Eigen::Matrix3d R =
       (Eigen::AngleAxisd(rad.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rad.y(), Eigen::Vector3d::UnitY()) *
        Eigen::AngleAxisd(rad.x(), Eigen::Vector3d::UnitX()))

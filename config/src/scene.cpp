@@ -13,6 +13,7 @@
 
 #include "devices_reader.hpp"
 #include "map_reader.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/paths.hpp"
 #include "projbot/config/yaml_keys.hpp"
 #include "target_reader.hpp"
@@ -214,7 +215,7 @@ PanTiltConfig read_robot(MapReader& root, Scene& scene) {
   MapReader r(node, "robot", root.file());
   if (YAML::Node st = r.child("start", false)) {
     scene.robot_start = r.vector3(st, "robot.start");
-    scene.robot_start.z() *= std::numbers::pi / 180.0;
+    scene.robot_start.z() = radians(scene.robot_start.z());
   }
   if (YAML::Node dn = r.child("drift", false)) {
     MapReader d(dn, "robot.drift", root.file());
@@ -249,8 +250,8 @@ PanTiltConfig read_robot(MapReader& root, Scene& scene) {
     const std::string path = std::string("robot.pan_tilt.") + key;
     const auto v = p.numbers(n, path, 2);
     if (!(v[0] < v[1]) || v[0] < -180.0 || v[1] > 180.0) p.fail(n, path, "need min < max within -180..180 degrees");
-    lo = v[0] * std::numbers::pi / 180.0;
-    hi = v[1] * std::numbers::pi / 180.0;
+    lo = config::radians(v[0]);
+    hi = config::radians(v[1]);
   };
   limits("pan_limits_deg", c.pan_min_rad, c.pan_max_rad);
   limits("tilt_limits_deg", c.tilt_min_rad, c.tilt_max_rad);
@@ -461,7 +462,7 @@ TargetConfig read_target(const YAML::Node& node, const std::string& path, const 
   }
   if (YAML::Node st = t.child("stop", false)) {
     target.stop = t.vector3(st, path + ".stop");
-    target.stop->z() *= std::numbers::pi / 180.0;
+    target.stop->z() = radians(target.stop->z());
     if (const std::string why = place_problem(scene.room, target.stop->x(), target.stop->y()); !why.empty())
       t.fail(st, path + ".stop", "the robot's stop for '" + target.name + "' " + why);
   }

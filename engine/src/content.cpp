@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "projbot/assets/image.hpp"
+#include "projbot/config/angles.hpp"
 
 namespace projbot::engine {
 
@@ -196,8 +197,7 @@ void mix_keys(const config::TargetContent::Key& a, const config::TargetContent::
     if (a.uv_offset && b.uv_offset) t.offset[c] = mix((*a.uv_offset)[c], (*b.uv_offset)[c]);
     if (a.uv_scale && b.uv_scale) t.scale[c] = mix((*a.uv_scale)[c], (*b.uv_scale)[c]);
   }
-  if (a.uv_rotation_deg && b.uv_rotation_deg)
-    t.rotation_rad = mix(*a.uv_rotation_deg, *b.uv_rotation_deg) * std::numbers::pi / 180.0;
+  if (a.uv_rotation_deg && b.uv_rotation_deg) t.rotation_rad = config::radians(mix(*a.uv_rotation_deg, *b.uv_rotation_deg));
 }
 
 }  // namespace

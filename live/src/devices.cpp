@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "projbot/config/angles.hpp"
 #include "projbot/engine/renderer.hpp"
 
 namespace projbot::live {
@@ -73,14 +74,14 @@ std::string open_pan_tilt(const config::PanTiltDevice& p, Devices& out) {
   if (const auto status = out.pan_tilt->position(at); !status.ok) throw robot::RobotError(status.error);
   std::ostringstream s;
   s.precision(3);
-  s << "at pan " << at.pan_rad * 180.0 / M_PI << " deg, tilt " << at.tilt_rad * 180.0 / M_PI << " deg";
+  s << "at pan " << config::degrees(at.pan_rad) << " deg, tilt " << config::degrees(at.tilt_rad) << " deg";
   return s.str();
 }
 
 std::string open_laser(const config::LaserDevice& l, Devices& out) {
   out.laser = std::make_unique<robot::MrptLaser>(l.class_name, l.params);
   const robot::LaserScan scan = out.laser->next();
-  return std::to_string(scan.ranges_m.size()) + " rays over " + std::to_string(std::lround(scan.aperture_rad * 180.0 / M_PI)) +
+  return std::to_string(scan.ranges_m.size()) + " rays over " + std::to_string(std::lround(config::degrees(scan.aperture_rad))) +
          " deg";
 }
 
@@ -89,7 +90,7 @@ std::string open_base(const config::BaseDevice& b, Devices& out) {
   const robot::Odometry2D odo = out.base->odometry(2.0);
   std::ostringstream s;
   s.precision(3);
-  s << "odometry at x " << odo.pose.x_m << " m, y " << odo.pose.y_m << " m, heading " << odo.pose.theta_rad * 180.0 / M_PI
+  s << "odometry at x " << odo.pose.x_m << " m, y " << odo.pose.y_m << " m, heading " << config::degrees(odo.pose.theta_rad)
     << " deg";
   return s.str();
 }

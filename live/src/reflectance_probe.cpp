@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "projbot/alignment/equations.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/output_file.hpp"
 
 namespace projbot::live {
@@ -61,7 +62,7 @@ std::string ReflectanceProbe::frame(const alignment::RgbdFrame& f, double now_s,
   if (f.colour.rgba.empty()) return "reflectance of " + name + " not measured: the camera's frames carry no colour";
   if (!found) return "reflectance of " + name + " not measured: its pose was lost while measuring";
   const Eigen::Matrix4d moved = black_pose_.inverse() * pose.T_camera_target;
-  const double moved_deg = Eigen::AngleAxisd(Eigen::Matrix3d(moved.topLeftCorner<3, 3>())).angle() * 180.0 / M_PI;
+  const double moved_deg = config::degrees(Eigen::AngleAxisd(Eigen::Matrix3d(moved.topLeftCorner<3, 3>())).angle());
   if (moved.topRightCorner<3, 1>().norm() > kStillM || moved_deg > kStillDeg)
     return "reflectance of " + name + " not measured: it moved between the black and the grey image";
   return measure(f, pose);

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "projbot/alignment/equations.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/rigid.hpp"
 
 namespace projbot::live {
@@ -192,7 +193,7 @@ namespace {
 // 2 sqrt(2) sin(angle / 2), exactly 0 for the same matrix (the trace of R1^T R2 reads 1e-6 degrees there).
 double rotation_difference_deg(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
   const double s = std::min(1.0, (a.topLeftCorner<3, 3>() - b.topLeftCorner<3, 3>()).norm() / (2.0 * std::sqrt(2.0)));
-  return 2.0 * std::asin(s) * 180.0 / M_PI;
+  return 2.0 * config::degrees(std::asin(s));
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "projbot/alignment/latest_value.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/clock.hpp"
 #include "projbot/engine/content.hpp"
 #include "projbot/live/reflectance_probe.hpp"
@@ -121,7 +122,7 @@ class RunObserver final : public StopObserver {
     log_ << "visit " << stop.visit + 1 << ": " << scene_.targets[static_cast<std::size_t>(stop.target)].name << ", drove "
          << std::fixed << std::setprecision(1) << stop.drive.drive_seconds << " s" << (stop.drive.arrived ? "" : " (not arrived)")
          << ", believed at x " << std::setprecision(3) << stop.drive.estimate.x_m << " m, y " << stop.drive.estimate.y_m
-         << " m, heading " << std::setprecision(1) << stop.drive.estimate.theta_rad * 180.0 / M_PI << " deg; lit "
+         << " m, heading " << std::setprecision(1) << config::degrees(stop.drive.estimate.theta_rad) << " deg; lit "
          << stop.lit.size() << " target(s)";
     if (stop.drive.corrections > 0)  // localised on a laser: how far odometry alone had drifted from that
       log_ << "; " << stop.drive.corrections << " laser scans matched (" << stop.drive.rejected << " rejected), odometry alone "

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "projbot/config/angles.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/robot/localization.hpp"
 
@@ -63,7 +64,7 @@ TrajectoryErrors trajectory_errors(const std::vector<TrajectoryPoint>& est, cons
     const bool by_time = std::abs(truth[j].timestamp_s - est[i].timestamp_s) < 1e-3;
     const TrajectoryPoint* t = by_time ? &truth[j] : (i < truth.size() ? &truth[i] : nullptr);
     if (t == nullptr) continue;
-    const double e = distance_m(est[i].pose, t->pose), a = heading_error_rad(est[i].pose, t->pose) * 180.0 / std::numbers::pi;
+    const double e = distance_m(est[i].pose, t->pose), a = config::degrees(heading_error_rad(est[i].pose, t->pose));
     s.mean_m += e, s.mean_deg += a, s.max_m = std::max(s.max_m, e), s.max_deg = std::max(s.max_deg, a), ++s.n;
   }
   if (s.n > 0) s.mean_m /= static_cast<double>(s.n), s.mean_deg /= static_cast<double>(s.n);

@@ -12,6 +12,7 @@
 
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/scene.hpp"
 #include "projbot/engine/renderer.hpp"
 #include "projbot/live/devices.hpp"
@@ -69,8 +70,8 @@ int serve_sim_base(const cli::Args& args) {
   const auto& p = server.odometry_pose();
   const robot::Pose2D truth = robot::compose(T_room_odometry, server.true_pose());
   std::cout << "served " << steps << " odometry messages, " << server.commands_received() << " commands received; odometry at x "
-            << p.x_m << " m, y " << p.y_m << " m, heading " << p.theta_rad * 180.0 / M_PI << " deg; truly at x " << truth.x_m
-            << " m, y " << truth.y_m << " m, heading " << truth.theta_rad * 180.0 / M_PI << " deg";
+            << p.x_m << " m, y " << p.y_m << " m, heading " << config::degrees(p.theta_rad) << " deg; truly at x " << truth.x_m
+            << " m, y " << truth.y_m << " m, heading " << config::degrees(truth.theta_rad) << " deg";
   if (laser) std::cout << "; " << laser->scans_sent() << " laser scans sent";
   std::cout << "\n";
   return interrupted() ? interrupt_exit_code() : 0;

@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "progress.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/config/paths.hpp"
 #include "projbot/config/scene.hpp"
@@ -26,7 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using robot::Pose2D;
-constexpr double kDeg = 180.0 / std::numbers::pi;
+constexpr double kDeg = config::degrees(1.0);
 
 void print_errors(const std::string& what, const robot::TrajectoryErrors& s) {
   std::cout << std::fixed << std::setprecision(2) << "  " << what << ": mean " << s.mean_m * 100 << " cm / " << s.mean_deg

@@ -15,6 +15,7 @@
 #include "projbot/alignment/bop.hpp"
 #include "projbot/assets/image.hpp"
 #include "projbot/assets/model.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/config/lens.hpp"
 #include "projbot/config/output_file.hpp"
 #include "projbot/twin/shapes.hpp"
@@ -377,7 +378,7 @@ CameraPath camera_path(const std::vector<Placed>& placed, std::mt19937& rng) {
   CameraPath c;
   for (const auto& p : placed) c.target.head<2>() += p.footprint.center() / static_cast<double>(placed.size());
   c.target.z() = 0.04;
-  const double deg = M_PI / 180.0, sign = u(rng) < 0.5 ? -1.0 : 1.0;
+  const double deg = config::radians(1.0), sign = u(rng) < 0.5 ? -1.0 : 1.0;
   c.distance = 0.6 + 0.9 * u(rng);
   c.elevation = (20.0 + 40.0 * u(rng)) * deg;
   c.azimuth = (-40.0 + 80.0 * u(rng)) * deg;

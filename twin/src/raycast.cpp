@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "projbot/config/angles.hpp"
 #include "projbot/engine/projection.hpp"
 
 namespace projbot::twin {
@@ -211,7 +212,7 @@ bool seen_edge_on(std::span<const PlacedMesh> scene, const Eigen::Vector3d& p) {
     hits[i] = *hit;
   }
   const Eigen::Vector3d n = (hits[0] - hits[1]).cross(hits[2] - hits[3]);
-  return !(std::abs(n.normalized().dot(d)) >= std::cos(kEdgeOnDeg * M_PI / 180.0));
+  return !(std::abs(n.normalized().dot(d)) >= std::cos(config::radians(kEdgeOnDeg)));
 }
 
 }  // namespace projbot::twin

@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "projbot/config/angles.hpp"
+
 namespace projbot::twin {
 namespace {
 
@@ -143,7 +145,7 @@ std::vector<ProceduralShape> procedural_shapes() {
     v.normal = {n[2], n[1], -n[0]};
   }
   out.push_back({"lying cylinder", std::move(cylinder), Eigen::Vector3d::UnitX()});
-  out.push_back({"bent tube", bent_tube(0.018, 0.150, 70.0 * M_PI / 180.0, {0.90F, 0.80F, 0.20F, 1.0F}), std::nullopt});
+  out.push_back({"bent tube", bent_tube(0.018, 0.150, config::radians(70.0), {0.90F, 0.80F, 0.20F, 1.0F}), std::nullopt});
   for (auto& s : out) s.model.source = s.name + " (procedural)";
   return out;
 }

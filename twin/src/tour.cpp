@@ -15,6 +15,7 @@
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/tracker_worker.hpp"
 #include "projbot/assets/image.hpp"
+#include "projbot/config/angles.hpp"
 #include "projbot/engine/frame_profiler.hpp"
 #include "projbot/engine/photometry.hpp"
 #include "projbot/engine/projection.hpp"
@@ -219,7 +220,7 @@ alignment::RgbdCamera& TourStop::arrived(const live::Stop& at) {
   report.target = name;
   report.drive_s = at.drive.drive_seconds;
   report.base_error_cm = 100.0 * at.drive.error_m;
-  report.base_error_deg = at.drive.error_rad * 180.0 / M_PI;
+  report.base_error_deg = config::degrees(at.drive.error_rad);
   report.odometry_error_cm = 100.0 * at.drive.odometry_error_m;
   truth_ = tour_.twin.true_head();
   TwinTarget& target = tour_.twin.targets()[target_index_];

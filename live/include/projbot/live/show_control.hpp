@@ -146,10 +146,10 @@ class ShowControl {
 
 /// The stop as the render thread last read the robot's state.
 struct StopView {
-  std::vector<int> lit;                         ///< scene indices, the visited one first; empty while driving
-  int visit = 0;                                ///< 1-based; 0 before the first
-  bool done = false;                            ///< the tour is over (or the robot failed)
-  std::array<double, 3> believed{};             ///< where the robot believed it was at the stop (x, y m; heading rad)
+  std::vector<int> lit;                           ///< scene indices, the visited one first; empty while driving
+  int visit = 0;                                  ///< 1-based; 0 before the first
+  bool done = false;                              ///< the tour is over (or the robot failed)
+  std::array<double, 3> believed{};               ///< where the robot believed it was at the stop (x, y m; heading rad)
   std::optional<std::array<double, 3>> moving{};  ///< while driving: where it believes it is now
 };
 
