@@ -19,18 +19,14 @@
 #include "projbot/calibrate/procam.hpp"
 #include "projbot/config/angles.hpp"
 #include "projbot/config/scene.hpp"
+#include "temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace projbot::calibrate;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("projbot_calibrate_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path temp_dir(const std::string& name) { return test_support::temp_dir("calibrate_" + name); }
 
 std::string error_of(const std::function<void()>& f) {
   try {

@@ -14,6 +14,7 @@
 
 #include "projbot/config/angles.hpp"
 #include "projbot/robot/sim_tour.hpp"
+#include "temp_dir.hpp"
 
 namespace {
 
@@ -22,12 +23,7 @@ namespace fs = std::filesystem;
 const fs::path kData = fs::path(PROJBOT_SHARED_DATA) / "mrpt";
 [[maybe_unused]] double deg(double d) { return projbot::config::radians(d); }
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("projbot_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using test_support::temp_dir;
 
 TEST(Rawlog, ReadsTheRealDataset) {
   const auto steps = read_rawlog(kData / "2006-01ENE-21-SENA_Telecom_Faculty_one_loop_only.rawlog");

@@ -10,17 +10,16 @@
 #include <fstream>
 #include <thread>
 
+#include "temp_dir.hpp"
+
 namespace fs = std::filesystem;
 using namespace projbot::assets;
 
 namespace {
 
-fs::path temp_dir() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("projbot_video_test_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
+// One folder for the whole process: a test's clips stay while it runs.
+const fs::path& temp_dir() {
+  static const fs::path dir = test_support::temp_dir("video_test");
   return dir;
 }
 
