@@ -52,14 +52,21 @@ void append_bytes(void* context, void* data, int size) {
 
 namespace {
 
+// An 8-bit PNG of `channels` per pixel in memory; `what` names it in the errors.
+std::vector<std::uint8_t> encode_png_8bit(const std::string& what, int width, int height, int channels,
+                                          const std::vector<std::uint8_t>& data) {
+  if (width <= 0 || height <= 0 || data.size() != static_cast<std::size_t>(width) * height * channels)
+    throw AssetError(what + ": refusing to write an empty or inconsistent image");
+  std::vector<std::uint8_t> png;
+  if (stbi_write_png_to_func(append_bytes, &png, width, height, channels, data.data(), width * channels) == 0)
+    throw AssetError(what + ": cannot encode PNG");
+  return png;
+}
+
 // An 8-bit PNG of `channels` per pixel, written atomically.
 void write_png_8bit(const std::filesystem::path& path, int width, int height, int channels,
                     const std::vector<std::uint8_t>& data) {
-  if (width <= 0 || height <= 0 || data.size() != static_cast<std::size_t>(width) * height * channels)
-    throw AssetError(path.string() + ": refusing to write an empty or inconsistent image");
-  std::vector<std::uint8_t> png;
-  if (stbi_write_png_to_func(append_bytes, &png, width, height, channels, data.data(), width * channels) == 0)
-    throw AssetError(path.string() + ": cannot encode PNG");
+  const std::vector<std::uint8_t> png = encode_png_8bit(path.string(), width, height, channels, data);
   try {
     config::write_file_atomically(path, png.data(), png.size());
   } catch (const config::OutputError& e) {
@@ -70,12 +77,7 @@ void write_png_8bit(const std::filesystem::path& path, int width, int height, in
 }  // namespace
 
 std::vector<std::uint8_t> encode_png(const Image& image) {
-  if (image.width <= 0 || image.height <= 0 || image.rgba.size() != static_cast<std::size_t>(image.width) * image.height * 4)
-    throw AssetError("encode_png: an empty or inconsistent image");
-  std::vector<std::uint8_t> png;
-  if (stbi_write_png_to_func(append_bytes, &png, image.width, image.height, 4, image.rgba.data(), image.width * 4) == 0)
-    throw AssetError("encode_png: cannot encode PNG");
-  return png;
+  return encode_png_8bit("encode_png", image.width, image.height, 4, image.rgba);
 }
 
 // A box filter: each output pixel averages the source pixels whose centres fall in its footprint.

@@ -56,12 +56,8 @@ class OffscreenBackend final : public TargetBackend {
 
   assets::Image read_back() override {
     if (depth_output_) throw EngineError("read_back: this target renders depth; use read_back_depth");
-    assets::Image out;
-    out.width = static_cast<int>(color_.extent.width);
-    out.height = static_cast<int>(color_.extent.height);
-    const auto* bytes = static_cast<const std::uint8_t*>(copy_to_host());
-    out.rgba.assign(bytes, bytes + readback_.size);
-    return out;
+    copy_to_host();
+    return copied();
   }
 
   vk::Buffer copy_buffer() override { return depth_output_ ? vk::Buffer{} : *readback_.buffer; }
