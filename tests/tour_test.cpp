@@ -84,6 +84,10 @@ TEST(TourTest, TrackingFollowsTheMovedTarget) {
   for (const auto& s : moved.timeline) EXPECT_TRUE(s.shown);
 }
 
+// A start is blank until a pose confirms the motion restarted from it (MotionFilter::confirmed): the
+// pose that shows it and the next, two camera frames, four projector frames at 60 Hz.
+constexpr int kStartBlankFrames = 4;
+
 // Targets moved at human speed (assets/scenes/motion.yaml): the duck still, the box carried at 0.5 m/s,
 // the duck carried at 0.5 m/s while turned at 90 deg/s, the box at 1 m/s. Each projector frame's error
 // is measured at its display time (about 50 ms after the capture its pose came from).
@@ -101,7 +105,7 @@ TEST(TourTest, PredictionKeepsMovingTargetsWithinTheGoal) {
     ASSERT_TRUE(on.visits[i].moved);
     EXPECT_GT(off.visits[i].moving_mean_mm, 10.0);  // without prediction the content trails the target
     EXPECT_LT(on.visits[i].moving_mean_mm, 5.0);    // the goal at 0.5 m/s and 90 deg/s
-    EXPECT_EQ(on.visits[i].moving_blank_frames, 0);
+    EXPECT_LE(on.visits[i].moving_blank_frames, kStartBlankFrames);
     EXPECT_LT(on.visits[i].timeline.back().mean_mm, 3.0);
     EXPECT_NEAR(on.visits[i].age_p50_ms, 50.0, 1.0);  // 20 ms processing, the next frame, one refresh
   }
@@ -111,7 +115,7 @@ TEST(TourTest, PredictionKeepsMovingTargetsWithinTheGoal) {
   // light of the edge markers falls past the box onto the wall (about 200 mm on two frames), which
   // weighs on the mean; the median frame is on the object.
   EXPECT_EQ(on.visits[3].target, "box");
-  EXPECT_EQ(on.visits[3].moving_blank_frames, 0);
+  EXPECT_LE(on.visits[3].moving_blank_frames, kStartBlankFrames);
   // ...and within the tracker's first pass (its coarsest level reaches 10 cm): with 4 cm there the
   // start's frame needed the wider second pass, twice the time.
   EXPECT_EQ(on.visits[3].second_pass_frames, 0);
@@ -138,7 +142,7 @@ TEST(TourTest, ATargetTurnedAt180DegreesPerSecondIsFollowed) {
   ASSERT_EQ(on.visits.size(), 1U);
   const auto& v = on.visits[0];
   ASSERT_TRUE(v.moved);
-  EXPECT_EQ(v.moving_blank_frames, 0);
+  EXPECT_LE(v.moving_blank_frames, kStartBlankFrames);
   EXPECT_EQ(v.second_pass_frames, 0);
   EXPECT_LT(v.moving_mean_mm, 8.0);
   EXPECT_LT(v.moving_p95_mm, 15.0);
@@ -305,7 +309,7 @@ TEST(TourTest, AHeldBoxThatIsMovedIsFollowed) {
   ASSERT_EQ(tour.visits.size(), 1U);
   const auto& v = tour.visits[0];
   EXPECT_GT(v.icp.colour_shift_mm, 0.5);  // it was held
-  EXPECT_EQ(v.moving_blank_frames, 0);
+  EXPECT_LE(v.moving_blank_frames, kStartBlankFrames);
   ASSERT_FALSE(v.timeline.empty());
   EXPECT_TRUE(v.timeline.back().shown);
   EXPECT_LT(v.timeline.back().mean_mm, 4.0);  // depth alone along the face: about 2 mm

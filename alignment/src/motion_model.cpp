@@ -50,6 +50,7 @@ MotionFilter::MotionFilter(MotionModelConfig config)
 
 void MotionFilter::reset() {
   count_ = 0;
+  confirmed_ = true;
   measured_ = filtered_ = Eigen::Matrix4d::Identity();
   window_.clear();
   history_.clear();
@@ -92,24 +93,7 @@ void MotionFilter::update(const Eigen::Matrix4d& T, double t_s) {
   } else if (count_ == 1) {
     restart_velocity(T, dt);
   } else {
-    predict_to(dt);
-    // Innovations: the measured pose against the predicted one (rotation as a rotation vector).
-    const Eigen::Vector3d y_t = T.topRightCorner<3, 1>() - filtered_.topRightCorner<3, 1>();
-    const Eigen::Vector3d y_r = log_so3(T.topLeftCorner<3, 3>() * filtered_.topLeftCorner<3, 3>().transpose());
-    const double s_t = translation_.P(0, 0) + position_noise_ * position_noise_;
-    const double s_r = rotation_.P(0, 0) + rotation_noise_ * rotation_noise_;
-    if (y_t.squaredNorm() / s_t > cfg_.maneuver_gate || y_r.squaredNorm() / s_r > cfg_.maneuver_gate) {
-      ++maneuvers_;
-      restart_velocity(T, dt);  // a start or a stop: what the last frame interval says, nothing older
-    } else {
-      const Eigen::Vector2d k_t = translation_.P.col(0) / s_t, k_r = rotation_.P.col(0) / s_r;
-      filtered_.topRightCorner<3, 1>() += k_t(0) * y_t;
-      translation_.rate += k_t(1) * y_t;
-      filtered_.topLeftCorner<3, 3>() = exp_so3(k_r(0) * y_r) * filtered_.topLeftCorner<3, 3>();
-      rotation_.rate += k_r(1) * y_r;
-      translation_.P -= k_t * translation_.P.row(0);
-      rotation_.P -= k_r * rotation_.P.row(0);
-    }
+    correct(T, dt);
   }
   measured_ = T;
   t_ = t_s;
@@ -119,6 +103,32 @@ void MotionFilter::update(const Eigen::Matrix4d& T, double t_s) {
   history_.push_back({t_s, T});
   while (history_.size() > static_cast<std::size_t>(std::max(cfg_.noise_window, 0))) history_.pop_front();
   measure_noise();
+}
+
+// The filter's correction by a pose dt after the last: a Kalman update, or a restart of the velocity from
+// the last two poses when the pose breaks the prediction (a start or a stop), which is not confirmed
+// until a later pose agrees with the motion restarted from it.
+void MotionFilter::correct(const Eigen::Matrix4d& T, double dt) {
+  predict_to(dt);
+  // Innovations: the measured pose against the predicted one (rotation as a rotation vector).
+  const Eigen::Vector3d y_t = T.topRightCorner<3, 1>() - filtered_.topRightCorner<3, 1>();
+  const Eigen::Vector3d y_r = log_so3(T.topLeftCorner<3, 3>() * filtered_.topLeftCorner<3, 3>().transpose());
+  const double s_t = translation_.P(0, 0) + position_noise_ * position_noise_;
+  const double s_r = rotation_.P(0, 0) + rotation_noise_ * rotation_noise_;
+  const bool outside = y_t.squaredNorm() / s_t > cfg_.maneuver_gate || y_r.squaredNorm() / s_r > cfg_.maneuver_gate;
+  confirmed_ = !outside;
+  if (outside) {
+    ++maneuvers_;
+    restart_velocity(T, dt);  // a start or a stop: what the last frame interval says, nothing older
+    return;
+  }
+  const Eigen::Vector2d k_t = translation_.P.col(0) / s_t, k_r = rotation_.P.col(0) / s_r;
+  filtered_.topRightCorner<3, 1>() += k_t(0) * y_t;
+  translation_.rate += k_t(1) * y_t;
+  filtered_.topLeftCorner<3, 3>() = exp_so3(k_r(0) * y_r) * filtered_.topLeftCorner<3, 3>();
+  rotation_.rate += k_r(1) * y_r;
+  translation_.P -= k_t * translation_.P.row(0);
+  rotation_.P -= k_r * rotation_.P.row(0);
 }
 
 void MotionFilter::measure_noise() {
@@ -146,6 +156,40 @@ void MotionFilter::measure_noise() {
   rotation_noise_ = std::max(cfg_.rotation_noise_rad, median(turns) / 1.538);
 }
 
+// The window's motion: how far the newest pose is from the oldest, and the least-squares velocity of its
+// poses with the spread of their times (a slope's variance is the pose noise's over it).
+MotionFilter::WindowMotion MotionFilter::window_motion() const {
+  WindowMotion m;
+  const Eigen::Matrix4d& oldest = window_.front().T;
+  const Eigen::Matrix3d R_inv = measured_.topLeftCorner<3, 3>().transpose();
+  m.span_s = t_ - window_.front().t_s;
+  m.moved_m = (measured_.topRightCorner<3, 1>() - oldest.topRightCorner<3, 1>()).norm();
+  m.turned_rad = log_so3(oldest.topLeftCorner<3, 3>() * R_inv).norm();
+  double mean_t = 0.0;
+  for (const auto& w : window_) mean_t += w.t_s / static_cast<double>(window_.size());
+  for (const auto& w : window_) {
+    const double d = w.t_s - mean_t;
+    m.time_spread_s2 += d * d;
+    m.velocity_m_s += d * w.T.topRightCorner<3, 1>();
+    m.angular_velocity_rad_s += d * log_so3(w.T.topLeftCorner<3, 3>() * R_inv);
+  }
+  if (m.time_spread_s2 > 0.0) {
+    m.velocity_m_s /= m.time_spread_s2;
+    m.angular_velocity_rad_s /= m.time_spread_s2;
+  }
+  return m;
+}
+
+// A part of the motion (translation or rotation) stands out of the noise when the newest pose is
+// farther from the oldest than still_sigmas times their difference's noise (sqrt(2) times a pose's) and
+// than the minimum speed over the window, and the window's velocity is farther from zero than
+// velocity_gate allows its noise to take it.
+bool MotionFilter::stands_out(double moved, const Eigen::Vector3d& velocity, double noise, double min_rate,
+                              const WindowMotion& m) const {
+  if (moved <= std::max(cfg_.still_sigmas * M_SQRT2 * noise, min_rate * m.span_s)) return false;
+  return m.time_spread_s2 > 0.0 && velocity.squaredNorm() * m.time_spread_s2 > cfg_.velocity_gate * noise * noise;
+}
+
 MotionState MotionFilter::state() const {
   MotionState s;
   s.T = measured_;
@@ -153,15 +197,11 @@ MotionState MotionFilter::state() const {
   s.max_horizon_s = cfg_.max_horizon_s;
   if (count_ < std::max(2, cfg_.min_poses)) return s;
   // Each part of the motion is used only when it stands out of the measurement noise over the window;
-  // the other part stays as measured, so a target that only turns is not also slid by noise. The
-  // difference of two measured poses has sqrt(2) times their noise.
-  const Eigen::Matrix4d& oldest = window_.front().T;
-  const double span_s = t_ - window_.front().t_s;
-  const double moved_m = (measured_.topRightCorner<3, 1>() - oldest.topRightCorner<3, 1>()).norm();
-  const double turned_rad = log_so3(measured_.topLeftCorner<3, 3>() * oldest.topLeftCorner<3, 3>().transpose()).norm();
-  const bool translating = moved_m > std::max(cfg_.still_sigmas * M_SQRT2 * position_noise_, cfg_.min_speed_m_s * span_s);
+  // the other part stays as measured, so a target that only turns is not also slid by noise.
+  const WindowMotion m = window_motion();
+  const bool translating = stands_out(m.moved_m, m.velocity_m_s, position_noise_, cfg_.min_speed_m_s, m);
   const bool turning =
-      turned_rad > std::max(cfg_.still_sigmas * M_SQRT2 * rotation_noise_, config::radians(cfg_.min_rate_deg_s) * span_s);
+      stands_out(m.turned_rad, m.angular_velocity_rad_s, rotation_noise_, config::radians(cfg_.min_rate_deg_s), m);
   // A still part whose measured noise is well above the configured one: the mean of the window's poses.
   if (!translating && position_noise_ > cfg_.average_above * cfg_.position_noise_m) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();

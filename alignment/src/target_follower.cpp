@@ -142,7 +142,9 @@ PoseSample TargetFollower::found(const DepthImage& frame, const Eigen::Matrix4d&
   last_found_s_ = frame.capture_time_s;
   PoseSample sample = still_sample(T, frame.capture_time_s, false, inlier_ratio, rmse_mm);
   filter_.update(T, frame.capture_time_s);
-  if (cfg_.predict) sample.motion = filter_.drawn_state();
+  if (!cfg_.predict) return sample;
+  sample.motion = filter_.drawn_state();
+  sample.held = !filter_.confirmed();
   return sample;
 }
 
@@ -259,7 +261,13 @@ std::optional<PoseSample> TargetFollower::track(const DepthImage& frame) {
     } catch (const AlignmentError&) {  // too little depth near it: as a refused frame
     }
   }
-  if (++rejected_ < cfg_.lost_after) return std::nullopt;  // one bad frame: keep showing the last pose
+  // One bad frame: blank it, and track on from the last pose. The last pose drawn on would be a pose
+  // this frame did not confirm, extrapolated further each frame it is drawn.
+  if (++rejected_ < cfg_.lost_after) {
+    PoseSample held = still_sample(*pose_, frame.capture_time_s, false, w.inlier_ratio, w.rmse_mm);
+    held.held = true;
+    return held;
+  }
   // Lost: blank it now and search from where it was last seen, or where its motion was taking it.
   guess_ = start;
   pose_.reset();

@@ -31,7 +31,7 @@ std::vector<DrawnPose> ProjectionFrames::compose(double now_s, const LitNow& lit
   }
   for (const int target : lit.targets) {
     alignment::PoseSample pose;
-    if (!poses(target, pose) || pose.lost || pose.capture_time_s < std::max(lit.since_s, stale_before_s_)) continue;
+    if (!poses(target, pose) || !pose.drawable() || pose.capture_time_s < std::max(lit.since_s, stale_before_s_)) continue;
     if (cfg_.max_unconfirmed_s > 0.0 && lit.last_frame_s - pose.capture_time_s > cfg_.max_unconfirmed_s) {
       ++unconfirmed_;
       continue;

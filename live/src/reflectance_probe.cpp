@@ -42,7 +42,7 @@ std::string ReflectanceProbe::frame(const alignment::RgbdFrame& f, double now_s,
   if (phase_ == Phase::done || target_ < 0) return "";
   const std::string& name = scene_.targets[static_cast<std::size_t>(target_)].name;
   alignment::PoseSample pose;
-  const bool found = poses(target_, pose) && !pose.lost && pose.capture_time_s >= since_s_;
+  const bool found = poses(target_, pose) && pose.drawable() && pose.capture_time_s >= since_s_;
   if (phase_ == Phase::idle) {
     if (!found) return "";  // not yet accepted at this stop
     phase_ = Phase::black, phase_s_ = now_s;

@@ -72,7 +72,7 @@ const Command kBenchMotion{
      {"seed", "K", "seed of the drift, laser and depth noise (default 1)"},
      {"dwell", "S", "simulated seconds of projection per visit (default 3)"},
      depth_model_option(),
-     {"process-noise", "Q", "the motion filter's acceleration noise, m s^-1.5 (turning: 3 Q rad s^-1.5; default 1)"},
+     {"process-noise", "Q", "the motion filter's acceleration noise, m s^-1.5 (turning: 3 Q rad s^-1.5; default 0.2)"},
      processing_ms_option()},
     [](const cli::Args& args) {
       twin::TourOptions o;

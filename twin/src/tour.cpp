@@ -451,7 +451,7 @@ void TourStop::take_results(double start_s) {
   for (std::size_t k = 0; k < lit_.size(); ++k)
     for (const auto& sample : tour_.trackers[lit_[k]].ready_by(start_s)) {
       newest_[k] = sample;
-      if (!sample.lost) (k == 0 ? drawn_ : lights_[k - 1].drawn) = sample;
+      if (sample.drawable()) (k == 0 ? drawn_ : lights_[k - 1].drawn) = sample;
     }
   const double track_ms = tour_.trackers[target_index_].track_ms();  // the visited target's frames tracked since the last
   if (report.first_light_s < 0.0) wall_to_light_ms_ += track_ms - seen_track_ms_;

@@ -143,6 +143,11 @@ struct PoseSample {
   std::uint64_t sequence = 0;   ///< increases with every publication
   double capture_time_s = 0.0;  ///< capture time of the depth frame the pose came from
   bool lost = true;             ///< true: blank the target, do not project
+  /// Found (or still followed) but blank in this frame: the pose broke the motion's prediction (a start, a
+  /// stop or one bad pose, MotionFilter::confirmed), or the tracker refused this frame and follows on from
+  /// the last pose (T_camera_target is that pose). Drawn on, either would be light no frame confirmed.
+  bool held = false;
+  bool drawable() const { return !lost && !held; }
   double inlier_ratio = 0.0;
   double rmse_mm = 0.0;
   /// The motion to draw it with: predict_pose(motion, display time). Still (motion.T is
