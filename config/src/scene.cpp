@@ -271,6 +271,21 @@ Photometry read_calibrated_photometry(const MapReader& r, const YAML::Node& node
   return p;
 }
 
+// `fleet: {name: NAME, domain: D}`: this robot on the fleet's DDS bus (issue 69; the name is checked where
+// the fleet starts).
+void read_fleet(MapReader& root, Scene& scene) {
+  if (YAML::Node n = root.child("fleet", false)) {
+    MapReader m(n, "fleet", root.file());
+    FleetSite f;
+    f.name = m.get<std::string>("name", "", true);
+    if (f.name.empty()) m.fail(n["name"], "fleet.name", "expected the robot's name in the fleet");
+    f.domain = m.get<int>("domain", 0);
+    if (f.domain < 0 || f.domain > 232) m.fail(n["domain"], "fleet.domain", "must be 0..232 (a DDS domain)");
+    m.reject_unknown();
+    scene.fleet = f;
+  }
+}
+
 // `console: {listen: [ADDR:]PORT, token_file: FILE}` and `osc: {port: N, allow: [HOST...], send: HOST:PORT}`:
 // how the operator's controls start at this site (issue 70). The listen address is checked where the
 // console starts (its parser is the console's); the token file is an input, beside the scene.
@@ -547,6 +562,7 @@ Scene parse_scene_nodes(std::string_view yaml_text, const std::filesystem::path&
   read_props(r, file, base, scene);
   scene.devices = read_devices(r);
   read_operator(r, base, scene);
+  read_fleet(r, scene);
   apply_calibration(r, scene, base);
   read_tour(r, file, scene);
   r.reject_unknown();

@@ -16,6 +16,7 @@
 #include "projbot/console/console.hpp"
 #include "projbot/console/osc.hpp"
 #include "projbot/engine/frame_profiler.hpp"
+#include "projbot/fleet/fleet_member.hpp"
 #include "projbot/live/run.hpp"
 #include "projbot/twin/twin_rig.hpp"
 #include "scene_setup.hpp"
@@ -155,12 +156,27 @@ void write_profile(const std::string& csv, const std::vector<live::ProjectionRow
   std::cout << "per-frame profile written to " << csv << '\n';
 }
 
-// The operator's controls (--console, --osc): the show's, and the servers acting on them, which go first.
+// The operator's controls (--console, --osc) and the fleet's bus (--fleet): the show's, and the servers
+// acting on it or telling it, which go first.
 struct Operated {
   std::unique_ptr<live::ShowControl> show;
   std::unique_ptr<console::Console> console;
   std::unique_ptr<console::OscControl> osc;
+  std::unique_ptr<fleet::FleetMember> fleet;
 };
+
+// --fleet and --fleet-domain, else the site file's `fleet:`.
+std::optional<fleet::FleetConfig> fleet_config(const cli::Args& args, const config::Scene& scene) {
+  const auto name = args.get("fleet");
+  if (!name && args.get("fleet-domain")) throw cli::UsageError("--fleet-domain applies to --fleet");
+  if (!name && !scene.fleet) return std::nullopt;
+  fleet::FleetConfig c;
+  c.name = name ? *name : scene.fleet->name;
+  c.domain = args.get("fleet-domain") ? args.get_int("fleet-domain", 0, 0, 232) : scene.fleet ? scene.fleet->domain : 0;
+  if (const std::string why = fleet::fleet_name_problem(c.name); !why.empty())
+    throw cli::UsageError((name ? "--fleet " : "fleet.name in " + scene.source.string() + ": ") + c.name + ": " + why);
+  return c;
+}
 
 // --console and --console-token, else the site file's `console:` (its keys named with the file).
 std::optional<console::ConsoleConfig> console_config(const cli::Args& args, const config::Scene& scene) {
@@ -221,22 +237,33 @@ std::optional<console::OscConfig> osc_config(const cli::Args& args, const config
 }
 
 Operated open_controls(const cli::Args& args, const config::Scene& scene, bool replay) {
-  if (replay && !args.get("console") && !args.get("osc")) {  // a site's controls serve the live show only
-    if (scene.console || scene.osc) std::cout << "note: the site file's console: and osc: are not started for a replay\n";
+  if (replay && !args.get("console") && !args.get("osc") && !args.get("fleet")) {  // the live show's only
+    if (scene.console || scene.osc || scene.fleet)
+      std::cout << "note: the site file's console:, osc: and fleet: are not started for a replay\n";
     return {};
   }
   const std::optional<console::ConsoleConfig> page = console_config(args, scene);
   const std::optional<console::OscConfig> osc = osc_config(args, scene);
-  if (!page && !osc) return {};
+  const std::optional<fleet::FleetConfig> bus = fleet_config(args, scene);
+  if (!page && !osc && !bus) return {};
   if (replay)
     throw cli::UsageError(
-        "--console and --osc do not apply to --replay: a replay's frames wait on its robot, which a "
-        "pause would stall");
+        "--console, --osc and --fleet do not apply to --replay: a replay's frames wait on its robot, which a "
+        "pause would stall, and it is no robot on the floor");
   Operated o;
   o.show = std::make_unique<live::ShowControl>(live::site_targets(scene), scene.content_folder);
   if (page) {
     o.console = std::make_unique<console::Console>(*o.show, *page);
     std::cout << "console: " << o.console->url() << (page->token.empty() ? "" : " (actions need the token)") << std::endl;
+  }
+  if (bus) {
+    try {
+      o.fleet = std::make_unique<fleet::FleetMember>(*o.show, *bus);
+    } catch (const fleet::FleetError& e) {
+      throw cli::UsageError(e.what());
+    }
+    std::cout << "fleet: " << bus->name << " on DDS domain " << bus->domain << " (rt/" << bus->name << "/pose, rt/" << bus->name
+              << "/state)" << std::endl;
   }
   if (osc) {
     o.osc = std::make_unique<console::OscControl>(*o.show, *osc);
@@ -249,6 +276,8 @@ Operated open_controls(const cli::Args& args, const config::Scene& scene, bool r
 }
 
 void print_controls(std::ostream& out, const live::RunResult& r, const Operated& o) {
+  if (o.fleet) out << "fleet: " << o.fleet->published() << " states published as " << o.fleet->config().name << '\n';
+  if (!o.console && !o.osc) return;
   out << "console: " << r.blackout_frames << " frames blacked out";
   if (!r.blackout_latency_ms.empty()) {
     out << "; from each blackout's request to its first black frame's display:";
@@ -270,7 +299,7 @@ const Command kRun{
     "            [--seconds S] [--visits N] [--dwell S] [--seed K] [--present-mode fifo|mailbox|immediate]\n"
     "            [--no-predict] [--compensation on|off] [--learn-reflectance [--reflectance-out DIR]]\n"
     "            [--depth-model fitted|kinect] [--console [ADDR:]PORT [--console-token FILE]]\n"
-    "            [--osc PORT [--osc-allow HOSTS] [--osc-send [HOST:]PORT]]\n\n"
+    "            [--osc PORT [--osc-allow HOSTS] [--osc-send [HOST:]PORT]] [--fleet NAME [--fleet-domain D]]\n\n"
     "Opens the projector output and draws, every frame, each target the robot is projecting onto (the\n"
     "visited one and the others it expects in the projector's view at that stop) at the\n"
     "newest pose its tracker worker accepted (Eq. 2, Eq. 3), moved on by its measured motion to the frame's\n"
@@ -358,8 +387,11 @@ const Command kRun{
       cli::PathRole::input_file},
      {"osc", "PORT", "take show control over OSC on this UDP port (0: any free one): /projbot/blackout i, pause i, goto s"},
      {"osc-allow", "HOSTS", "with --osc: the senders besides loopback whose actions are taken (IP addresses, comma-separated)"},
-     {"osc-send", "[HOST:]PORT",
-      "with --osc: send /projbot/state (phase, visit, target, blackout, paused) there on each change"}},
+     {"osc-send", "[HOST:]PORT", "with --osc: send /projbot/state (phase, visit, target, blackout, paused) there on each change"},
+     {"fleet", "NAME",
+      "join the fleet's DDS bus as robot NAME: its pose (rt/NAME/pose, geometry_msgs/PoseStamped) and state "
+      "(rt/NAME/state) at 5 Hz, its liveliness"},
+     {"fleet-domain", "D", "with --fleet: the DDS domain, 0..232 (default: the site file's fleet.domain, else 0)"}},
     [](const cli::Args& args) {
       catch_interrupts();  // Ctrl-C / SIGTERM: leave the frame loop at the next frame, then write what was measured
       if (args.flag("learn-reflectance") && args.get("replay"))

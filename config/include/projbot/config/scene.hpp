@@ -187,6 +187,12 @@ struct OscSite {
   std::string send;                ///< HOST:PORT the show's state goes to on each change; empty: none
 };
 
+/// `fleet:` this robot on the fleet's DDS bus (issue 69), as the site file names it (--fleet replaces it).
+struct FleetSite {
+  std::string name;  ///< its name in the fleet (a ROS 2 namespace; checked where the fleet starts)
+  int domain = 0;    ///< the DDS domain, 0..232
+};
+
 /// A whole scene file.
 struct Scene {
   std::filesystem::path source;       ///< the file it came from (empty when parsed from a string)
@@ -206,6 +212,7 @@ struct Scene {
   DevicesConfig devices;                              ///< `devices:` real devices (none: the twin)
   std::optional<ConsoleSite> console;                 ///< `console:` the operator's page (none: not served)
   std::optional<OscSite> osc;                         ///< `osc:` show control from a desk (none: not listened for)
+  std::optional<FleetSite> fleet;                     ///< `fleet:` this robot on the fleet's bus (none: alone)
   /// `content_folder:` (beside the scene file) the videos an operator may switch a target's content to,
   /// by name (the console, OSC); empty: none.
   std::filesystem::path content_folder;

@@ -1,0 +1,52 @@
+#pragma once
+// A robot of the fleet on the DDS bus (issue 69, item 1). Under its name's namespace, in ROS 2's wire
+// conventions (topic "rt/NAME/...", type "package::msg::dds_::Type_"), so a ROS 2 tool on the same domain
+// reads the standard ones:
+//
+//   rt/NAME/pose    geometry_msgs/msg/PoseStamped, frame "map": where the robot believes it is
+//   rt/NAME/state   projbot_msgs RobotState: phase, visited target, visit, frame rate, blackout, paused
+//
+// each at least five times a second (the show's state as the render thread publishes it, and again when
+// none newer came in 0.2 s). Reliable, the newest kept; DDS liveliness (automatic, a 1 s lease) tells the
+// others when the robot is gone, even killed. Its own thread: the engine never waits on the bus.
+
+#include <cstddef>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "projbot/live/show_control.hpp"
+
+namespace projbot::fleet {
+
+struct FleetError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct FleetConfig {
+  std::string name;  ///< the robot's name in the fleet: a ROS 2 namespace ([A-Za-z][A-Za-z0-9_]*, <= 64)
+  int domain = 0;    ///< the DDS domain, 0..232
+};
+
+/// Whether `name` may name a fleet robot; empty when it may, else why not.
+std::string fleet_name_problem(const std::string& name);
+
+/// How long a robot the bus hears nothing from is alive: the writers' liveliness lease.
+constexpr double kLivelinessLeaseS = 1.0;
+
+class FleetMember {
+ public:
+  /// Joins the domain and starts publishing. Throws FleetError naming the name or the domain when it cannot.
+  FleetMember(live::ShowControl& show, FleetConfig config);
+  ~FleetMember();
+  FleetMember(const FleetMember&) = delete;
+  FleetMember& operator=(const FleetMember&) = delete;
+  const FleetConfig& config() const;
+  std::size_t published() const;  ///< states published (each with its pose where one is known)
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace projbot::fleet
