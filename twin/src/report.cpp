@@ -174,6 +174,9 @@ void print_table(const TourReport& report, std::ostream& out) {
   out << "Lit far off (the visited targets and their neighbours, " << report.depth_model << " depth model): " << off.over_20mm
       << " frames more than 20 mm off, " << off.over_10mm << " more than 10 mm"
       << (off.over_10mm > 0 ? " (worst " + fixed(off.worst_mm, 0) + " mm)" : std::string()) << ".\n";
+  if (off.over_20mm_change_unseen > 0)
+    out << "Of those more than 20 mm off, " << off.over_20mm_change_unseen
+        << " drew a pose captured before its target started or stopped moving: no frame had shown it yet.\n";
 }
 
 FarOff far_off(const TourReport& report) {
@@ -260,6 +263,7 @@ nlohmann::json visit_json(const VisitReport& v) {
       {"lit_frames", v.lit_frames},
       {"lit_over_10mm_frames", v.far_off.over_10mm},
       {"lit_over_20mm_frames", v.far_off.over_20mm},
+      {"lit_over_20mm_change_unseen_frames", v.far_off.over_20mm_change_unseen},
       {"lit_worst_mm", v.far_off.worst_mm},
       {"first_light_s", v.first_light_s},
       {"first_light_wall_ms", v.first_light_wall_ms},
@@ -292,7 +296,10 @@ void write_report_json(const TourReport& report, const std::filesystem::path& pa
       {"wall_s", report.wall_s},
       {"interrupted", report.interrupted},
       {"lit_far_off",
-       {{"over_10mm_frames", all_off.over_10mm}, {"over_20mm_frames", all_off.over_20mm}, {"worst_mm", all_off.worst_mm}}},
+       {{"over_10mm_frames", all_off.over_10mm},
+        {"over_20mm_frames", all_off.over_20mm},
+        {"over_20mm_change_unseen_frames", all_off.over_20mm_change_unseen},
+        {"worst_mm", all_off.worst_mm}}},
       {"visits", visits}};
   config::write_file_atomically(path, out.dump(2) + '\n');
 }

@@ -479,7 +479,7 @@ void TourStop::project(double start_s) {
   for (std::size_t k = 1; k < lit_.size(); ++k) measure_neighbour(c, lights_[k - 1], drawn_of(static_cast<int>(k)));
   report.timeline.push_back(s);
   report.lit_frames += shown_ ? 1 : 0;
-  if (shown_ && s.in_world) report.far_off.count(s.mean_mm);
+  if (shown_ && s.in_world) report.far_off.count(s.mean_mm, s.change_unseen);
   if (shown_ && report.first_light_s < 0.0) {
     report.first_light_s = s.t_s;
     report.first_light_wall_ms = wall_to_light_ms_;

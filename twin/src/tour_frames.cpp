@@ -58,6 +58,10 @@ TimelineSample measure_frame(const DwellContext& c, const VisitReport& r, double
   s.moving = motion && motion->moving_at(display_s);
   s.age_ms = 1000.0 * (display_s - (drawn ? drawn->capture_s : last_lit.capture_time_s));
   s.in_world = target.in_world;
+  const double captured_s = display_s - 0.001 * s.age_ms;
+  // A capture at the change's instant shows the target where it was: it moves from just after start_s.
+  const auto between = [&](double t) { return t >= captured_s - 1e-6 && t <= display_s; };
+  s.change_unseen = motion && (between(motion->start_s) || between(motion->end_s()));
   const Eigen::Matrix4d T_camera_target = light_pose(drawn, last_lit, display_s, c.options.predict);
   const MarkerErrors e = marker_errors(c.twin, c.target, c.models, c.truth.T_world_projector.matrix(), T_camera_target);
   s.mean_mm = e.mean_mm;

@@ -105,6 +105,9 @@ struct TimelineSample {
   bool shown = true;     ///< false while the target is blanked (lost)
   double age_ms = 0.0;   ///< of the pose drawn: from its depth frame's capture to display
   bool in_world = true;  ///< the target was there (not carried away)
+  /// The target started or stopped moving after the drawn pose's capture: no frame the drawing could
+  /// have come from showed it yet (the pipeline's latency, not the tracker's error).
+  bool change_unseen = false;
 };
 
 /// The lit projector frames of a target that showed it far off: by their mean error at the markers (the
@@ -112,17 +115,20 @@ struct TimelineSample {
 /// the light are not judged.
 struct FarOff {
   int over_10mm = 0, over_20mm = 0;
-  double worst_mm = 0.0;  ///< the worst lit frame's mean error (0 when none was measured)
-  /// One lit frame whose mean error is `mean_mm` (NaN: none measured).
-  void count(double mean_mm) {
+  int over_20mm_change_unseen = 0;  ///< of over_20mm, those drawn before any frame showed a start or stop
+  double worst_mm = 0.0;            ///< the worst lit frame's mean error (0 when none was measured)
+  /// One lit frame whose mean error is `mean_mm` (NaN: none measured); `change_unseen` as TimelineSample's.
+  void count(double mean_mm, bool change_unseen = false) {
     if (!(mean_mm >= 0.0)) return;
     over_10mm += mean_mm > 10.0 ? 1 : 0;
     over_20mm += mean_mm > 20.0 ? 1 : 0;
+    over_20mm_change_unseen += mean_mm > 20.0 && change_unseen ? 1 : 0;
     worst_mm = std::max(worst_mm, mean_mm);
   }
   void add(const FarOff& o) {
     over_10mm += o.over_10mm;
     over_20mm += o.over_20mm;
+    over_20mm_change_unseen += o.over_20mm_change_unseen;
     worst_mm = std::max(worst_mm, o.worst_mm);
   }
 };
