@@ -136,10 +136,7 @@ TEST_F(CliTest, RunServesTheConsoleItsBlackoutAndGoTo) {
 // the tour scene with both sections serves the page and listens for OSC without an option given; a console
 // off loopback needs the site's token file (mode 0600), refused naming the site file's key otherwise.
 TEST_F(CliTest, RunStartsTheControlsTheSiteFileNames) {
-  std::ifstream in(fs::path(PROJBOT_ASSET_DIR) / "scenes" / "tour.yaml");
-  std::string tour{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  for (std::size_t at = 0; (at = tour.find("../models/", at)) != std::string::npos;)
-    tour.replace(at, 3, std::string(PROJBOT_ASSET_DIR) + "/");
+  const std::string tour = shipped_scene("tour.yaml");
   const fs::path site = write("site.yaml", tour + "console: {listen: \"127.0.0.1:0\"}\nosc: {port: 49555, allow: [10.0.0.7]}\n");
   const CliRun r = run_projbot("run --sim --headless --seconds 2 --config " + site.string());
   EXPECT_EQ(r.code, 0) << r.output;
@@ -188,10 +185,7 @@ TEST_F(CliTest, RunRefusesAConsoleItCannotServeSafely) {
 // `content_folder:`, a video in it switched to on the duck over HTTP, said in run's output as it comes in;
 // a folder that is not there refused naming the key.
 TEST_F(CliTest, RunSwitchesATargetsVideoFromTheContentFolder) {
-  std::ifstream in(fs::path(PROJBOT_ASSET_DIR) / "scenes" / "content.yaml");
-  std::string scene{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  for (std::size_t at = 0; (at = scene.find("../models/", at)) != std::string::npos;)
-    scene.replace(at, 3, std::string(PROJBOT_ASSET_DIR) + "/");
+  std::string scene = shipped_scene("content.yaml");
   for (std::size_t at = 0; (at = scene.find("../videos/", at)) != std::string::npos;)
     scene.replace(at, 3, std::string(PROJBOT_GENERATED_ASSET_DIR) + "/");
   fs::create_directories(dir_ / "videos");

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -124,5 +125,15 @@ inline int trajectory_lines(const fs::path& file) {
 
 inline const std::string kDuck = std::string(PROJBOT_SHARED_DATA) + "/gltf/Duck/glTF-Binary/Duck.glb";
 inline const std::string kRawlog = std::string(PROJBOT_SHARED_DATA) + "/mrpt/localization_demo.rawlog";
+
+// A shipped scene's text (assets/scenes/NAME) with its models' paths made absolute, for a test's own site
+// file written elsewhere.
+inline std::string shipped_scene(const std::string& name) {
+  std::ifstream in(fs::path(PROJBOT_ASSET_DIR) / "scenes" / name);
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  for (std::size_t at = 0; (at = text.find("../models/", at)) != std::string::npos;)
+    text.replace(at, 3, std::string(PROJBOT_ASSET_DIR) + "/");
+  return text;
+}
 
 }  // namespace cli_fixture

@@ -124,10 +124,7 @@ TEST_F(CliTest, RunRefusesAFleetNameOrDomainItCannotUse) {
     EXPECT_NE(r.output.find(bad.find("domain") != std::string::npos ? "--fleet-domain" : "--fleet "), std::string::npos)
         << r.output;
   }
-  std::ifstream in(fs::path(PROJBOT_ASSET_DIR) / "scenes" / "tour.yaml");
-  std::string tour{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  for (std::size_t at = 0; (at = tour.find("../models/", at)) != std::string::npos;)
-    tour.replace(at, 3, std::string(PROJBOT_ASSET_DIR) + "/");
+  const std::string tour = shipped_scene("tour.yaml");
   const fs::path far = write("far.yaml", tour + "fleet: {name: r1, domain: 999}\n");
   const CliRun domain = run_projbot("run --sim --headless --seconds 1 --config " + far.string());
   EXPECT_EQ(domain.code, 1) << domain.output;
