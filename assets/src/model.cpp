@@ -4,6 +4,9 @@
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <string>
+
+#include "projbot/config/stop_request.hpp"
 
 namespace projbot::assets {
 namespace {
@@ -97,6 +100,8 @@ SurfaceSamples sample_surface(const Model& model, std::size_t count, std::uint32
   double total = 0.0;
   for (const auto& p : model.primitives)
     for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+      if (t % (3 * config::kStopCheckEvery) == 0)
+        config::stop_if_requested("sampling the surface of a model of " + std::to_string(p.indices.size() / 3) + " triangles");
       const Vertex& va = p.vertices[p.indices[t]];
       const Vertex& vb = p.vertices[p.indices[t + 1]];
       const Vertex& vc = p.vertices[p.indices[t + 2]];

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "projbot/config/paths.hpp"
+#include "projbot/config/stop_request.hpp"
 #include "projbot/config/write_all.hpp"
 
 // A fuzzer's or sanitizer's report-and-exit hook, present only in such builds.
@@ -83,21 +84,25 @@ class ReadClock {
   std::chrono::milliseconds blocked_{0};
 };
 
-// Everything the child writes, until it closes the pipe or it has spent `limit` on the read (then: false).
-bool read_all(int fd, pid_t pid, std::chrono::milliseconds limit, std::string& out) {
-  constexpr int kSliceMs = 50;  // how often the child's clock is looked at
+enum class ReadEnd { whole, late, stopped };
+
+// Everything the child writes, until it closes the pipe, it has spent `limit` on the read (late) or a stop
+// is asked of the process (stopped).
+ReadEnd read_all(int fd, pid_t pid, std::chrono::milliseconds limit, std::string& out) {
+  constexpr int kSliceMs = 50;  // how often the child's clock and the stop request are looked at
   ReadClock clock(pid);
   char buf[65536];
   for (;;) {
-    if (clock.spent() >= limit) return false;
+    if (clock.spent() >= limit) return ReadEnd::late;
+    if (stop_requested()) return ReadEnd::stopped;
     pollfd p{fd, POLLIN, 0};
     const int ready = ::poll(&p, 1, kSliceMs);
     if (ready < 0 && errno == EINTR) continue;
     if (ready == 0) continue;
-    if (ready < 0) return true;
+    if (ready < 0) return ReadEnd::whole;
     const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return true;
+    if (n <= 0) return ReadEnd::whole;
     out.append(buf, static_cast<std::size_t>(n));
   }
 }
@@ -207,7 +212,8 @@ std::string read_isolated(const std::filesystem::path& file, const IsolatedReade
   }
   ::close(fds[1]);
   std::string reply;
-  const bool in_time = pid < 0 || read_all(fds[0], pid, limit, reply);
+  const ReadEnd end = pid < 0 ? ReadEnd::whole : read_all(fds[0], pid, limit, reply);
+  const bool in_time = end == ReadEnd::whole;
   ::close(fds[0]);
   if (!in_time) ::kill(pid, SIGKILL);
   int status = 0;
@@ -216,6 +222,7 @@ std::string read_isolated(const std::filesystem::path& file, const IsolatedReade
   const ReadProgress at = *progress;
   ::munmap(shared, sizeof(ReadProgress));
   if (pid < 0) throw IsolatedReadError(name + ": cannot set up the isolated reader (fork)");
+  if (end == ReadEnd::stopped) throw StopRequested("stopped while reading " + name);
   if (!in_time)
     throw IsolatedReadError(name + ": " + what.reader + " took longer than " + seconds(limit) + " s on it (a corrupt " +
                             what.kind + "?" + where(at) + ")");

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "projbot/config/stop_request.hpp"
+
 namespace projbot::config {
 
 namespace {
@@ -94,7 +96,7 @@ std::uint64_t list_count(const char* bytes, int size, bool big_endian) {
 }
 
 // The bytes the binary body takes, walking lists; stops early (returns more than `size`) once past it.
-std::uint64_t binary_body_bytes(std::ifstream& in, const Header& h, std::uint64_t size) {
+std::uint64_t binary_body_bytes(std::ifstream& in, const Header& h, std::uint64_t size, const std::string& file) {
   const bool big = h.format == "binary_big_endian";
   std::uint64_t at = h.body;
   for (const Element& e : h.elements) {
@@ -109,18 +111,25 @@ std::uint64_t binary_body_bytes(std::ifstream& in, const Header& h, std::uint64_
       at += e.count * fixed;
       continue;
     }
-    for (std::uint64_t i = 0; i < e.count && at <= size; ++i)
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(at));  // then read on in order: a seek per list emptied the buffer each time
+    for (std::uint64_t i = 0; i < e.count && at <= size; ++i) {
+      if (i % kStopCheckEvery == 0) stop_if_requested("checking the body of " + file);
       for (const Property& p : e.properties) {
         if (p.count_size == 0) {
           at += static_cast<std::uint64_t>(p.size);
+          in.ignore(p.size);
           continue;
         }
         char bytes[8];
-        in.seekg(static_cast<std::streamoff>(at));
         if (!in.read(bytes, p.count_size)) return size + 1;
         const std::uint64_t n = list_count(bytes, p.count_size, big);
-        at += static_cast<std::uint64_t>(p.count_size) + n * static_cast<std::uint64_t>(p.size);
+        at += static_cast<std::uint64_t>(p.count_size);
+        if (n > size / static_cast<std::uint64_t>(p.size)) return size + 1;
+        at += n * static_cast<std::uint64_t>(p.size);
+        in.ignore(static_cast<std::streamsize>(n * static_cast<std::uint64_t>(p.size)));
       }
+    }
   }
   return at;
 }
@@ -154,8 +163,11 @@ PlyCounts check_ply_body(const std::filesystem::path& path) {
     in.clear();
     in.seekg(static_cast<std::streamoff>(h.body));
     std::uint64_t lines = 0;
-    for (std::string line; std::getline(in, line);)
+    std::uint64_t read = 0;
+    for (std::string line; std::getline(in, line);) {
+      if (++read % kStopCheckEvery == 0) stop_if_requested("checking the body of " + file);
       if (line.find_first_not_of(" \t\r") != std::string::npos) ++lines;
+    }
     if (lines != total)
       throw PlyError(file + ": the header declares " + std::to_string(total) + " elements (" + std::to_string(vertices) +
                      " vertices), the body holds " + std::to_string(lines) + " lines");
@@ -163,7 +175,7 @@ PlyCounts check_ply_body(const std::filesystem::path& path) {
   }
   if (h.format != "binary_little_endian" && h.format != "binary_big_endian")
     throw PlyError(file + ": PLY format '" + h.format + "' is none of ascii, binary_little_endian, binary_big_endian");
-  const std::uint64_t end = binary_body_bytes(in, h, size);
+  const std::uint64_t end = binary_body_bytes(in, h, size, file);
   if (end != size)
     throw PlyError(file + ": the header declares " + std::to_string(vertices) + " vertices and " +
                    std::to_string(total - vertices) + " other elements, " +

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstring>
 
+#include "projbot/config/stop_request.hpp"
 #include "renderer_impl.hpp"
 
 namespace projbot::engine {
@@ -207,7 +208,10 @@ GpuModel Renderer::Impl::make_gpu_model(const assets::Model& model) {
       throw EngineError(model.source + ": primitive refers to a missing material");
     g.parts.push_back({static_cast<std::uint32_t>(indices.size()), static_cast<std::uint32_t>(p.indices.size()),
                        static_cast<std::int32_t>(vertices.size()), static_cast<std::size_t>(p.material)});
-    for (const auto& v : p.vertices) vertices.push_back(to_gpu(v));
+    for (const auto& v : p.vertices) {
+      if (vertices.size() % config::kStopCheckEvery == 0) config::stop_if_requested("uploading " + model.source);
+      vertices.push_back(to_gpu(v));
+    }
     indices.insert(indices.end(), p.indices.begin(), p.indices.end());
   }
   upload_geometry(g, model, vertices, indices);

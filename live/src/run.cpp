@@ -13,6 +13,7 @@
 #include "projbot/alignment/latest_value.hpp"
 #include "projbot/config/angles.hpp"
 #include "projbot/config/clock.hpp"
+#include "projbot/config/stop_request.hpp"
 #include "projbot/engine/content.hpp"
 #include "projbot/live/reflectance_probe.hpp"
 #include "projbot/live/rig.hpp"
@@ -191,7 +192,7 @@ class RobotThread {
   Handoffs& handoffs() { return handoffs_; }  // the robot thread's until finish()
   // After the frame loop: a device (or the twin) that failed while projecting blanks the projector at once,
   // so nothing it last showed stays lit; then the thread is stopped and joined. The failure's message
-  // (empty: none); a failure that is not a std::exception is rethrown.
+  // (empty: none); a failure that is not a std::exception, or a stop asked during the set-up, is rethrown.
   std::string finish(engine::Renderer& renderer, engine::RenderTarget& target, const config::ProjectorConfig& projector);
 
  private:
@@ -248,6 +249,7 @@ std::string RobotThread::finish(engine::Renderer& renderer, engine::RenderTarget
     renderer.draw_frame(target, projector, std::span<const engine::DrawItem>{});
     try {
       std::rethrow_exception(error_);
+    } catch (const config::StopRequested&) {  // Ctrl-C while the robot set up: no failure; thrown on below
     } catch (const std::exception& e) {
       failure = e.what();
     }

@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "projbot/config/stop_request.hpp"
+
 namespace projbot::tools {
 namespace {
 
@@ -30,6 +32,7 @@ void catch_interrupts() {
   sa.sa_flags = SA_RESTART;
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  config::set_stop_request(&interrupted);  // heard inside the loaders too (a model of millions of triangles)
 }
 
 bool interrupted() { return g_signal.load() != 0; }

@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "projbot/config/paths.hpp"
+#include "projbot/config/stop_request.hpp"
 #include "projbot/robot/error.hpp"
 #include "scene_setup.hpp"
 
@@ -189,6 +190,8 @@ int run_command(const Command& cmd, int argc, char** argv, int first, const std:
     return cmd.run(args);
   } catch (const projbot::robot::SetupInterrupted& e) {  // SIGTERM while the twin was built: nothing made
     return projbot::tools::nothing_written(std::string("while building the twin (") + e.what() + ")");
+  } catch (const projbot::config::StopRequested& e) {  // a signal while a big model was read or prepared
+    return projbot::tools::nothing_written(std::string("(") + e.what() + ")");
   } catch (const std::bad_alloc&) {
     std::cerr << "projbot " << name << ": out of memory: an input is larger than this machine can hold\n";
     return 1;

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "projbot/config/angles.hpp"
+#include "projbot/config/stop_request.hpp"
 #include "projbot/engine/projection.hpp"
 
 namespace projbot::twin {
@@ -15,6 +16,9 @@ MeshRaycaster::MeshRaycaster(const assets::Model& model) {
   std::size_t n = 0;
   for (const auto& p : model.primitives) {
     for (std::size_t i = 0; i + 2 < p.indices.size(); i += 3) {
+      if (n % config::kStopCheckEvery == 0)
+        config::stop_if_requested("preparing a model of " + std::to_string(p.indices.size() / 3) +
+                                  " triangles for the twin's ray-caster");
       const auto v = [&](std::size_t k) {
         const auto& q = p.vertices[p.indices[i + k]].position;
         return Eigen::Vector3d(q[0], q[1], q[2]);
@@ -38,6 +42,8 @@ MeshRaycaster::MeshRaycaster(const assets::Model& model) {
 // The node over order_[first, first + count): a leaf of at most 8 triangles, else split at the median of
 // their centroids along the widest axis. Boxes are padded so that rounding never hides a hit on their faces.
 std::int32_t MeshRaycaster::build(std::uint32_t first, std::uint32_t count) {
+  if (count >= config::kStopCheckEvery)
+    config::stop_if_requested("building the twin's ray-caster over a model of " + std::to_string(a_.size()) + " triangles");
   const auto index = static_cast<std::int32_t>(nodes_.size());
   nodes_.emplace_back();
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;

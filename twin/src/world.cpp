@@ -9,6 +9,7 @@
 
 #include "projbot/alignment/equations.hpp"
 #include "projbot/alignment/kinect_noise.hpp"
+#include "projbot/config/stop_request.hpp"
 #include "projbot/engine/content.hpp"
 #include "projbot/engine/photometry.hpp"
 #include "projbot/engine/projection.hpp"
@@ -143,8 +144,11 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
     TwinTarget tt;
     tt.config = t;
     tt.model = assets::load_model(t.model);
+    const std::string preparing = "preparing target '" + t.name + "' for the twin";
+    config::stop_if_requested(preparing);  // between the steps that each take a second on millions of triangles
     assets::scale_and_recenter(tt.model, t.scale, t.recenter);
     tt.raycaster = std::make_shared<MeshRaycaster>(tt.model);
+    config::stop_if_requested(preparing);
     for (std::size_t k = 0; k < t.markers_m.size(); ++k) {
       const Eigen::Vector3d q = tt.raycaster->closest_point(t.markers_m[k]);
       const double d = (q - t.markers_m[k]).norm();
@@ -157,12 +161,14 @@ Twin::Twin(const config::Scene& scene, const TwinOptions& options, engine::Rende
       }
     }
     tt.cloud = alignment::model_cloud_from(tt.model, 50000);
+    config::stop_if_requested(preparing);
     tt.T_world_target_true = *t.T_world_target;
     place_support(tt, where, footprints);
     tt.surface_texture = engine::load_surface_texture(t, tt.model);
     target_ids_.push_back(renderer_.add_model(tt.model));
     if (tt.surface_texture) renderer_.set_surface(target_ids_.back(), *tt.surface_texture);  // what compensation divides by
     surface_ids_.push_back(renderer_.add_model(surface_model(tt.model, t.surface.albedo, tt.surface_texture.get())));
+    config::stop_if_requested(preparing);
     facet_ids_.push_back(renderer_.add_model(facet_normal_model(tt.model)));
     tt.in_world = t.present;
     home_.push_back(tt.T_world_target_true);
