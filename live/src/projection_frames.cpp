@@ -42,6 +42,7 @@ std::vector<DrawnPose> ProjectionFrames::compose(double now_s, const LitNow& lit
     d.display_s = display_s;
     d.T_camera_target = cfg_.predict ? alignment::predict_pose(pose.motion, display_s) : pose.T_camera_target;
     d.T_projector_target = alignment::projector_from_target(cfg_.T_projector_camera, d.T_camera_target);  // Eq. 2
+    d.quality = pose.inlier_ratio;
     drawn.push_back(d);
   }
   return drawn;

@@ -41,6 +41,7 @@ struct RobotState {
   // null where nothing serves a truth (a replay, the configured robot).
   std::shared_ptr<const StopTruth> truth{};
   std::optional<std::array<double, 3>> moving{};  // while driving: where it believes it is now (none at a stop)
+  robot::HeadPoses head{};                        // at a stop: where it believes its camera and projector are
 };
 
 // The mean marker error of a target drawn (at its display time and pose), against the truth then; NaN
@@ -97,7 +98,7 @@ class RunObserver final : public StopObserver {
     visit_ = stop.visit + 1;
     driving_since_s_ = -1.0;  // at a stop: the map shows the stop's pose
     const robot::Pose2D& at = stop.drive.estimate;
-    state_.publish({lit, since_s, visit_, false, {at.x_m, at.y_m, at.theta_rad}, rig_.truth(stop)});
+    state_.publish({lit, since_s, visit_, false, {at.x_m, at.y_m, at.theta_rad}, rig_.truth(stop), {}, stop.believed});
   }
   void frame(const live::Stop& stop, int k, const alignment::RgbdFrame& f,
              const std::vector<std::optional<alignment::PoseSample>>& samples) override {
@@ -169,6 +170,27 @@ void take_the_operators_turn(ShowControl& show, StopSequence& session, std::ostr
   }
 }
 
+// How long a fleet robot waits at its start for the coordinator's plan before it sets off on its own tour.
+constexpr double kFirstPlanWaitS = 5.0;
+
+// Before a fleet robot's stop: the plan's next target for it, waiting where it is while the plan gives it
+// none (and, before the first stop, up to kFirstPlanWaitS for a plan). False while no plan was heard (the
+// tour goes on as listed).
+bool follow_the_plan(const std::function<std::optional<int>()>& next, StopSequence& session, std::ostream& log,
+                     const std::stop_token& cancel, bool first) {
+  const double give_up_s = config::steady_now_s() + (first ? kFirstPlanWaitS : 0.0);
+  std::optional<int> target = next();
+  for (; (target ? *target < 0 : config::steady_now_s() < give_up_s) && !cancel.stop_requested(); target = next())
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  if (!target || *target < 0) return target.has_value();
+  try {
+    session.visit_next(*target);
+  } catch (const SessionError& e) {
+    log << "fleet plan: " << e.what() << " (the tour goes on)" << std::endl;
+  }
+  return true;
+}
+
 // The robot thread of a run: the session at each stop (the rig built on this thread: the twin renders on
 // it), publishing what the render thread draws; a failure is kept for the render thread to report. A
 // replay's session keeps time on `replay_clock` (null: the steady clock).
@@ -232,9 +254,15 @@ void RobotThread::drive(const config::Scene& scene, const RunOptions& o, live::S
     });
     rig.projector_shows([probe = probe_] { return probe->showing(); });
   }
+  const robot::Pose2D start = rig.session().navigator().believed_pose();  // on the operator's map (and the fleet's)
+  state_.publish(
+      {.lit = {}, .since_s = clock.now_s(), .visit = 0, .moving = std::array<double, 3>{start.x_m, start.y_m, start.theta_rad}});
   const int visits = rig.visits(o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size()));
   const Dwell dwell = sources.show ? operated(rig.dwell(o.dwell_s), *sources.show) : rig.dwell(o.dwell_s);
-  for (int v = 0; (v < visits || asked_to_go(sources.show)) && !cancel.stop_requested(); ++v) {
+  for (int v = 0; !cancel.stop_requested(); ++v) {
+    const bool asked = asked_to_go(sources.show);
+    const bool planned = sources.next_target && follow_the_plan(sources.next_target, rig.session(), *sources.log, cancel, v == 0);
+    if (!(v < visits || asked || planned) || cancel.stop_requested()) break;
     if (sources.show) take_the_operators_turn(*sources.show, rig.session(), *sources.log, cancel);
     rig.session().visit(v, trackers.workers, dwell, observer, cancel);
   }
@@ -393,6 +421,7 @@ void operate_in_loop(ProjectionInputs& in, ShowControl& show, ShowReporter& repo
     }
     StopView stop{{}, seen.visit, seen.done, seen.believed, seen.moving};
     for (const DrawnTarget& lit : seen.lit) stop.lit.push_back(lit.target);
+    if (!seen.lit.empty()) stop.T_map_camera = seen.head.T_world_camera, stop.T_map_projector = seen.head.T_world_projector;
     reporter.frame(f, stop, loop.figures(), f.start_s, f.start_s - loop.started_s());
   };
 }

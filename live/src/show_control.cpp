@@ -196,6 +196,7 @@ ShowState ShowReporter::build(const StopView& stop, const ProjectionFigures& fig
   if (!stop.lit.empty()) s.visiting = site.at(static_cast<std::size_t>(stop.lit.front())).name;
   s.stops = stops_;
   s.robot = stop.moving ? stop.moving : stops_.empty() ? std::nullopt : std::optional(stops_.back());
+  if (!stop.lit.empty()) s.T_map_projector = stop.T_map_projector;
   const ProjectionRow* newest = figures.rows.empty() ? nullptr : &figures.rows.back();
   for (std::size_t i = 0; i < site.size(); ++i) {
     TargetShowState t;
@@ -203,8 +204,13 @@ ShowState ShowReporter::build(const StopView& stop, const ProjectionFigures& fig
     t.at = site[i].at;
     const int index = static_cast<int>(i);
     const bool lit = std::find(stop.lit.begin(), stop.lit.end(), index) != stop.lit.end();
-    const bool drawn = std::any_of(drawn_.begin(), drawn_.end(), [&](const DrawnPose& d) { return d.target == index; });
+    const auto d = std::find_if(drawn_.begin(), drawn_.end(), [&](const DrawnPose& p) { return p.target == index; });
+    const bool drawn = d != drawn_.end();
     t.state = drawn ? "lit" : lit ? "blank" : "idle";
+    if (drawn && stop.T_map_camera) {
+      t.T_map_target = *stop.T_map_camera * Eigen::Isometry3d(d->T_camera_target);
+      t.quality = d->quality;
+    }
     t.visited = !stop.lit.empty() && stop.lit.front() == index;
     t.content = control_.content_of(i);
     if (drawn && newest && newest->target == index && !std::isnan(newest->error_mm)) t.error_mm = newest->error_mm;

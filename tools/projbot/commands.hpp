@@ -44,6 +44,7 @@ extern const Command kRun;
 extern const Command kDevices;
 extern const Command kSimBase;
 extern const Command kRecord;
+extern const Command kFleet;
 extern const Command kCalibrateSimulate;
 extern const Command kCalibrateSolve;
 extern const Command kCalibrateCapture;

@@ -276,7 +276,9 @@ Operated open_controls(const cli::Args& args, const config::Scene& scene, bool r
 }
 
 void print_controls(std::ostream& out, const live::RunResult& r, const Operated& o) {
-  if (o.fleet) out << "fleet: " << o.fleet->published() << " states published as " << o.fleet->config().name << '\n';
+  if (o.fleet)
+    out << "fleet: " << o.fleet->published() << " states published as " << o.fleet->config().name << ", "
+        << o.fleet->plans_heard() << " plan(s) heard for it\n";
   if (!o.console && !o.osc) return;
   out << "console: " << r.blackout_frames << " frames blacked out";
   if (!r.blackout_latency_ms.empty()) {
@@ -430,6 +432,7 @@ const Command kRun{
       sources.log = &std::cout;
       sources.errors = &std::cerr;
       sources.show = operated.show.get();
+      if (operated.fleet) sources.next_target = [&fleet = *operated.fleet] { return fleet.next_target(); };
       const live::RunResult r = live::run(renderer, scene, o, sources);
 
       print_frames(std::cout, r);

@@ -3,15 +3,21 @@
 // conventions (topic "rt/NAME/...", type "package::msg::dds_::Type_"), so a ROS 2 tool on the same domain
 // reads the standard ones:
 //
-//   rt/NAME/pose    geometry_msgs/msg/PoseStamped, frame "map": where the robot believes it is
-//   rt/NAME/state   projbot_msgs RobotState: phase, visited target, visit, frame rate, blackout, paused
+//   rt/NAME/pose       geometry_msgs/msg/PoseStamped, frame "map": where the robot believes it is
+//   rt/NAME/state      projbot_msgs RobotState: phase, visited target, visit, frame rate, blackout, paused,
+//                      and each drawn target's pose in the map with the tracker's quality
+//   rt/NAME/projector  geometry_msgs/msg/PoseStamped, frame "map": the projector's pose while lit
 //
-// each at least five times a second (the show's state as the render thread publishes it, and again when
-// none newer came in 0.2 s). Reliable, the newest kept; DDS liveliness (automatic, a 1 s lease) tells the
-// others when the robot is gone, even killed. Its own thread: the engine never waits on the bus.
+// and reads the coordinator's plan (rt/fleet/plan) for the targets it is to visit.
+//
+// pose and state at least five times a second (the show's state as the render thread publishes it, and
+// again when none newer came in 0.2 s), the projector's at about the camera's rate (30 Hz). Reliable, the newest kept; DDS
+// liveliness (automatic, a 1 s lease) tells the others when the robot is gone, even killed. Its own thread: the engine never
+// waits on the bus.
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -43,6 +49,12 @@ class FleetMember {
   FleetMember& operator=(const FleetMember&) = delete;
   const FleetConfig& config() const;
   std::size_t published() const;  ///< states published (each with its pose where one is known)
+  /// What the coordinator's plan (rt/fleet/plan) says this robot visits next, asked before each stop: a
+  /// scene index (its targets in turn, from the first again after the last, and from the first of a new
+  /// list when the plan changes), -1 while the plan gives it nothing (it waits), nullopt while no plan
+  /// was heard (it goes on with its own tour). A robot whose coordinator is gone keeps the last plan.
+  std::optional<int> next_target();
+  std::size_t plans_heard() const;  ///< plans that changed this robot's list
 
  private:
   struct Impl;

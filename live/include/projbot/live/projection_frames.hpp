@@ -51,6 +51,7 @@ struct DrawnPose {
   double display_s = 0;                                              ///< when the frame is expected to be lit
   Eigen::Matrix4d T_camera_target = Eigen::Matrix4d::Identity();     ///< at display_s (predicted) or as measured
   Eigen::Matrix4d T_projector_target = Eigen::Matrix4d::Identity();  ///< Eq. 2 of the above
+  double quality = 0.0;                                              ///< the tracker's inlier ratio for the pose
 };
 
 /// A target's newest accepted pose (TrackerWorker::latest): false where there is none yet.

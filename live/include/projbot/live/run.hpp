@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -52,6 +53,11 @@ struct RunSources {
   /// The operator's controls (blackout, pause, go to a target) and the state they are shown (the console,
   /// OSC); null: none. Not with a replay, whose frames wait on the robot's.
   ShowControl* show = nullptr;
+  /// A fleet's plan (run --fleet), asked before each stop: the scene index of the target to visit next,
+  /// -1 while the plan gives this robot nothing (it waits where it is), nullopt while it has no plan (the
+  /// tour goes on as listed). While a plan is followed the tour goes on past its visits, to --seconds or
+  /// Ctrl-C. Empty: no fleet.
+  std::function<std::optional<int>()> next_target;
 };
 
 /// What a run measured.

@@ -6,6 +6,7 @@
 // (ShowPictures) while someone looks at them. Neither engine thread ever
 // waits on an operator: every call here is a flag or a pointer swapped under a short lock.
 
+#include <Eigen/Geometry>
 #include <array>
 #include <atomic>
 #include <condition_variable>
@@ -45,6 +46,10 @@ struct TargetShowState {
   double error_mm = -1;                     ///< at its display time, where a truth is known; -1: not measured
   std::optional<std::array<double, 2>> at;  ///< where the map says it stands (x, y m)
   std::string content;                      ///< the video it plays (the last one switched to); empty: none
+  /// Where the newest frame drew it in the map: the stop's believed camera (Eq. 1's T_map_camera) times the
+  /// drawn T_camera_target; nullopt unless lit.
+  std::optional<Eigen::Isometry3d> T_map_target;
+  double quality = -1.0;  ///< the tracker's inlier ratio for that pose, 0..1; -1 unless lit
 };
 
 /// One visit of the tour as the projector lit it: its visited target's frames while the robot stood there.
@@ -70,6 +75,8 @@ struct ShowState {
   std::vector<std::array<double, 3>> stops;
   /// Where it believes it is now: while driving, its pose at the newest control step read; else the newest stop's.
   std::optional<std::array<double, 3>> robot;
+  /// Where the robot believes its projector is in the map, at a stop (what a neighbour blends against).
+  std::optional<Eigen::Isometry3d> T_map_projector;
   std::vector<TargetShowState> targets;  ///< by scene index
   double frame_rate_hz = 0.0;            ///< over the last second
   double pose_age_ms = -1.0;             ///< the newest drawn pose's age at display; -1: nothing drawn
@@ -151,6 +158,8 @@ struct StopView {
   bool done = false;                              ///< the tour is over (or the robot failed)
   std::array<double, 3> believed{};               ///< where the robot believed it was at the stop (x, y m; heading rad)
   std::optional<std::array<double, 3>> moving{};  ///< while driving: where it believes it is now
+  /// At a stop: where the robot believes its camera and projector are in the map (robot::HeadPoses).
+  std::optional<Eigen::Isometry3d> T_map_camera{}, T_map_projector{};
 };
 
 /// The render thread's side of ShowControl: each frame seen, the show's state published about five times

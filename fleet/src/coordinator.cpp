@@ -1,0 +1,219 @@
+#include "projbot/fleet/coordinator.hpp"
+
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "plan_wire.hpp"
+#include "projbot/robot/ros2_wire.hpp"
+
+namespace projbot::fleet {
+namespace {
+
+constexpr const char* kStateType = "projbot_msgs::msg::dds_::RobotState_";
+constexpr auto kStep = std::chrono::milliseconds(20);        // how often the bus is read
+constexpr auto kRepublish = std::chrono::milliseconds(100);  // the plan again, for a takeover within a lease
+
+// The robot a state topic belongs to ("rt/NAME/state"); empty for any other topic.
+std::string robot_of(const std::string& topic, const std::string& type) {
+  const std::string head = "rt/", tail = "/state";
+  if (type != kStateType || topic.size() <= head.size() + tail.size() || topic.rfind(head, 0) != 0 ||
+      topic.compare(topic.size() - tail.size(), tail.size(), tail) != 0)
+    return {};
+  const std::string name = topic.substr(head.size(), topic.size() - head.size() - tail.size());
+  return fleet_name_problem(name).empty() ? name : std::string();
+}
+
+std::string default_name() {
+  std::array<char, 256> host{};
+  ::gethostname(host.data(), host.size() - 1);
+  return std::string(host.data()) + ":" + std::to_string(::getpid());
+}
+
+char* c_str(const std::string& s) { return const_cast<char*>(s.c_str()); }  // written before it changes
+
+// A robot as the coordinator hears it.
+struct Heard {
+  dds_entity_t state = 0, pose = 0;
+  std::optional<std::array<double, 2>> at;
+  bool alive = false;
+};
+
+}  // namespace
+
+struct Coordinator::Impl {
+  const config::Scene& scene;
+  CoordinatorConfig config;
+  FloorMap floor;
+  dds_entity_t participant = 0, publications = 0, plan_writer = 0;
+  std::map<std::string, Heard> robots;
+  Plan plan;
+  std::uint64_t epoch = 0;
+
+  Impl(const config::Scene& s, CoordinatorConfig c) : scene(s), config(std::move(c)), floor(s) {}
+  ~Impl() {
+    if (participant > 0) dds_delete(participant);
+  }
+
+  void check(dds_return_t rc, const std::string& what) const {
+    if (rc < 0) throw FleetError("fleet coordinator: " + what + ": " + dds_strretcode(rc));
+  }
+
+  void open() {
+    participant = dds_create_participant(static_cast<dds_domainid_t>(config.domain), nullptr, nullptr);
+    check(participant, "cannot join DDS domain " + std::to_string(config.domain));
+    publications = dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+    check(publications, "cannot read the domain's publications");
+    const dds_entity_t topic =
+        dds_create_topic(participant, &projbot_msgs_msg_dds__FleetPlan__desc, wire::kPlanTopic.c_str(), nullptr, nullptr);
+    check(topic, "cannot create topic " + wire::kPlanTopic);
+    dds_qos_t* qos = wire::plan_qos(config.strength);
+    plan_writer = dds_create_writer(participant, topic, qos, nullptr);
+    dds_delete_qos(qos);
+    check(plan_writer, "cannot create a writer on " + wire::kPlanTopic);
+  }
+
+  dds_entity_t reader(const dds_topic_descriptor_t* type, const std::string& topic) {
+    const dds_entity_t t = dds_create_topic(participant, type, topic.c_str(), nullptr, nullptr);
+    check(t, "cannot create topic " + topic);
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+    const dds_entity_t r = dds_create_reader(participant, t, qos, nullptr);
+    dds_delete_qos(qos);
+    check(r, "cannot read " + topic);
+    return r;
+  }
+
+  // Robots whose state writers discovery has found since the last call.
+  void discover(const CoordinatorLog& said) {
+    for (;;) {
+      void* samples[1] = {nullptr};
+      dds_sample_info_t info[1];
+      const dds_return_t got = dds_take(publications, samples, info, 1, 1);
+      if (got <= 0) return;
+      const auto* e = static_cast<const dds_builtintopic_endpoint_t*>(samples[0]);
+      const std::string name = info[0].valid_data ? robot_of(e->topic_name, e->type_name) : std::string();
+      dds_return_loan(publications, samples, got);
+      if (name.empty() || robots.count(name)) continue;
+      Heard& h = robots[name];
+      h.state = reader(&projbot_msgs_msg_dds__RobotState__desc, robot::wire_topic(name + "/state"));
+      h.pose = reader(&geometry_msgs_msg_dds__PoseStamped__desc, robot::wire_topic(name + "/pose"));
+      said("robot " + name + " found on the bus");
+    }
+  }
+
+  // Each robot's newest pose and whether it is alive; true when the robots a plan counts changed.
+  bool listen(const CoordinatorLog& said) {
+    bool changed = false;
+    for (auto& [name, h] : robots) {
+      const bool counted = h.alive && h.at;
+      for (;;) {
+        void* samples[1] = {nullptr};
+        dds_sample_info_t info[1];
+        const dds_return_t got = dds_take(h.pose, samples, info, 1, 1);
+        if (got <= 0) break;
+        if (info[0].valid_data) {
+          const auto* p = static_cast<const geometry_msgs_msg_dds__PoseStamped_*>(samples[0]);
+          h.at = std::array<double, 2>{p->pose.position.x, p->pose.position.y};
+        }
+        dds_return_loan(h.pose, samples, got);
+      }
+      dds_liveliness_changed_status_t live{};
+      dds_get_liveliness_changed_status(h.state, &live);
+      if (h.alive != (live.alive_count > 0)) said("robot " + name + (live.alive_count > 0 ? " is alive" : " is lost"));
+      h.alive = live.alive_count > 0;
+      changed = changed || counted != (h.alive && h.at.has_value());
+    }
+    return changed;
+  }
+
+  void replan(const CoordinatorLog& said) {
+    std::vector<RobotSeen> seen;
+    for (const auto& [name, h] : robots)
+      if (h.alive && h.at) seen.push_back({name, *h.at});
+    Plan next = make_plan(scene, floor, seen);
+    if (epoch > 0 && next == plan) return;
+    plan = std::move(next);
+    ++epoch;
+    said("plan " + std::to_string(epoch) + " for " + std::to_string(seen.size()) + " robot(s):\n" + plan_table(plan));
+  }
+
+  void publish() {
+    std::vector<std::vector<char*>> targets;
+    std::vector<projbot_msgs_msg_dds__Assignment_> assignments;
+    targets.reserve(plan.targets_of.size());
+    for (const auto& [robot, list] : plan.targets_of) {
+      std::vector<char*>& names = targets.emplace_back();
+      for (const std::string& t : list) names.push_back(c_str(t));
+      assignments.push_back(
+          {c_str(robot),
+           {static_cast<std::uint32_t>(names.size()), static_cast<std::uint32_t>(names.size()), names.data(), false}});
+    }
+    std::vector<char*> unreachable;
+    for (const std::string& t : plan.unreachable) unreachable.push_back(c_str(t));
+    projbot_msgs_msg_dds__FleetPlan_ sample{};
+    const std::string map = "map";
+    const double now_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+    sample.header.stamp = robot::ros_time<builtin_interfaces_msg_dds__Time_>(now_s);
+    sample.header.frame_id = c_str(map);
+    sample.coordinator = c_str(config.name);
+    sample.epoch = epoch;
+    sample.assignments = {static_cast<std::uint32_t>(assignments.size()), static_cast<std::uint32_t>(assignments.size()),
+                          assignments.data(), false};
+    sample.unreachable = {static_cast<std::uint32_t>(unreachable.size()), static_cast<std::uint32_t>(unreachable.size()),
+                          unreachable.data(), false};
+    dds_write(plan_writer, &sample);
+  }
+};
+
+Coordinator::Coordinator(const config::Scene& scene, CoordinatorConfig config)
+    : impl_(std::make_unique<Impl>(scene, std::move(config))) {
+  if (impl_->config.domain < 0 || impl_->config.domain > 232)
+    throw FleetError("fleet domain " + std::to_string(impl_->config.domain) + ": a DDS domain is from 0 to 232");
+  if (impl_->config.name.empty()) impl_->config.name = default_name();
+  impl_->open();
+}
+
+Coordinator::~Coordinator() = default;
+
+void Coordinator::run(const std::function<bool()>& stop, const CoordinatorLog& said) {
+  impl_->replan(said);  // the plan with no robot: every target waits for one
+  auto published = std::chrono::steady_clock::now() - kRepublish;
+  while (!stop()) {
+    impl_->discover(said);
+    if (impl_->listen(said)) impl_->replan(said);
+    if (std::chrono::steady_clock::now() - published >= kRepublish) {
+      impl_->publish();
+      published = std::chrono::steady_clock::now();
+    }
+    std::this_thread::sleep_for(kStep);
+  }
+}
+
+std::uint64_t Coordinator::plans() const { return impl_->epoch; }
+
+std::string plan_table(const Plan& plan) {
+  std::ostringstream out;
+  out << "| robot | targets, in order |\n|---|---|\n";
+  for (const auto& [robot, targets] : plan.targets_of) {
+    out << "| " << robot << " | ";
+    for (std::size_t i = 0; i < targets.size(); ++i) out << (i ? ", " : "") << targets[i];
+    out << (targets.empty() ? "(none)" : "") << " |\n";
+  }
+  if (plan.targets_of.empty()) out << "| (no robot heard) | - |\n";
+  if (!plan.unreachable.empty()) {
+    out << "\nNo robot can reach:";
+    for (const std::string& t : plan.unreachable) out << ' ' << t;
+    out << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace projbot::fleet
