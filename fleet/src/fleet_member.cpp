@@ -55,7 +55,7 @@ struct FleetMember::Impl {
   std::atomic<std::size_t> published{0};
   std::mutex plan_mutex;  // the plan's part for this robot, read by the robot thread
   std::optional<std::vector<std::string>> mine;
-  std::size_t next = 0, plans_heard = 0;
+  std::size_t plans_heard = 0;
   std::jthread thread;
 
   Impl(live::ShowControl& s, FleetConfig c) : config(std::move(c)), show(s) {}
@@ -113,7 +113,7 @@ struct FleetMember::Impl {
         const auto it = plan.targets_of.find(config.name);
         std::vector<std::string> part = it == plan.targets_of.end() ? std::vector<std::string>{} : it->second;
         const std::lock_guard lock(plan_mutex);
-        if (!mine || *mine != part) mine = std::move(part), next = 0, ++plans_heard;
+        if (!mine || *mine != part) mine = std::move(part), ++plans_heard;
       }
       dds_return_loan(plan_reader, samples, got);
     }
@@ -190,17 +190,15 @@ const FleetConfig& FleetMember::config() const { return impl_->config; }
 
 std::size_t FleetMember::published() const { return impl_->published.load(); }
 
-std::optional<int> FleetMember::next_target() {
+std::optional<std::vector<int>> FleetMember::planned_targets() const {
   const std::lock_guard lock(impl_->plan_mutex);
   if (!impl_->mine) return std::nullopt;
-  const std::vector<std::string>& mine = *impl_->mine;
   const std::vector<live::SiteTarget>& site = impl_->show.targets();
-  for (std::size_t tried = 0; tried < mine.size(); ++tried) {  // a name the scene lacks is passed over
-    const std::string& name = mine[impl_->next++ % mine.size()];
+  std::vector<int> out;
+  for (const std::string& name : *impl_->mine)
     for (std::size_t i = 0; i < site.size(); ++i)
-      if (site[i].name == name && site[i].reachable) return static_cast<int>(i);
-  }
-  return -1;
+      if (site[i].name == name && site[i].reachable) out.push_back(static_cast<int>(i));
+  return out;
 }
 
 std::size_t FleetMember::plans_heard() const {

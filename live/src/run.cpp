@@ -173,23 +173,46 @@ void take_the_operators_turn(ShowControl& show, StopSequence& session, std::ostr
 // How long a fleet robot waits at its start for the coordinator's plan before it sets off on its own tour.
 constexpr double kFirstPlanWaitS = 5.0;
 
-// Before a fleet robot's stop: the plan's next target for it, waiting where it is while the plan gives it
-// none (and, before the first stop, up to kFirstPlanWaitS for a plan). False while no plan was heard (the
-// tour goes on as listed).
-bool follow_the_plan(const std::function<std::optional<int>()>& next, StopSequence& session, std::ostream& log,
-                     const std::stop_token& cancel, bool first) {
-  const double give_up_s = config::steady_now_s() + (first ? kFirstPlanWaitS : 0.0);
-  std::optional<int> target = next();
-  for (; (target ? *target < 0 : config::steady_now_s() < give_up_s) && !cancel.stop_requested(); target = next())
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  if (!target || *target < 0) return target.has_value();
-  try {
-    session.visit_next(*target);
-  } catch (const SessionError& e) {
-    log << "fleet plan: " << e.what() << " (the tour goes on)" << std::endl;
+// A fleet robot's side of the coordinator's plan (RunSources::planned_targets): its targets in turn.
+class PlanFollower {
+ public:
+  explicit PlanFollower(std::function<std::optional<std::vector<int>>()> plan) : plan_(std::move(plan)) {}
+  bool on() const { return static_cast<bool>(plan_); }
+
+  // Before a stop: the next of its targets, from the first of a new list (the one it stands at skipped),
+  // waiting where it is while the plan gives it none and, before the first stop, up to kFirstPlanWaitS for
+  // a plan. False while no plan was heard (the tour goes on as listed).
+  bool next(StopSequence& session, std::ostream& log, const std::stop_token& cancel, bool first) {
+    const double give_up_s = config::steady_now_s() + (first ? kFirstPlanWaitS : 0.0);
+    std::optional<std::vector<int>> plan = plan_();
+    for (; (plan ? plan->empty() : config::steady_now_s() < give_up_s) && !cancel.stop_requested(); plan = plan_())
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (!plan || plan->empty()) return plan.has_value();
+    if (*plan != list_) list_ = *plan, next_ = list_.size() > 1 && list_.front() == at_ ? 1 : 0;
+    at_ = list_[next_++ % list_.size()];
+    try {
+      session.visit_next(at_);
+    } catch (const SessionError& e) {
+      log << "fleet plan: " << e.what() << " (the tour goes on)" << std::endl;
+    }
+    return true;
   }
-  return true;
-}
+
+  // The dwell at a stop goes on while the plan gives the robot that stop's target alone: it stays lit.
+  Dwell staying(Dwell dwell) const {
+    dwell.over = [over = dwell.over, this](const Stop& stop, int frames, double elapsed_s) {
+      const std::optional<std::vector<int>> plan = plan_();
+      return over(stop, frames, elapsed_s) && !(plan && plan->size() == 1 && plan->front() == stop.target);
+    };
+    return dwell;
+  }
+
+ private:
+  std::function<std::optional<std::vector<int>>()> plan_;
+  std::vector<int> list_;
+  std::size_t next_ = 0;
+  int at_ = -1;  // the target it went to last
+};
 
 // The robot thread of a run: the session at each stop (the rig built on this thread: the twin renders on
 // it), publishing what the render thread draws; a failure is kept for the render thread to report. A
@@ -258,10 +281,12 @@ void RobotThread::drive(const config::Scene& scene, const RunOptions& o, live::S
   state_.publish(
       {.lit = {}, .since_s = clock.now_s(), .visit = 0, .moving = std::array<double, 3>{start.x_m, start.y_m, start.theta_rad}});
   const int visits = rig.visits(o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size()));
-  const Dwell dwell = sources.show ? operated(rig.dwell(o.dwell_s), *sources.show) : rig.dwell(o.dwell_s);
+  PlanFollower plan(sources.planned_targets);
+  const Dwell own = plan.on() ? plan.staying(rig.dwell(o.dwell_s)) : rig.dwell(o.dwell_s);
+  const Dwell dwell = sources.show ? operated(own, *sources.show) : own;
   for (int v = 0; !cancel.stop_requested(); ++v) {
     const bool asked = asked_to_go(sources.show);
-    const bool planned = sources.next_target && follow_the_plan(sources.next_target, rig.session(), *sources.log, cancel, v == 0);
+    const bool planned = plan.on() && plan.next(rig.session(), *sources.log, cancel, v == 0);
     if (!(v < visits || asked || planned) || cancel.stop_requested()) break;
     if (sources.show) take_the_operators_turn(*sources.show, rig.session(), *sources.log, cancel);
     rig.session().visit(v, trackers.workers, dwell, observer, cancel);

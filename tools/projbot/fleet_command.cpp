@@ -48,11 +48,11 @@ const Command kFleet{
     "publishes the plan on rt/fleet/plan: each of the site's targets with a stop goes to one robot, the one\n"
     "whose route would end soonest with it (path lengths on the room's floor, its obstacles grown by the\n"
     "robot's radius), so every reachable target is visited and the robots share the work. A robot visits its\n"
-    "targets in turn and again; a robot the plan gives nothing waits where it is. When a robot joins or is lost\n"
-    "(its liveliness, a 1 s lease) the plan is made again at once. The plan is durable: a robot that starts\n"
-    "late reads the newest. Two coordinators may run: the plan read is the stronger one's (DDS exclusive\n"
-    "ownership, --strength), and the other's within half a second of it going. Each change is printed with\n"
-    "the time since the start. Ctrl-C ends it.\n",
+    "targets in turn and again (one target alone: it stays lit on it); a robot the plan gives nothing waits.\n"
+    "When a robot joins or is lost (its liveliness, a 1 s lease) the plan is made again at once. The plan is\n"
+    "durable: a robot that starts late reads the newest. Two coordinators may run: the plan read is the\n"
+    "stronger one's (DDS exclusive ownership, --strength), and the other's within half a second of it going.\n"
+    "Each change is printed with the time since the start. Ctrl-C ends it.\n",
     {{"config", "FILE", "site file: the targets, their stops, the room (default: assets/scenes/tour.yaml)",
       cli::PathRole::input_file},
      {"domain", "D", "the DDS domain, 0..232 (default: the site file's fleet.domain, else 0)"},

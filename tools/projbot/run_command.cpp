@@ -432,7 +432,7 @@ const Command kRun{
       sources.log = &std::cout;
       sources.errors = &std::cerr;
       sources.show = operated.show.get();
-      if (operated.fleet) sources.next_target = [&fleet = *operated.fleet] { return fleet.next_target(); };
+      if (operated.fleet) sources.planned_targets = [&fleet = *operated.fleet] { return fleet.planned_targets(); };
       const live::RunResult r = live::run(renderer, scene, o, sources);
 
       print_frames(std::cout, r);

@@ -20,6 +20,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "projbot/live/show_control.hpp"
 
@@ -49,11 +50,10 @@ class FleetMember {
   FleetMember& operator=(const FleetMember&) = delete;
   const FleetConfig& config() const;
   std::size_t published() const;  ///< states published (each with its pose where one is known)
-  /// What the coordinator's plan (rt/fleet/plan) says this robot visits next, asked before each stop: a
-  /// scene index (its targets in turn, from the first again after the last, and from the first of a new
-  /// list when the plan changes), -1 while the plan gives it nothing (it waits), nullopt while no plan
-  /// was heard (it goes on with its own tour). A robot whose coordinator is gone keeps the last plan.
-  std::optional<int> next_target();
+  /// This robot's targets in the coordinator's newest plan (rt/fleet/plan), in order, as scene indices (a
+  /// name the scene lacks, or a target without a stop, left out); nullopt while no plan was heard. A robot
+  /// whose coordinator is gone keeps the last plan.
+  std::optional<std::vector<int>> planned_targets() const;
   std::size_t plans_heard() const;  ///< plans that changed this robot's list
 
  private:

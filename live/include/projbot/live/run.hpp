@@ -53,11 +53,12 @@ struct RunSources {
   /// The operator's controls (blackout, pause, go to a target) and the state they are shown (the console,
   /// OSC); null: none. Not with a replay, whose frames wait on the robot's.
   ShowControl* show = nullptr;
-  /// A fleet's plan (run --fleet), asked before each stop: the scene index of the target to visit next,
-  /// -1 while the plan gives this robot nothing (it waits where it is), nullopt while it has no plan (the
-  /// tour goes on as listed). While a plan is followed the tour goes on past its visits, to --seconds or
+  /// A fleet's plan (run --fleet): this robot's targets (scene indices, in order), nullopt while it has
+  /// none. Asked before each stop: its targets are visited in turn (from the first of a new list); given
+  /// none, the robot waits where it is; given only the one it is at, it stays lit there; with no plan the
+  /// tour goes on as listed. While a plan is followed the tour goes on past its visits, to --seconds or
   /// Ctrl-C. Empty: no fleet.
-  std::function<std::optional<int>()> next_target;
+  std::function<std::optional<std::vector<int>>()> planned_targets;
 };
 
 /// What a run measured.
