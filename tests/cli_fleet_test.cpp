@@ -302,6 +302,13 @@ TEST_F(CliTest, AStandbyCoordinatorTakesOverThePlan) {
   Background standby({"fleet", "--domain", std::to_string(domain), "--strength", "5", "--name", "standby"}, dir_ / "standby.log");
   ASSERT_TRUE(strong.wait_for_output("plan 1", std::chrono::seconds(30)));
   ASSERT_TRUE(standby.wait_for_output("plan 1", std::chrono::seconds(30)));
+  // Until the reader has matched both writers, it reads whichever it met first (discovery's order); from
+  // the stronger one's first plan on, only the stronger one's.
+  std::string first;
+  for (const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+       first != "strong" && std::chrono::steady_clock::now() < until; std::this_thread::sleep_for(std::chrono::milliseconds(20)))
+    if (const std::string w = writer_of_newest(); !w.empty()) first = w;
+  ASSERT_EQ(first, "strong");
   std::set<std::string> heard;
   for (int i = 0; i < 40; ++i, std::this_thread::sleep_for(std::chrono::milliseconds(50)))
     if (const std::string w = writer_of_newest(); !w.empty()) heard.insert(w);
@@ -329,9 +336,72 @@ TEST_F(CliTest, TheCoordinatorRefusesWhatItCannotUse) {
   const CliRun missing = run_projbot("fleet --config " + (dir_ / "none.yaml").string());
   EXPECT_EQ(missing.code, 1) << missing.output;
   EXPECT_NE(missing.output.find("none.yaml"), std::string::npos) << missing.output;
-  // A short run with nobody on its domain: the plan with no robot, said, and a clean end.
-  const CliRun alone = run_projbot("fleet --domain 231 --seconds 1");
+  // Nobody on its domain (the robots on another one): the plan with no robot, and after 10 s it says so.
+  use_loopback_dds();
+  const CliRun alone = run_projbot("fleet --domain 231 --seconds 11");
   EXPECT_EQ(alone.code, 0) << alone.output;
   EXPECT_NE(alone.output.find("| (no robot heard) | - |"), std::string::npos) << alone.output;
+  EXPECT_NE(alone.output.find("no robot heard on DDS domain 231 in 10 s"), std::string::npos) << alone.output;
   EXPECT_NE(alone.output.find("coordinator: 1 plan(s) made"), std::string::npos) << alone.output;
+}
+
+// A second robot under a name the bus already has is refused, naming where the first one runs; a robot
+// with no coordinator on its domain says so and goes on with its own tour.
+TEST_F(CliTest, ASecondRobotOfTheSameNameIsRefused) {
+  use_loopback_dds();
+  const int domain = 100 + static_cast<int>((::getpid() + 89) % 100);
+  Background first({"run", "--sim", "--headless", "--depth-model", "kinect", "--seconds", "30", "--fleet", "r1", "--fleet-domain",
+                    std::to_string(domain)},
+                   dir_ / "first.log");
+  ASSERT_TRUE(first.wait_for_output("fleet: r1 on DDS domain", std::chrono::seconds(60))) << first.output();
+  const CliRun second = run_projbot("run --sim --headless --seconds 5 --fleet r1 --fleet-domain " + std::to_string(domain));
+  EXPECT_EQ(second.code, 2) << second.output;
+  EXPECT_NE(second.output.find("fleet name 'r1' is taken on DDS domain " + std::to_string(domain)), std::string::npos)
+      << second.output;
+  EXPECT_NE(second.output.find(":" + std::to_string(first.pid)), std::string::npos) << "names the first one's process";
+  ASSERT_TRUE(first.wait_for_output("visit 1: ", std::chrono::seconds(60))) << first.output();
+  EXPECT_NE(first.output().find("no coordinator's plan heard in 5 s"), std::string::npos) << first.output();
+}
+
+// What one robot learns, the others use (issue 69, item 3): the box stands 10 cm from where the map's
+// survey places it. The first robot finds it from the survey; the second robot's guess for it comes from
+// the first one's estimate on the bus, near where the box truly stands, and it is lit true.
+TEST_F(CliTest, WhereOneRobotFoundATargetTheNextLooksFirst) {
+  use_loopback_dds();
+  const int domain = 100 + static_cast<int>((::getpid() + 53) % 100);
+  std::string scene = shipped_scene("tour.yaml");
+  const auto replace = [&scene](const std::string& from, const std::string& to) {
+    const std::size_t at = scene.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    scene.replace(at, from.size(), to);
+  };
+  replace("    world_pose: {translation: [5.5, 3.6, 0.6], rpy_deg: [0, 0, 30]}\n",
+          "    world_pose: {translation: [5.5, 3.6, 0.6], rpy_deg: [0, 0, 30]}\n"
+          "    map_pose: {translation: [5.58, 3.66, 0.6], rpy_deg: [0, 0, 30]}\n");  // surveyed 100 mm away
+  replace("motion:", "# motion:");  // each robot's twin would move it on its own: one world here
+  replace("visits: [duck, box, duck, box, duck, box]", "visits: [box, duck]");
+  const fs::path site = write("moved.yaml", scene);
+  const auto robot = [&](const std::string& name, const std::string& seconds) {
+    return std::vector<std::string>{"run",         "--sim",   "--headless", "--depth-model",  "kinect",
+                                    "--dwell",     "3",       "--seconds",  seconds,          "--config",
+                                    site.string(), "--fleet", name,         "--fleet-domain", std::to_string(domain)};
+  };
+  Background r1(robot("r1", "45"), dir_ / "r1.log");
+  ASSERT_TRUE(r1.wait_for_output("visit 1: box", std::chrono::seconds(60))) << r1.output();
+  std::this_thread::sleep_for(std::chrono::seconds(3));  // found and drawn: its estimate is on the bus
+  Background r2(robot("r2", "20"), dir_ / "r2.log");
+  ASSERT_TRUE(r2.wait_for_output("visit 1: box", std::chrono::seconds(60))) << r2.output();
+  std::this_thread::sleep_for(std::chrono::seconds(3));  // lit and measured a while
+  const auto [code, seconds] = r2.signal_and_wait(SIGINT, std::chrono::seconds(30));
+  EXPECT_EQ(code, 130);
+  const std::string r1_log = r1.output(), r2_log = r2.output();
+  const std::string r1_first =
+      r1_log.substr(r1_log.find("visit 1: box"), r1_log.find('\n', r1_log.find("visit 1: box")) - r1_log.find("visit 1: box"));
+  EXPECT_EQ(r1_first.find("placed by"), std::string::npos) << r1_first;  // the first one had the survey alone
+  const double mm = number_after(r2_log, "placed by r1's estimate, ", r2_log.find("visit 1: box"));
+  std::cout << "r2's guess for the box placed " << mm << " mm from the survey (100 mm from where it stands)\n";
+  EXPECT_GT(mm, 75.0) << r2_log;
+  EXPECT_LT(mm, 125.0) << r2_log;
+  ASSERT_TRUE(r2.wait_for_output("still mean", std::chrono::seconds(1))) << r2_log;
+  EXPECT_LT(number_after(r2_log, "still mean "), 3.0) << r2_log;
 }

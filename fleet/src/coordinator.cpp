@@ -10,25 +10,15 @@
 #include <thread>
 #include <vector>
 
-#include "plan_wire.hpp"
+#include "bus.hpp"
 #include "projbot/robot/ros2_wire.hpp"
 
 namespace projbot::fleet {
 namespace {
 
-constexpr const char* kStateType = "projbot_msgs::msg::dds_::RobotState_";
 constexpr auto kStep = std::chrono::milliseconds(20);        // how often the bus is read
 constexpr auto kRepublish = std::chrono::milliseconds(100);  // the plan again, for a takeover within a lease
-
-// The robot a state topic belongs to ("rt/NAME/state"); empty for any other topic.
-std::string robot_of(const std::string& topic, const std::string& type) {
-  const std::string head = "rt/", tail = "/state";
-  if (type != kStateType || topic.size() <= head.size() + tail.size() || topic.rfind(head, 0) != 0 ||
-      topic.compare(topic.size() - tail.size(), tail.size(), tail) != 0)
-    return {};
-  const std::string name = topic.substr(head.size(), topic.size() - head.size() - tail.size());
-  return fleet_name_problem(name).empty() ? name : std::string();
-}
+constexpr auto kNobodyAfter = std::chrono::seconds(10);      // no robot heard this long: said, once
 
 std::string default_name() {
   std::array<char, 256> host{};
@@ -79,32 +69,13 @@ struct Coordinator::Impl {
     check(plan_writer, "cannot create a writer on " + wire::kPlanTopic);
   }
 
-  dds_entity_t reader(const dds_topic_descriptor_t* type, const std::string& topic) {
-    const dds_entity_t t = dds_create_topic(participant, type, topic.c_str(), nullptr, nullptr);
-    check(t, "cannot create topic " + topic);
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-    const dds_entity_t r = dds_create_reader(participant, t, qos, nullptr);
-    dds_delete_qos(qos);
-    check(r, "cannot read " + topic);
-    return r;
-  }
-
   // Robots whose state writers discovery has found since the last call.
   void discover(const CoordinatorLog& said) {
-    for (;;) {
-      void* samples[1] = {nullptr};
-      dds_sample_info_t info[1];
-      const dds_return_t got = dds_take(publications, samples, info, 1, 1);
-      if (got <= 0) return;
-      const auto* e = static_cast<const dds_builtintopic_endpoint_t*>(samples[0]);
-      const std::string name = info[0].valid_data ? robot_of(e->topic_name, e->type_name) : std::string();
-      dds_return_loan(publications, samples, got);
-      if (name.empty() || robots.count(name)) continue;
+    for (const std::string& name : wire::robots_found(publications)) {
+      if (robots.count(name)) continue;
       Heard& h = robots[name];
-      h.state = reader(&projbot_msgs_msg_dds__RobotState__desc, robot::wire_topic(name + "/state"));
-      h.pose = reader(&geometry_msgs_msg_dds__PoseStamped__desc, robot::wire_topic(name + "/pose"));
+      h.state = wire::newest_reader(participant, &projbot_msgs_msg_dds__RobotState__desc, robot::wire_topic(name + "/state"));
+      h.pose = wire::newest_reader(participant, &geometry_msgs_msg_dds__PoseStamped__desc, robot::wire_topic(name + "/pose"));
       said("robot " + name + " found on the bus");
     }
   }
@@ -114,17 +85,9 @@ struct Coordinator::Impl {
     bool changed = false;
     for (auto& [name, h] : robots) {
       const bool counted = h.alive && h.at;
-      for (;;) {
-        void* samples[1] = {nullptr};
-        dds_sample_info_t info[1];
-        const dds_return_t got = dds_take(h.pose, samples, info, 1, 1);
-        if (got <= 0) break;
-        if (info[0].valid_data) {
-          const auto* p = static_cast<const geometry_msgs_msg_dds__PoseStamped_*>(samples[0]);
-          h.at = std::array<double, 2>{p->pose.position.x, p->pose.position.y};
-        }
-        dds_return_loan(h.pose, samples, got);
-      }
+      wire::take_each<geometry_msgs_msg_dds__PoseStamped_>(h.pose, [&h](const geometry_msgs_msg_dds__PoseStamped_& p) {
+        h.at = std::array<double, 2>{p.pose.position.x, p.pose.position.y};
+      });
       dds_liveliness_changed_status_t live{};
       dds_get_liveliness_changed_status(h.state, &live);
       if (h.alive != (live.alive_count > 0)) said("robot " + name + (live.alive_count > 0 ? " is alive" : " is lost"));
@@ -185,9 +148,17 @@ Coordinator::~Coordinator() = default;
 
 void Coordinator::run(const std::function<bool()>& stop, const CoordinatorLog& said) {
   impl_->replan(said);  // the plan with no robot: every target waits for one
-  auto published = std::chrono::steady_clock::now() - kRepublish;
+  const auto started = std::chrono::steady_clock::now();
+  auto published = started - kRepublish;
+  bool said_alone = false;
   while (!stop()) {
     impl_->discover(said);
+    if (!said_alone && impl_->robots.empty() && std::chrono::steady_clock::now() - started > kNobodyAfter) {
+      said("no robot heard on DDS domain " + std::to_string(impl_->config.domain) + " in " +
+           std::to_string(kNobodyAfter.count()) + " s: robots join with `projbot run --fleet NAME` on the same domain " +
+           "(--fleet-domain, or the site file's fleet.domain)");
+      said_alone = true;
+    }
     if (impl_->listen(said)) impl_->replan(said);
     if (std::chrono::steady_clock::now() - published >= kRepublish) {
       impl_->publish();

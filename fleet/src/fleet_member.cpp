@@ -1,16 +1,20 @@
 #include "projbot/fleet/fleet_member.hpp"
 
+#include <unistd.h>
+
 #include <Eigen/Geometry>
+#include <array>
 #include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <thread>
 #include <vector>
 
-#include "plan_wire.hpp"
+#include "bus.hpp"
 #include "projbot/robot/ros2_wire.hpp"
 
 namespace projbot::fleet {
@@ -32,6 +36,16 @@ geometry_msgs_msg_dds__Pose_ ros_pose(const Eigen::Isometry3d& T) {
   return p;
 }
 
+std::string host_and_pid() {
+  std::array<char, 256> host{};
+  ::gethostname(host.data(), host.size() - 1);
+  return std::string(host.data()) + ":" + std::to_string(::getpid());
+}
+
+// How long a robot listens for another one of its name before it joins: discovery on a network takes a
+// few hundred milliseconds, and a robot publishes its state at least five times a second.
+constexpr double kNameCheckS = 1.5;
+
 // The projector's pose goes out at about the camera's rate while lit (a neighbour blends against it).
 constexpr int kProjectorPeriodMs = 33;
 constexpr double kStatePeriodS = 0.2;  // the state again when none newer came in this long
@@ -51,11 +65,19 @@ std::string fleet_name_problem(const std::string& name) {
 struct FleetMember::Impl {
   FleetConfig config;
   live::ShowControl& show;
-  dds_entity_t participant = 0, pose_writer = 0, state_writer = 0, projector_writer = 0, plan_reader = 0;
+  dds_entity_t participant = 0, pose_writer = 0, state_writer = 0, projector_writer = 0, found_writer = 0, plan_reader = 0;
   std::atomic<std::size_t> published{0};
-  std::mutex plan_mutex;  // the plan's part for this robot, read by the robot thread
-  std::optional<std::vector<std::string>> mine;
+  const std::string process = host_and_pid();
+  dds_entity_t publications = 0;                 // DDS discovery: the robots on the bus
+  std::map<std::string, dds_entity_t> finds;     // each robot's found targets (this one's too), by name
+  std::mutex mutex;                              // what the robot thread reads: under it, the next three
+  std::optional<std::vector<std::string>> mine;  // this robot's part of the newest plan
   std::size_t plans_heard = 0;
+  struct Heard {
+    live::MapPose pose;
+    double stamp_s = -1.0;  // when it was found, on the finder's clock
+  };
+  std::map<std::string, Heard> heard;  // the newest estimate of each target heard, by name
   std::jthread thread;
 
   Impl(live::ShowControl& s, FleetConfig c) : config(std::move(c)), show(s) {}
@@ -76,9 +98,28 @@ struct FleetMember::Impl {
     return w;
   }
 
+  // Before it writes anything: another robot already publishing under this name is named, and refused.
+  void refuse_a_taken_name() {
+    const dds_entity_t reader =
+        wire::newest_reader(participant, &projbot_msgs_msg_dds__RobotState__desc, robot::wire_topic(config.name + "/state"));
+    std::string taken;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(kNameCheckS);
+    while (taken.empty() && std::chrono::steady_clock::now() < until) {
+      wire::take_each<projbot_msgs_msg_dds__RobotState_>(reader, [&taken](const projbot_msgs_msg_dds__RobotState_& s) {
+        taken = s.process != nullptr && s.process[0] != '\0' ? s.process : "a process that does not say";
+      });
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    dds_delete(reader);
+    if (!taken.empty())
+      throw FleetError("fleet name '" + config.name + "' is taken on DDS domain " + std::to_string(config.domain) +
+                       ": a robot of that name runs at " + taken + " (give this one another --fleet name)");
+  }
+
   void open() {
     participant = dds_create_participant(static_cast<dds_domainid_t>(config.domain), nullptr, nullptr);
     check(participant, "cannot join DDS domain " + std::to_string(config.domain));
+    refuse_a_taken_name();
     dds_qos_t* qos = dds_create_qos();
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
     dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
@@ -99,6 +140,48 @@ struct FleetMember::Impl {
     plan_reader = dds_create_reader(participant, plan, plan_qos, nullptr);
     dds_delete_qos(plan_qos);
     check(plan_reader, "cannot read " + wire::kPlanTopic);
+    publications = dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+    check(publications, "cannot read the domain's publications");
+    dds_qos_t* kept = wire::found_qos();
+    const std::string topic = robot::wire_topic(config.name + "/found");
+    const dds_entity_t t =
+        dds_create_topic(participant, &projbot_msgs_msg_dds__TargetFound__desc, topic.c_str(), nullptr, nullptr);
+    found_writer = t < 0 ? t : dds_create_writer(participant, t, kept, nullptr);
+    dds_delete_qos(kept);
+    check(found_writer, "cannot create a writer on " + topic);
+  }
+
+  dds_entity_t found_reader(const std::string& robot_name) {
+    const std::string topic = robot::wire_topic(robot_name + "/found");
+    const dds_entity_t t =
+        dds_create_topic(participant, &projbot_msgs_msg_dds__TargetFound__desc, topic.c_str(), nullptr, nullptr);
+    check(t, "cannot create topic " + topic);
+    dds_qos_t* kept = wire::found_qos();
+    const dds_entity_t r = dds_create_reader(participant, t, kept, nullptr);
+    dds_delete_qos(kept);
+    check(r, "cannot read " + topic);
+    return r;
+  }
+
+  // Every robot's newest estimate of each target it found (this robot's own among them, and those found
+  // before this robot joined: transient-local): the newest of a target places it for the next stop's
+  // guess (what one robot learns, the others use).
+  void hear_estimates() {
+    for (const std::string& name : wire::robots_found(publications))
+      if (!finds.count(name)) finds[name] = found_reader(name);
+    for (const auto& [robot_name, reader] : finds)
+      wire::take_each<projbot_msgs_msg_dds__TargetFound_>(reader, [this,
+                                                                   &robot_name](const projbot_msgs_msg_dds__TargetFound_& f) {
+        Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+        T.translation() = Eigen::Vector3d(f.pose.position.x, f.pose.position.y, f.pose.position.z);
+        T.linear() = Eigen::Quaterniond(f.pose.orientation.w, f.pose.orientation.x, f.pose.orientation.y, f.pose.orientation.z)
+                         .normalized()
+                         .toRotationMatrix();
+        const double stamp_s = f.header.stamp.sec + 1e-9 * f.header.stamp.nanosec;
+        const std::lock_guard lock(mutex);
+        Heard& h = heard[f.name];
+        if (stamp_s >= h.stamp_s) h = Heard{live::MapPose{T.matrix(), robot_name + "'s estimate"}, stamp_s};
+      });
   }
 
   // The newest plan on the bus, if one came: this robot's part of it kept when it changed.
@@ -112,7 +195,7 @@ struct FleetMember::Impl {
         const Plan plan = wire::plan_of(*static_cast<const projbot_msgs_msg_dds__FleetPlan_*>(samples[0]));
         const auto it = plan.targets_of.find(config.name);
         std::vector<std::string> part = it == plan.targets_of.end() ? std::vector<std::string>{} : it->second;
-        const std::lock_guard lock(plan_mutex);
+        const std::lock_guard lock(mutex);
         if (!mine || *mine != part) mine = std::move(part), ++plans_heard;
       }
       dds_return_loan(plan_reader, samples, got);
@@ -154,7 +237,12 @@ struct FleetMember::Impl {
     state.estimates._length = state.estimates._maximum = static_cast<std::uint32_t>(estimates.size());
     state.estimates._buffer = estimates.data();
     state.estimates._release = false;
+    state.process = c_str(process);
     if (dds_write(state_writer, &state) >= 0) published.fetch_add(1);
+    for (const projbot_msgs_msg_dds__TargetEstimate_& e : estimates) {
+      const projbot_msgs_msg_dds__TargetFound_ f{state.header, e.name, e.pose, e.quality};
+      dds_write(found_writer, &f);
+    }
   }
 
   // The show's state as it comes, and the newest again when none newer came in 0.2 s; while lit, the
@@ -165,6 +253,7 @@ struct FleetMember::Impl {
     while (!stop.stop_requested()) {
       const std::shared_ptr<const live::ShowState> s = show.wait_newer(sequence, kProjectorPeriodMs);
       read_plan();
+      hear_estimates();
       const auto now = std::chrono::steady_clock::now();
       if (s->T_map_projector && s->phase == "lit") publish_pose(projector_writer, ros_pose(*s->T_map_projector));
       if (s->sequence == sequence && now - stated < std::chrono::duration<double>(kStatePeriodS)) continue;
@@ -191,7 +280,7 @@ const FleetConfig& FleetMember::config() const { return impl_->config; }
 std::size_t FleetMember::published() const { return impl_->published.load(); }
 
 std::optional<std::vector<int>> FleetMember::planned_targets() const {
-  const std::lock_guard lock(impl_->plan_mutex);
+  const std::lock_guard lock(impl_->mutex);
   if (!impl_->mine) return std::nullopt;
   const std::vector<live::SiteTarget>& site = impl_->show.targets();
   std::vector<int> out;
@@ -201,8 +290,16 @@ std::optional<std::vector<int>> FleetMember::planned_targets() const {
   return out;
 }
 
+std::optional<live::MapPose> FleetMember::map_pose(int target) const {
+  const std::vector<live::SiteTarget>& site = impl_->show.targets();
+  if (target < 0 || static_cast<std::size_t>(target) >= site.size()) return std::nullopt;
+  const std::lock_guard lock(impl_->mutex);
+  const auto it = impl_->heard.find(site[static_cast<std::size_t>(target)].name);
+  return it == impl_->heard.end() ? std::nullopt : std::optional(it->second.pose);
+}
+
 std::size_t FleetMember::plans_heard() const {
-  const std::lock_guard lock(impl_->plan_mutex);
+  const std::lock_guard lock(impl_->mutex);
   return impl_->plans_heard;
 }
 

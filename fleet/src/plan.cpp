@@ -101,23 +101,26 @@ Plan make_plan(const config::Scene& scene, const FloorMap& floor, const std::vec
   const auto stop_of = [&](std::size_t t) {
     return std::array<double, 2>{scene.targets[t].stop->x(), scene.targets[t].stop->y()};
   };
-  std::vector<double> driven(by_name.size(), 0.0);
+  std::vector<std::size_t> given(by_name.size(), 0);
   std::vector<std::vector<double>> from;  // each robot's lengths from where its route now ends
   for (const RobotSeen& r : by_name) {
     plan.targets_of[r.name];
     from.push_back(floor.lengths_from(r.at));
   }
+  // Round by round, the nearest pair of a target and a robot among those given the fewest so far.
   while (!open.empty() && !by_name.empty()) {
     double best = kInfinity;
     std::size_t best_r = 0, best_k = 0;
-    for (std::size_t r = 0; r < by_name.size(); ++r)
-      for (std::size_t k = 0; k < open.size(); ++k)
-        if (const double end = driven[r] + floor.length_to(from[r], stop_of(open[k])); end < best)
-          best = end, best_r = r, best_k = k;
+    const std::size_t last_round = *std::max_element(given.begin(), given.end());
+    for (std::size_t round = *std::min_element(given.begin(), given.end()); !std::isfinite(best) && round <= last_round; ++round)
+      for (std::size_t r = 0; r < by_name.size(); ++r)
+        for (std::size_t k = 0; given[r] == round && k < open.size(); ++k)
+          if (const double length = floor.length_to(from[r], stop_of(open[k])); length < best)
+            best = length, best_r = r, best_k = k;
     if (!std::isfinite(best)) break;
     const std::size_t t = open[best_k];
     plan.targets_of[by_name[best_r].name].push_back(scene.targets[t].name);
-    driven[best_r] = best;
+    ++given[best_r];
     from[best_r] = floor.lengths_from(stop_of(t));
     open.erase(open.begin() + static_cast<std::ptrdiff_t>(best_k));
   }

@@ -126,6 +126,12 @@ class RunObserver final : public StopObserver {
          << ", believed at x " << std::setprecision(3) << stop.drive.estimate.x_m << " m, y " << stop.drive.estimate.y_m
          << " m, heading " << std::setprecision(1) << config::degrees(stop.drive.estimate.theta_rad) << " deg; lit "
          << stop.lit.size() << " target(s)";
+    if (!stop.lit.empty() && !stop.lit.front().map_pose_from.empty())  // a fleet's newer place than the survey
+      log_ << "; placed by " << stop.lit.front().map_pose_from << ", " << std::setprecision(0)
+           << 1000.0 * (stop.lit.front().T_map_target.block<3, 1>(0, 3) -
+                        surveyed_pose(scene_.targets[static_cast<std::size_t>(stop.target)]).block<3, 1>(0, 3))
+                           .norm()
+           << " mm from its survey";
     if (stop.drive.corrections > 0)  // localised on a laser: how far odometry alone had drifted from that
       log_ << "; " << stop.drive.corrections << " laser scans matched (" << stop.drive.rejected << " rejected), odometry alone "
            << std::setprecision(0) << 1000.0 * robot::distance_m(stop.drive.estimate, stop.drive.odometry) << " mm away";
@@ -187,6 +193,9 @@ class PlanFollower {
     std::optional<std::vector<int>> plan = plan_();
     for (; (plan ? plan->empty() : config::steady_now_s() < give_up_s) && !cancel.stop_requested(); plan = plan_())
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (first && !plan && !cancel.stop_requested())
+      log << "fleet: no coordinator's plan heard in " << kFirstPlanWaitS
+          << " s (is `projbot fleet` running on this robot's DDS domain?); the tour goes on as listed" << std::endl;
     if (!plan || plan->empty()) return plan.has_value();
     if (*plan != list_) list_ = *plan, next_ = list_.size() > 1 && list_.front() == at_ ? 1 : 0;
     at_ = list_[next_++ % list_.size()];
@@ -281,6 +290,7 @@ void RobotThread::drive(const config::Scene& scene, const RunOptions& o, live::S
   state_.publish(
       {.lit = {}, .since_s = clock.now_s(), .visit = 0, .moving = std::array<double, 3>{start.x_m, start.y_m, start.theta_rad}});
   const int visits = rig.visits(o.visits > 0 ? o.visits : static_cast<int>(scene.visits.size()));
+  if (sources.map_poses) rig.session().use_map_poses(sources.map_poses);
   PlanFollower plan(sources.planned_targets);
   const Dwell own = plan.on() ? plan.staying(rig.dwell(o.dwell_s)) : rig.dwell(o.dwell_s);
   const Dwell dwell = sources.show ? operated(own, *sources.show) : own;

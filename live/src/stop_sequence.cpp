@@ -63,15 +63,22 @@ const Target& StopSequence::find(int target) const {
                      "' is visited but the session was given no model of it");
 }
 
+MapPose StopSequence::map_pose(int target) const {
+  if (map_poses_)
+    if (std::optional<MapPose> shared = map_poses_(target)) return *shared;
+  return {surveyed_pose(scene_.targets.at(static_cast<std::size_t>(target))), {}};
+}
+
 Eigen::Vector3d StopSequence::surveyed_middle(int target) const {
-  const Eigen::Matrix4d T_map_target = surveyed_pose(scene_.targets.at(static_cast<std::size_t>(target)));
-  return (T_map_target * find(target).middle_model.homogeneous()).head<3>();
+  return (map_pose(target).T_map_target * find(target).middle_model.homogeneous()).head<3>();
 }
 
 LitTarget StopSequence::plan(int target, const robot::HeadPoses& believed) const {
   LitTarget l;
   l.target = target;
-  l.T_map_target = surveyed_pose(scene_.targets.at(static_cast<std::size_t>(target)));
+  MapPose placed = map_pose(target);
+  l.T_map_target = placed.T_map_target;
+  l.map_pose_from = std::move(placed.from);
   const Eigen::Matrix4d T_world_camera = believed.T_world_camera.matrix();
   l.T_camera_target_guess = alignment::camera_from_target_initial(T_world_camera, l.T_map_target);  // Eq. 1
   l.footing = alignment::footing_in_camera(*find(target).cloud, l.T_map_target, T_world_camera);

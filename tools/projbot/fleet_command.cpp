@@ -45,9 +45,10 @@ const Command kFleet{
     "the fleet's coordinator: which robot visits which target, over DDS",
     "projbot fleet [--config site.yaml] [--domain D] [--strength N] [--name NAME] [--seconds S]\n\n"
     "Hears every robot on the DDS domain (`projbot run --fleet NAME`: its rt/NAME/state and rt/NAME/pose) and\n"
-    "publishes the plan on rt/fleet/plan: each of the site's targets with a stop goes to one robot, the one\n"
-    "whose route would end soonest with it (path lengths on the room's floor, its obstacles grown by the\n"
-    "robot's radius), so every reachable target is visited and the robots share the work. A robot visits its\n"
+    "publishes the plan on rt/fleet/plan: each of the site's targets with a stop goes to one robot, the\n"
+    "nearest free one (round by round, each robot given the fewest so far takes the nearest target left from\n"
+    "where its route ends; path lengths on the room's floor, its obstacles grown by the robot's radius), so\n"
+    "every reachable target is visited and the robots share the work. A robot visits its\n"
     "targets in turn and again (one target alone: it stays lit on it); a robot the plan gives nothing waits.\n"
     "When a robot joins or is lost (its liveliness, a 1 s lease) the plan is made again at once. The plan is\n"
     "durable: a robot that starts late reads the newest. Two coordinators may run: the plan read is the\n"

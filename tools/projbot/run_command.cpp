@@ -432,7 +432,10 @@ const Command kRun{
       sources.log = &std::cout;
       sources.errors = &std::cerr;
       sources.show = operated.show.get();
-      if (operated.fleet) sources.planned_targets = [&fleet = *operated.fleet] { return fleet.planned_targets(); };
+      if (operated.fleet) {
+        sources.planned_targets = [&fleet = *operated.fleet] { return fleet.planned_targets(); };
+        sources.map_poses = [&fleet = *operated.fleet](int target) { return fleet.map_pose(target); };
+      }
       const live::RunResult r = live::run(renderer, scene, o, sources);
 
       print_frames(std::cout, r);

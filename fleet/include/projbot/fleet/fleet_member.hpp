@@ -7,8 +7,11 @@
 //   rt/NAME/state      projbot_msgs RobotState: phase, visited target, visit, frame rate, blackout, paused,
 //                      and each drawn target's pose in the map with the tracker's quality
 //   rt/NAME/projector  geometry_msgs/msg/PoseStamped, frame "map": the projector's pose while lit
+//   rt/NAME/found      projbot_msgs TargetFound, keyed by target: the newest estimate of each target it
+//                      found, kept for robots that join later (transient-local)
 //
-// and reads the coordinator's plan (rt/fleet/plan) for the targets it is to visit.
+// and reads the coordinator's plan (rt/fleet/plan) for the targets it is to visit, and every robot's
+// estimates (their rt/NAME/state, found through DDS discovery) for where the targets are.
 //
 // pose and state at least five times a second (the show's state as the render thread publishes it, and
 // again when none newer came in 0.2 s), the projector's at about the camera's rate (30 Hz). Reliable, the newest kept; DDS
@@ -23,6 +26,7 @@
 #include <vector>
 
 #include "projbot/live/show_control.hpp"
+#include "projbot/live/stop_sequence.hpp"
 
 namespace projbot::fleet {
 
@@ -54,6 +58,9 @@ class FleetMember {
   /// name the scene lacks, or a target without a stop, left out); nullopt while no plan was heard. A robot
   /// whose coordinator is gone keeps the last plan.
   std::optional<std::vector<int>> planned_targets() const;
+  /// Where the newest estimate any robot on the bus published (this one's included) places scene target
+  /// `target`, and whose it was; nullopt before any. For the next stop's Eq. 1 guess (live::MapPoses).
+  std::optional<live::MapPose> map_pose(int target) const;
   std::size_t plans_heard() const;  ///< plans that changed this robot's list
 
  private:

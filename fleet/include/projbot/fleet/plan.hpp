@@ -1,10 +1,10 @@
 #pragma once
 // The fleet's plan (issue 69, item 2): which robot visits which of the site's targets, in what order. The
 // floor is a grid over the room with its obstacles grown by the robot's radius; path lengths are the
-// shortest 8-connected paths on it. Each target with a stop goes to the robot whose route would end
-// soonest with it (greedy, fewest metres driven by the busiest robot), so every reachable target is
-// visited, the robots share the work, and a target is never given to two robots. The same robots at the
-// same places give the same plan on any coordinator.
+// shortest 8-connected paths on it. Round by round, each robot given the fewest targets so far takes
+// the nearest target left from where its route ends (the nearest free robot first), so every reachable
+// target is visited, the robots share the work, and a target is never given to two robots. The same
+// robots at the same places give the same plan on any coordinator.
 
 #include <array>
 #include <cstdint>

@@ -59,6 +59,9 @@ struct RunSources {
   /// tour goes on as listed. While a plan is followed the tour goes on past its visits, to --seconds or
   /// Ctrl-C. Empty: no fleet.
   std::function<std::optional<std::vector<int>>()> planned_targets;
+  /// A fleet's shared estimates (run --fleet): where another robot (or this one, earlier) found a target,
+  /// used instead of its survey for Eq. 1's guess and the aim. Empty: the survey alone.
+  MapPoses map_poses;
 };
 
 /// What a run measured.

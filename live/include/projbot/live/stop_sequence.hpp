@@ -15,6 +15,7 @@
 #include <optional>
 #include <stdexcept>
 #include <stop_token>
+#include <string>
 #include <vector>
 
 #include "projbot/alignment/depth.hpp"
@@ -44,10 +45,20 @@ struct Target {
   Eigen::Vector3d middle_model = Eigen::Vector3d::Zero();  ///< its model's bounding-box centre: where the pan-tilt aims
 };
 
+/// A target's place in the map known more recently than its survey (a fleet's shared estimate, issue 69),
+/// with who found it.
+struct MapPose {
+  Eigen::Matrix4d T_map_target = Eigen::Matrix4d::Identity();
+  std::string from;  ///< said in the log: "r1's estimate"
+};
+/// A target's newest MapPose (scene index), nullopt where the survey is all there is.
+using MapPoses = std::function<std::optional<MapPose>(int target)>;
+
 /// A target the robot projects onto at a stop.
 struct LitTarget {
   int target = -1;                                                      ///< scene index
-  Eigen::Matrix4d T_map_target = Eigen::Matrix4d::Identity();           ///< as surveyed
+  Eigen::Matrix4d T_map_target = Eigen::Matrix4d::Identity();           ///< as surveyed, or as MapPoses said
+  std::string map_pose_from;                                            ///< who placed it there; empty: the survey
   Eigen::Matrix4d T_camera_target_guess = Eigen::Matrix4d::Identity();  ///< Eq. 1, from the believed head
   alignment::Footing footing;                                           ///< the surveyed footing, seen from the believed camera
 };
@@ -107,6 +118,8 @@ class StopSequence {
   const config::Clock& clock() const { return clock_; }
   /// The robot it drives (to watch its drives).
   robot::Navigator& navigator() { return base_; }
+  /// From now on, where `poses` places a target replaces its survey for Eq. 1's guess and the aim.
+  void use_map_poses(MapPoses poses) { map_poses_ = std::move(poses); }
 
   /// The target of the tour's `visit`-th stop (0-based, cycling through scene.visits): its scene index.
   int target_of(int visit) const;
@@ -127,8 +140,10 @@ class StopSequence {
   std::vector<LitTarget> neighbours(int visited, const robot::HeadPoses& believed) const;
   /// Eq. 1 and the surveyed footing of one target from a believed head.
   LitTarget plan(int target, const robot::HeadPoses& believed) const;
-  /// Where the map says a target's middle stands (world frame).
+  /// Where the map says a target's middle stands (world frame): its MapPose's, else its survey's.
   Eigen::Vector3d surveyed_middle(int target) const;
+  /// Where the map places a target: its MapPose, else its survey (`from` empty).
+  MapPose map_pose(int target) const;
 
  private:
   const Target& find(int target) const;
@@ -139,6 +154,7 @@ class StopSequence {
   config::Clock clock_;
   std::vector<int> visits_per_target_;  // by scene index
   int next_target_ = -1;                // visit_next's; -1: the tour's
+  MapPoses map_poses_;                  // empty: the survey alone
 };
 
 }  // namespace projbot::live
