@@ -4,7 +4,9 @@
 // generated type; the robots found through DDS discovery; readers of the newest sample.
 
 #include <dds/dds.h>
+#include <unistd.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,13 @@
 namespace projbot::fleet::wire {
 
 inline const std::string kPlanTopic = "rt/fleet/plan";
+
+/// This process, as the bus names it to others: "host:pid".
+inline std::string host_and_pid() {
+  std::array<char, 256> host{};
+  ::gethostname(host.data(), host.size() - 1);
+  return std::string(host.data()) + ":" + std::to_string(::getpid());
+}
 
 /// How long a coordinator the bus hears nothing from still owns the plan: the standby's takes over after.
 constexpr double kCoordinatorLeaseS = 0.5;

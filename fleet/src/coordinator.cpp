@@ -1,7 +1,5 @@
 #include "projbot/fleet/coordinator.hpp"
 
-#include <unistd.h>
-
 #include <array>
 #include <chrono>
 #include <map>
@@ -19,12 +17,6 @@ namespace {
 constexpr auto kStep = std::chrono::milliseconds(20);        // how often the bus is read
 constexpr auto kRepublish = std::chrono::milliseconds(100);  // the plan again, for a takeover within a lease
 constexpr auto kNobodyAfter = std::chrono::seconds(10);      // no robot heard this long: said, once
-
-std::string default_name() {
-  std::array<char, 256> host{};
-  ::gethostname(host.data(), host.size() - 1);
-  return std::string(host.data()) + ":" + std::to_string(::getpid());
-}
 
 char* c_str(const std::string& s) { return const_cast<char*>(s.c_str()); }  // written before it changes
 
@@ -140,7 +132,7 @@ Coordinator::Coordinator(const config::Scene& scene, CoordinatorConfig config)
     : impl_(std::make_unique<Impl>(scene, std::move(config))) {
   if (impl_->config.domain < 0 || impl_->config.domain > 232)
     throw FleetError("fleet domain " + std::to_string(impl_->config.domain) + ": a DDS domain is from 0 to 232");
-  if (impl_->config.name.empty()) impl_->config.name = default_name();
+  if (impl_->config.name.empty()) impl_->config.name = wire::host_and_pid();
   impl_->open();
 }
 

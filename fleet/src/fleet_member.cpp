@@ -1,7 +1,5 @@
 #include "projbot/fleet/fleet_member.hpp"
 
-#include <unistd.h>
-
 #include <Eigen/Geometry>
 #include <array>
 #include <atomic>
@@ -36,12 +34,6 @@ geometry_msgs_msg_dds__Pose_ ros_pose(const Eigen::Isometry3d& T) {
   return p;
 }
 
-std::string host_and_pid() {
-  std::array<char, 256> host{};
-  ::gethostname(host.data(), host.size() - 1);
-  return std::string(host.data()) + ":" + std::to_string(::getpid());
-}
-
 // How long a robot listens for another one of its name before it joins: discovery on a network takes a
 // few hundred milliseconds, and a robot publishes its state at least five times a second.
 constexpr double kNameCheckS = 1.5;
@@ -67,7 +59,7 @@ struct FleetMember::Impl {
   live::ShowControl& show;
   dds_entity_t participant = 0, pose_writer = 0, state_writer = 0, projector_writer = 0, found_writer = 0, plan_reader = 0;
   std::atomic<std::size_t> published{0};
-  const std::string process = host_and_pid();
+  const std::string process = wire::host_and_pid();
   dds_entity_t publications = 0;                 // DDS discovery: the robots on the bus
   std::map<std::string, dds_entity_t> finds;     // each robot's found targets (this one's too), by name
   std::mutex mutex;                              // what the robot thread reads: under it, the next three
