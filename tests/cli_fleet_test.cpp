@@ -7,6 +7,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli_fixture.hpp"
@@ -404,4 +406,42 @@ TEST_F(CliTest, WhereOneRobotFoundATargetTheNextLooksFirst) {
   EXPECT_LT(mm, 125.0) << r2_log;
   ASSERT_TRUE(r2.wait_for_output("still mean", std::chrono::seconds(1))) << r2_log;
   EXPECT_LT(number_after(r2_log, "still mean "), 3.0) << r2_log;
+}
+
+// A robot whose clock is 10 s ahead (a participant of the test's stamping its state so): the coordinator
+// says so, naming it.
+TEST_F(CliTest, TheCoordinatorSaysARobotsClockIsOff) {
+  use_loopback_dds();
+  const int domain = 100 + static_cast<int>((::getpid() + 17) % 100);
+  const dds_entity_t participant = dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr);
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  const dds_entity_t writer = dds_create_writer(
+      participant, dds_create_topic(participant, &projbot_msgs_msg_dds__RobotState__desc, "rt/r9/state", nullptr, nullptr), qos,
+      nullptr);
+  dds_delete_qos(qos);
+  std::atomic<bool> done{false};
+  std::thread robot([&] {
+    std::string name = "r9", phase = "lit", map = "map", none;
+    while (!done) {
+      const double ahead_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() + 10.0;
+      projbot_msgs_msg_dds__RobotState_ s{};
+      s.header.stamp.sec = static_cast<std::int32_t>(ahead_s);
+      s.header.stamp.nanosec = static_cast<std::uint32_t>(1e9 * (ahead_s - std::floor(ahead_s)));
+      s.header.frame_id = map.data();
+      s.robot = name.data();
+      s.phase = phase.data();
+      s.target = none.data();
+      s.process = none.data();
+      dds_write(writer, &s);
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  });
+  const CliRun r = run_projbot("fleet --domain " + std::to_string(domain) + " --seconds 4");
+  done = true;
+  robot.join();
+  dds_delete(participant);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("robot r9's clock is 10.0 s ahead of this coordinator's"), std::string::npos) << r.output;
 }

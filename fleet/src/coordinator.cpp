@@ -2,6 +2,8 @@
 
 #include <array>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -25,7 +27,25 @@ struct Heard {
   dds_entity_t state = 0, pose = 0;
   std::optional<std::array<double, 2>> at;
   bool alive = false;
+  bool clock_said = false;  // its clock was found out of step and said so
 };
+
+// A robot's stamps further than this from the coordinator's clock (beyond the bus's own delay) say its
+// clock is off: its estimates' times cannot be compared with the others'.
+constexpr double kClockToleranceS = 2.0;
+
+double system_now_s() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
+
+// A robot whose clock is out of step with this one's, said once: "robot r9's clock is 10.0 s ahead ...".
+void check_clock(const std::string& name, Heard& h, double stamp_s, const CoordinatorLog& said) {
+  const double off_s = stamp_s - system_now_s();
+  if (h.clock_said || std::abs(off_s) <= kClockToleranceS) return;
+  char text[64];
+  std::snprintf(text, sizeof text, "%.1f s %s", std::abs(off_s), off_s > 0 ? "ahead of" : "behind");
+  said("robot " + name + "'s clock is " + text + " this coordinator's: the times it stamps (its estimates') are out of step; " +
+       "set its clock (NTP)");
+  h.clock_said = true;
+}
 
 }  // namespace
 
@@ -79,6 +99,9 @@ struct Coordinator::Impl {
       const bool counted = h.alive && h.at;
       wire::take_each<geometry_msgs_msg_dds__PoseStamped_>(h.pose, [&h](const geometry_msgs_msg_dds__PoseStamped_& p) {
         h.at = std::array<double, 2>{p.pose.position.x, p.pose.position.y};
+      });
+      wire::take_each<projbot_msgs_msg_dds__RobotState_>(h.state, [&](const projbot_msgs_msg_dds__RobotState_& st) {
+        check_clock(name, h, st.header.stamp.sec + 1e-9 * st.header.stamp.nanosec, said);
       });
       dds_liveliness_changed_status_t live{};
       dds_get_liveliness_changed_status(h.state, &live);

@@ -1,6 +1,7 @@
 #include "projbot/fleet/fleet_member.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cctype>
@@ -169,7 +170,9 @@ struct FleetMember::Impl {
         T.linear() = Eigen::Quaterniond(f.pose.orientation.w, f.pose.orientation.x, f.pose.orientation.y, f.pose.orientation.z)
                          .normalized()
                          .toRotationMatrix();
-        const double stamp_s = f.header.stamp.sec + 1e-9 * f.header.stamp.nanosec;
+        // A finder whose clock runs ahead would keep its estimates newest for ever: none later than now.
+        const double now_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+        const double stamp_s = std::min(f.header.stamp.sec + 1e-9 * f.header.stamp.nanosec, now_s);
         const std::lock_guard lock(mutex);
         Heard& h = heard[f.name];
         if (stamp_s >= h.stamp_s) h = Heard{live::MapPose{T.matrix(), robot_name + "'s estimate"}, stamp_s};
