@@ -388,9 +388,31 @@ TEST_F(CliTest, WhereOneRobotFoundATargetTheNextLooksFirst) {
                                     "--dwell",     "3",       "--seconds",  seconds,          "--config",
                                     site.string(), "--fleet", name,         "--fleet-domain", std::to_string(domain)};
   };
-  Background r1(robot("r1", "45"), dir_ / "r1.log");
-  ASSERT_TRUE(r1.wait_for_output("visit 1: box", std::chrono::seconds(60))) << r1.output();
-  std::this_thread::sleep_for(std::chrono::seconds(3));  // found and drawn: its estimate is on the bus
+  // The test's own reader of r1's found targets: r2 starts once r1's estimate of the box is on the bus (a
+  // fixed wait was too short for a loaded machine's acquisition).
+  const dds_entity_t participant = dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr);
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+  const dds_entity_t found = dds_create_reader(
+      participant, dds_create_topic(participant, &projbot_msgs_msg_dds__TargetFound__desc, "rt/r1/found", nullptr, nullptr), qos,
+      nullptr);
+  dds_delete_qos(qos);
+  Background r1(robot("r1", "60"), dir_ / "r1.log");
+  bool box_found = false;
+  for (const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+       !box_found && std::chrono::steady_clock::now() < until; std::this_thread::sleep_for(std::chrono::milliseconds(50))) {
+    void* samples[1] = {nullptr};
+    dds_sample_info_t info[1];
+    if (const dds_return_t got = dds_take(found, samples, info, 1, 1); got > 0) {
+      box_found =
+          info[0].valid_data && std::string(static_cast<const projbot_msgs_msg_dds__TargetFound_*>(samples[0])->name) == "box";
+      dds_return_loan(found, samples, got);
+    }
+  }
+  dds_delete(participant);
+  ASSERT_TRUE(box_found) << r1.output();
   Background r2(robot("r2", "20"), dir_ / "r2.log");
   ASSERT_TRUE(r2.wait_for_output("visit 1: box", std::chrono::seconds(60))) << r2.output();
   std::this_thread::sleep_for(std::chrono::seconds(3));  // lit and measured a while
