@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
@@ -371,7 +372,7 @@ TEST_F(RealFrames, TrackingFollowsWhatTheFirstImageFinds) {
   const fs::path report = dir_ / "t.json";
   const CliRun r = run_projbot("bench dataset " + kYcbv.string() + " --scenes 000002 --track --report " + report.string(), 600);
   ASSERT_EQ(r.code, 0) << r.output;
-  int potted_meat = 0, potted_meat_within = 0, banana_within = 0, block_within = 0, false_accepts = 0;
+  int potted_meat = 0, potted_meat_within = 0, banana_within = 0, block_within = 0, marker_within = 0, false_accepts = 0;
   const auto j = read_json(report);
   for (const auto& row : j.at("instances")) {
     EXPECT_EQ(row.at("mode").get<std::string>(), "track");
@@ -380,6 +381,7 @@ TEST_F(RealFrames, TrackingFollowsWhatTheFirstImageFinds) {
     false_accepts += lit && e > 20.0 ? 1 : 0;
     if (row.at("obj_id").get<int>() == 10) banana_within += lit && e <= 10.0 ? 1 : 0;
     if (row.at("obj_id").get<int>() == 16) block_within += lit && e <= 10.0 ? 1 : 0;
+    if (row.at("obj_id").get<int>() == 18) marker_within += lit && e <= 10.0 ? 1 : 0;
     if (row.at("obj_id").get<int>() != 9) continue;
     ++potted_meat;
     potted_meat_within += lit && e <= 10.0 ? 1 : 0;
@@ -388,7 +390,33 @@ TEST_F(RealFrames, TrackingFollowsWhatTheFirstImageFinds) {
   EXPECT_GE(potted_meat_within, 19) << r.output;
   EXPECT_GE(banana_within, 19) << r.output;
   EXPECT_GE(block_within, 16) << r.output;
+  // The marker standing upright, its cap hardly measured: ICP slid it 6.8 mm up its axis, above the
+  // support found around it, which refused it on every image (0 of 20) until such a pose was put down
+  // onto the support where the depth agrees as well there (20 of 20).
+  EXPECT_GE(marker_within, 18) << r.output;
   EXPECT_EQ(false_accepts, 0) << r.output;
+}
+
+// Ours per video, where a run spans several: each video's estimates as the report has them.
+TEST_F(RealFrames, BenchDatasetTellsEachVideoApart) {
+  const fs::path report = dir_ / "v.json";
+  const CliRun r =
+      run_projbot("bench dataset " + kYcbv.string() + " --scenes 000000,000001 --track --report " + report.string(), 600);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::map<std::string, std::pair<int, int>> by_video;  // estimates, lit within 10 mm
+  const auto j = read_json(report);
+  for (const auto& row : j.at("instances")) {
+    auto& [n, within] = by_video[row.at("scene").get<std::string>()];
+    ++n;
+    within += row.at("accepted").get<bool>() && row.at("error_mm").get<double>() <= 10.0 ? 1 : 0;
+  }
+  ASSERT_EQ(by_video.size(), 2U);
+  for (const auto& [video, counts] : by_video) {
+    char row[96];
+    std::snprintf(row, sizeof row, "| %s | 20 mm, 5 deg | %d | %.1f %% | 0 |", video.c_str(), counts.first,
+                  100.0 * counts.second / counts.first);
+    EXPECT_NE(r.output.find(row), std::string::npos) << row << "\n" << r.output;
+  }
 }
 
 // The mug seen from above, its inside showing (scene 000000): the projective tracker pulled it 17 mm and

@@ -358,6 +358,26 @@ struct Aligner::Impl {
     return r.stands;
   }
 
+  // Depth may leave how high a target stands free: a marker standing upright, its cap hardly measured,
+  // slid 7 mm up its own axis and floated above the support found in the frame. Where the support can
+  // say, it does: a pose floating above a frame's support by at most twice the float it may have (a
+  // slide of a few millimetres) is put down onto it, along its normal, when the depth agrees there as
+  // well, as colour's moves along weak directions are judged (the gate passes, at most 2 % fewer points
+  // explained, the RMS error at most 10 % larger). A pose the depth pins (a mug lifted by its neighbours)
+  // loses its fit when moved, and stays refused; one pulled farther up (the wood block, 17-19 mm by the
+  // box it carries) is not put down: found there, the block lay 10-20 mm off, where a later search finds it.
+  bool put_down(const PointCloud& scan, const Footing& footing, bool close_guess, AlignmentResult& r) const {
+    if (footing.upright_known || !(r.footing_height_error_mm > 0.0) || r.footing_height_error_mm > 2000.0 * cfg.support_float_m)
+      return false;
+    AlignmentResult down = r;
+    down.T_scan_model = stood(footing, r.T_scan_model);
+    evaluate(*near_scan(scan, down.T_scan_model, gate_margin()), down.T_scan_model, down, close_guess);
+    if (!stands(footing, down) || !passes(down) || down.inlier_ratio < r.inlier_ratio - 0.02 || down.rmse_mm > 1.1 * r.rmse_mm)
+      return false;
+    r = down;
+    return true;
+  }
+
   // The scan within `margin` of the model's sphere under T_init, on the coarse grid, thinned by a coarser
   // grid until at most max_global_points remain: what a bounded global search works on.
   pcl::PointCloud<pcl::PointXYZ>::Ptr global_points(const PointCloud& scan, const Eigen::Matrix4d& T_init, double margin,
@@ -490,7 +510,8 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
     r.weak_held = held > 0;
     r.reinitialised = reinitialised;
     m.evaluate(*m.near_scan(scan, r.T_scan_model, m.gate_margin()), r.T_scan_model, r, close_guess);
-    const bool stands = !footing || m.stands(*footing, r);
+    bool stands = !footing || m.stands(*footing, r);
+    if (!stands && footing) stands = m.put_down(scan, *footing, close_guess, r);
     r.converged = icp_converged && m.passes(r) && stands;
     r.iterations = best.iterations;
     if (better_than(r, best)) best = r;
