@@ -54,11 +54,18 @@ TEST(DatasetBench, EstimatesEachVisibleInstanceByBothMethodsFromTheSameStart) {
 
 TEST(DatasetBench, AStopRequestEndsTheWorkAndTrackingFollowsTheScene) {
   const alignment::BopDataset data = alignment::read_bop_dataset(kYcbv, {"000001"});
+  // The stop is asked before each estimate and after it: a stop that came while it ran drops it (cut
+  // short, it says nothing), one after it keeps it.
   int asked = 0;
-  bench::DatasetBench stopped(data, 0.001, {bench::Perturbation{}}, 1, [&] { return ++asked > 1; });
+  bench::DatasetBench stopped(data, 0.001, {bench::Perturbation{}}, 1, [&] { return ++asked > 2; });
   std::vector<bench::DatasetEstimate> rows;
   stopped.image(data.scenes.front(), data.scenes.front().images.front(), 1500, rows);
   EXPECT_EQ(rows.size(), 2U);  // one instance by both methods, then stopped
+  asked = 0;
+  bench::DatasetBench during(data, 0.001, {bench::Perturbation{}}, 1, [&] { return ++asked > 1; });
+  std::vector<bench::DatasetEstimate> none;
+  during.image(data.scenes.front(), data.scenes.front().images.front(), 1500, none);
+  EXPECT_TRUE(none.empty());
 
   bench::DatasetBench tracked(data, 0.001, {bench::Perturbation{}}, 1);
   std::vector<bench::DatasetEstimate> track;

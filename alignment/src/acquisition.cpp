@@ -11,9 +11,15 @@
 #include "projbot/alignment/target_follower.hpp"
 #include "projbot/alignment/verification.hpp"
 #include "projbot/config/clock.hpp"
+#include "projbot/config/stop_request.hpp"
 
 namespace projbot::alignment {
 namespace {
+
+// Past the deadline, or a stop asked of the process: either ends the search (what was found is judged).
+bool out_of_time(const std::optional<ThreadCpuClock::time_point>& deadline) {
+  return ThreadCpuClock::past(deadline) || config::stop_requested();
+}
 
 // How far the model's centroid c moves between poses A and B (a symmetric shape's equivalent poses
 // share it).
@@ -97,7 +103,7 @@ AlignmentResult TargetFollower::align_near(const DepthImage& frame, const DepthI
   AlignmentResult r =
       recropped(frame, aligner_.align(near, guess, first, known.footing, hold, known.deadline, known.close), known, first, hold);
   if (r.converged || stage == SearchStage::refine || stage == SearchStage::icp_only) return r;
-  if (ThreadCpuClock::past(known.deadline)) return r;
+  if (out_of_time(known.deadline)) return r;
   AlignmentResult wider =
       recropped(frame, aligner_.align(near, guess, stage, known.footing, hold, known.deadline, known.close), known, first, hold);
   wider.iterations += r.iterations;
@@ -145,11 +151,11 @@ AlignmentResult TargetFollower::searched(const DepthImage& frame, const Eigen::M
   // A close guess: ICP from it; where that fails (the mug pulled onto its neighbours, 2 in 20 from 20 mm /
   // 5 degree starts on the real frames), the candidates around it, then the restarts and global search.
   AlignmentResult r = acquire_at(frame, guess, given, grow_m, colour, coarse ? SearchStage::icp_only : SearchStage::full);
-  if (r.converged || !coarse || ThreadCpuClock::past(given.deadline)) return r;
+  if (r.converged || !coarse || out_of_time(given.deadline)) return r;
   double spent_ms = r.time_ms;
   if (auto again = from_candidates(frame, guess, given, grow_m, colour)) {
     spent_ms += again->time_ms;
-    if (again->converged || ThreadCpuClock::past(given.deadline)) {
+    if (again->converged || out_of_time(given.deadline)) {
       again->time_ms = spent_ms;
       return *again;
     }
@@ -176,7 +182,7 @@ std::optional<AlignmentResult> TargetFollower::from_candidates(const DepthImage&
   std::optional<AlignmentResult> best, found;
   double spent_ms = 0.0, found_move_m = 0.0;
   for (const auto& c : coarse_candidates(model_, guess, frame, k_, search)) {
-    if ((best || found) && ThreadCpuClock::past(given.deadline)) break;
+    if ((best || found) && out_of_time(given.deadline)) break;
     // Without a map, the support is the one under the candidate: under a gross guess's wider reach
     // another plane may qualify (a neighbour's top) that the target does not stand on.
     Known known = given;
@@ -255,7 +261,7 @@ AlignmentResult TargetFollower::acquire_at(const DepthImage& frame, const Eigen:
       if (r.converged && beyond_bound(known, r.T_scan_model)) r.converged = false;
       return r;
     }
-    if (ThreadCpuClock::past(known.deadline)) {  // out of time to place it another way: not confirmed
+    if (out_of_time(known.deadline)) {  // out of time to place it another way: not confirmed
       r.converged = false;
       return r;
     }

@@ -24,6 +24,7 @@
 #include "projbot/alignment/verification.hpp"
 #include "projbot/config/angles.hpp"
 #include "projbot/config/clock.hpp"
+#include "projbot/config/stop_request.hpp"
 #include "serial_kdtree.hpp"
 
 namespace projbot::alignment {
@@ -491,8 +492,8 @@ AlignmentResult Aligner::align(const PointCloud& scan, const Eigen::Matrix4d& T_
 
   // A bounded stage stops starting new work once attempt_budget_ms has passed; `full` runs to the end;
   // any stage at the caller's deadline.
-  const auto out_of_time = [&] {
-    if (ThreadCpuClock::past(deadline)) return true;
+  const auto out_of_time = [&] {  // a stop asked of the process ends the search as its deadline would
+    if (ThreadCpuClock::past(deadline) || config::stop_requested()) return true;
     return stage != SearchStage::full && stage != SearchStage::icp_only && config::ms_since(t0) > m.cfg.attempt_budget_ms;
   };
   AlignmentResult best;

@@ -119,6 +119,7 @@ void DatasetBench::image(const alignment::BopScene& scene, const alignment::BopI
         row.agree_ratio = check.agree_ratio();
         row.flush_ratio = check.flush_ratio();
       });
+      if (stopped()) return;  // the estimate a stop cut short says nothing: dropped, as the rest not made
       row.inlier_ratio = r.inlier_ratio, row.rmse_mm = r.rmse_mm;
       row.T_est = r.T_scan_model;
       score(row, m, inst.T_camera_model);
@@ -164,6 +165,7 @@ void DatasetBench::follow(const alignment::BopScene& scene, const std::vector<al
     row.time_ms = timed_ms([&] {
       if (auto s = follower.step(frames[f])) shown = s;
     });
+    if (stopped()) break;  // a frame a stop cut short: dropped
     row.accepted = shown && !shown->lost;
     row.T_est = shown ? shown->T_camera_target : follower.last_pose();
     if (shown) row.inlier_ratio = shown->inlier_ratio, row.rmse_mm = shown->rmse_mm;
